@@ -1,0 +1,58 @@
+// Settings of the SLP method. Defaults are the thresholds of METHOD.md
+// section 3 (Etman et al. 1994); every field is documented in docs/method.md.
+#pragma once
+
+#include "absl/status/status.h"
+
+namespace mbopt::slp {
+
+enum class FiniteDifferenceScheme {
+  kForward,  // n extra analyses per cycle, O(h) error (the report's choice)
+  kCentral,  // 2n extra analyses per cycle, O(h^2) error
+};
+
+struct SlpOptions {
+  // Move limits (section 3): relative factor f_i, box |x_i - x0_i| <= f_i |x0_i|.
+  double initial_move_limit = 0.2;
+  // Floor of the box half-width, as a fraction of (upper - lower), for
+  // variables at or near zero.
+  double move_limit_floor_fraction_of_range = 0.01;
+  double min_move_limit = 1e-6;   // f_i is never shrunk below this
+  double max_move_limit = 1.0;    // nor widened above this
+
+  // Constraint screening: rows whose normalized value is below this are left
+  // out of the cycle's LP (-0.3: "within 30 % of the limit or violated").
+  double screening_threshold = -0.3;
+
+  // Finite differences, in scaled variables: step h_i = relative_step *
+  // max(|x_i|, typical_magnitude_i) where typical_magnitude_i = (upper_i -
+  // lower_i) * 0.01 guards x_i = 0; a step that would leave the bounds is
+  // taken backwards (forward scheme) or shrunk to fit (central scheme).
+  FiniteDifferenceScheme finite_difference = FiniteDifferenceScheme::kForward;
+  double finite_difference_relative_step = 1e-4;
+
+  // Acceptance and strategy thresholds (section 3).
+  double reject_max_approximation_error = 0.40;
+  double reject_max_violation = 0.10;
+  double widen_max_approximation_error = 0.10;
+  double widen_max_violation = 0.05;
+  double narrow_max_approximation_error = 0.25;
+  double narrow_max_violation = 0.075;
+  double oscillation_objective_change = 0.02;
+
+  // Convergence: |F* - F0| / |F0| < objective_tolerance and maxg < violation_tolerance.
+  double convergence_objective_tolerance = 0.005;
+  double convergence_violation_tolerance = 0.005;
+
+  // Penalty on the infeasibility variable s, relative to the objective's scale.
+  double infeasibility_penalty = 1e3;
+
+  int max_cycles = 50;
+  // Consecutive rejections of one cycle's trial points before the cycle gives
+  // up (the move limits are then tiny; the job ends "stalled").
+  int max_rejections_per_cycle = 20;
+
+  absl::Status Validate() const;
+};
+
+}  // namespace mbopt::slp

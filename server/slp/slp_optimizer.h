@@ -1,0 +1,140 @@
+// The SLP optimizer core: a deterministic state machine for one optimization.
+//
+// It does no I/O, reads no clock and starts no thread. The caller asks it
+// which analyses it needs (PendingRequests), runs them anywhere, and hands the
+// results back in any order (SubmitResult). When a batch is complete the core
+// runs the rest of the cycle (screening, LP, acceptance, move limits,
+// convergence) and emits CycleRecords. Its whole state is a function of the
+// ProblemSpec, the SlpOptions and the sequence of results it was given, keyed
+// by request id: replaying the logged results into a fresh optimizer rebuilds
+// it bit for bit (this is what the server's resume relies on). The order in
+// which results of one batch arrive does not matter.
+//
+// Analyses: a request asks for F and g at one scaled design point. Request ids
+// count up from 0 in the order the core creates them.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "absl/status/status.h"
+#include "server/lp/linear_program.h"
+#include "server/slp/options.h"
+#include "server/slp/problem.h"
+
+namespace mbopt::slp {
+
+enum class RequestPurpose {
+  kCycleStart,    // the design point x0 of a cycle
+  kPerturbation,  // a finite-difference perturbation of x0
+  kTrial,         // the LP optimum x*, to be accepted or rejected
+};
+
+struct AnalysisRequest {
+  std::int64_t id = 0;
+  int cycle = 0;                 // 1-based cycle number
+  RequestPurpose purpose = RequestPurpose::kCycleStart;
+  int perturbed_variable = -1;   // for kPerturbation
+  double perturbation_step = 0;  // signed scaled step, for kPerturbation
+  Eigen::VectorXd x;             // scaled design point
+};
+
+enum class AnalysisOutcome {
+  kOk,
+  kFailed,  // the analysis did not produce values (integrator failure,
+            // mechanism cannot assemble, NaN, worker gave up, ...)
+};
+
+struct AnalysisResult {
+  std::int64_t request_id = 0;
+  AnalysisOutcome outcome = AnalysisOutcome::kOk;
+  std::string failure_reason;        // for kFailed
+  Eigen::VectorXd objective_terms;   // num_objective_terms, for kOk
+  Eigen::VectorXd constraint_values; // num_constraints (g_h, not normalized), for kOk
+};
+
+enum class RunState {
+  kRunning,     // PendingRequests() is not empty
+  kConverged,   // the convergence test of METHOD.md section 3 held
+  kMaxCycles,   // SlpOptions::max_cycles cycles were run
+  kStalled,     // move limits collapsed or every trial point failed
+  kFailed,      // x0 of the first cycle could not be analysed
+};
+
+const char* RunStateName(RunState state);
+
+// One LP solve of a cycle and what became of its trial point. A cycle has one
+// record per trial point: the rejected ones and finally the accepted one.
+struct CycleRecord {
+  int cycle = 0;          // 1-based
+  int attempt = 0;        // 0-based index of the trial within the cycle
+  bool accepted = false;
+  std::string rejection_reason;   // empty when accepted
+
+  Eigen::VectorXd x0;             // scaled
+  Eigen::VectorXd x_trial;        // scaled LP optimum x*
+  double objective_x0 = 0;        // F(x0)
+  double objective_trial = 0;     // F(x*), NaN if the trial analysis failed
+  double objective_predicted = 0; // F~(x*)
+  double max_violation_x0 = 0;    // maxg at x0 (normalized, > 0 violated)
+  double max_violation_trial = 0; // maxg at x*
+  int worst_constraint_trial = -1;  // row index of maxg at x*, -1 if none
+  double objective_error = 0;       // e_o
+  double max_approximation_error = 0;  // maxfout
+  int worst_approximation_row = -1;    // -1: the objective
+  bool lp_feasible = true;          // feas: infeasibility variable s == 0
+  double infeasibility = 0;         // s at the LP optimum
+  std::string lp_status;            // LpStatusName of the LP solve
+  int lp_iterations = 0;
+  int rows_screened_in = 0;         // constraint rows kept in this LP
+  Eigen::VectorXd move_limits;      // f_i used for this LP
+  Eigen::VectorXd move_limits_next; // f_i after the strategy
+  std::vector<bool> on_move_limit;  // mvlimact(i)
+  std::vector<bool> on_bound;       // boundact(i)
+  std::int64_t analyses_total = 0;  // analyses consumed by the run so far
+  bool converged = false;           // this record ended the run converged
+};
+
+class SlpOptimizer {
+ public:
+  // `lp_solver` is owned; one per optimizer. Check the spec and options
+  // before constructing (Validate); invalid ones are a bug here.
+  SlpOptimizer(ProblemSpec spec, SlpOptions options,
+               std::unique_ptr<lp::LpSolver> lp_solver);
+  ~SlpOptimizer();
+  SlpOptimizer(const SlpOptimizer&) = delete;
+  SlpOptimizer& operator=(const SlpOptimizer&) = delete;
+
+  // Analyses requested and not yet answered, ordered by id.
+  std::vector<AnalysisRequest> PendingRequests() const;
+
+  // Hands in one result. InvalidArgument for an unknown or already answered
+  // id, or value vectors of the wrong size. NaN or infinite values are
+  // accepted and treated as a failed analysis. When the result completes a
+  // batch, the cycle advances inside this call.
+  absl::Status SubmitResult(const AnalysisResult& result);
+
+  // Records emitted since the last call, in order.
+  std::vector<CycleRecord> TakeNewRecords();
+
+  RunState state() const;
+  // The best accepted design so far (scaled) and its values.
+  const Eigen::VectorXd& current_design() const;
+  double current_objective() const;
+  double current_max_violation() const;
+  int cycles_completed() const;
+  std::int64_t analyses_used() const;
+  const ProblemSpec& spec() const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mbopt::slp

@@ -1,0 +1,81 @@
+// A study as domain types: what spec/io makes of a .study.textproto. Field
+// meanings are documented in proto/mbopt/v1/study.proto.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "spec/scene.h"
+
+namespace mbopt::spec {
+
+struct DesignVariable {
+  std::string name;
+  int parameter = -1;     // index into scene.parameters
+  double scale = 1.0;     // parameter value (in the parameter's unit) = scale * x
+  double initial = 0.0;   // scaled
+  double lower = 0.0;     // scaled
+  double upper = 0.0;     // scaled
+};
+
+enum class Reduction { kMax, kMaxAbs, kMin, kFinal };
+
+struct TargetTerm {
+  int output = -1;
+  double target = 0.0;       // in `unit`
+  double weight = 1.0;
+  double si_per_unit = 1.0;  // output value in unit = value_si / si_per_unit
+  std::string unit;
+};
+
+struct Objective {
+  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance } form = Form::kMinimize;
+  int output = -1;                 // kMinimizeMaxOf, kMinimize
+  Reduction reduction = Reduction::kMax;
+  std::vector<TargetTerm> terms;   // kTargetDistance
+  std::string unit;
+  double si_per_unit = 1.0;
+};
+
+struct Constraint {
+  std::string name;
+  int output = -1;
+  Reduction reduction = Reduction::kMaxAbs;
+  double limit = 0.0;        // in `unit`
+  std::string unit;
+  double si_per_unit = 1.0;
+};
+
+struct OptimizerSettings {
+  double initial_move_limit = 0.2;
+  int max_cycles = 50;
+  double convergence_objective_tolerance = 0.005;
+  double convergence_violation_tolerance = 0.005;
+  double screening_threshold = -0.3;
+  bool central_differences = false;
+  double finite_difference_relative_step = 1e-4;
+};
+
+struct AnalysisOverrides {
+  int time_grid_points = 0;
+  double relative_tolerance = 0.0;
+  double absolute_tolerance = 0.0;
+  int elements_per_flexible_link = 0;
+  bool rigid_links = false;
+};
+
+struct Study {
+  std::string name;
+  std::string source_file;
+  Scene scene;  // with the study's AnalysisOverrides already applied
+  std::vector<DesignVariable> variables;
+  Objective objective;
+  std::vector<Constraint> constraints;
+  OptimizerSettings optimizer;
+  AnalysisOverrides analysis;
+
+  // SI parameter values of the scene at scaled design x (others at default).
+  std::vector<double> ParameterValuesAt(const std::vector<double>& x_scaled) const;
+};
+
+}  // namespace mbopt::spec
