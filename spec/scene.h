@@ -125,6 +125,9 @@ struct Output {
 struct TimeGrid {
   double start_s = 0.0, end_s = 0.0;
   int points = 1;  // 1: only end_s
+  // The instants: `points` equally spaced from start_s to end_s inclusive
+  // (only end_s when points == 1).
+  std::vector<double> Instants() const;
 };
 
 struct IntegratorSettings {

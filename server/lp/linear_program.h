@@ -50,9 +50,20 @@ struct LpSolution {
   std::string message;
 };
 
+// Which LP the simplex method works on. The answer (x, duals, reduced costs)
+// is the same; the work is not: a tall LP (many rows, few columns, like the
+// SLP's time-gridded constraints) is much cheaper through its dual, whose
+// basis has one row per column of the original.
+enum class LpFormulation {
+  kAuto,    // the dual when rows > 2 * columns, else the primal
+  kPrimal,
+  kDual,
+};
+
 struct LpSolverOptions {
   int max_iterations = 100000;
   double max_seconds = 60.0;  // CLP's own limit; not used for determinism
+  LpFormulation formulation = LpFormulation::kAuto;
 };
 
 // Solves a sequence of LPs, reusing the previous optimal basis when the next

@@ -24,10 +24,22 @@ struct SlpOptions {
   // out of the cycle's LP (-0.3: "within 30 % of the limit or violated").
   double screening_threshold = -0.3;
 
+  // Objective terms of a min-max objective are screened the same way, with
+  // (f_j - F) / max(|F|, objective_magnitude_floor) against this threshold.
+  // Both screens also keep every row whose linearization could reach its
+  // limit (the current maximum, for objective terms) inside the move-limit
+  // box, so a screened-out row is redundant in the LP: screening changes the
+  // LP's size, never its solution.
+  double objective_screening_threshold = -0.3;
+
   // Finite differences, in scaled variables: step h_i = relative_step *
   // max(|x_i|, typical_magnitude_i) where typical_magnitude_i = (upper_i -
-  // lower_i) * 0.01 guards x_i = 0; a step that would leave the bounds is
-  // taken backwards (forward scheme) or shrunk to fit (central scheme).
+  // lower_i) * move_limit_floor_fraction_of_range guards x_i = 0; a step that
+  // would leave the bounds is taken backwards (forward scheme) or shrunk to
+  // fit (central scheme; below half the step it falls back to one side).
+  // A failed perturbation is retried once on the other side (or with half
+  // the step when the other side is out of bounds); if that fails too, the
+  // variable is held fixed for the cycle.
   FiniteDifferenceScheme finite_difference = FiniteDifferenceScheme::kForward;
   double finite_difference_relative_step = 1e-4;
 
@@ -46,6 +58,12 @@ struct SlpOptions {
 
   // Penalty on the infeasibility variable s, relative to the objective's scale.
   double infeasibility_penalty = 1e3;
+  // The LP counts as feasible ("feas") when s <= this (s is a normalized
+  // constraint violation).
+  double infeasibility_tolerance = 1e-7;
+  // |F| below this counts as zero in relative objective measures (e_o, the
+  // convergence and oscillation tests): they divide by max(|F|, floor).
+  double objective_magnitude_floor = 1e-10;
 
   int max_cycles = 50;
   // Consecutive rejections of one cycle's trial points before the cycle gives

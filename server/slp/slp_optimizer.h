@@ -124,7 +124,12 @@ class SlpOptimizer {
   std::vector<CycleRecord> TakeNewRecords();
 
   RunState state() const;
-  // The best accepted design so far (scaled) and its values.
+  // Why the run ended stalled or failed (empty otherwise).
+  const std::string& end_reason() const;
+  // The current design x0 (scaled): the last accepted trial point, or the
+  // initial design before any acceptance; the method's result when the run
+  // ends. Its values: F (the maximum term for min-max) and maxg (0 without
+  // constraints); NaN before x0 was analysed.
   const Eigen::VectorXd& current_design() const;
   double current_objective() const;
   double current_max_violation() const;

@@ -1,0 +1,57 @@
+// The fixed prose of docs/comparison.md: how the comparison is set up and
+// why the methods differ. Numbers are never written here; they come from
+// the runs.
+#pragma once
+
+namespace mbopt::compare {
+
+inline constexpr char kProtocol[] = R"(## Protocol
+
+- **Same problem for every method.** Each study file is loaded as the service loads it; every
+  method analyses designs with the same engine call (`local_run::EvaluateDesign`) on the same
+  scaled design variables and bounds, and sees the same constraint rows normalized as
+  (g - c) / scale <= 0 (METHOD.md's g/c - 1).
+- **mbopt SLP**: `local_run::RunStudyLocally` with the study's own optimizer settings (the
+  defaults of METHOD.md section 3): adaptive move limits, forward differences, CLP for the LPs.
+- **NLopt SLSQP** (`NLOPT_LD_SLSQP`) and **NLopt MMA** (`NLOPT_LD_MMA`), NLopt 2.7 from Debian,
+  set up as a user would: gradients by forward differences with exactly the SLP core's step rule
+  (`slp::PlanSteps`, forward scheme, step 1e-4 max(|x|, 1 % of the range), backwards at an
+  upper bound, one retry after a failed perturbation); the objective divided by |F(x0)|; a
+  min-max objective in the same bound formulation the SLP uses (an extra variable b in
+  [-10, 10]: minimize b subject to f_i / |F(x0)| - b <= 0), so the peers see a smooth problem;
+  stopping at ftol_rel = xtol_rel = 1e-6 or when the next request would exceed the analysis cap.
+  NLopt asks for the gradient with every function value (line-search and inner points too), so
+  each NLopt evaluation costs 1 + n analyses. A design whose analysis fails is reported to the
+  peer as a large constraint violation and objective.
+- **Counting.** Every engine analysis counts (a gradient costs n). A method *reaches the target*
+  at the first candidate design it analysed (the initial design, SLP trial points, NLopt's
+  evaluation points; never a finite-difference perturbation) whose objective is within 0.5 %
+  of the best known objective F* and whose max normalized violation is at most 0.2 %. F* is the
+  lowest objective any of the methods analysed at a design feasible within 0.2 %; where F* is
+  near zero (landing gear) the 0.5 % is taken of max(|F*|, 1 % of |F(x0)|). "final" is the
+  design each method returns. Wall time is the whole run on one core, analyses included.
+)";
+
+inline constexpr char kDiscussion[] = R"(## Why the methods differ
+
+- **Cost of a gradient.** All three pay n analyses per forward-difference gradient. The SLP
+  asks for one gradient per cycle and one analysis per trial point; a rejected trial costs one
+  analysis. NLopt's SLSQP and MMA evaluate the gradient at every point they visit, including
+  line-search points (SLSQP) and inner conservative iterations (MMA), so a step that the SLP
+  would reject for one analysis costs them 1 + n. With analytic sensitivities this difference
+  would disappear; the engine has none yet (see docs/accuracy.md).
+- **Many constraint rows.** The time-dependent constraints become hundreds to thousands of rows
+  (vehicle: 1010 rows plus 202 objective terms; four-bar: 3232 rows). The SLP screens rows far
+  from their limits out of each LP; SLSQP carries every row in its quadratic subproblem and MMA
+  in its dual, which costs time (not analyses).
+- **Convergence test.** The SLP stops when a cycle changes F by less than 0.5 % at a design
+  feasible within 0.5 % (METHOD.md section 3); NLopt stops on a relative change of 1e-6, so it
+  tends to spend more analyses polishing the last digits. The "analyses to target" column is
+  the fair measure of speed; "total analyses" includes each method's own stopping rule.
+- **Noise from the analyses.** Time-integrated outputs carry the integrator's error (relative
+  tolerance 1e-6 by default), and forward differences with step 1e-4 amplify it. Quasi-Newton
+  methods such as SLSQP build curvature from gradient differences and are sensitive to this;
+  the SLP only needs first-order information and move limits.
+)";
+
+}  // namespace mbopt::compare

@@ -1,0 +1,185 @@
+#include "client/commands.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "client/args.h"
+#include "client/connection.h"
+#include "client/exit_codes.h"
+#include "client/interrupts.h"
+#include "client/job_format.h"
+#include "client/study_file.h"
+#include "client/watch.h"
+
+namespace mbopt::client {
+namespace {
+
+const ArgSpec kServerOnly{{"--server"}, {}};
+
+// Parses `args`, requiring exactly `positional` positional arguments.
+absl::StatusOr<ParsedArgs> Parse(const Args& args, const ArgSpec& spec, size_t positional,
+                                 const char* usage) {
+  auto parsed = ParseArgs(args, spec);
+  if (!parsed.ok()) return parsed.status();
+  if (parsed->positional.size() != positional) {
+    return absl::InvalidArgumentError(std::string("usage: ") + usage);
+  }
+  return parsed;
+}
+
+struct Connection {
+  std::string address;
+  std::unique_ptr<v1::JobService::Stub> stub;
+};
+
+Connection Connect(const ParsedArgs& parsed) {
+  Connection c;
+  c.address = ResolveServerAddress(parsed.Value("--server"));
+  c.stub = ConnectJobService(c.address);
+  return c;
+}
+
+int FailRpc(const grpc::Status& status, const std::string& address) {
+  RpcFailure f = DescribeRpcFailure(status, address);
+  return Fail(f.message, f.exit_code);
+}
+
+// Follows a job to its end, printing the table; returns the exit code of its
+// final state.
+int Follow(Connection& c, const std::string& job_id) {
+  Interrupts::Install();
+  WatchOptions options;
+  options.progress_line = isatty(STDOUT_FILENO) != 0;
+  WatchOutcome outcome = WatchJob(*c.stub, c.address, job_id, options);
+  if (outcome.interrupted) {
+    std::fprintf(stderr, "mbopt: stopped watching; job %s goes on on the server\n",
+                 job_id.c_str());
+    return kExitInterrupted;
+  }
+  if (!outcome.ok) return Fail(outcome.failure.message, outcome.failure.exit_code);
+  const auto& s = outcome.summary;
+  std::printf("%s: %s after %d cycles, %lld analyses, F = %.10g %s, max violation %.4g\n",
+              job_id.c_str(), StateName(s.state()).c_str(), s.cycles(),
+              static_cast<long long>(s.analyses()), s.objective(), s.objective_unit().c_str(),
+              s.max_violation());
+  if (!s.message().empty()) std::printf("%s\n", s.message().c_str());
+  return ExitCodeForState(s.state());
+}
+
+}  // namespace
+
+int Fail(const std::string& message, int exit_code) {
+  std::fprintf(stderr, "mbopt: %s\n", message.c_str());
+  return exit_code;
+}
+
+int SubmitCommand(const Args& args) {
+  auto parsed = Parse(args, {{"--server"}, {"--watch"}}, 1,
+                      "mbopt submit STUDY_FILE [--watch] [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  const std::string path = parsed->positional[0];
+  auto study = ReadStudyForSubmission(path);
+  if (!study.ok()) return Fail(std::string(study.status().message()), kExitBadInput);
+  Connection c = Connect(*parsed);
+  v1::SubmitJobRequest request;
+  *request.mutable_study() = *std::move(study);
+  request.set_source_name(path);
+  v1::SubmitJobResponse response;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = c.stub->Submit(&context, request, &response);
+  if (!status.ok()) return FailRpc(status, c.address);
+  std::printf("%s\n", response.job_id().c_str());
+  std::fflush(stdout);
+  if (!parsed->Has("--watch")) return kExitOk;
+  return Follow(c, response.job_id());
+}
+
+int WatchCommand(const Args& args) {
+  auto parsed = Parse(args, kServerOnly, 1, "mbopt watch JOB [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  Connection c = Connect(*parsed);
+  return Follow(c, parsed->positional[0]);
+}
+
+int StatusCommand(const Args& args) {
+  auto parsed = Parse(args, kServerOnly, 1, "mbopt status JOB [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  Connection c = Connect(*parsed);
+  v1::JobRef ref;
+  ref.set_job_id(parsed->positional[0]);
+  v1::GetJobResponse response;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = c.stub->Get(&context, ref, &response);
+  if (!status.ok()) return FailRpc(status, c.address);
+  std::fputs(SummaryText(response.summary()).c_str(), stdout);
+  return kExitOk;
+}
+
+int ListCommand(const Args& args) {
+  auto parsed = Parse(args, kServerOnly, 0, "mbopt list [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  Connection c = Connect(*parsed);
+  v1::ListJobsResponse response;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = c.stub->List(&context, v1::ListJobsRequest(), &response);
+  if (!status.ok()) return FailRpc(status, c.address);
+  std::printf("%s\n", ListHeader().c_str());
+  for (const auto& job : response.jobs()) std::printf("%s\n", ListRow(job).c_str());
+  return kExitOk;
+}
+
+namespace {
+
+int CancelOrResume(const Args& args, bool cancel) {
+  auto parsed = Parse(args, kServerOnly, 1,
+                      cancel ? "mbopt cancel JOB [--server ADDRESS]"
+                             : "mbopt resume JOB [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  Connection c = Connect(*parsed);
+  v1::JobRef ref;
+  ref.set_job_id(parsed->positional[0]);
+  v1::JobSummary summary;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = cancel ? c.stub->Cancel(&context, ref, &summary)
+                               : c.stub->Resume(&context, ref, &summary);
+  if (!status.ok()) return FailRpc(status, c.address);
+  std::printf("%s: %s\n", summary.job_id().c_str(), StateName(summary.state()).c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+int CancelCommand(const Args& args) { return CancelOrResume(args, true); }
+int ResumeCommand(const Args& args) { return CancelOrResume(args, false); }
+
+int ResultsCommand(const Args& args) {
+  auto parsed = Parse(args, {{"--server"}, {"--csv", "--json"}}, 1,
+                      "mbopt results JOB [--csv | --json] [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  if (parsed->Has("--csv") && parsed->Has("--json")) {
+    return Fail("--csv and --json exclude each other", kExitBadInput);
+  }
+  Connection c = Connect(*parsed);
+  v1::JobRef ref;
+  ref.set_job_id(parsed->positional[0]);
+  v1::GetJobResponse response;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = c.stub->Get(&context, ref, &response);
+  if (!status.ok()) return FailRpc(status, c.address);
+  if (parsed->Has("--json")) {
+    std::fputs(ResultsJson(response).c_str(), stdout);
+  } else if (parsed->Has("--csv")) {
+    std::fputs(ResultsCsv(response).c_str(), stdout);
+  } else {
+    std::fputs(ResultsTable(response).c_str(), stdout);
+  }
+  return ExitCodeForState(response.summary().state());
+}
+
+}  // namespace mbopt::client

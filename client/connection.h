@@ -1,0 +1,37 @@
+// Where the CLI finds its server and how it reports RPC failures. The address
+// comes from --server, else $MBOPT_SERVER, else 127.0.0.1:50051. Every gRPC
+// error becomes one clear message and an exit code (exit_codes.h) here, and
+// nowhere else.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <grpcpp/grpcpp.h>
+
+#include "mbopt/v1/service.grpc.pb.h"
+
+namespace mbopt::client {
+
+inline constexpr char kDefaultServerAddress[] = "127.0.0.1:50051";
+
+// `flag_value` is the --server option ("" if not given).
+std::string ResolveServerAddress(const std::string& flag_value);
+
+std::unique_ptr<v1::JobService::Stub> ConnectJobService(const std::string& address);
+
+// An RPC failure as the user should read it, e.g. "cannot reach server at
+// 127.0.0.1:50051: failed to connect to all addresses" or "no job 'j-9' on
+// server ...".
+struct RpcFailure {
+  std::string message;
+  int exit_code = 0;
+};
+RpcFailure DescribeRpcFailure(const grpc::Status& status, const std::string& address);
+
+// Deadline for the short unary calls (Submit, Get, List, Cancel, Resume): a
+// guard against a hung server, not a pacing mechanism.
+inline constexpr int kUnaryDeadlineSeconds = 30;
+void SetUnaryDeadline(grpc::ClientContext* context);
+
+}  // namespace mbopt::client

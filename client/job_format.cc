@@ -1,0 +1,213 @@
+#include "client/job_format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "client/exit_codes.h"
+#include "client/json_writer.h"
+
+namespace mbopt::client {
+namespace {
+
+std::string Format(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+std::vector<double> ToVector(const google::protobuf::RepeatedField<double>& values) {
+  return std::vector<double>(values.begin(), values.end());
+}
+
+// Min and max of the move limits of one LP.
+std::pair<double, double> MinMax(const google::protobuf::RepeatedField<double>& values) {
+  if (values.empty()) return {NAN, NAN};
+  auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  return {*lo, *hi};
+}
+
+std::string DesignLines(const v1::JobSummary& s) {
+  std::string out;
+  for (int i = 0; i < s.design_names_size() && i < s.design_size(); ++i) {
+    char buf[256];
+    std::string unit = i < s.design_units_size() ? s.design_units(i) : "";
+    std::snprintf(buf, sizeof buf, "  %-16s %.8g %s\n", s.design_names(i).c_str(), s.design(i),
+                  unit.c_str());
+    out += buf;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string StateName(v1::JobState state) {
+  switch (state) {
+    case v1::JOB_STATE_QUEUED: return "queued";
+    case v1::JOB_STATE_RUNNING: return "running";
+    case v1::JOB_STATE_CONVERGED: return "converged";
+    case v1::JOB_STATE_MAX_CYCLES: return "max_cycles";
+    case v1::JOB_STATE_STALLED: return "stalled";
+    case v1::JOB_STATE_FAILED: return "failed";
+    case v1::JOB_STATE_CANCELLED: return "cancelled";
+    case v1::JOB_STATE_INTERRUPTED: return "interrupted";
+    default: return "unknown";
+  }
+}
+
+bool IsTerminal(v1::JobState state) {
+  switch (state) {
+    case v1::JOB_STATE_CONVERGED:
+    case v1::JOB_STATE_MAX_CYCLES:
+    case v1::JOB_STATE_STALLED:
+    case v1::JOB_STATE_FAILED:
+    case v1::JOB_STATE_CANCELLED:
+    case v1::JOB_STATE_INTERRUPTED:
+      return true;
+    default:
+      return false;
+  }
+}
+
+int ExitCodeForState(v1::JobState state) {
+  switch (state) {
+    case v1::JOB_STATE_CONVERGED: return kExitOk;
+    case v1::JOB_STATE_FAILED: return kExitJobFailed;
+    case v1::JOB_STATE_QUEUED:
+    case v1::JOB_STATE_RUNNING: return kExitOk;
+    default: return kExitNotConverged;
+  }
+}
+
+std::string CycleTableHeader() {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%5s %3s %14s %10s %10s %4s %4s %9s %9s %9s", "cycle", "att",
+                "F", "maxg", "maxfout", "feas", "acc", "ml_min", "ml_max", "analyses");
+  return buf;
+}
+
+std::string CycleTableRow(const v1::CycleRecord& r) {
+  auto [ml_min, ml_max] = MinMax(r.move_limits());
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%5d %3d %14.7g %10.4g %10.4g %4s %4s %9.3g %9.3g %9lld",
+                r.cycle(), r.attempt(), r.objective_trial(), r.max_violation_trial(),
+                r.max_approximation_error(), r.lp_feasible() ? "yes" : "no",
+                r.accepted() ? "yes" : "no", ml_min, ml_max,
+                static_cast<long long>(r.analyses_total()));
+  return buf;
+}
+
+std::string SummaryText(const v1::JobSummary& s) {
+  std::string out;
+  out += "job:           " + s.job_id() + "\n";
+  out += "study:         " + s.study_name() + "\n";
+  out += "status:        " + StateName(s.state()) + "\n";
+  out += "cycles:        " + std::to_string(s.cycles()) +
+         (s.max_cycles() > 0 ? " (of at most " + std::to_string(s.max_cycles()) + ")" : "") + "\n";
+  out += "analyses:      " + std::to_string(s.analyses()) + "\n";
+  out += "objective:     " + Format("%.10g", s.objective()) +
+         (s.objective_unit().empty() ? "" : " " + s.objective_unit()) + "\n";
+  out += "max violation: " + Format("%.4g", s.max_violation()) + "\n";
+  out += "wall time:     " + Format("%.2f", s.wall_seconds()) + " s\n";
+  if (!s.message().empty()) out += "message:       " + s.message() + "\n";
+  if (s.design_size() > 0) out += "design:\n" + DesignLines(s);
+  return out;
+}
+
+std::string ListHeader() {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6s %9s %14s", "JOB", "STUDY", "STATUS",
+                "CYCLES", "ANALYSES", "OBJECTIVE");
+  return buf;
+}
+
+std::string ListRow(const v1::JobSummary& s) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6d %9lld %14.7g", s.job_id().c_str(),
+                s.study_name().c_str(), StateName(s.state()).c_str(), s.cycles(),
+                static_cast<long long>(s.analyses()), s.objective());
+  return buf;
+}
+
+std::string ResultsTable(const v1::GetJobResponse& job) {
+  std::string out = SummaryText(job.summary());
+  out += "\n" + CycleTableHeader() + "\n";
+  for (const auto& r : job.cycles()) out += CycleTableRow(r) + "\n";
+  return out;
+}
+
+std::string ResultsCsv(const v1::GetJobResponse& job) {
+  const auto& s = job.summary();
+  std::string out = "cycle,attempt,accepted,objective,max_violation,max_approximation_error,"
+                    "lp_feasible,move_limit_min,move_limit_max,analyses";
+  for (const auto& name : s.design_names()) out += "," + name;
+  out += "\n";
+  for (const auto& r : job.cycles()) {
+    auto [ml_min, ml_max] = MinMax(r.move_limits());
+    out += std::to_string(r.cycle()) + "," + std::to_string(r.attempt()) + "," +
+           (r.accepted() ? "1" : "0") + "," + JsonWriter::FormatDouble(r.objective_trial()) +
+           "," + JsonWriter::FormatDouble(r.max_violation_trial()) + "," +
+           JsonWriter::FormatDouble(r.max_approximation_error()) + "," +
+           (r.lp_feasible() ? "1" : "0") + "," + JsonWriter::FormatDouble(ml_min) + "," +
+           JsonWriter::FormatDouble(ml_max) + "," + std::to_string(r.analyses_total());
+    for (int i = 0; i < s.design_names_size(); ++i) {
+      out += ",";
+      if (i < r.x_trial_physical_size()) out += JsonWriter::FormatDouble(r.x_trial_physical(i));
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string ResultsJson(const v1::GetJobResponse& job) {
+  const auto& s = job.summary();
+  JsonWriter w;
+  w.BeginObject();
+  w.Field("job_id", s.job_id());
+  w.Field("study", s.study_name());
+  w.Field("status", StateName(s.state()));
+  w.Field("cycles", s.cycles());
+  w.Field("analyses", static_cast<long long>(s.analyses()));
+  w.Field("objective", s.objective());
+  w.Field("objective_unit", s.objective_unit());
+  w.Field("max_violation", s.max_violation());
+  w.Key("design");
+  w.BeginObject();
+  for (int i = 0; i < s.design_names_size() && i < s.design_size(); ++i) {
+    w.Field(s.design_names(i), s.design(i));
+  }
+  w.EndObject();
+  w.Key("design_units");
+  w.BeginObject();
+  for (int i = 0; i < s.design_names_size() && i < s.design_units_size(); ++i) {
+    w.Field(s.design_names(i), s.design_units(i));
+  }
+  w.EndObject();
+  w.Field("wall_seconds", s.wall_seconds());
+  w.Field("message", s.message());
+  w.Key("history");
+  w.BeginArray();
+  for (const auto& r : job.cycles()) {
+    if (!r.accepted()) continue;
+    w.BeginObject();
+    w.Field("cycle", r.cycle());
+    w.Field("attempts", r.attempt() + 1);
+    w.Field("objective", r.objective_trial());
+    w.Field("max_violation", r.max_violation_trial());
+    w.Field("max_approximation_error", r.max_approximation_error());
+    w.Field("lp_feasible", r.lp_feasible());
+    w.Field("analyses", static_cast<long long>(r.analyses_total()));
+    w.NumberArray("move_limits", ToVector(r.move_limits()));
+    w.NumberArray("move_limits_next", ToVector(r.move_limits_next()));
+    w.NumberArray("design", ToVector(r.x_trial_physical()));
+    w.NumberArray("x_scaled", ToVector(r.x_trial_scaled()));
+    w.EndObject();
+  }
+  w.EndArray();
+  w.EndObject();
+  return w.str() + "\n";
+}
+
+}  // namespace mbopt::client

@@ -1,0 +1,56 @@
+// mbopt: the command-line client of an mbopt server (see docs/cli.md).
+#include <signal.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "client/commands.h"
+#include "client/exit_codes.h"
+
+namespace {
+
+constexpr char kUsage[] =
+    "usage: mbopt COMMAND [ARGS]\n"
+    "\n"
+    "commands:\n"
+    "  run FILE [--workers N] [--db PATH] [--json] [--quiet]\n"
+    "                        start a local server and N workers, optimize, print the result\n"
+    "  submit FILE [--watch] submit a study to a server; prints the job id\n"
+    "  watch JOB             follow a job's cycles until it ends\n"
+    "  status JOB            a job's state, objective and design\n"
+    "  list                  all jobs on the server\n"
+    "  cancel JOB            stop a job\n"
+    "  resume JOB            continue an interrupted job\n"
+    "  results JOB [--csv|--json]\n"
+    "                        a job's result and cycle history\n"
+    "\n"
+    "every command but run takes --server HOST:PORT (default $MBOPT_SERVER, else\n"
+    "127.0.0.1:50051). See docs/cli.md for the exit codes.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mbopt::client;
+  // A closed output pipe (e.g. `mbopt run ... | head`) must not kill mbopt
+  // before it has stopped its children and removed its temporary files.
+  signal(SIGPIPE, SIG_IGN);
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
+      std::strcmp(argv[1], "help") == 0) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? kExitBadInput : kExitOk;
+  }
+  const std::string command = argv[1];
+  const Args args(argv + 2, argv + argc);
+  if (command == "run") return RunCommandMain(args);
+  if (command == "submit") return SubmitCommand(args);
+  if (command == "watch") return WatchCommand(args);
+  if (command == "status") return StatusCommand(args);
+  if (command == "list") return ListCommand(args);
+  if (command == "cancel") return CancelCommand(args);
+  if (command == "resume") return ResumeCommand(args);
+  if (command == "results") return ResultsCommand(args);
+  std::fprintf(stderr, "mbopt: unknown command '%s'\n\n%s", command.c_str(), kUsage);
+  return kExitBadInput;
+}

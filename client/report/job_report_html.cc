@@ -1,0 +1,132 @@
+#include "client/report/job_report_html.h"
+
+#include <cmath>
+#include <string>
+
+#include "client/report/history_plots.h"
+#include "client/report/html_escape.h"
+#include "client/report/number_format.h"
+#include "client/report/report_tables.h"
+#include "client/report/svg_line_plot.h"
+
+namespace mbopt::report {
+namespace {
+
+constexpr const char* kStyle = R"css(
+body { font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; color: #222;
+       margin: 24px; max-width: 1180px; }
+h1 { font-size: 22px; margin-bottom: 4px; }
+h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccc; }
+p.description { color: #555; margin-top: 0; }
+table { border-collapse: collapse; font-size: 13px; margin: 8px 0; }
+th, td { border: 1px solid #ccc; padding: 3px 7px; text-align: left; vertical-align: top; }
+th { background: #f2f2f2; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+td.on-bound { font-weight: bold; color: #8a4b00; }
+tr.rejected td { background: #fdecea; }
+div.wide { overflow-x: auto; }
+table.cycles { font-size: 12px; }
+table.cycles td { white-space: nowrap; }
+table.cycles td:last-child { white-space: normal; min-width: 160px; }
+table.summary th { width: 190px; }
+p.note, p.empty { color: #555; font-size: 13px; }
+div.figure { margin: 10px 0 18px 0; }
+svg.plot { max-width: 100%; height: auto; font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; }
+svg .plot-title { font-size: 14px; font-weight: bold; fill: #222; }
+svg .tick { font-size: 11px; fill: #333; }
+svg .axis-label { font-size: 12px; fill: #222; }
+svg .legend { font-size: 12px; fill: #222; }
+svg .ref-label { font-size: 10px; fill: #555; }
+svg .note, svg .no-data { font-size: 11px; fill: #555; }
+)css";
+
+std::string Row(const std::string& header, const std::string& escaped_value) {
+  return "<tr><th>" + EscapeHtml(header) + "</th><td>" + escaped_value + "</td></tr>\n";
+}
+
+double FinalObjective(const ReportData& data) {
+  if (std::isfinite(data.objective)) return data.objective;
+  for (auto it = data.records.rbegin(); it != data.records.rend(); ++it) {
+    if (it->accepted) return it->objective_trial;
+  }
+  return data.records.empty() ? data.objective : data.records.front().objective_x0;
+}
+
+std::string SummaryTable(const ReportData& data) {
+  std::string out = "<table class=\"summary\">\n<tbody>\n";
+  if (!data.job_id.empty()) out += Row("job", EscapeHtml(data.job_id));
+  out += Row("state", "<strong>" + EscapeHtml(data.state.empty() ? "unknown" : data.state) + "</strong>");
+  out += Row("cycles", std::to_string(data.cycles));
+  out += Row("analyses", std::to_string(data.analyses));
+  std::string objective = EscapeHtml(FormatValue(FinalObjective(data), 6, "not known"));
+  if (!data.objective_unit.empty()) objective += " " + EscapeHtml(data.objective_unit);
+  out += Row("final objective F", objective);
+  out += Row("max violation maxg", EscapeHtml(FormatValue(data.max_violation, 4, "not known")) +
+                                       (data.max_violation > 0 ? " (violated)" : ""));
+  if (data.wall_seconds > 0) out += Row("wall time", EscapeHtml(FormatValue(data.wall_seconds, 4)) + " s");
+  if (!data.message.empty()) out += Row("message", EscapeHtml(data.message));
+  out += "</tbody>\n</table>\n";
+  return out;
+}
+
+// False when no record names a worst constraint row and every maxg is 0:
+// a study without constraints (failed trials have neither).
+bool HasConstraintRows(const ReportData& data) {
+  for (const ReportCycle& r : data.records) {
+    if (!r.worst_constraint.empty()) return true;
+    for (double g : {r.max_violation_x0, r.max_violation_trial}) {
+      if (std::isfinite(g) && g != 0.0) return true;
+    }
+  }
+  return false;
+}
+
+std::string Figure(const PlotSpec& spec) {
+  return "<div class=\"figure\">\n" + RenderLinePlotSvg(spec) + "</div>\n";
+}
+
+}  // namespace
+
+std::string RenderJobReportHtml(const ReportData& data) {
+  const std::string name = data.study_name.empty() ? std::string("(unnamed study)") : data.study_name;
+  std::string out;
+  out += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  out += "<title>mbopt report: " + EscapeHtml(name) + "</title>\n";
+  out += "<style>" + std::string(kStyle) + "</style>\n</head>\n<body>\n";
+  out += "<h1>" + EscapeHtml(name) + "</h1>\n";
+  if (!data.description.empty()) out += "<p class=\"description\">" + EscapeHtml(data.description) + "</p>\n";
+  out += SummaryTable(data);
+
+  out += "<h2>Cycle history</h2>\n";
+  if (data.records.empty()) {
+    out += "<p class=\"empty\">No cycle has been recorded for this job yet: there is no history "
+           "to plot.</p>\n";
+  } else {
+    out += "<p class=\"note\">Each point k is the design accepted in cycle k (0: the initial "
+           "design, which is x0 of cycle 1). Hollow red markers are trial points x* that the "
+           "move-limit strategy rejected; a failed analysis leaves a gap.</p>\n";
+    out += Figure(ObjectivePlot(data));
+    if (HasConstraintRows(data)) {
+      out += Figure(ViolationPlot(data));
+    } else {
+      out += "<p class=\"note\">The study has no constraint rows: maxg is 0 throughout, so there is "
+             "no violation plot.</p>\n";
+    }
+    out += Figure(ApproximationErrorPlot(data));
+    out += Figure(MoveLimitPlot(data));
+    out += Figure(DesignVariablePlot(data));
+  }
+
+  out += "<h2>Final design</h2>\n";
+  out += FinalDesignTableHtml(data);
+  out += "<h2>Active constraints</h2>\n";
+  out += ActiveConstraintsHtml(data);
+  out += "<h2>Cycles</h2>\n";
+  out += "<p class=\"note\">One row per LP solve: a cycle repeats its LP with smaller move "
+         "limits after each rejected trial point.</p>\n";
+  out += "<div class=\"wide\">\n" + CycleTableHtml(data) + "</div>\n";
+  out += "</body>\n</html>\n";
+  return out;
+}
+
+}  // namespace mbopt::report

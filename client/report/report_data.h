@@ -1,0 +1,103 @@
+// What the job report page shows, as plain data: the job's summary, its
+// design variables with bounds, and every CycleRecord (rejected attempts
+// included). Filled from the wire messages by report_from_proto.h, or by
+// hand in tests; the page generator (job_report_html.h) sees only this.
+//
+// Units: objective values are in `objective_unit`; constraint values and
+// approximation errors are normalized and dimensionless (> 0 violated);
+// scaled design values are the optimizer's dimensionless variables x, with
+// physical value = scale * x in the variable's `unit`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mbopt::report {
+
+struct ReportVariable {
+  std::string name;
+  std::string unit;        // unit of the physical value; empty: SI / none
+  double scale = 1.0;      // physical value = scale * scaled value
+  bool has_bounds = false; // false when the study was not available
+  double lower_scaled = 0.0;
+  double upper_scaled = 0.0;
+};
+
+// One LP solve of a cycle and what became of its trial point (mirrors the
+// SLP core's CycleRecord). NaN marks a value that does not exist, e.g. F(x*)
+// of a trial whose analysis failed.
+struct ReportCycle {
+  int cycle = 0;    // 1-based
+  int attempt = 0;  // 0-based trial index within the cycle
+  bool accepted = false;
+  std::string rejection_reason;  // empty when accepted
+  std::vector<double> x0_scaled;
+  std::vector<double> x_trial_scaled;
+  double objective_x0 = 0.0;
+  double objective_trial = 0.0;
+  double objective_predicted = 0.0;
+  double max_violation_x0 = 0.0;
+  double max_violation_trial = 0.0;
+  std::string worst_constraint;  // row name of maxg at x*, empty if none
+  double objective_error = 0.0;           // e_o
+  double max_approximation_error = 0.0;   // maxfout
+  std::string worst_approximation;        // "objective" or a row name
+  bool lp_feasible = true;
+  double infeasibility = 0.0;
+  std::string lp_status;
+  std::vector<double> move_limits;        // f_i used for this LP
+  std::vector<double> move_limits_next;   // f_i after the strategy
+  std::int64_t analyses_total = 0;
+  bool converged = false;
+};
+
+// A constraint row known to be active (normalized value above
+// kActiveThreshold) at the final design.
+struct ActiveConstraint {
+  std::string name;
+  double normalized_value = 0.0;
+};
+
+// Axis choice for a history plot.
+enum class ScaleChoice {
+  kAuto,    // logarithmic when the positive values span two decades or more
+  kLinear,
+  kLog,
+};
+
+struct ReportData {
+  std::string job_id;
+  std::string study_name;
+  std::string description;
+  std::string state;       // e.g. "converged", "max_cycles", "running"
+  std::string message;     // failure or stall reason
+  int cycles = 0;          // cycles completed
+  std::int64_t analyses = 0;
+  double objective = 0.0;  // current best F, NaN when unknown
+  std::string objective_unit;
+  double max_violation = 0.0;  // normalized maxg of the current best design
+  double wall_seconds = 0.0;
+
+  std::vector<ReportVariable> variables;
+  // Current best design in physical units, one per variable; empty when
+  // unknown (the page then derives it from the last accepted record).
+  std::vector<double> final_design_physical;
+  // Rows known to be active at the final design beyond the worst row of the
+  // last accepted record (the job record keeps only that one per trial).
+  std::vector<ActiveConstraint> active_constraints;
+
+  std::vector<ReportCycle> records;  // in the order the optimizer emitted them
+
+  // kAuto for the objective: logarithmic only when every value is > 0.
+  ScaleChoice objective_scale = ScaleChoice::kAuto;
+  ScaleChoice error_scale = ScaleChoice::kAuto;
+  ScaleChoice violation_scale = ScaleChoice::kAuto;
+  ScaleChoice move_limit_scale = ScaleChoice::kAuto;
+};
+
+// Rows with a normalized value above this count as active (METHOD.md's
+// convergence tolerance on maxg).
+inline constexpr double kActiveThreshold = -0.005;
+
+}  // namespace mbopt::report

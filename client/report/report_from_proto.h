@@ -1,0 +1,14 @@
+// Builds the report page's data from the server's GetJob answer: summary,
+// cycle records and the study (for variable scales and bounds).
+#pragma once
+
+#include "client/report/report_data.h"
+#include "mbopt/v1/service.pb.h"
+
+namespace mbopt::report {
+
+// Never fails: a job without a study gets variables without bounds, and
+// fields the server left empty stay empty on the page.
+ReportData ReportDataFromJob(const v1::GetJobResponse& job);
+
+}  // namespace mbopt::report

@@ -1,0 +1,142 @@
+// `mbopt run`: the embedded default. Server, workers, submission, watch and
+// result in one command; everything it started is stopped and its temporary
+// database removed on the way out, also after Ctrl-C.
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "client/args.h"
+#include "client/commands.h"
+#include "client/connection.h"
+#include "client/exit_codes.h"
+#include "client/interrupts.h"
+#include "client/job_format.h"
+#include "client/local_cluster.h"
+#include "client/study_file.h"
+#include "client/watch.h"
+
+namespace mbopt::client {
+namespace {
+
+// A directory for the port file, logs and (by default) the database, removed
+// when the run ends unless the user asked to keep its database.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-run-XXXXXX").string();
+    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
+  }
+  ~TempDir() {
+    if (path_.empty()) return;
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+}  // namespace
+
+int RunCommandMain(const Args& args) {
+  auto parsed = ParseArgs(args, {{"--workers", "--db"}, {"--json", "--quiet"}});
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  if (parsed->positional.size() != 1) {
+    return Fail("usage: mbopt run STUDY_FILE [--workers N] [--db PATH] [--json] [--quiet]",
+                kExitBadInput);
+  }
+  auto workers = parsed->IntValue("--workers", 1);
+  if (!workers.ok()) return Fail(std::string(workers.status().message()), kExitBadInput);
+  const int num_workers = workers->value_or(
+      std::max(1, static_cast<int>(std::thread::hardware_concurrency())));
+  const bool json = parsed->Has("--json");
+  const bool quiet = parsed->Has("--quiet");
+  const std::string path = parsed->positional[0];
+
+  // Bad input is reported before anything is started.
+  auto study = ReadStudyForSubmission(path);
+  if (!study.ok()) return Fail(std::string(study.status().message()), kExitBadInput);
+  auto server_binary = FindMboptBinary("mbopt-server", "MBOPT_SERVER_BIN", "server/main");
+  if (!server_binary.ok()) return Fail(std::string(server_binary.status().message()), kExitBadInput);
+  auto worker_binary = FindMboptBinary("mbopt-worker", "MBOPT_WORKER_BIN", "worker/main");
+  if (!worker_binary.ok()) return Fail(std::string(worker_binary.status().message()), kExitBadInput);
+
+  Interrupts::Install();  // before any thread (gRPC's included) is started
+  TempDir temp;
+  if (temp.path().empty()) return Fail("cannot create a temporary directory", kExitBadInput);
+  LocalClusterOptions cluster_options;
+  cluster_options.server_binary = *server_binary;
+  cluster_options.worker_binary = *worker_binary;
+  cluster_options.db_path = parsed->Value("--db", temp.path() + "/mbopt.db");
+  cluster_options.log_dir = temp.path();
+  cluster_options.workers = num_workers;
+  auto cluster = LocalCluster::Start(cluster_options);
+  if (!cluster.ok()) return Fail(std::string(cluster.status().message()), kExitUnreachable);
+  const std::string address = (*cluster)->address();
+  if (!quiet && !json) {
+    std::printf("mbopt run: server at %s, %d workers\n", address.c_str(), num_workers);
+  }
+
+  auto stub = ConnectJobService(address);
+  v1::SubmitJobRequest request;
+  *request.mutable_study() = *std::move(study);
+  request.set_source_name(path);
+  v1::SubmitJobResponse submitted;
+  {
+    grpc::ClientContext context;
+    SetUnaryDeadline(&context);
+    grpc::Status status = stub->Submit(&context, request, &submitted);
+    if (!status.ok()) {
+      RpcFailure f = DescribeRpcFailure(status, address);
+      return Fail(f.message, f.exit_code);
+    }
+  }
+  const std::string job_id = submitted.job_id();
+  if (!quiet && !json) std::printf("job %s\n", job_id.c_str());
+
+  WatchOptions watch_options;
+  watch_options.table_out = (quiet || json) ? nullptr : stdout;
+  watch_options.progress_line = watch_options.table_out != nullptr && isatty(STDOUT_FILENO);
+  WatchOutcome outcome = WatchJob(*stub, address, job_id, watch_options);
+
+  v1::GetJobResponse job;
+  grpc::Status get_status;
+  {
+    v1::JobRef ref;
+    ref.set_job_id(job_id);
+    grpc::ClientContext context;
+    SetUnaryDeadline(&context);
+    get_status = stub->Get(&context, ref, &job);
+  }
+  (*cluster)->Stop();
+
+  if (outcome.interrupted) {
+    std::fprintf(stderr, "mbopt run: interrupted; server and workers stopped%s\n",
+                 parsed->Value("--db").empty() ? ", temporary database removed"
+                                               : ", the job can be resumed from the database");
+    if (json && get_status.ok()) {
+      job.mutable_summary()->set_state(v1::JOB_STATE_INTERRUPTED);
+      std::fputs(ResultsJson(job).c_str(), stdout);
+    }
+    return kExitInterrupted;
+  }
+  if (!outcome.ok) return Fail(outcome.failure.message, outcome.failure.exit_code);
+  if (!get_status.ok()) {
+    RpcFailure f = DescribeRpcFailure(get_status, address);
+    return Fail(f.message, f.exit_code);
+  }
+  if (json) {
+    std::fputs(ResultsJson(job).c_str(), stdout);
+  } else if (!quiet) {
+    std::printf("\n%s", SummaryText(job.summary()).c_str());
+  }
+  return ExitCodeForState(job.summary().state());
+}
+
+}  // namespace mbopt::client

@@ -1,0 +1,68 @@
+#include "client/watch.h"
+
+#include "client/interrupts.h"
+#include "client/job_format.h"
+
+namespace mbopt::client {
+namespace {
+
+void ClearProgress(const WatchOptions& options) {
+  if (options.progress_line) std::fputs("\r\033[K", options.table_out);
+}
+
+void DrawProgress(const WatchOptions& options, const v1::JobSummary& s) {
+  if (!options.progress_line) return;
+  char objective[64] = "";
+  if (s.cycles() > 0) std::snprintf(objective, sizeof objective, ", F = %.7g", s.objective());
+  std::fprintf(options.table_out, "\r\033[K  %s: %d cycles, %lld analyses%s, %.1f s",
+               StateName(s.state()).c_str(), s.cycles(), static_cast<long long>(s.analyses()),
+               objective, s.wall_seconds());
+  std::fflush(options.table_out);
+}
+
+}  // namespace
+
+WatchOutcome WatchJob(v1::JobService::Stub& stub, const std::string& address,
+                      const std::string& job_id, const WatchOptions& options) {
+  WatchOutcome outcome;
+  grpc::ClientContext context;
+  Interrupts::SetCancelTarget(&context);
+  v1::JobRef ref;
+  ref.set_job_id(job_id);
+  auto reader = stub.Watch(&context, ref);
+  bool header_printed = false;
+  v1::JobEvent event;
+  while (reader->Read(&event)) {
+    if (event.has_cycle()) {
+      if (options.table_out == nullptr) continue;
+      ClearProgress(options);
+      if (!header_printed) {
+        std::fprintf(options.table_out, "%s\n", CycleTableHeader().c_str());
+        header_printed = true;
+      }
+      std::fprintf(options.table_out, "%s\n", CycleTableRow(event.cycle()).c_str());
+      std::fflush(options.table_out);
+    } else if (event.has_summary()) {
+      outcome.summary = event.summary();
+      if (options.table_out != nullptr) DrawProgress(options, outcome.summary);
+    }
+  }
+  grpc::Status status = reader->Finish();
+  Interrupts::SetCancelTarget(nullptr);
+  if (options.table_out != nullptr) {
+    ClearProgress(options);
+    std::fflush(options.table_out);
+  }
+  if (Interrupts::interrupted()) {
+    outcome.interrupted = true;
+    return outcome;
+  }
+  if (!status.ok()) {
+    outcome.failure = DescribeRpcFailure(status, address);
+    return outcome;
+  }
+  outcome.ok = true;
+  return outcome;
+}
+
+}  // namespace mbopt::client

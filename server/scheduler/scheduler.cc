@@ -1,0 +1,281 @@
+#include "server/scheduler/scheduler.h"
+
+#include <algorithm>
+#include <chrono>
+#include <utility>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+
+namespace mbopt::scheduler {
+
+absl::Status SchedulerOptions::Validate() const {
+  if (lease_ms <= 0) return absl::InvalidArgumentError(absl::StrCat("lease_ms must be > 0, got ", lease_ms));
+  if (heartbeat_interval_ms <= 0 || heartbeat_interval_ms >= lease_ms) {
+    return absl::InvalidArgumentError(absl::StrCat("heartbeat interval must be > 0 and below the lease (",
+                                                   lease_ms, " ms), got ", heartbeat_interval_ms, " ms"));
+  }
+  if (max_attempts < 1) {
+    return absl::InvalidArgumentError(absl::StrCat("max_attempts must be >= 1, got ", max_attempts));
+  }
+  return absl::OkStatus();
+}
+
+Scheduler::Scheduler(const Clock* clock, SchedulerOptions options)
+    : clock_(clock), options_(std::move(options)) {}
+
+std::string Scheduler::RegisterWorker(const std::string& name, int slots) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::string id = absl::StrCat("w-", next_worker_++);
+  workers_[id] = Worker{name, std::max(1, slots), clock_->NowMs()};
+  return id;
+}
+
+bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Key key{job_id, request_id};
+    if (entries_.count(key) != 0 || finished_.count(key) != 0) return false;
+    Entry& entry = entries_[key];
+    entry.job_id = job_id;
+    entry.request_id = request_id;
+    entry.x_scaled = std::move(x_scaled);
+    queues_[job_id].push_back(request_id);
+  }
+  task_available_.notify_all();
+  return true;
+}
+
+bool Scheduler::HasOtherLiveWorker(const std::string& worker_id, const std::set<std::string>& excluded) const {
+  const std::int64_t silence = options_.worker_silence_ms > 0 ? options_.worker_silence_ms : 3 * options_.lease_ms;
+  const std::int64_t now = clock_->NowMs();
+  for (const auto& [id, worker] : workers_) {
+    if (id == worker_id || excluded.count(id) != 0) continue;
+    if (now - worker.last_seen_ms <= silence) return true;
+  }
+  return false;
+}
+
+std::vector<Task> Scheduler::AcquireLocked(const std::string& worker_id, int max_tasks) {
+  std::vector<Task> tasks;
+  const std::int64_t now = clock_->NowMs();
+  while (static_cast<int>(tasks.size()) < max_tasks && !queues_.empty()) {
+    // Round robin: the first job after the last one served, wrapping around,
+    // that has a task this worker may take.
+    auto start = queues_.upper_bound(last_served_job_);
+    bool found = false;
+    for (size_t step = 0; step < queues_.size() && !found; ++step) {
+      if (start == queues_.end()) start = queues_.begin();
+      auto& [job_id, queue] = *start;
+      for (auto it = queue.begin(); it != queue.end(); ++it) {
+        Entry& entry = entries_.at(Key{job_id, *it});
+        // A retry goes to a worker that has not failed it yet, if one is around.
+        if (entry.failed_workers.count(worker_id) != 0 && HasOtherLiveWorker(worker_id, entry.failed_workers)) {
+          continue;
+        }
+        entry.leased = true;
+        entry.attempts += 1;
+        entry.worker_id = worker_id;
+        entry.task_id = absl::StrCat(job_id, "/", entry.request_id, "/", entry.attempts);
+        entry.lease_deadline_ms = now + options_.lease_ms;
+        leases_[entry.task_id] = Key{job_id, entry.request_id};
+        tasks.push_back(Task{entry.task_id, job_id, entry.request_id, entry.x_scaled, entry.attempts,
+                             entry.lease_deadline_ms});
+        queue.erase(it);
+        last_served_job_ = job_id;
+        found = true;
+        break;
+      }
+      if (found && queue.empty()) {
+        queues_.erase(start);
+      } else if (!found) {
+        ++start;
+      }
+    }
+    if (!found) break;
+  }
+  return tasks;
+}
+
+absl::StatusOr<std::vector<Task>> Scheduler::Acquire(const std::string& worker_id, int max_tasks) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto worker = workers_.find(worker_id);
+  if (worker == workers_.end()) {
+    return absl::NotFoundError(absl::StrCat("unknown worker '", worker_id, "'; register again"));
+  }
+  worker->second.last_seen_ms = clock_->NowMs();
+  return AcquireLocked(worker_id, std::max(1, max_tasks));
+}
+
+absl::StatusOr<std::vector<Task>> Scheduler::AcquireWait(const std::string& worker_id, int max_tasks,
+                                                         std::int64_t wait_ms) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max<std::int64_t>(0, wait_ms));
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    auto worker = workers_.find(worker_id);
+    if (worker == workers_.end()) {
+      return absl::NotFoundError(absl::StrCat("unknown worker '", worker_id, "'; register again"));
+    }
+    worker->second.last_seen_ms = clock_->NowMs();
+    std::vector<Task> tasks = AcquireLocked(worker_id, std::max(1, max_tasks));
+    if (!tasks.empty() || shutdown_) return tasks;
+    if (task_available_.wait_until(lock, deadline) == std::cv_status::timeout) {
+      return AcquireLocked(worker_id, std::max(1, max_tasks));
+    }
+  }
+}
+
+void Scheduler::RemoveFromQueue(const Key& key) {
+  auto queue = queues_.find(key.first);
+  if (queue == queues_.end()) return;
+  auto& ids = queue->second;
+  ids.erase(std::remove(ids.begin(), ids.end(), key.second), ids.end());
+  if (ids.empty()) queues_.erase(queue);
+}
+
+absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, const std::string& task_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto worker = workers_.find(worker_id);
+  if (worker != workers_.end()) worker->second.last_seen_ms = clock_->NowMs();
+  // The task id names its analysis; an older attempt's id is still good.
+  const size_t slash2 = task_id.rfind('/');
+  const size_t slash1 = slash2 == std::string::npos || slash2 == 0 ? std::string::npos : task_id.rfind('/', slash2 - 1);
+  std::int64_t request_id = -1;
+  if (slash1 != std::string::npos &&
+      !absl::SimpleAtoi(task_id.substr(slash1 + 1, slash2 - slash1 - 1), &request_id)) {
+    request_id = -1;
+  }
+  const Key key{slash1 == std::string::npos ? std::string() : task_id.substr(0, slash1), request_id};
+  auto entry = entries_.find(key);
+  if (request_id < 0 || entry == entries_.end() || entry->second.attempts == 0) {
+    return absl::NotFoundError(absl::StrCat("task '", task_id, "' is not outstanding (unknown, finished, "
+                                                               "given up, or its job ended)"));
+  }
+  FinishedTask done{entry->second.job_id, entry->second.request_id, std::move(entry->second.x_scaled),
+                    entry->second.attempts, worker_id, ""};
+  if (entry->second.leased) {
+    leases_.erase(entry->second.task_id);
+  } else {
+    RemoveFromQueue(key);
+  }
+  entries_.erase(entry);
+  finished_.insert(key);
+  return done;
+}
+
+std::optional<FinishedTask> Scheduler::FailLocked(const Key& key, const std::string& reason) {
+  Entry& entry = entries_.at(key);
+  leases_.erase(entry.task_id);
+  entry.leased = false;
+  entry.failures += 1;
+  entry.failed_workers.insert(entry.worker_id);
+  entry.last_failure = reason;
+  if (entry.failures >= options_.max_attempts) {
+    FinishedTask given_up{entry.job_id, entry.request_id, std::move(entry.x_scaled), entry.attempts, "",
+                          absl::StrCat("gave up after ", entry.failures, " failed attempts; last: ", reason)};
+    entries_.erase(key);
+    finished_.insert(key);
+    return given_up;
+  }
+  queues_[key.first].push_front(key.second);
+  return std::nullopt;
+}
+
+absl::StatusOr<std::optional<FinishedTask>> Scheduler::Fail(const std::string& worker_id,
+                                                            const std::string& task_id,
+                                                            const std::string& reason) {
+  std::optional<FinishedTask> result;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto lease = leases_.find(task_id);
+    if (lease == leases_.end() || entries_.at(lease->second).worker_id != worker_id) {
+      return absl::NotFoundError(absl::StrCat("task '", task_id, "' is not leased to worker '", worker_id, "'"));
+    }
+    result = FailLocked(lease->second, absl::StrCat("worker ", worker_id, ": ", reason));
+  }
+  if (!result) task_available_.notify_all();
+  return result;
+}
+
+HeartbeatReply Scheduler::Heartbeat(const std::string& worker_id, const std::vector<std::string>& task_ids) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  HeartbeatReply reply;
+  auto worker = workers_.find(worker_id);
+  if (worker == workers_.end()) return reply;
+  reply.known = true;
+  const std::int64_t now = clock_->NowMs();
+  worker->second.last_seen_ms = now;
+  for (const std::string& task_id : task_ids) {
+    auto lease = leases_.find(task_id);
+    if (lease == leases_.end()) {
+      reply.cancelled_task_ids.push_back(task_id);
+      continue;
+    }
+    Entry& entry = entries_.at(lease->second);
+    if (entry.worker_id != worker_id) {
+      reply.cancelled_task_ids.push_back(task_id);
+      continue;
+    }
+    entry.lease_deadline_ms = now + options_.lease_ms;
+  }
+  return reply;
+}
+
+std::vector<FinishedTask> Scheduler::ExpireLeases() {
+  std::vector<FinishedTask> given_up;
+  bool requeued = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::int64_t now = clock_->NowMs();
+    std::vector<Key> expired;
+    for (const auto& [task_id, key] : leases_) {
+      if (entries_.at(key).lease_deadline_ms <= now) expired.push_back(key);
+    }
+    for (const Key& key : expired) {
+      const Entry& entry = entries_.at(key);
+      std::optional<FinishedTask> done =
+          FailLocked(key, absl::StrCat("lease of task ", entry.task_id, " on worker ", entry.worker_id, " expired"));
+      if (done) {
+        given_up.push_back(std::move(*done));
+      } else {
+        requeued = true;
+      }
+    }
+  }
+  if (requeued) task_available_.notify_all();
+  return given_up;
+}
+
+void Scheduler::DropJob(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  queues_.erase(job_id);
+  for (auto it = entries_.lower_bound(Key{job_id, INT64_MIN}); it != entries_.end() && it->first.first == job_id;) {
+    if (it->second.leased) leases_.erase(it->second.task_id);
+    it = entries_.erase(it);
+  }
+  for (auto it = finished_.lower_bound(Key{job_id, INT64_MIN}); it != finished_.end() && it->first == job_id;) {
+    it = finished_.erase(it);
+  }
+}
+
+void Scheduler::Shutdown() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shutdown_ = true;
+  }
+  task_available_.notify_all();
+}
+
+int Scheduler::QueuedCount() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  int count = 0;
+  for (const auto& [job, queue] : queues_) count += static_cast<int>(queue.size());
+  return count;
+}
+
+int Scheduler::LeasedCount() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<int>(leases_.size());
+}
+
+}  // namespace mbopt::scheduler

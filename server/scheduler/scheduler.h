@@ -1,0 +1,168 @@
+// The task queue of the server: analyses waiting for workers, across all
+// jobs, and the leases of the ones being worked on.
+//
+// - Fair between jobs: each task handed out comes from the next job (in job
+//   id order, round robin) that has a task waiting, so a job with hundreds of
+//   perturbations does not starve a job with one.
+// - Leases: a task given to a worker carries a deadline (lease_ms from now on
+//   the injected clock); a heartbeat naming the task extends it. When a lease
+//   expires (ExpireLeases), the attempt counts as failed and the task is
+//   queued again, preferring a worker that has not failed it yet.
+// - Retry limit: after max_attempts failed attempts (lease expiries or
+//   worker-side errors) the task is given up and returned to the caller, who
+//   reports it to the optimizer as a failed analysis. An analysis that itself
+//   reports failure is not a failed attempt: the caller completes the task
+//   with that result and it is not retried.
+// - A result that arrives after its lease expired is still taken if no other
+//   attempt of the same analysis has finished first: analyses are
+//   deterministic, so any attempt's values are as good as another's.
+//
+// The scheduler knows nothing of optimizers, gRPC or the database. It is
+// thread-safe; AcquireWait blocks (real time) for the long poll of workers.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "server/scheduler/clock.h"
+
+namespace mbopt::scheduler {
+
+struct SchedulerOptions {
+  std::int64_t lease_ms = 30'000;
+  // How often workers are asked to send heartbeats; well below lease_ms.
+  std::int64_t heartbeat_interval_ms = 5'000;
+  int max_attempts = 3;
+  // A worker not heard from for this long is not counted as a live
+  // alternative when choosing who retries a task. 0: 3 * lease_ms.
+  std::int64_t worker_silence_ms = 0;
+  absl::Status Validate() const;
+};
+
+// A task as handed to a worker.
+struct Task {
+  std::string task_id;  // "<job id>/<request id>/<attempt>", unique on the server
+  std::string job_id;
+  std::int64_t request_id = 0;
+  std::vector<double> x_scaled;
+  int attempt = 1;                    // 1-based
+  std::int64_t lease_deadline_ms = 0; // on the scheduler's clock
+};
+
+// A task finished: its result was taken (Complete) or it was given up.
+struct FinishedTask {
+  std::string job_id;
+  std::int64_t request_id = 0;
+  std::vector<double> x_scaled;
+  int attempts = 0;           // leases handed out for it
+  std::string worker_id;      // Complete: who delivered
+  std::string failure_reason; // given up: the last attempt's failure
+};
+
+struct HeartbeatReply {
+  bool known = false;                        // false: the worker must register again
+  std::vector<std::string> cancelled_task_ids;  // no longer wanted: stop working on them
+};
+
+class Scheduler {
+ public:
+  // `clock` is not owned and must outlive the scheduler.
+  Scheduler(const Clock* clock, SchedulerOptions options);
+
+  const SchedulerOptions& options() const { return options_; }
+
+  // Returns the new worker's id ("w-<n>").
+  std::string RegisterWorker(const std::string& name, int slots);
+
+  // Queues an analysis of `job_id`. A request already queued, leased or
+  // finished is ignored (returns false), so callers may offer the
+  // optimizer's whole pending list each time.
+  bool Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled);
+
+  // Up to `max_tasks` tasks for `worker_id`, fairly across jobs. NotFound
+  // for an unknown worker (it must register again).
+  absl::StatusOr<std::vector<Task>> Acquire(const std::string& worker_id, int max_tasks);
+  // As Acquire, but waits up to `wait_ms` (real time) for a task to appear
+  // when none is available. Returns early (empty) on Shutdown().
+  absl::StatusOr<std::vector<Task>> AcquireWait(const std::string& worker_id, int max_tasks,
+                                                std::int64_t wait_ms);
+
+  // The worker delivered the result of `task_id`: the task is finished and
+  // the caller hands the result to the optimizer. NotFound when the task is
+  // not outstanding any more (finished by another attempt, given up, or its
+  // job cancelled): the result must be dropped.
+  absl::StatusOr<FinishedTask> Complete(const std::string& worker_id, const std::string& task_id);
+
+  // The worker could not run `task_id` (not a failure of the analysis
+  // itself). Returns the task if this used up its attempts (give up: report
+  // a failed analysis), nullopt if it was queued again. NotFound as Complete.
+  absl::StatusOr<std::optional<FinishedTask>> Fail(const std::string& worker_id,
+                                                   const std::string& task_id,
+                                                   const std::string& reason);
+
+  HeartbeatReply Heartbeat(const std::string& worker_id, const std::vector<std::string>& task_ids);
+
+  // Handles every lease past its deadline; returns the tasks given up.
+  std::vector<FinishedTask> ExpireLeases();
+
+  // Forgets every queued and leased task of `job_id` (cancelled or ended).
+  void DropJob(const std::string& job_id);
+
+  // Wakes every AcquireWait; later calls do not wait.
+  void Shutdown();
+
+  // Counts, for progress displays and tests.
+  int QueuedCount() const;
+  int LeasedCount() const;
+
+ private:
+  struct Entry {
+    std::string job_id;
+    std::int64_t request_id = 0;
+    std::vector<double> x_scaled;
+    int attempts = 0;                  // leases handed out
+    int failures = 0;                  // failed attempts
+    std::set<std::string> failed_workers;
+    std::string last_failure;
+    bool leased = false;
+    std::string worker_id;             // while leased
+    std::string task_id;               // current attempt's id, while leased
+    std::int64_t lease_deadline_ms = 0;
+  };
+  using Key = std::pair<std::string, std::int64_t>;  // job id, request id
+  struct Worker {
+    std::string name;
+    int slots = 1;
+    std::int64_t last_seen_ms = 0;
+  };
+
+  std::vector<Task> AcquireLocked(const std::string& worker_id, int max_tasks);
+  bool HasOtherLiveWorker(const std::string& worker_id, const std::set<std::string>& excluded) const;
+  // Records a failed attempt; returns the finished task if it is given up.
+  std::optional<FinishedTask> FailLocked(const Key& key, const std::string& reason);
+  void RemoveFromQueue(const Key& key);
+
+  const Clock* clock_;
+  const SchedulerOptions options_;
+  mutable std::mutex mutex_;
+  std::condition_variable task_available_;
+  bool shutdown_ = false;
+  std::int64_t next_worker_ = 1;
+  std::map<std::string, Worker> workers_;
+  std::map<Key, Entry> entries_;                       // queued or leased
+  std::set<Key> finished_;                             // never re-queued
+  std::map<std::string, std::deque<std::int64_t>> queues_;  // job -> queued request ids
+  std::map<std::string, Key> leases_;                  // task id -> entry
+  std::string last_served_job_;
+};
+
+}  // namespace mbopt::scheduler

@@ -1,0 +1,175 @@
+#include "server/service/grpc_services.h"
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "server/service/proto_convert.h"
+#include "server/service/status_conversion.h"
+
+namespace mbopt::service {
+namespace {
+
+// How often a Watch stream checks whether its client went away.
+constexpr std::int64_t kWatchPollMs = 250;
+
+std::int64_t NowUnixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ jobs --
+
+grpc::Status JobServiceImpl::Submit(grpc::ServerContext*, const v1::SubmitJobRequest* request,
+                                    v1::SubmitJobResponse* response) {
+  if (!request->has_study()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
+  const std::string source = request->source_name().empty()
+                                 ? absl::StrCat("study '", request->study().name(), "'")
+                                 : request->source_name();
+  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source);
+  if (!id.ok()) return ToGrpcStatus(id.status());
+  response->set_job_id(*id);
+  return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::Get(grpc::ServerContext*, const v1::JobRef* request, v1::GetJobResponse* response) {
+  absl::StatusOr<JobView> view = manager_->Get(request->job_id());
+  if (!view.ok()) return ToGrpcStatus(view.status());
+  *response->mutable_summary() = ToProto(view->summary);
+  for (const slp::CycleRecord& r : view->records) {
+    *response->add_cycles() = ToProto(r, view->row_names, view->variable_scales);
+  }
+  if (!response->mutable_study()->ParseFromString(view->study_bytes)) response->clear_study();
+  return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::List(grpc::ServerContext*, const v1::ListJobsRequest*, v1::ListJobsResponse* response) {
+  absl::StatusOr<std::vector<JobSummaryData>> jobs = manager_->List();
+  if (!jobs.ok()) return ToGrpcStatus(jobs.status());
+  for (const JobSummaryData& s : *jobs) *response->add_jobs() = ToProto(s);
+  return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRef* request,
+                                   grpc::ServerWriter<v1::JobEvent>* writer) {
+  std::size_t next_record = 0;
+  std::int64_t version = -1;
+  while (!context->IsCancelled()) {
+    absl::StatusOr<JobView> view =
+        version < 0 ? manager_->Get(request->job_id(), 0)
+                    : manager_->WaitForChange(request->job_id(), next_record, version, kWatchPollMs);
+    if (!view.ok()) return ToGrpcStatus(view.status());
+    if (view->version == version) continue;
+    version = view->version;
+    for (const slp::CycleRecord& r : view->records) {
+      v1::JobEvent event;
+      *event.mutable_cycle() = ToProto(r, view->row_names, view->variable_scales);
+      if (!writer->Write(event)) return grpc::Status::CANCELLED;
+    }
+    next_record = view->first_record + view->records.size();
+    v1::JobEvent summary;
+    *summary.mutable_summary() = ToProto(view->summary);
+    if (!writer->Write(summary)) return grpc::Status::CANCELLED;
+    if (view->ended) return grpc::Status::OK;
+  }
+  return grpc::Status::CANCELLED;
+}
+
+grpc::Status JobServiceImpl::Cancel(grpc::ServerContext*, const v1::JobRef* request, v1::JobSummary* response) {
+  absl::StatusOr<JobSummaryData> summary = manager_->Cancel(request->job_id());
+  if (!summary.ok()) return ToGrpcStatus(summary.status());
+  *response = ToProto(*summary);
+  return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::Resume(grpc::ServerContext*, const v1::JobRef* request, v1::JobSummary* response) {
+  absl::StatusOr<JobSummaryData> summary = manager_->Resume(request->job_id());
+  if (!summary.ok()) return ToGrpcStatus(summary.status());
+  *response = ToProto(*summary);
+  return grpc::Status::OK;
+}
+
+// --------------------------------------------------------------- workers --
+
+grpc::Status WorkerServiceImpl::Register(grpc::ServerContext*, const v1::RegisterWorkerRequest* request,
+                                         v1::RegisterWorkerResponse* response) {
+  response->set_worker_id(scheduler_->RegisterWorker(request->name(), request->slots()));
+  response->set_heartbeat_interval_ms(static_cast<std::int32_t>(scheduler_->options().heartbeat_interval_ms));
+  response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext*, const v1::AcquireTasksRequest* request,
+                                             v1::AcquireTasksResponse* response) {
+  const std::int64_t wait_ms = std::clamp<std::int64_t>(request->wait_ms(), 0, kMaxWaitMs);
+  absl::StatusOr<std::vector<scheduler::Task>> tasks =
+      scheduler_->AcquireWait(request->worker_id(), std::max(1, request->max_tasks()), wait_ms);
+  if (!tasks.ok()) return ToGrpcStatus(tasks.status());
+  const std::int64_t unix_now = NowUnixMs();
+  const std::int64_t clock_now = clock_->NowMs();
+  for (const scheduler::Task& t : *tasks) {
+    v1::AnalysisTask* task = response->add_tasks();
+    task->set_task_id(t.task_id);
+    task->set_job_id(t.job_id);
+    task->set_request_id(t.request_id);
+    for (double x : t.x_scaled) task->add_x_scaled(x);
+    task->set_lease_deadline_unix_ms(unix_now + (t.lease_deadline_ms - clock_now));
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext*, const v1::GetStudyRequest* request,
+                                         v1::GetStudyResponse* response) {
+  absl::StatusOr<std::string> bytes = manager_->StudyBytes(request->job_id());
+  if (!bytes.ok()) return ToGrpcStatus(bytes.status());
+  if (!response->mutable_study()->ParseFromString(*bytes)) {
+    return ToGrpcStatus(absl::DataLossError(absl::StrCat("the stored study of job ", request->job_id(),
+                                                         " cannot be parsed")));
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::TaskResult* request,
+                                             v1::ReportResultResponse* response) {
+  if (request->retry()) {
+    absl::Status status = manager_->ReportWorkerError(request->worker_id(), request->task_id(),
+                                                      request->failure_reason());
+    // A retry request for a task that is not outstanding is simply dropped.
+    response->set_accepted(status.ok());
+    return absl::IsNotFound(status) ? grpc::Status::OK : ToGrpcStatus(status);
+  }
+  WorkerResult result;
+  result.worker_id = request->worker_id();
+  result.task_id = request->task_id();
+  result.job_id = request->job_id();
+  result.request_id = request->request_id();
+  result.ok = request->ok();
+  result.failure_reason = request->failure_reason();
+  result.objective_terms.assign(request->objective_terms().begin(), request->objective_terms().end());
+  result.constraint_values.assign(request->constraint_values().begin(), request->constraint_values().end());
+  result.wall_seconds = request->counters().wall_seconds();
+  result.counters.time_steps = request->counters().time_steps();
+  result.counters.rhs_evaluations = request->counters().rhs_evaluations();
+  result.counters.jacobian_evaluations = request->counters().jacobian_evaluations();
+  result.counters.newton_iterations = request->counters().newton_iterations();
+  result.counters.position_solves = request->counters().position_solves();
+  absl::StatusOr<bool> accepted = manager_->ReportResult(result);
+  if (!accepted.ok()) return ToGrpcStatus(accepted.status());
+  response->set_accepted(*accepted);
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const v1::HeartbeatRequest* request,
+                                          v1::HeartbeatResponse* response) {
+  std::vector<std::string> task_ids(request->task_ids().begin(), request->task_ids().end());
+  scheduler::HeartbeatReply reply = scheduler_->Heartbeat(request->worker_id(), task_ids);
+  response->set_known(reply.known);
+  for (const std::string& id : reply.cancelled_task_ids) response->add_cancelled_task_ids(id);
+  return grpc::Status::OK;
+}
+
+}  // namespace mbopt::service

@@ -1,0 +1,59 @@
+// The gRPC services (sync API): JobService for clients, WorkerService for
+// workers. Each method translates the request, calls the job manager or the
+// scheduler, and translates the answer; errors pass through ToGrpcStatus.
+#pragma once
+
+#include <cstdint>
+
+#include "mbopt/v1/service.grpc.pb.h"
+#include "server/scheduler/clock.h"
+#include "server/scheduler/scheduler.h"
+#include "server/service/job_manager.h"
+
+namespace mbopt::service {
+
+class JobServiceImpl final : public v1::JobService::Service {
+ public:
+  explicit JobServiceImpl(JobManager* manager) : manager_(manager) {}
+
+  grpc::Status Submit(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
+                      v1::SubmitJobResponse* response) override;
+  grpc::Status Get(grpc::ServerContext* context, const v1::JobRef* request, v1::GetJobResponse* response) override;
+  grpc::Status List(grpc::ServerContext* context, const v1::ListJobsRequest* request,
+                    v1::ListJobsResponse* response) override;
+  grpc::Status Watch(grpc::ServerContext* context, const v1::JobRef* request,
+                     grpc::ServerWriter<v1::JobEvent>* writer) override;
+  grpc::Status Cancel(grpc::ServerContext* context, const v1::JobRef* request, v1::JobSummary* response) override;
+  grpc::Status Resume(grpc::ServerContext* context, const v1::JobRef* request, v1::JobSummary* response) override;
+
+ private:
+  JobManager* manager_;
+};
+
+class WorkerServiceImpl final : public v1::WorkerService::Service {
+ public:
+  // The clock is the scheduler's (lease deadlines are on it).
+  WorkerServiceImpl(JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock)
+      : manager_(manager), scheduler_(scheduler), clock_(clock) {}
+
+  grpc::Status Register(grpc::ServerContext* context, const v1::RegisterWorkerRequest* request,
+                        v1::RegisterWorkerResponse* response) override;
+  grpc::Status AcquireTasks(grpc::ServerContext* context, const v1::AcquireTasksRequest* request,
+                            v1::AcquireTasksResponse* response) override;
+  grpc::Status GetStudy(grpc::ServerContext* context, const v1::GetStudyRequest* request,
+                        v1::GetStudyResponse* response) override;
+  grpc::Status ReportResult(grpc::ServerContext* context, const v1::TaskResult* request,
+                            v1::ReportResultResponse* response) override;
+  grpc::Status Heartbeat(grpc::ServerContext* context, const v1::HeartbeatRequest* request,
+                         v1::HeartbeatResponse* response) override;
+
+  // The longest a long poll waits, whatever the worker asks.
+  static constexpr std::int64_t kMaxWaitMs = 30'000;
+
+ private:
+  JobManager* manager_;
+  scheduler::Scheduler* scheduler_;
+  const scheduler::Clock* clock_;
+};
+
+}  // namespace mbopt::service

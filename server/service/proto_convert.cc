@@ -1,0 +1,85 @@
+#include "server/service/proto_convert.h"
+
+#include "absl/strings/str_cat.h"
+#include "spec/io/study_io.h"
+
+namespace mbopt::service {
+
+v1::JobState ToProto(jobs::JobState state) { return static_cast<v1::JobState>(static_cast<int>(state)); }
+
+v1::JobSummary ToProto(const JobSummaryData& s) {
+  v1::JobSummary out;
+  out.set_job_id(s.job_id);
+  out.set_study_name(s.study_name);
+  out.set_state(ToProto(s.state));
+  out.set_cycles(s.cycles);
+  out.set_analyses(s.analyses);
+  out.set_objective(s.objective);
+  out.set_objective_unit(s.objective_unit);
+  out.set_max_violation(s.max_violation);
+  for (const std::string& name : s.design_names) out.add_design_names(name);
+  for (double value : s.design) out.add_design(value);
+  for (const std::string& unit : s.design_units) out.add_design_units(unit);
+  out.set_wall_seconds(s.wall_seconds);
+  out.set_message(s.message);
+  out.set_created_unix_ms(s.created_unix_ms);
+  out.set_max_cycles(s.max_cycles);
+  return out;
+}
+
+namespace {
+
+std::string RowName(int row, const std::vector<std::string>& row_names) {
+  if (row < 0) return "";
+  if (static_cast<size_t>(row) < row_names.size()) return row_names[static_cast<size_t>(row)];
+  return absl::StrCat("row ", row);
+}
+
+}  // namespace
+
+v1::CycleRecord ToProto(const slp::CycleRecord& r, const std::vector<std::string>& row_names,
+                        const std::vector<double>& variable_scales) {
+  v1::CycleRecord out;
+  out.set_cycle(r.cycle);
+  out.set_attempt(r.attempt);
+  out.set_accepted(r.accepted);
+  out.set_rejection_reason(r.rejection_reason);
+  for (Eigen::Index i = 0; i < r.x0.size(); ++i) out.add_x0_scaled(r.x0[i]);
+  for (Eigen::Index i = 0; i < r.x_trial.size(); ++i) {
+    out.add_x_trial_scaled(r.x_trial[i]);
+    const double scale = static_cast<size_t>(i) < variable_scales.size() ? variable_scales[static_cast<size_t>(i)] : 1.0;
+    out.add_x_trial_physical(scale * r.x_trial[i]);
+  }
+  out.set_objective_x0(r.objective_x0);
+  out.set_objective_trial(r.objective_trial);
+  out.set_objective_predicted(r.objective_predicted);
+  out.set_max_violation_x0(r.max_violation_x0);
+  out.set_max_violation_trial(r.max_violation_trial);
+  out.set_worst_constraint(RowName(r.worst_constraint_trial, row_names));
+  out.set_objective_error(r.objective_error);
+  out.set_max_approximation_error(r.max_approximation_error);
+  out.set_worst_approximation(r.worst_approximation_row < 0 ? "objective"
+                                                            : RowName(r.worst_approximation_row, row_names));
+  out.set_lp_feasible(r.lp_feasible);
+  out.set_infeasibility(r.infeasibility);
+  out.set_lp_status(r.lp_status);
+  out.set_lp_iterations(r.lp_iterations);
+  out.set_rows_screened_in(r.rows_screened_in);
+  for (Eigen::Index i = 0; i < r.move_limits.size(); ++i) out.add_move_limits(r.move_limits[i]);
+  for (Eigen::Index i = 0; i < r.move_limits_next.size(); ++i) out.add_move_limits_next(r.move_limits_next[i]);
+  for (bool b : r.on_move_limit) out.add_on_move_limit(b);
+  for (bool b : r.on_bound) out.add_on_bound(b);
+  out.set_analyses_total(r.analyses_total);
+  out.set_converged(r.converged);
+  return out;
+}
+
+absl::StatusOr<spec::Study> DecodeStudy(const std::string& bytes, const std::string& source_name) {
+  v1::Study study;
+  if (!study.ParseFromString(bytes)) {
+    return absl::InvalidArgumentError(absl::StrCat(source_name, ": the stored study is not a valid mbopt.v1.Study"));
+  }
+  return spec::io::StudyFromProto(study, source_name);
+}
+
+}  // namespace mbopt::service

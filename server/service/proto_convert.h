@@ -1,0 +1,26 @@
+// Domain types of the job manager <-> mbopt.v1 messages. Pure translation:
+// names for row indices, physical values (scale * x) for scaled designs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "mbopt/v1/service.pb.h"
+#include "mbopt/v1/study.pb.h"
+#include "server/service/job_manager.h"
+#include "spec/study.h"
+
+namespace mbopt::service {
+
+v1::JobState ToProto(jobs::JobState state);
+v1::JobSummary ToProto(const JobSummaryData& summary);
+// `row_names` and `variable_scales` as in JobView.
+v1::CycleRecord ToProto(const slp::CycleRecord& record, const std::vector<std::string>& row_names,
+                        const std::vector<double>& variable_scales);
+
+// The study decoder of the job manager: binary mbopt.v1.Study -> validated
+// study (spec/io), InvalidArgument with the loader's message.
+absl::StatusOr<spec::Study> DecodeStudy(const std::string& bytes, const std::string& source_name);
+
+}  // namespace mbopt::service

@@ -1,0 +1,110 @@
+#include "server/service/server.h"
+
+#include <algorithm>
+#include <chrono>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "common/status_macros.h"
+#include "server/service/proto_convert.h"
+
+namespace mbopt::service {
+namespace {
+
+// In-flight calls get this long to finish when the server stops; long polls
+// and watches are woken before. gRPC also waits this long for clients that
+// keep a connection open, so it bounds the time a stop takes.
+constexpr auto kGrpcShutdownGrace = std::chrono::milliseconds(1000);
+
+}  // namespace
+
+MboptServer::MboptServer(ServerOptions options) : options_(std::move(options)) {}
+
+absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions options) {
+  std::unique_ptr<MboptServer> server(new MboptServer(std::move(options)));
+  MboptServer& s = *server;
+  if (s.options_.clock == nullptr) {
+    s.own_clock_ = std::make_unique<scheduler::SteadyClock>();
+    s.clock_ = s.own_clock_.get();
+  } else {
+    s.clock_ = s.options_.clock;
+  }
+  scheduler::SchedulerOptions scheduler_options;
+  scheduler_options.lease_ms = s.options_.lease_ms;
+  scheduler_options.heartbeat_interval_ms = s.options_.heartbeat_ms;
+  MBOPT_RETURN_IF_ERROR(scheduler_options.Validate());
+  MBOPT_ASSIGN_OR_RETURN(s.store_, store::Store::Open(s.options_.db_path));
+  s.scheduler_ = std::make_unique<scheduler::Scheduler>(s.clock_, scheduler_options);
+  s.manager_ = std::make_unique<JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, s.options_.manager);
+  MBOPT_RETURN_IF_ERROR(s.manager_->Start());
+
+  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get());
+  s.worker_service_ = std::make_unique<WorkerServiceImpl>(s.manager_.get(), s.scheduler_.get(), s.clock_);
+  grpc::ServerBuilder builder;
+  // Without this, gRPC on Linux binds with SO_REUSEPORT and a second server
+  // on a port in use would silently share it instead of failing.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.AddListeningPort(s.options_.listen_address, grpc::InsecureServerCredentials(), &s.port_);
+  builder.RegisterService(s.job_service_.get());
+  builder.RegisterService(s.worker_service_.get());
+  s.grpc_server_ = builder.BuildAndStart();
+  if (s.grpc_server_ == nullptr || s.port_ == 0) {
+    return absl::UnavailableError(absl::StrCat("cannot listen on ", s.options_.listen_address,
+                                               " (address in use or invalid?)"));
+  }
+  const std::string& listen = s.options_.listen_address;
+  const size_t colon = listen.rfind(':');
+  s.address_ = absl::StrCat(colon == std::string::npos ? listen : listen.substr(0, colon), ":", s.port_);
+
+  const std::int64_t interval =
+      s.options_.reaper_interval_ms > 0 ? s.options_.reaper_interval_ms : std::max<std::int64_t>(10, s.options_.lease_ms / 4);
+  s.reaper_ = std::thread([&s, interval] { s.ReaperLoop(interval); });
+  return server;
+}
+
+void MboptServer::ReaperLoop(std::int64_t interval_ms) {
+  std::unique_lock<std::mutex> lock(reaper_mutex_);
+  while (!stopping_) {
+    reaper_wake_.wait_for(lock, std::chrono::milliseconds(interval_ms), [this] { return stopping_; });
+    if (stopping_) break;
+    lock.unlock();
+    manager_->ExpireLeases();
+    lock.lock();
+  }
+}
+
+std::shared_ptr<grpc::Channel> MboptServer::InProcessChannel() {
+  return grpc_server_->InProcessChannel(grpc::ChannelArguments());
+}
+
+void MboptServer::StopThreads() {
+  {
+    std::lock_guard<std::mutex> lock(reaper_mutex_);
+    stopping_ = true;
+  }
+  reaper_wake_.notify_all();
+  if (reaper_.joinable()) reaper_.join();
+  scheduler_->Shutdown();
+  if (grpc_server_ != nullptr) {
+    grpc_server_->Shutdown(std::chrono::system_clock::now() + kGrpcShutdownGrace);
+    grpc_server_->Wait();
+  }
+}
+
+void MboptServer::Shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  manager_->Shutdown();
+  StopThreads();
+  manager_.reset();
+  store_.reset();  // closes the database cleanly (checkpoints the WAL)
+}
+
+MboptServer::~MboptServer() {
+  if (shut_down_ || manager_ == nullptr) return;
+  // Not shut down: stop the threads but leave the jobs as they are in the
+  // database, as a crash would.
+  StopThreads();
+}
+
+}  // namespace mbopt::service

@@ -1,0 +1,85 @@
+// The optimizer server as one object: the job database, the scheduler, the
+// job manager, the gRPC services and the lease reaper, wired together and
+// started. Used by the mbopt-server executable and by in-process tests.
+//
+// Start() opens (or creates) the database, resumes the jobs that were running
+// or interrupted, then listens. Shutdown() is the graceful stop: running jobs
+// become INTERRUPTED (resumed on the next start), the listener stops and the
+// database is closed. Destroying a server that was not shut down stops its
+// threads but leaves the database as a crash would (jobs still RUNNING), which
+// the next Start() recovers from the same way.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <grpcpp/grpcpp.h>
+
+#include "absl/status/statusor.h"
+#include "server/scheduler/clock.h"
+#include "server/scheduler/scheduler.h"
+#include "server/service/grpc_services.h"
+#include "server/service/job_manager.h"
+#include "server/store/store.h"
+
+namespace mbopt::service {
+
+struct ServerOptions {
+  std::string listen_address = "127.0.0.1:50051";  // port 0: the OS picks
+  std::string db_path = "mbopt.db";
+  std::int64_t lease_ms = 30'000;
+  std::int64_t heartbeat_ms = 5'000;
+  // Not owned; nullptr: a monotonic clock. Tests pass a FakeClock.
+  const scheduler::Clock* clock = nullptr;
+  // Checks for expired leases run this often (real time); 0: lease_ms / 4.
+  std::int64_t reaper_interval_ms = 0;
+  JobManagerOptions manager;
+};
+
+class MboptServer {
+ public:
+  static absl::StatusOr<std::unique_ptr<MboptServer>> Start(ServerOptions options);
+  ~MboptServer();
+  MboptServer(const MboptServer&) = delete;
+  MboptServer& operator=(const MboptServer&) = delete;
+
+  int port() const { return port_; }
+  // "host:port" as listening, with the port the OS picked.
+  const std::string& address() const { return address_; }
+  std::shared_ptr<grpc::Channel> InProcessChannel();
+  JobManager& manager() { return *manager_; }
+  scheduler::Scheduler& scheduler() { return *scheduler_; }
+
+  // Graceful stop (see above). Idempotent.
+  void Shutdown();
+
+ private:
+  explicit MboptServer(ServerOptions options);
+  void ReaperLoop(std::int64_t interval_ms);
+  void StopThreads();
+
+  ServerOptions options_;
+  std::unique_ptr<scheduler::SteadyClock> own_clock_;
+  const scheduler::Clock* clock_ = nullptr;
+  std::unique_ptr<store::Store> store_;
+  std::unique_ptr<scheduler::Scheduler> scheduler_;
+  std::unique_ptr<JobManager> manager_;
+  std::unique_ptr<JobServiceImpl> job_service_;
+  std::unique_ptr<WorkerServiceImpl> worker_service_;
+  std::unique_ptr<grpc::Server> grpc_server_;
+  int port_ = 0;
+  std::string address_;
+
+  std::mutex reaper_mutex_;
+  std::condition_variable reaper_wake_;
+  bool stopping_ = false;
+  std::thread reaper_;
+  bool shut_down_ = false;
+};
+
+}  // namespace mbopt::service

@@ -1,0 +1,143 @@
+#include "server/slp/cycle_lp.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/check.h"
+
+namespace mbopt::slp {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Largest and smallest change of a linear function grad . d over the box.
+double MaxOverBox(const Eigen::VectorXd& grad, const MoveBox& box) {
+  double sum = 0;
+  for (Eigen::Index i = 0; i < grad.size(); ++i) {
+    sum += std::max(grad[i] * box.d_lower[i], grad[i] * box.d_upper[i]);
+  }
+  return sum;
+}
+double MinOverBox(const Eigen::VectorXd& grad, const MoveBox& box) {
+  double sum = 0;
+  for (Eigen::Index i = 0; i < grad.size(); ++i) {
+    sum += std::min(grad[i] * box.d_lower[i], grad[i] * box.d_upper[i]);
+  }
+  return sum;
+}
+
+}  // namespace
+
+double ObjectiveValue(const Eigen::VectorXd& terms) { return terms.maxCoeff(); }
+
+MoveBox ComputeMoveBox(const ProblemSpec& spec, const SlpOptions& o, const Eigen::VectorXd& x0,
+                       const Eigen::VectorXd& move_limits, const std::vector<bool>& frozen) {
+  const int n = spec.num_variables();
+  MoveBox box;
+  box.half_width.resize(n);
+  box.d_lower.resize(n);
+  box.d_upper.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double range = spec.upper[i] - spec.lower[i];
+    const double w =
+        frozen[i] ? 0.0
+                  : move_limits[i] * std::max(std::abs(x0[i]),
+                                              o.move_limit_floor_fraction_of_range * range);
+    box.half_width[i] = w;
+    box.d_lower[i] = std::min(0.0, std::max(spec.lower[i] - x0[i], -w));
+    box.d_upper[i] = std::max(0.0, std::min(spec.upper[i] - x0[i], w));
+  }
+  return box;
+}
+
+CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& o, const Linearization& lin,
+                     const MoveBox& box) {
+  const int n = spec.num_variables();
+  const bool minmax = spec.objective_form == ObjectiveForm::kMinMax;
+  const double f0 = ObjectiveValue(lin.terms0);
+  CycleLp out;
+
+  // Objective terms: keep those near the maximum and any that could overtake
+  // the current maximum term inside the box.
+  if (minmax) {
+    Eigen::Index top = 0;
+    lin.terms0.maxCoeff(&top);
+    const double top_floor =
+        lin.terms0[top] + MinOverBox(lin.terms_gradient.row(top).transpose(), box);
+    const double denom = std::max(std::abs(f0), o.objective_magnitude_floor);
+    for (int j = 0; j < lin.terms0.size(); ++j) {
+      const double normalized = (lin.terms0[j] - f0) / denom;
+      const double reach =
+          lin.terms0[j] + MaxOverBox(lin.terms_gradient.row(j).transpose(), box);
+      if (j == top || normalized > o.objective_screening_threshold || reach > top_floor) {
+        out.kept_terms.push_back(j);
+      }
+    }
+  } else {
+    out.kept_terms.push_back(0);
+  }
+  // Constraints: keep the critical and potentially critical ones, and any
+  // whose linearization could reach its limit inside the box.
+  for (int h = 0; h < spec.num_constraints(); ++h) {
+    const double c = spec.constraint_limits[h];
+    const double normalized = (lin.constraints0[h] - c) / spec.constraint_scales[h];
+    const double reach =
+        lin.constraints0[h] + MaxOverBox(lin.constraints_gradient.row(h).transpose(), box);
+    if (normalized > o.screening_threshold || reach > c) out.kept_constraints.push_back(h);
+  }
+
+  double spread = 0;
+  for (int j : out.kept_terms) {
+    spread = std::max(spread, (lin.terms_gradient.row(j).transpose().cwiseAbs().array() *
+                               box.half_width.array())
+                                  .sum());
+  }
+  out.objective_scale = std::max({std::abs(f0), spread, o.objective_magnitude_floor});
+  const double scale = out.objective_scale;
+
+  const int columns = n + (minmax ? 1 : 0) + 1;
+  out.beta_column = minmax ? n : -1;
+  out.s_column = columns - 1;
+  const int term_rows = minmax ? static_cast<int>(out.kept_terms.size()) : 0;
+  const int rows = term_rows + static_cast<int>(out.kept_constraints.size());
+
+  lp::LinearProgram& lp = out.lp;
+  lp.objective = Eigen::VectorXd::Zero(columns);
+  lp.column_lower.resize(columns);
+  lp.column_upper.resize(columns);
+  lp.column_lower.head(n) = box.d_lower;
+  lp.column_upper.head(n) = box.d_upper;
+  if (minmax) {
+    lp.objective[out.beta_column] = 1.0;
+    lp.column_lower[out.beta_column] = -kInf;
+    lp.column_upper[out.beta_column] = kInf;
+  } else {
+    lp.objective.head(n) = lin.terms_gradient.row(0).transpose() / scale;
+  }
+  lp.objective[out.s_column] = o.infeasibility_penalty;
+  lp.column_lower[out.s_column] = 0.0;
+  lp.column_upper[out.s_column] = kInf;
+
+  lp.rows = decltype(lp.rows)::Zero(rows, columns);
+  lp.row_lower = Eigen::VectorXd::Constant(rows, -kInf);
+  lp.row_upper.resize(rows);
+  int r = 0;
+  for (int k = 0; k < term_rows; ++k, ++r) {
+    const int j = out.kept_terms[k];
+    lp.rows.row(r).head(n) = lin.terms_gradient.row(j) / scale;
+    lp.rows(r, out.beta_column) = -1.0;
+    lp.row_upper[r] = (f0 - lin.terms0[j]) / scale;
+  }
+  for (int h : out.kept_constraints) {
+    const double sh = spec.constraint_scales[h];
+    lp.rows.row(r).head(n) = lin.constraints_gradient.row(h) / sh;
+    lp.rows(r, out.s_column) = -1.0;
+    lp.row_upper[r] = (spec.constraint_limits[h] - lin.constraints0[h]) / sh;
+    ++r;
+  }
+  MBOPT_CHECK(r == rows, "row count mismatch");
+  return out;
+}
+
+}  // namespace mbopt::slp

@@ -1,0 +1,65 @@
+// The LP of one SLP cycle (METHOD.md section 2.4): the move-limit box,
+// screening, and the linear program in the step d = x - x0, with the bound
+// variable beta for a min-max objective and the infeasibility variable s.
+// Pure: builds an lp::LinearProgram and reads its solution back.
+//
+// LP columns: d_0..d_{n-1}, then beta' (min-max only), then s. Scaled so that
+// every row is dimensionless:
+//   objective (scalar):  minimize grad F . d / S + penalty * s
+//   objective (min-max): minimize beta' + penalty * s, with one row per kept
+//                        term j: (f_j0 + grad f_j . d - F0) / S <= beta'
+//   constraint h kept:   (g_h0 + grad g_h . d - c_h) / scale_h <= s
+// where S = max(|F0|, sum_i |grad F_i| w_i, objective_magnitude_floor) is the
+// objective's scale (for min-max, the largest such sum over the kept terms),
+// so the objective can change by at most about 1 inside the box and the
+// penalty dominates it.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "server/lp/linear_program.h"
+#include "server/slp/options.h"
+#include "server/slp/problem.h"
+
+namespace mbopt::slp {
+
+// Values and first derivatives of every response at x0.
+struct Linearization {
+  Eigen::VectorXd x0;
+  Eigen::VectorXd terms0;        // objective terms f_j(x0)
+  Eigen::VectorXd constraints0;  // g_h(x0)
+  Eigen::MatrixXd terms_gradient;        // K x n
+  Eigen::MatrixXd constraints_gradient;  // m x n
+  std::vector<bool> frozen;      // variables held at x0 this cycle
+};
+
+// The box of this LP for the step d: half-width w_i = f_i * max(|x0_i|,
+// floor_fraction * (upper_i - lower_i)), clipped to the bounds.
+struct MoveBox {
+  Eigen::VectorXd half_width;  // w_i (0 for a frozen variable)
+  Eigen::VectorXd d_lower;     // max(lower - x0, -w)
+  Eigen::VectorXd d_upper;     // min(upper - x0, w)
+};
+
+MoveBox ComputeMoveBox(const ProblemSpec& spec, const SlpOptions& options,
+                       const Eigen::VectorXd& x0, const Eigen::VectorXd& move_limits,
+                       const std::vector<bool>& frozen);
+
+struct CycleLp {
+  lp::LinearProgram lp;
+  std::vector<int> kept_constraints;  // row h of the spec for each constraint row
+  std::vector<int> kept_terms;        // objective term j for each term row (min-max)
+  int beta_column = -1;
+  int s_column = -1;
+  double objective_scale = 1;  // S
+};
+
+CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& options,
+                     const Linearization& lin, const MoveBox& box);
+
+// max_j f_j over the given values: the objective F of either form.
+double ObjectiveValue(const Eigen::VectorXd& terms);
+
+}  // namespace mbopt::slp

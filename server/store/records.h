@@ -1,0 +1,81 @@
+// The rows of the job database as plain structs. The store does not know
+// protobuf or the SLP core: studies and cycle records arrive as opaque bytes
+// serialized by the layers that own their formats (the service serializes the
+// study as a binary mbopt.v1.Study; server/jobs encodes cycle records), and
+// the store keeps them bit for bit. Doubles of analyses are kept exactly
+// (double_blob.h), which is what a bit-identical resume needs.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mbopt::store {
+
+struct JobRow {
+  std::string id;               // "job-<seq>", assigned by the store
+  std::int64_t seq = 0;         // creation order, 1-based
+  std::string study_name;
+  std::string source_name;      // the study file's path, for messages
+  std::string study;            // opaque bytes (serialized study)
+  std::string state;            // a job state name (server/jobs/job_state.h)
+  std::string message;          // failure, stall or interruption reason
+  std::int64_t created_unix_ms = 0;
+  std::int64_t updated_unix_ms = 0;
+  // Progress, updated in the same transaction as the cycle records.
+  std::int64_t records = 0;     // cycle records committed
+  std::int32_t cycles = 0;      // cycles completed
+  std::int64_t analyses = 0;    // analyses consumed by the optimizer
+  double wall_seconds = 0;      // running time, not counting interruptions
+};
+
+struct AnalysisCounters {
+  std::int64_t time_steps = 0;
+  std::int64_t rhs_evaluations = 0;
+  std::int64_t jacobian_evaluations = 0;
+  std::int64_t newton_iterations = 0;
+  std::int64_t position_solves = 0;
+};
+
+// One analysis result as it was handed to the optimizer.
+struct AnalysisRow {
+  std::string job_id;
+  std::int64_t request_id = 0;
+  std::vector<double> x_scaled;
+  bool ok = false;
+  std::string failure_reason;
+  std::vector<double> objective_terms;
+  std::vector<double> constraint_values;
+  std::string worker;           // worker id, or "" for a server-side failure
+  double wall_seconds = 0;      // the analysis' own running time
+  std::int32_t attempts = 1;    // attempts it took (leases given out)
+  AnalysisCounters counters;
+  std::int64_t committed_unix_ms = 0;
+};
+
+// One cycle record (one LP solve and its trial point) of a job.
+struct CycleRow {
+  std::int64_t index = 0;       // 0-based position in the job's record log
+  std::int32_t cycle = 0;
+  std::int32_t attempt = 0;
+  std::string record;           // opaque bytes (server/jobs/record_codec.h)
+};
+
+// What a cycle commit changes on the job row, atomically with the records.
+struct JobProgress {
+  std::string state;
+  std::string message;
+  std::int32_t cycles = 0;
+  std::int64_t analyses = 0;
+  double wall_seconds = 0;
+};
+
+struct EventRow {
+  std::int64_t id = 0;
+  std::string job_id;
+  std::int64_t unix_ms = 0;
+  std::string kind;             // "submitted", "resumed", "interrupted", ...
+  std::string message;
+};
+
+}  // namespace mbopt::store

@@ -1,0 +1,449 @@
+#include "server/store/store.h"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "common/status_macros.h"
+#include "server/store/double_blob.h"
+#include "server/store/sqlite_statement.h"
+
+namespace mbopt::store {
+namespace {
+
+// How long a statement waits for a lock held by another connection.
+constexpr int kBusyTimeoutMs = 1000;
+
+std::int64_t NowUnixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Version 1. Changing a table means a new version and a migration in Open().
+constexpr const char* kSchemaV1 = R"sql(
+CREATE TABLE schema_version (
+  version INTEGER NOT NULL
+);
+CREATE TABLE jobs (
+  id              TEXT PRIMARY KEY,
+  seq             INTEGER NOT NULL UNIQUE,
+  study_name      TEXT NOT NULL,
+  source_name     TEXT NOT NULL,
+  study           BLOB NOT NULL,
+  state           TEXT NOT NULL,
+  message         TEXT NOT NULL,
+  created_unix_ms INTEGER NOT NULL,
+  updated_unix_ms INTEGER NOT NULL,
+  records         INTEGER NOT NULL DEFAULT 0,
+  cycles          INTEGER NOT NULL DEFAULT 0,
+  analyses        INTEGER NOT NULL DEFAULT 0,
+  wall_seconds    REAL NOT NULL DEFAULT 0
+);
+CREATE TABLE analyses (
+  job_id               TEXT NOT NULL REFERENCES jobs(id),
+  request_id           INTEGER NOT NULL,
+  x_scaled             BLOB NOT NULL,
+  ok                   INTEGER NOT NULL,
+  failure_reason       TEXT NOT NULL,
+  objective_terms      BLOB NOT NULL,
+  constraint_values    BLOB NOT NULL,
+  worker               TEXT NOT NULL,
+  wall_seconds         REAL NOT NULL,
+  attempts             INTEGER NOT NULL,
+  time_steps           INTEGER NOT NULL,
+  rhs_evaluations      INTEGER NOT NULL,
+  jacobian_evaluations INTEGER NOT NULL,
+  newton_iterations    INTEGER NOT NULL,
+  position_solves      INTEGER NOT NULL,
+  committed_unix_ms    INTEGER NOT NULL,
+  PRIMARY KEY (job_id, request_id)
+);
+CREATE TABLE cycles (
+  job_id   TEXT NOT NULL REFERENCES jobs(id),
+  idx      INTEGER NOT NULL,
+  cycle    INTEGER NOT NULL,
+  attempt  INTEGER NOT NULL,
+  record   BLOB NOT NULL,
+  PRIMARY KEY (job_id, idx)
+);
+CREATE TABLE events (
+  id       INTEGER PRIMARY KEY AUTOINCREMENT,
+  job_id   TEXT NOT NULL,
+  unix_ms  INTEGER NOT NULL,
+  kind     TEXT NOT NULL,
+  message  TEXT NOT NULL
+);
+)sql";
+
+absl::StatusOr<std::int64_t> QueryInt(sqlite3* db, const std::string& sql) {
+  MBOPT_ASSIGN_OR_RETURN(Statement stmt, Statement::Prepare(db, sql));
+  MBOPT_ASSIGN_OR_RETURN(bool row, stmt.Step());
+  if (!row) return absl::InternalError(absl::StrCat("`", sql, "` returned no row"));
+  return stmt.ColumnInt(0);
+}
+
+absl::StatusOr<std::string> QueryText(sqlite3* db, const std::string& sql) {
+  MBOPT_ASSIGN_OR_RETURN(Statement stmt, Statement::Prepare(db, sql));
+  MBOPT_ASSIGN_OR_RETURN(bool row, stmt.Step());
+  if (!row) return absl::InternalError(absl::StrCat("`", sql, "` returned no row"));
+  return stmt.ColumnText(0);
+}
+
+// Prefixes every error of opening with the file name and what it means.
+absl::Status NotUsable(const std::string& path, const absl::Status& status) {
+  return absl::Status(status.code(), absl::StrCat("cannot use '", path, "' as the mbopt job database: ",
+                                                  status.message()));
+}
+
+absl::Status CreateSchema(sqlite3* db) {
+  MBOPT_RETURN_IF_ERROR(Exec(db, "BEGIN IMMEDIATE"));
+  absl::Status status = Exec(db, kSchemaV1);
+  if (status.ok()) status = Exec(db, absl::StrCat("INSERT INTO schema_version(version) VALUES (", kSchemaVersion, ")"));
+  if (status.ok()) status = Exec(db, absl::StrCat("PRAGMA application_id = ", kApplicationId));
+  if (status.ok()) return Exec(db, "COMMIT");
+  (void)Exec(db, "ROLLBACK");
+  return status;
+}
+
+// Checks that `db` is an mbopt database this code can use, creating the
+// schema in an empty file.
+absl::Status CheckOrCreateSchema(sqlite3* db) {
+  // Reading the header is the first access to the file: a file that is not
+  // SQLite fails here with "file is not a database".
+  MBOPT_ASSIGN_OR_RETURN(std::int64_t application_id, QueryInt(db, "PRAGMA application_id"));
+  MBOPT_ASSIGN_OR_RETURN(std::int64_t objects, QueryInt(db, "SELECT count(*) FROM sqlite_master"));
+  if (application_id == 0 && objects == 0) {
+    MBOPT_RETURN_IF_ERROR(Exec(db, "PRAGMA journal_mode = WAL"));
+    return CreateSchema(db);
+  }
+  if (application_id != kApplicationId) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "it is an SQLite database of another application (application_id ", application_id,
+        ", expected ", kApplicationId, ")"));
+  }
+  MBOPT_ASSIGN_OR_RETURN(std::int64_t version, QueryInt(db, "SELECT max(version) FROM schema_version"));
+  if (version > kSchemaVersion) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "it has schema version ", version, ", newer than version ", kSchemaVersion,
+        " of this mbopt-server; use a newer mbopt-server"));
+  }
+  if (version < 1) {
+    return absl::DataLossError(absl::StrCat("its schema version table holds ", version));
+  }
+  MBOPT_ASSIGN_OR_RETURN(std::string check, QueryText(db, "PRAGMA quick_check"));
+  if (check != "ok") return absl::DataLossError(absl::StrCat("integrity check failed: ", check));
+  return absl::OkStatus();
+}
+
+JobRow ReadJob(const Statement& stmt) {
+  JobRow job;
+  job.id = stmt.ColumnText(0);
+  job.seq = stmt.ColumnInt(1);
+  job.study_name = stmt.ColumnText(2);
+  job.source_name = stmt.ColumnText(3);
+  job.study = stmt.ColumnBlob(4);
+  job.state = stmt.ColumnText(5);
+  job.message = stmt.ColumnText(6);
+  job.created_unix_ms = stmt.ColumnInt(7);
+  job.updated_unix_ms = stmt.ColumnInt(8);
+  job.records = stmt.ColumnInt(9);
+  job.cycles = static_cast<std::int32_t>(stmt.ColumnInt(10));
+  job.analyses = stmt.ColumnInt(11);
+  job.wall_seconds = stmt.ColumnDouble(12);
+  return job;
+}
+
+constexpr const char* kJobColumns =
+    "id, seq, study_name, source_name, study, state, message, created_unix_ms, "
+    "updated_unix_ms, records, cycles, analyses, wall_seconds";
+
+// Runs `body` inside BEGIN IMMEDIATE .. COMMIT, rolling back on any error.
+template <typename Body>
+absl::Status InTransaction(sqlite3* db, Body body) {
+  MBOPT_RETURN_IF_ERROR(Exec(db, "BEGIN IMMEDIATE"));
+  absl::Status status = body();
+  if (status.ok()) status = Exec(db, "COMMIT");
+  if (!status.ok()) (void)Exec(db, "ROLLBACK");
+  return status;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path) {
+  sqlite3* db = nullptr;
+  const int code = sqlite3_open_v2(path.c_str(), &db,
+                                   SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+                                   nullptr);
+  if (code != SQLITE_OK) {
+    absl::Status status = SqliteStatus(db, code, "open");
+    sqlite3_close(db);
+    return NotUsable(path, status);
+  }
+  std::unique_ptr<Store> store(new Store(path, db));
+  sqlite3_extended_result_codes(db, 1);
+  // One server per database: the exclusive lock, taken below and held until
+  // close, makes a second process's open fail instead of both running the
+  // same jobs. (The lock dies with the process, so a crash does not leave it.)
+  absl::Status status = Exec(db, absl::StrCat("PRAGMA busy_timeout = ", kBusyTimeoutMs));
+  if (status.ok()) status = Exec(db, "PRAGMA locking_mode = EXCLUSIVE");
+  if (status.ok()) status = CheckOrCreateSchema(db);
+  // WAL survives in the file; FULL syncs the WAL on every commit so that a
+  // commit that returned is on disk even if the machine loses power.
+  if (status.ok()) {
+    absl::StatusOr<std::string> mode = QueryText(db, "PRAGMA journal_mode = WAL");
+    if (!mode.ok()) {
+      status = mode.status();
+    } else if (*mode != "wal") {
+      status = absl::UnavailableError(absl::StrCat("SQLite refused WAL mode (journal_mode is ", *mode, ")"));
+    }
+  }
+  if (status.ok()) status = Exec(db, "PRAGMA synchronous = FULL");
+  if (status.ok()) status = Exec(db, "PRAGMA foreign_keys = ON");
+  if (status.ok()) status = Exec(db, "BEGIN EXCLUSIVE; COMMIT");
+  if (absl::IsUnavailable(status)) {
+    status = absl::UnavailableError(
+        absl::StrCat("it is in use by another process (is another mbopt-server running on it?): ", status.message()));
+  }
+  if (!status.ok()) return NotUsable(path, status);
+  return store;
+}
+
+Store::Store(std::string path, sqlite3* db) : path_(std::move(path)), db_(db) {}
+
+Store::~Store() {
+  // Closing checkpoints the WAL into the main file; nothing is lost if it
+  // fails (the WAL is replayed on the next open).
+  sqlite3_close_v2(db_);
+}
+
+absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  JobRow stored = job;
+  const std::int64_t now = NowUnixMs();
+  if (stored.created_unix_ms == 0) stored.created_unix_ms = now;
+  stored.updated_unix_ms = now;
+  MBOPT_RETURN_IF_ERROR(InTransaction(db_, [&]() -> absl::Status {
+    MBOPT_ASSIGN_OR_RETURN(std::int64_t last, QueryInt(db_, "SELECT coalesce(max(seq), 0) FROM jobs"));
+    stored.seq = last + 1;
+    stored.id = absl::StrCat("job-", stored.seq);
+    MBOPT_ASSIGN_OR_RETURN(Statement stmt,
+                           Statement::Prepare(db_, absl::StrCat("INSERT INTO jobs(", kJobColumns,
+                                                                ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)")));
+    stmt.BindText(1, stored.id);
+    stmt.BindInt(2, stored.seq);
+    stmt.BindText(3, stored.study_name);
+    stmt.BindText(4, stored.source_name);
+    stmt.BindBlob(5, stored.study);
+    stmt.BindText(6, stored.state);
+    stmt.BindText(7, stored.message);
+    stmt.BindInt(8, stored.created_unix_ms);
+    stmt.BindInt(9, stored.updated_unix_ms);
+    stmt.BindInt(10, stored.records);
+    stmt.BindInt(11, stored.cycles);
+    stmt.BindInt(12, stored.analyses);
+    stmt.BindDouble(13, stored.wall_seconds);
+    return stmt.Run();
+  }));
+  return stored;
+}
+
+absl::StatusOr<JobRow> Store::GetJob(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(Statement stmt,
+                         Statement::Prepare(db_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs WHERE id = ?")));
+  stmt.BindText(1, job_id);
+  MBOPT_ASSIGN_OR_RETURN(bool row, stmt.Step());
+  if (!row) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
+  return ReadJob(stmt);
+}
+
+absl::StatusOr<std::vector<JobRow>> Store::ListJobs() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(Statement stmt,
+                         Statement::Prepare(db_, absl::StrCat("SELECT ", kJobColumns, " FROM jobs ORDER BY seq")));
+  std::vector<JobRow> jobs;
+  while (true) {
+    MBOPT_ASSIGN_OR_RETURN(bool row, stmt.Step());
+    if (!row) break;
+    jobs.push_back(ReadJob(stmt));
+  }
+  return jobs;
+}
+
+absl::Status Store::SetJobState(const std::string& job_id, const std::string& state,
+                                const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(Statement stmt,
+                         Statement::Prepare(db_, "UPDATE jobs SET state = ?, message = ?, updated_unix_ms = ? WHERE id = ?"));
+  stmt.BindText(1, state);
+  stmt.BindText(2, message);
+  stmt.BindInt(3, NowUnixMs());
+  stmt.BindText(4, job_id);
+  MBOPT_RETURN_IF_ERROR(stmt.Run());
+  if (sqlite3_changes(db_) != 1) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
+  return absl::OkStatus();
+}
+
+absl::Status Store::AddAnalysis(const AnalysisRow& a) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement stmt,
+      Statement::Prepare(db_,
+                         "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
+                         "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
+                         "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms) "
+                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
+  stmt.BindText(1, a.job_id);
+  stmt.BindInt(2, a.request_id);
+  stmt.BindBlob(3, EncodeDoubles(a.x_scaled));
+  stmt.BindInt(4, a.ok ? 1 : 0);
+  stmt.BindText(5, a.failure_reason);
+  stmt.BindBlob(6, EncodeDoubles(a.objective_terms));
+  stmt.BindBlob(7, EncodeDoubles(a.constraint_values));
+  stmt.BindText(8, a.worker);
+  stmt.BindDouble(9, a.wall_seconds);
+  stmt.BindInt(10, a.attempts);
+  stmt.BindInt(11, a.counters.time_steps);
+  stmt.BindInt(12, a.counters.rhs_evaluations);
+  stmt.BindInt(13, a.counters.jacobian_evaluations);
+  stmt.BindInt(14, a.counters.newton_iterations);
+  stmt.BindInt(15, a.counters.position_solves);
+  stmt.BindInt(16, a.committed_unix_ms != 0 ? a.committed_unix_ms : NowUnixMs());
+  absl::Status status = stmt.Run();
+  if (absl::IsAlreadyExists(status)) {
+    return absl::AlreadyExistsError(absl::StrCat("job '", a.job_id, "' already has a result for request ",
+                                                 a.request_id, " (or the job does not exist)"));
+  }
+  return status;
+}
+
+absl::StatusOr<std::vector<AnalysisRow>> Store::LoadAnalyses(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement stmt,
+      Statement::Prepare(db_,
+                         "SELECT request_id, x_scaled, ok, failure_reason, objective_terms, constraint_values, "
+                         "worker, wall_seconds, attempts, time_steps, rhs_evaluations, jacobian_evaluations, "
+                         "newton_iterations, position_solves, committed_unix_ms "
+                         "FROM analyses WHERE job_id = ? ORDER BY request_id"));
+  stmt.BindText(1, job_id);
+  std::vector<AnalysisRow> rows;
+  while (true) {
+    MBOPT_ASSIGN_OR_RETURN(bool more, stmt.Step());
+    if (!more) break;
+    AnalysisRow a;
+    a.job_id = job_id;
+    a.request_id = stmt.ColumnInt(0);
+    MBOPT_ASSIGN_OR_RETURN(a.x_scaled, DecodeDoubles(stmt.ColumnBlob(1)));
+    a.ok = stmt.ColumnInt(2) != 0;
+    a.failure_reason = stmt.ColumnText(3);
+    MBOPT_ASSIGN_OR_RETURN(a.objective_terms, DecodeDoubles(stmt.ColumnBlob(4)));
+    MBOPT_ASSIGN_OR_RETURN(a.constraint_values, DecodeDoubles(stmt.ColumnBlob(5)));
+    a.worker = stmt.ColumnText(6);
+    a.wall_seconds = stmt.ColumnDouble(7);
+    a.attempts = static_cast<std::int32_t>(stmt.ColumnInt(8));
+    a.counters.time_steps = stmt.ColumnInt(9);
+    a.counters.rhs_evaluations = stmt.ColumnInt(10);
+    a.counters.jacobian_evaluations = stmt.ColumnInt(11);
+    a.counters.newton_iterations = stmt.ColumnInt(12);
+    a.counters.position_solves = stmt.ColumnInt(13);
+    a.committed_unix_ms = stmt.ColumnInt(14);
+    rows.push_back(std::move(a));
+  }
+  return rows;
+}
+
+absl::Status Store::CommitCycle(const std::string& job_id, const std::vector<CycleRow>& records,
+                                const JobProgress& progress) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return InTransaction(db_, [&]() -> absl::Status {
+    MBOPT_ASSIGN_OR_RETURN(Statement count, Statement::Prepare(db_, "SELECT records FROM jobs WHERE id = ?"));
+    count.BindText(1, job_id);
+    MBOPT_ASSIGN_OR_RETURN(bool found, count.Step());
+    if (!found) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
+    std::int64_t next = count.ColumnInt(0);
+    MBOPT_ASSIGN_OR_RETURN(
+        Statement insert,
+        Statement::Prepare(db_, "INSERT INTO cycles(job_id, idx, cycle, attempt, record) VALUES (?,?,?,?,?)"));
+    for (const CycleRow& r : records) {
+      insert.BindText(1, job_id);
+      insert.BindInt(2, next++);
+      insert.BindInt(3, r.cycle);
+      insert.BindInt(4, r.attempt);
+      insert.BindBlob(5, r.record);
+      MBOPT_RETURN_IF_ERROR(insert.Run());
+      insert.Reset();
+    }
+    MBOPT_ASSIGN_OR_RETURN(
+        Statement update,
+        Statement::Prepare(db_,
+                           "UPDATE jobs SET records = ?, state = ?, message = ?, cycles = ?, analyses = ?, "
+                           "wall_seconds = ?, updated_unix_ms = ? WHERE id = ?"));
+    update.BindInt(1, next);
+    update.BindText(2, progress.state);
+    update.BindText(3, progress.message);
+    update.BindInt(4, progress.cycles);
+    update.BindInt(5, progress.analyses);
+    update.BindDouble(6, progress.wall_seconds);
+    update.BindInt(7, NowUnixMs());
+    update.BindText(8, job_id);
+    return update.Run();
+  });
+}
+
+absl::StatusOr<std::vector<CycleRow>> Store::LoadCycles(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement stmt,
+      Statement::Prepare(db_, "SELECT idx, cycle, attempt, record FROM cycles WHERE job_id = ? ORDER BY idx"));
+  stmt.BindText(1, job_id);
+  std::vector<CycleRow> rows;
+  while (true) {
+    MBOPT_ASSIGN_OR_RETURN(bool more, stmt.Step());
+    if (!more) break;
+    CycleRow r;
+    r.index = stmt.ColumnInt(0);
+    r.cycle = static_cast<std::int32_t>(stmt.ColumnInt(1));
+    r.attempt = static_cast<std::int32_t>(stmt.ColumnInt(2));
+    r.record = stmt.ColumnBlob(3);
+    rows.push_back(std::move(r));
+  }
+  return rows;
+}
+
+absl::Status Store::AddEvent(const std::string& job_id, const std::string& kind, const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement stmt, Statement::Prepare(db_, "INSERT INTO events(job_id, unix_ms, kind, message) VALUES (?,?,?,?)"));
+  stmt.BindText(1, job_id);
+  stmt.BindInt(2, NowUnixMs());
+  stmt.BindText(3, kind);
+  stmt.BindText(4, message);
+  return stmt.Run();
+}
+
+absl::StatusOr<std::vector<EventRow>> Store::LoadEvents(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement stmt,
+      Statement::Prepare(db_, "SELECT id, job_id, unix_ms, kind, message FROM events WHERE job_id = ? ORDER BY id"));
+  stmt.BindText(1, job_id);
+  std::vector<EventRow> rows;
+  while (true) {
+    MBOPT_ASSIGN_OR_RETURN(bool more, stmt.Step());
+    if (!more) break;
+    EventRow e;
+    e.id = stmt.ColumnInt(0);
+    e.job_id = stmt.ColumnText(1);
+    e.unix_ms = stmt.ColumnInt(2);
+    e.kind = stmt.ColumnText(3);
+    e.message = stmt.ColumnText(4);
+    rows.push_back(std::move(e));
+  }
+  return rows;
+}
+
+}  // namespace mbopt::store

@@ -1,0 +1,79 @@
+// The job database: one SQLite file holding jobs, their studies, every
+// analysis result, every cycle record and an event log. The schema, the
+// version rule and what survives a crash are written down in docs/store.md.
+//
+// Durability: WAL journal with synchronous=FULL, so a call that returned OK
+// has reached the disk. An analysis is committed on its own when it arrives;
+// a cycle's records are committed in one transaction with the job's progress,
+// so after a crash the database holds either all of a cycle or none of it.
+//
+// Thread-safe: one connection, serialized by a mutex. Calls are short
+// (a handful of rows); the caller should still not hold its own locks across
+// them if it can avoid it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "server/store/records.h"
+
+struct sqlite3;
+
+namespace mbopt::store {
+
+// The schema version this code writes. A database with a newer version is
+// refused; older versions are migrated on open (none exist yet).
+inline constexpr int kSchemaVersion = 1;
+// PRAGMA application_id of an mbopt database ("mbop").
+inline constexpr std::int32_t kApplicationId = 0x6d626f70;
+
+class Store {
+ public:
+  // Opens or creates the database at `path`. FailedPrecondition for a file
+  // that is not an mbopt database (another SQLite database, or not SQLite at
+  // all) or one written by a newer mbopt; DataLoss when SQLite reports
+  // corruption; Unavailable when the file cannot be opened.
+  static absl::StatusOr<std::unique_ptr<Store>> Open(const std::string& path);
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  const std::string& path() const { return path_; }
+
+  // Inserts a job; `id` and `seq` of `job` are ignored and assigned. Returns
+  // the row as stored.
+  absl::StatusOr<JobRow> CreateJob(const JobRow& job);
+  absl::StatusOr<JobRow> GetJob(const std::string& job_id);  // NotFound
+  absl::StatusOr<std::vector<JobRow>> ListJobs();             // by seq
+  absl::Status SetJobState(const std::string& job_id, const std::string& state,
+                           const std::string& message);
+
+  // Commits one analysis result (its own transaction). AlreadyExists if the
+  // job already has a result for that request id.
+  absl::Status AddAnalysis(const AnalysisRow& analysis);
+  absl::StatusOr<std::vector<AnalysisRow>> LoadAnalyses(const std::string& job_id);  // by request id
+
+  // Commits `records` (appended to the job's record log, indices assigned in
+  // order after the existing ones) and `progress` in ONE transaction.
+  absl::Status CommitCycle(const std::string& job_id, const std::vector<CycleRow>& records,
+                           const JobProgress& progress);
+  absl::StatusOr<std::vector<CycleRow>> LoadCycles(const std::string& job_id);  // by index
+
+  absl::Status AddEvent(const std::string& job_id, const std::string& kind,
+                        const std::string& message);
+  absl::StatusOr<std::vector<EventRow>> LoadEvents(const std::string& job_id);
+
+ private:
+  Store(std::string path, sqlite3* db);
+
+  std::string path_;
+  std::mutex mutex_;
+  sqlite3* db_;  // owned
+};
+
+}  // namespace mbopt::store

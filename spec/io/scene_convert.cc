@@ -1,0 +1,693 @@
+#include "spec/io/scene_convert.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "spec/layout.h"
+#include "spec/units.h"
+
+namespace mbopt::spec::io {
+namespace {
+
+class SceneConverter {
+ public:
+  SceneConverter(const v1::Scene& message, const Where& where, Errors* errors)
+      : msg_(message), where_(where), errors_(*errors) {}
+
+  Scene Run() {
+    scene_.name = msg_.name();
+    scene_.source_file = where_.file();
+    ConvertParameters();
+    ConvertEffects();
+    switch (msg_.model_case()) {
+      case v1::Scene::kLinkage:
+        scene_.model = ConvertLinkage(msg_.linkage(), where_.Child("linkage"));
+        break;
+      case v1::Scene::kLumped:
+        scene_.model = ConvertLumped(msg_.lumped(), where_.Child("lumped"));
+        break;
+      case v1::Scene::MODEL_NOT_SET:
+        errors_.Add(where_, "",
+                    "the scene has no model: expected `linkage { ... }` or "
+                    "`lumped { ... }`");
+        return scene_;
+    }
+    if (msg_.model_case() == v1::Scene::kLumped && msg_.has_effects()) {
+      // Silently ignoring a declared effect would give wrong answers.
+      if (msg_.effects().has_gravity()) {
+        errors_.Add(where_.Child("effects"), "gravity",
+                    "a lumped model moves about its static equilibrium, where gravity is "
+                    "balanced by the spring preloads: leave gravity out");
+      }
+      if (msg_.effects().has_structural_damping()) {
+        errors_.Add(where_.Child("effects"), "structural_damping",
+                    "structural damping applies to flexible links; a lumped model takes its "
+                    "damping from its elements");
+      }
+    }
+    ConvertOutputs();
+    ConvertGrid();
+    ConvertIntegrator();
+    return scene_;
+  }
+
+ private:
+  void ConvertParameters() {
+    std::set<std::string> seen;
+    for (int i = 0; i < msg_.parameters_size(); ++i) {
+      const v1::Parameter& p = msg_.parameters(i);
+      const Where w = where_.Child("parameters", i);
+      Parameter out;
+      out.name = p.name();
+      out.unit = p.unit();
+      if (p.name().empty()) errors_.Add(w, "name", "a parameter needs a name");
+      if (!seen.insert(p.name()).second) {
+        errors_.Add(w, "name", absl::StrCat("duplicate parameter name \"", p.name(), "\""));
+      }
+      absl::StatusOr<Unit> unit = FindUnit(p.unit());
+      if (!unit.ok()) {
+        errors_.Add(w, "unit", std::string(unit.status().message()));
+      } else {
+        out.si_per_unit = unit->si_per_unit;
+      }
+      if (!std::isfinite(p.value())) errors_.Add(w, "value", "must be a finite number");
+      out.value_si = p.value() * out.si_per_unit;
+      units_.push_back(unit.ok() ? unit->dimension : Dimension::kAny);
+      scene_.parameters.push_back(std::move(out));
+    }
+  }
+
+  // A Number field `field` of the message at `w`; `present` says whether the
+  // field was given. Absent: `fallback` if it is set, else an error.
+  Number Num(const Where& w, const std::string& field, bool present, const v1::Number& n,
+             Dimension dimension, std::optional<double> fallback = std::nullopt) {
+    Number out;
+    if (!present) {
+      if (fallback) {
+        out.value = *fallback;
+      } else {
+        errors_.Add(w, field,
+                    absl::StrFormat("missing: expected a number in SI (%s), "
+                                    "`{ value: ... }` or `{ param: \"name\" }`",
+                                    DimensionName(dimension)));
+      }
+      return out;
+    }
+    switch (n.source_case()) {
+      case v1::Number::kValue:
+        if (!std::isfinite(n.value())) errors_.Add(w, field, "must be a finite number");
+        out.value = n.value();
+        break;
+      case v1::Number::kParam: {
+        out.param = scene_.FindParameter(n.param());
+        if (out.param < 0) {
+          errors_.Add(w, field, absl::StrCat("unknown parameter \"", n.param(), "\""));
+        } else {
+          const Dimension unit_dimension = units_[static_cast<size_t>(out.param)];
+          if (unit_dimension != Dimension::kAny && dimension != Dimension::kAny &&
+              unit_dimension != dimension) {
+            errors_.Add(w, field,
+                        absl::StrFormat("parameter \"%s\" has unit \"%s\" (%s) but this field "
+                                        "is a %s",
+                                        n.param(), scene_.parameters[out.param].unit,
+                                        DimensionName(unit_dimension), DimensionName(dimension)));
+          }
+        }
+        break;
+      }
+      case v1::Number::SOURCE_NOT_SET:
+        errors_.Add(w, field, "empty number: expected `value: ...` or `param: \"name\"`");
+        break;
+    }
+    return out;
+  }
+
+  double Default(const Number& n) const {
+    return n.param >= 0 ? scene_.parameters[static_cast<size_t>(n.param)].value_si : n.value;
+  }
+
+  void RequirePositive(const Where& w, const std::string& field, const Number& n) {
+    const double v = Default(n);
+    if (!(v > 0.0)) {
+      errors_.Add(w, field, absl::StrFormat("must be positive, got %g (SI)", v));
+    }
+  }
+  void RequireNotNegative(const Where& w, const std::string& field, const Number& n) {
+    const double v = Default(n);
+    if (!(v >= 0.0)) {
+      errors_.Add(w, field, absl::StrFormat("must not be negative, got %g (SI)", v));
+    }
+  }
+
+  Vec2 Vec(const Where& w, const std::string& field, bool present, const v1::Vector2& v,
+           Dimension dimension) {
+    Vec2 out;
+    if (!present) return out;  // (0, 0)
+    const Where c = w.Child(field);
+    out.x = Num(c, "x", v.has_x(), v.x(), dimension, 0.0);
+    out.y = Num(c, "y", v.has_y(), v.y(), dimension, 0.0);
+    return out;
+  }
+
+  // A fixed unit direction: literal numbers, not zero; normalized here.
+  void Direction(const Where& w, const std::string& field, bool present, const v1::Vector2& v,
+                 double* dx, double* dy) {
+    if (!present) {
+      errors_.Add(w, field,
+                  "missing: expected a direction vector `{ x { value: 0 } y { value: 1 } }`");
+      return;
+    }
+    const Where c = w.Child(field);
+    if ((v.has_x() && v.x().has_param()) || (v.has_y() && v.y().has_param())) {
+      errors_.Add(w, field, "a direction must be literal values, not parameters");
+      return;
+    }
+    const double x = v.has_x() ? v.x().value() : 0.0;
+    const double y = v.has_y() ? v.y().value() : 0.0;
+    const double norm = std::hypot(x, y);
+    if (!(norm > 0.0) || !std::isfinite(norm)) {
+      errors_.Add(w, field,
+                  absl::StrFormat("zero direction vector (%g, %g): expected a "
+                                  "non-zero vector",
+                                  x, y));
+      return;
+    }
+    *dx = x / norm;
+    *dy = y / norm;
+  }
+
+  void ConvertEffects() {
+    if (!msg_.has_effects()) return;
+    const Where w = where_.Child("effects");
+    const v1::Effects& e = msg_.effects();
+    if (e.has_gravity()) {
+      const Where g = w.Child("gravity");
+      scene_.effects.gravity_m_per_s2 =
+          Vec(g, "acceleration_m_per_s2", e.gravity().has_acceleration_m_per_s2(),
+              e.gravity().acceleration_m_per_s2(), Dimension::kAcceleration);
+    }
+    if (e.has_structural_damping()) {
+      const double ratio = e.structural_damping().ratio_of_critical();
+      if (!(ratio >= 0.0) || !std::isfinite(ratio)) {
+        errors_.Add(w.Child("structural_damping"), "ratio_of_critical",
+                    absl::StrFormat("must not be negative, got %g", ratio));
+      }
+      scene_.effects.structural_damping_ratio = ratio;
+    }
+  }
+
+  // ------------------------------------------------------------- lumped --
+  LumpedModel ConvertLumped(const v1::LumpedModel& m, const Where& w) {
+    LumpedModel out;
+    std::map<std::string, int> bodies, inputs;
+    for (int i = 0; i < m.bodies_size(); ++i) {
+      const v1::Body& b = m.bodies(i);
+      const Where bw = w.Child("bodies", i);
+      Body body;
+      body.name = b.name();
+      if (b.name().empty()) errors_.Add(bw, "name", "a body needs a name");
+      if (!bodies.emplace(b.name(), i).second) {
+        errors_.Add(bw, "name", absl::StrCat("duplicate body name \"", b.name(), "\""));
+      }
+      std::set<int> dofs;
+      for (int d = 0; d < b.dofs_size(); ++d) {
+        if (!dofs.insert(b.dofs(d)).second) {
+          errors_.Add(bw, "dofs", d, "duplicate degree of freedom");
+          continue;
+        }
+        switch (b.dofs(d)) {
+          case v1::DOF_X:
+            body.dofs.push_back(Dof::kX);
+            break;
+          case v1::DOF_Y:
+            body.dofs.push_back(Dof::kY);
+            break;
+          case v1::DOF_ROTATION:
+            body.dofs.push_back(Dof::kRotation);
+            break;
+          default:
+            errors_.Add(bw, "dofs", d, "expected DOF_X, DOF_Y or DOF_ROTATION");
+        }
+      }
+      const bool translates = dofs.count(v1::DOF_X) > 0 || dofs.count(v1::DOF_Y) > 0;
+      const bool rotates = dofs.count(v1::DOF_ROTATION) > 0;
+      body.mass_kg = Num(bw, "mass_kg", b.has_mass_kg(), b.mass_kg(), Dimension::kMass,
+                         translates ? std::nullopt : std::optional<double>(0.0));
+      if (translates) RequirePositive(bw, "mass_kg", body.mass_kg);
+      body.inertia_kg_m2 =
+          Num(bw, "inertia_kg_m2", b.has_inertia_kg_m2(), b.inertia_kg_m2(), Dimension::kInertia,
+              rotates ? std::nullopt : std::optional<double>(0.0));
+      if (rotates) RequirePositive(bw, "inertia_kg_m2", body.inertia_kg_m2);
+      body.position_m =
+          Vec(bw, "position_m", b.has_position_m(), b.position_m(), Dimension::kLength);
+      out.bodies.push_back(std::move(body));
+    }
+    if (m.bodies_size() == 0) errors_.Add(w, "bodies", "a lumped model needs at least one body");
+    for (int i = 0; i < m.inputs_size(); ++i) {
+      const v1::GroundInput& g = m.inputs(i);
+      const Where iw = w.Child("inputs", i);
+      GroundInput input;
+      input.name = g.name();
+      if (g.name().empty()) errors_.Add(iw, "name", "an input needs a name");
+      if (!inputs.emplace(g.name(), i).second) {
+        errors_.Add(iw, "name", absl::StrCat("duplicate input name \"", g.name(), "\""));
+      }
+      if (g.profile_case() != v1::GroundInput::kCosineBump) {
+        errors_.Add(iw, "", "missing profile: expected `cosine_bump { ... }`");
+      } else {
+        const Where cw = iw.Child("cosine_bump");
+        const v1::CosineBump& c = g.cosine_bump();
+        input.bump.height_m =
+            Num(cw, "height_m", c.has_height_m(), c.height_m(), Dimension::kLength);
+        input.bump.length_m =
+            Num(cw, "length_m", c.has_length_m(), c.length_m(), Dimension::kLength);
+        RequirePositive(cw, "length_m", input.bump.length_m);
+        input.bump.speed_m_per_s = Num(cw, "speed_m_per_s", c.has_speed_m_per_s(),
+                                       c.speed_m_per_s(), Dimension::kVelocity);
+        RequirePositive(cw, "speed_m_per_s", input.bump.speed_m_per_s);
+        input.bump.start_time_s =
+            Num(cw, "start_time_s", c.has_start_time_s(), c.start_time_s(), Dimension::kTime, 0.0);
+      }
+      input.delay_s = Num(iw, "delay_s", g.has_delay_s(), g.delay_s(), Dimension::kTime, 0.0);
+      Direction(iw, "direction", g.has_direction(), g.direction(), &input.direction_x,
+                &input.direction_y);
+      out.inputs.push_back(std::move(input));
+    }
+    std::set<std::string> element_names;
+    for (int i = 0; i < m.elements_size(); ++i) {
+      const v1::SpringDamper& e = m.elements(i);
+      const Where ew = w.Child("elements", i);
+      SpringDamper element;
+      element.name = e.name();
+      if (e.name().empty()) errors_.Add(ew, "name", "an element needs a name");
+      if (!element_names.insert(e.name()).second) {
+        errors_.Add(ew, "name", absl::StrCat("duplicate element name \"", e.name(), "\""));
+      }
+      element.a = Attach(ew, "a", e.has_a(), e.a(), bodies, inputs);
+      element.b = Attach(ew, "b", e.has_b(), e.b(), bodies, inputs);
+      Direction(ew, "direction", e.has_direction(), e.direction(), &element.direction_x,
+                &element.direction_y);
+      element.stiffness_n_per_m = Num(ew, "stiffness_n_per_m", e.has_stiffness_n_per_m(),
+                                      e.stiffness_n_per_m(), Dimension::kStiffness, 0.0);
+      RequireNotNegative(ew, "stiffness_n_per_m", element.stiffness_n_per_m);
+      element.damping_n_s_per_m = Num(ew, "damping_n_s_per_m", e.has_damping_n_s_per_m(),
+                                      e.damping_n_s_per_m(), Dimension::kDamping, 0.0);
+      RequireNotNegative(ew, "damping_n_s_per_m", element.damping_n_s_per_m);
+      out.elements.push_back(std::move(element));
+    }
+    lumped_bodies_ = bodies;
+    lumped_elements_.clear();
+    for (size_t i = 0; i < out.elements.size(); ++i) {
+      lumped_elements_.emplace(out.elements[i].name, static_cast<int>(i));
+    }
+    return out;
+  }
+
+  Attachment Attach(const Where& w, const std::string& field, bool present, const v1::Attachment& a,
+                    const std::map<std::string, int>& bodies,
+                    const std::map<std::string, int>& inputs) {
+    Attachment out;
+    if (!present) {
+      errors_.Add(w, field,
+                  "missing: expected `{ body: \"name\" }`, `{ input: \"name\" }` or "
+                  "`{ ground: true }`");
+      return out;
+    }
+    const Where aw = w.Child(field);
+    switch (a.target_case()) {
+      case v1::Attachment::kBody: {
+        out.kind = Attachment::Kind::kBody;
+        auto it = bodies.find(a.body());
+        if (it == bodies.end()) {
+          errors_.Add(aw, "body", absl::StrCat("unknown body \"", a.body(), "\""));
+        } else {
+          out.index = it->second;
+        }
+        out.offset_m = Vec(aw, "offset_m", a.has_offset_m(), a.offset_m(), Dimension::kLength);
+        break;
+      }
+      case v1::Attachment::kInput: {
+        out.kind = Attachment::Kind::kInput;
+        auto it = inputs.find(a.input());
+        if (it == inputs.end()) {
+          errors_.Add(aw, "input", absl::StrCat("unknown input \"", a.input(), "\""));
+        } else {
+          out.index = it->second;
+        }
+        break;
+      }
+      case v1::Attachment::kGround:
+        out.kind = Attachment::Kind::kGround;
+        break;
+      case v1::Attachment::TARGET_NOT_SET:
+        errors_.Add(w, field, "expected `body: \"name\"`, `input: \"name\"` or `ground: true`");
+        break;
+    }
+    if (a.has_offset_m() && out.kind != Attachment::Kind::kBody) {
+      errors_.Add(aw, "offset_m", "an offset is only meaningful on a body attachment");
+    }
+    return out;
+  }
+
+  // ------------------------------------------------------------ linkage --
+  LinkageModel ConvertLinkage(const v1::LinkageModel& m, const Where& w) {
+    LinkageModel out;
+    std::map<std::string, int> joints;
+    for (int i = 0; i < m.joints_size(); ++i) {
+      const v1::Joint& j = m.joints(i);
+      const Where jw = w.Child("joints", i);
+      Joint joint;
+      joint.name = j.name();
+      joint.ground = j.ground();
+      if (j.name().empty()) errors_.Add(jw, "name", "a joint needs a name");
+      if (!joints.emplace(j.name(), i).second) {
+        errors_.Add(jw, "name", absl::StrCat("duplicate joint name \"", j.name(), "\""));
+      }
+      if (!j.has_position_m())
+        errors_.Add(jw, "position_m", "missing: expected the joint's position");
+      joint.position_m =
+          Vec(jw, "position_m", j.has_position_m(), j.position_m(), Dimension::kLength);
+      out.joints.push_back(std::move(joint));
+    }
+    auto joint_index = [&](const Where& at, const std::string& field, const std::string& name) {
+      auto it = joints.find(name);
+      if (it == joints.end()) {
+        errors_.Add(at, field, absl::StrCat("unknown joint \"", name, "\""));
+        return -1;
+      }
+      return it->second;
+    };
+    std::map<std::string, int> links;
+    for (int i = 0; i < m.links_size(); ++i) {
+      const v1::Link& l = m.links(i);
+      const Where lw = w.Child("links", i);
+      Link link;
+      link.name = l.name();
+      if (l.name().empty()) errors_.Add(lw, "name", "a link needs a name");
+      if (!links.emplace(l.name(), i).second) {
+        errors_.Add(lw, "name", absl::StrCat("duplicate link name \"", l.name(), "\""));
+      }
+      link.joint_a = joint_index(lw, "joint_a", l.joint_a());
+      link.joint_b = joint_index(lw, "joint_b", l.joint_b());
+      if (link.joint_a >= 0 && link.joint_a == link.joint_b) {
+        errors_.Add(lw, "joint_b", "a link needs two different joints");
+      }
+      if (l.has_length_m()) {
+        link.length_m = Num(lw, "length_m", true, l.length_m(), Dimension::kLength);
+        RequirePositive(lw, "length_m", *link.length_m);
+      }
+      if (l.has_section()) {
+        const Where sw = lw.Child("section");
+        const v1::Section& s = l.section();
+        Section section;
+        section.area_m2 = Num(sw, "area_m2", s.has_area_m2(), s.area_m2(), Dimension::kArea);
+        RequirePositive(sw, "area_m2", section.area_m2);
+        section.youngs_modulus_pa = Num(sw, "youngs_modulus_pa", s.has_youngs_modulus_pa(),
+                                        s.youngs_modulus_pa(), Dimension::kPressure);
+        RequirePositive(sw, "youngs_modulus_pa", section.youngs_modulus_pa);
+        section.density_kg_per_m3 = Num(sw, "density_kg_per_m3", s.has_density_kg_per_m3(),
+                                        s.density_kg_per_m3(), Dimension::kDensity);
+        RequirePositive(sw, "density_kg_per_m3", section.density_kg_per_m3);
+        link.section = section;
+      }
+      if (l.has_flexible()) {
+        if (l.flexible().elements() < 1) {
+          errors_.Add(lw.Child("flexible"), "elements",
+                      absl::StrCat("a flexible link needs at least 1 element, got ",
+                                   l.flexible().elements()));
+        }
+        if (!l.has_section()) {
+          errors_.Add(lw, "section", "a flexible link needs a section");
+        }
+        link.flexible_elements = std::max(1, l.flexible().elements());
+        link.rotary_inertia = l.flexible().rotary_inertia();
+      }
+      std::set<std::string> points;
+      for (int p = 0; p < l.points_size(); ++p) {
+        const Where pw = lw.Child("points", p);
+        LinkPoint point;
+        point.name = l.points(p).name();
+        if (point.name.empty()) errors_.Add(pw, "name", "a point needs a name");
+        if (!points.insert(point.name).second) {
+          errors_.Add(pw, "name", absl::StrCat("duplicate point name \"", point.name, "\""));
+        }
+        point.position_m = Vec(pw, "position_m", l.points(p).has_position_m(),
+                               l.points(p).position_m(), Dimension::kLength);
+        link.points.push_back(std::move(point));
+      }
+      out.links.push_back(std::move(link));
+    }
+    if (m.links_size() == 0) errors_.Add(w, "links", "a linkage needs at least one link");
+    if (!m.has_driver()) {
+      errors_.Add(w, "driver", "missing: expected the driven link and its pivot");
+    } else {
+      const Where dw = w.Child("driver");
+      const v1::Driver& d = m.driver();
+      auto it = links.find(d.link());
+      if (it == links.end()) {
+        errors_.Add(dw, "link", absl::StrCat("unknown link \"", d.link(), "\""));
+      } else {
+        out.driver.link = it->second;
+      }
+      out.driver.pivot_joint = joint_index(dw, "pivot_joint", d.pivot_joint());
+      if (out.driver.link >= 0 && out.driver.pivot_joint >= 0) {
+        const Link& link = out.links[static_cast<size_t>(out.driver.link)];
+        if (link.joint_a != out.driver.pivot_joint && link.joint_b != out.driver.pivot_joint) {
+          errors_.Add(dw, "pivot_joint",
+                      absl::StrCat("joint \"", d.pivot_joint(), "\" is not an end of link \"",
+                                   d.link(), "\""));
+        } else if (!out.joints[static_cast<size_t>(out.driver.pivot_joint)].ground) {
+          errors_.Add(
+              dw, "pivot_joint",
+              absl::StrCat("the driver's pivot \"", d.pivot_joint(), "\" must be a ground joint"));
+        }
+      }
+      if (d.has_start_angle_rad()) {
+        out.driver.start_angle_rad =
+            Num(dw, "start_angle_rad", true, d.start_angle_rad(), Dimension::kAngle);
+      }
+      out.driver.angular_velocity_rad_per_s =
+          Num(dw, "angular_velocity_rad_per_s", d.has_angular_velocity_rad_per_s(),
+              d.angular_velocity_rad_per_s(), Dimension::kAngularVelocity);
+    }
+    linkage_links_ = links;
+    linkage_joints_ = joints;
+    return out;
+  }
+
+  // ------------------------------------------------------------ outputs --
+  void ConvertOutputs() {
+    std::set<std::string> names;
+    const bool lumped = std::holds_alternative<LumpedModel>(scene_.model);
+    auto lookup = [&](const std::map<std::string, int>& table, const Where& w,
+                      const std::string& field, const std::string& name, const char* what) {
+      auto it = table.find(name);
+      if (it == table.end()) {
+        errors_.Add(w, field, absl::StrCat("unknown ", what, " \"", name, "\""));
+        return -1;
+      }
+      return it->second;
+    };
+    auto axis = [&](const Where& w, v1::Axis a) {
+      if (a == v1::AXIS_X) return Axis::kX;
+      if (a != v1::AXIS_Y) errors_.Add(w, "axis", "expected AXIS_X or AXIS_Y");
+      return Axis::kY;
+    };
+    for (int i = 0; i < msg_.outputs_size(); ++i) {
+      const v1::Output& o = msg_.outputs(i);
+      const Where ow = where_.Child("outputs", i);
+      Output out;
+      out.name = o.name();
+      if (o.name().empty()) errors_.Add(ow, "name", "an output needs a name");
+      if (!names.insert(o.name()).second) {
+        errors_.Add(ow, "name", absl::StrCat("duplicate output name \"", o.name(), "\""));
+      }
+      const char* needs = nullptr;  // the model kind this output needs
+      switch (o.kind_case()) {
+        case v1::Output::kElementDeflection: {
+          needs = "lumped";
+          ElementDeflectionOutput k;
+          if (lumped) {
+            k.element = lookup(lumped_elements_, ow.Child("element_deflection"), "element",
+                               o.element_deflection().element(), "element");
+          }
+          out.kind = k;
+          break;
+        }
+        case v1::Output::kBodyAcceleration: {
+          needs = "lumped";
+          const Where kw = ow.Child("body_acceleration");
+          const v1::BodyAccelerationOutput& a = o.body_acceleration();
+          BodyAccelerationOutput k;
+          if (lumped) k.body = lookup(lumped_bodies_, kw, "body", a.body(), "body");
+          k.offset_m = Vec(kw, "offset_m", a.has_offset_m(), a.offset_m(), Dimension::kLength);
+          k.axis = axis(kw, a.axis());
+          out.kind = k;
+          break;
+        }
+        case v1::Output::kPointPosition: {
+          needs = "linkage";
+          const Where kw = ow.Child("point_position");
+          PointPositionOutput k;
+          k.axis = axis(kw, o.point_position().axis());
+          if (!lumped) ResolvePoint(kw, o.point_position().point(), &k);
+          out.kind = k;
+          break;
+        }
+        case v1::Output::kLinkRotation: {
+          needs = "linkage";
+          LinkRotationOutput k;
+          if (!lumped) {
+            k.link = lookup(linkage_links_, ow.Child("link_rotation"), "link",
+                            o.link_rotation().link(), "link");
+          }
+          out.kind = k;
+          break;
+        }
+        case v1::Output::kBendingStress: {
+          needs = "linkage";
+          BendingStressOutput k;
+          const Where kw = ow.Child("bending_stress");
+          if (!lumped) {
+            k.link = lookup(linkage_links_, kw, "link", o.bending_stress().link(), "link");
+            const auto& linkage = std::get<LinkageModel>(scene_.model);
+            if (k.link >= 0 && !linkage.links[static_cast<size_t>(k.link)].section) {
+              errors_.Add(kw, "link",
+                          absl::StrCat("link \"", o.bending_stress().link(),
+                                       "\" has no section: bending stress needs one"));
+            }
+          }
+          out.kind = k;
+          break;
+        }
+        case v1::Output::kDriveTorque:
+          needs = "linkage";
+          out.kind = DriveTorqueOutput{};
+          break;
+        case v1::Output::kMass:
+          needs = "linkage";
+          out.kind = MassOutput{};
+          break;
+        case v1::Output::KIND_NOT_SET:
+          errors_.Add(ow, "", "the output has no kind (e.g. `element_deflection { ... }`)");
+          break;
+      }
+      if (needs != nullptr && (std::string(needs) == "lumped") != lumped) {
+        errors_.Add(ow, "",
+                    absl::StrCat("output \"", o.name(), "\" needs a ", needs,
+                                 " model; this scene is ", lumped ? "lumped" : "a linkage"));
+      }
+      scene_.outputs.push_back(std::move(out));
+    }
+  }
+
+  void ResolvePoint(const Where& w, const std::string& name, PointPositionOutput* k) {
+    const auto& linkage = std::get<LinkageModel>(scene_.model);
+    const size_t dot = name.find('.');
+    if (dot == std::string::npos) {
+      auto it = linkage_joints_.find(name);
+      if (it == linkage_joints_.end()) {
+        errors_.Add(
+            w, "point",
+            absl::StrCat("unknown joint \"", name, "\" (a link point is written \"link.point\")"));
+      } else {
+        k->joint = it->second;
+      }
+      return;
+    }
+    const std::string link_name = name.substr(0, dot), point_name = name.substr(dot + 1);
+    auto it = linkage_links_.find(link_name);
+    if (it == linkage_links_.end()) {
+      errors_.Add(w, "point", absl::StrCat("unknown link \"", link_name, "\""));
+      return;
+    }
+    k->link = it->second;
+    const Link& link = linkage.links[static_cast<size_t>(k->link)];
+    for (size_t p = 0; p < link.points.size(); ++p) {
+      if (link.points[p].name == point_name) k->point = static_cast<int>(p);
+    }
+    if (k->point < 0) {
+      errors_.Add(w, "point",
+                  absl::StrCat("link \"", link_name, "\" has no point \"", point_name, "\""));
+    }
+  }
+
+  void ConvertGrid() {
+    if (!msg_.has_time_grid()) {
+      errors_.Add(where_, "time_grid",
+                  "missing: expected `time_grid { start_s: .. end_s: .. "
+                  "points: .. }`");
+      return;
+    }
+    const Where w = where_.Child("time_grid");
+    const v1::TimeGrid& g = msg_.time_grid();
+    scene_.time_grid.start_s = g.start_s();
+    scene_.time_grid.end_s = g.end_s();
+    scene_.time_grid.points = g.points();
+    if (g.points() < 1) {
+      errors_.Add(w, "points", absl::StrCat("must be at least 1, got ", g.points()));
+    }
+    if (!std::isfinite(g.start_s()) || g.start_s() < 0.0) {
+      errors_.Add(w, "start_s",
+                  absl::StrFormat("must be >= 0 (the simulation starts at "
+                                  "t = 0), got %g",
+                                  g.start_s()));
+    }
+    if (!std::isfinite(g.end_s()) || g.end_s() < g.start_s()) {
+      errors_.Add(w, "end_s",
+                  absl::StrFormat("must be >= start_s (%g), got %g", g.start_s(), g.end_s()));
+    }
+    if (g.points() > 1 && g.end_s() == g.start_s()) {
+      errors_.Add(w, "end_s", "several points need end_s > start_s");
+    }
+  }
+
+  void ConvertIntegrator() {
+    if (!msg_.has_integrator()) return;
+    const Where w = where_.Child("integrator");
+    const v1::IntegratorSettings& s = msg_.integrator();
+    IntegratorSettings& out = scene_.integrator;
+    if (s.relative_tolerance() < 0.0 || !std::isfinite(s.relative_tolerance())) {
+      errors_.Add(w, "relative_tolerance", "must be positive (0 for the default 1e-6)");
+    } else if (s.relative_tolerance() > 0.0) {
+      out.relative_tolerance = s.relative_tolerance();
+    }
+    if (s.absolute_tolerance() < 0.0 || !std::isfinite(s.absolute_tolerance())) {
+      errors_.Add(w, "absolute_tolerance", "must be positive (0 for the default 1e-9)");
+    } else if (s.absolute_tolerance() > 0.0) {
+      out.absolute_tolerance = s.absolute_tolerance();
+    }
+    if (s.max_steps() < 0) {
+      errors_.Add(w, "max_steps", "must be positive (0 for the default 100000)");
+    } else if (s.max_steps() > 0) {
+      out.max_steps = static_cast<long>(s.max_steps());
+    }
+    if (s.max_wall_seconds() < 0.0 || !std::isfinite(s.max_wall_seconds())) {
+      errors_.Add(w, "max_wall_seconds", "must not be negative (0: no limit)");
+    } else {
+      out.max_wall_seconds = s.max_wall_seconds();
+    }
+  }
+
+  const v1::Scene& msg_;
+  const Where& where_;
+  Errors& errors_;
+  Scene scene_;
+  std::vector<Dimension> units_;  // per parameter
+  std::map<std::string, int> lumped_bodies_, lumped_elements_;
+  std::map<std::string, int> linkage_links_, linkage_joints_;
+};
+
+}  // namespace
+
+Scene ConvertScene(const v1::Scene& message, const Where& where, Errors* errors) {
+  return SceneConverter(message, where, errors).Run();
+}
+
+}  // namespace mbopt::spec::io

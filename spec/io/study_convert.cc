@@ -1,0 +1,291 @@
+#include "spec/io/study_convert.h"
+
+#include <cmath>
+#include <optional>
+#include <set>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "spec/layout.h"
+#include "spec/units.h"
+
+namespace mbopt::spec::io {
+namespace {
+
+// The unit `name` for values of `dimension`; records an error otherwise.
+double UnitFactor(const Where& w, const std::string& field, const std::string& name,
+                  Dimension dimension, Errors* errors) {
+  absl::StatusOr<Unit> unit = FindUnit(name);
+  if (!unit.ok()) {
+    errors->Add(w, field, std::string(unit.status().message()));
+    return 1.0;
+  }
+  if (!UnitFits(*unit, dimension)) {
+    errors->Add(w, field,
+                absl::StrFormat("unit \"%s\" is a %s but the output is a %s", name,
+                                DimensionName(unit->dimension), DimensionName(dimension)));
+  }
+  return unit->si_per_unit;
+}
+
+int FindOutput(const Scene& scene, const Where& w, const std::string& field,
+               const std::string& name, Errors* errors) {
+  const int index = scene.FindOutput(name);
+  if (index < 0) {
+    std::string known;
+    for (const Output& o : scene.outputs)
+      absl::StrAppend(&known, known.empty() ? "" : ", ", "\"", o.name, "\"");
+    errors->Add(w, field,
+                absl::StrCat("unknown output \"", name,
+                             "\"; the scene's outputs: ", known.empty() ? "(none)" : known));
+  }
+  return index;
+}
+
+std::optional<Reduction> ToReduction(v1::Reduction r) {
+  switch (r) {
+    case v1::REDUCTION_MAX:
+      return Reduction::kMax;
+    case v1::REDUCTION_MAX_ABS:
+      return Reduction::kMaxAbs;
+    case v1::REDUCTION_MIN:
+      return Reduction::kMin;
+    case v1::REDUCTION_FINAL:
+      return Reduction::kFinal;
+    default:
+      return std::nullopt;
+  }
+}
+
+}  // namespace
+
+Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* errors) {
+  Study study;
+  study.name = m.name();
+  study.source_file = where.file();
+
+  // Overrides first: the layout (grid size) depends on them.
+  if (m.has_analysis()) {
+    const Where w = where.Child("analysis");
+    const v1::AnalysisOverrides& a = m.analysis();
+    if (a.time_grid_points() < 0) errors->Add(w, "time_grid_points", "must not be negative");
+    if (a.relative_tolerance() < 0) errors->Add(w, "relative_tolerance", "must not be negative");
+    if (a.absolute_tolerance() < 0) errors->Add(w, "absolute_tolerance", "must not be negative");
+    if (a.elements_per_flexible_link() < 0) {
+      errors->Add(w, "elements_per_flexible_link", "must not be negative");
+    }
+    study.analysis.time_grid_points = a.time_grid_points();
+    study.analysis.relative_tolerance = a.relative_tolerance();
+    study.analysis.absolute_tolerance = a.absolute_tolerance();
+    study.analysis.elements_per_flexible_link = a.elements_per_flexible_link();
+    study.analysis.rigid_links = a.rigid_links();
+    if (a.time_grid_points() > 0) scene.time_grid.points = a.time_grid_points();
+    if (a.relative_tolerance() > 0) scene.integrator.relative_tolerance = a.relative_tolerance();
+    if (a.absolute_tolerance() > 0) scene.integrator.absolute_tolerance = a.absolute_tolerance();
+    if (auto* linkage = std::get_if<LinkageModel>(&scene.model)) {
+      for (Link& link : linkage->links) {
+        if (a.elements_per_flexible_link() > 0 && link.flexible_elements > 0) {
+          link.flexible_elements = a.elements_per_flexible_link();
+        }
+        if (a.rigid_links()) link.flexible_elements = 0;
+      }
+    }
+  }
+
+  std::set<std::string> names;
+  std::set<int> bound;
+  for (int i = 0; i < m.variables_size(); ++i) {
+    const v1::DesignVariable& v = m.variables(i);
+    const Where w = where.Child("variables", i);
+    DesignVariable out;
+    out.name = v.name();
+    if (v.name().empty()) errors->Add(w, "name", "a design variable needs a name");
+    if (!names.insert(v.name()).second) {
+      errors->Add(w, "name", absl::StrCat("duplicate design variable \"", v.name(), "\""));
+    }
+    out.parameter = scene.FindParameter(v.parameter());
+    if (out.parameter < 0) {
+      errors->Add(w, "parameter", absl::StrCat("unknown scene parameter \"", v.parameter(), "\""));
+    } else if (!bound.insert(out.parameter).second) {
+      errors->Add(
+          w, "parameter",
+          absl::StrCat("parameter \"", v.parameter(), "\" is already bound to another variable"));
+    }
+    out.scale = v.scale() == 0.0 ? 1.0 : v.scale();
+    if (!(out.scale > 0.0) || !std::isfinite(out.scale)) {
+      errors->Add(w, "scale", absl::StrFormat("must be positive, got %g", v.scale()));
+      out.scale = 1.0;
+    }
+    out.lower = v.lower();
+    out.upper = v.upper();
+    if (!std::isfinite(v.lower()) || !std::isfinite(v.upper())) {
+      errors->Add(w, "lower", "bounds must be finite numbers");
+    } else if (!(v.lower() < v.upper())) {
+      errors->Add(w, "upper",
+                  absl::StrFormat("bounds reversed or empty: lower (%g) must be "
+                                  "below upper (%g)",
+                                  v.lower(), v.upper()));
+    }
+    if (v.has_initial()) {
+      out.initial = v.initial();
+    } else if (out.parameter >= 0) {
+      const Parameter& p = scene.parameters[static_cast<size_t>(out.parameter)];
+      out.initial = p.value_si / p.si_per_unit / out.scale;
+    }
+    const bool bounds_ok =
+        std::isfinite(v.lower()) && std::isfinite(v.upper()) && v.lower() < v.upper();
+    if (bounds_ok && !(out.initial >= out.lower && out.initial <= out.upper)) {
+      errors->Add(
+          w, v.has_initial() ? "initial" : "parameter",
+          absl::StrFormat("initial value %g (scaled%s) is outside the bounds [%g, %g]", out.initial,
+                          v.has_initial() ? "" : ", from the parameter", out.lower, out.upper));
+    }
+    study.variables.push_back(std::move(out));
+  }
+  if (m.variables_size() == 0)
+    errors->Add(where, "variables", "a study needs at least one design variable");
+
+  // Objective.
+  const Where ow = where.Child("objective");
+  const v1::Objective& o = m.objective();
+  Objective& obj = study.objective;
+  obj.unit = o.unit();
+  switch (o.form_case()) {
+    case v1::Objective::kMinimizeMaxOf: {
+      obj.form = Objective::Form::kMinimizeMaxOf;
+      obj.output = FindOutput(scene, ow, "minimize_max_of", o.minimize_max_of(), errors);
+      if (o.reduction() == v1::REDUCTION_MAX) {
+        obj.reduction = Reduction::kMax;
+      } else if (o.reduction() == v1::REDUCTION_MAX_ABS) {
+        obj.reduction = Reduction::kMaxAbs;
+      } else {
+        errors->Add(ow, "reduction", "minimize_max_of needs REDUCTION_MAX or REDUCTION_MAX_ABS");
+      }
+      break;
+    }
+    case v1::Objective::kMinimize:
+      obj.form = Objective::Form::kMinimize;
+      obj.output = FindOutput(scene, ow, "minimize", o.minimize(), errors);
+      if (o.reduction() != v1::REDUCTION_UNSPECIFIED && o.reduction() != v1::REDUCTION_FINAL) {
+        errors->Add(ow, "reduction",
+                    "minimize takes the final value: leave reduction out or "
+                    "use REDUCTION_FINAL (for a maximum over time use "
+                    "minimize_max_of)");
+      }
+      obj.reduction = Reduction::kFinal;
+      break;
+    case v1::Objective::kTargetDistance: {
+      obj.form = Objective::Form::kTargetDistance;
+      const Where tw = ow.Child("target_distance");
+      if (o.target_distance().terms_size() == 0) {
+        errors->Add(tw, "terms", "target_distance needs at least one term");
+      }
+      for (int k = 0; k < o.target_distance().terms_size(); ++k) {
+        const v1::TargetTerm& t = o.target_distance().terms(k);
+        const Where kw = tw.Child("terms", k);
+        TargetTerm term;
+        term.output = FindOutput(scene, kw, "output", t.output(), errors);
+        term.target = t.target();
+        term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
+        if (!(term.weight > 0.0) || !std::isfinite(term.weight)) {
+          errors->Add(kw, "weight", absl::StrFormat("must be positive, got %g", t.weight()));
+        }
+        if (!std::isfinite(t.target())) errors->Add(kw, "target", "must be a finite number");
+        term.unit = t.unit();
+        term.si_per_unit = UnitFactor(
+            kw, "unit", t.unit(),
+            term.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(term.output)])
+                             : Dimension::kAny,
+            errors);
+        obj.terms.push_back(std::move(term));
+      }
+      break;
+    }
+    case v1::Objective::FORM_NOT_SET:
+      errors->Add(where, "objective",
+                  "missing: expected `minimize_max_of`, `minimize` or "
+                  "`target_distance`");
+      break;
+  }
+  if (obj.form != Objective::Form::kTargetDistance) {
+    obj.si_per_unit =
+        UnitFactor(ow, "unit", o.unit(),
+                   obj.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(obj.output)])
+                                   : Dimension::kAny,
+                   errors);
+  }
+
+  // Constraints.
+  std::set<std::string> constraint_names;
+  for (int i = 0; i < m.constraints_size(); ++i) {
+    const v1::Constraint& c = m.constraints(i);
+    const Where w = where.Child("constraints", i);
+    Constraint out;
+    out.name = c.name();
+    if (c.name().empty()) errors->Add(w, "name", "a constraint needs a name");
+    if (!constraint_names.insert(c.name()).second) {
+      errors->Add(w, "name", absl::StrCat("duplicate constraint name \"", c.name(), "\""));
+    }
+    out.output = FindOutput(scene, w, "output", c.output(), errors);
+    if (std::optional<Reduction> r = ToReduction(c.reduction())) {
+      out.reduction = *r;
+    } else {
+      errors->Add(w, "reduction",
+                  "missing: expected REDUCTION_MAX, REDUCTION_MAX_ABS, "
+                  "REDUCTION_MIN or REDUCTION_FINAL");
+    }
+    out.limit = c.limit();
+    if (!std::isfinite(c.limit())) errors->Add(w, "limit", "must be a finite number");
+    if (out.reduction == Reduction::kMaxAbs && !(c.limit() > 0.0)) {
+      errors->Add(w, "limit",
+                  absl::StrFormat("REDUCTION_MAX_ABS needs a positive limit, got %g", c.limit()));
+    }
+    out.unit = c.unit();
+    out.si_per_unit =
+        UnitFactor(w, "unit", c.unit(),
+                   out.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(out.output)])
+                                   : Dimension::kAny,
+                   errors);
+    study.constraints.push_back(std::move(out));
+  }
+
+  // Optimizer settings: 0 / unset keeps the default.
+  if (m.has_optimizer()) {
+    const Where w = where.Child("optimizer");
+    const v1::OptimizerOptions& p = m.optimizer();
+    OptimizerSettings& s = study.optimizer;
+    auto positive = [&](const char* field, double value, double* target) {
+      if (value < 0.0 || !std::isfinite(value)) {
+        errors->Add(w, field,
+                    absl::StrFormat("must be positive (0 for the default), got %g", value));
+      } else if (value > 0.0) {
+        *target = value;
+      }
+    };
+    positive("initial_move_limit", p.initial_move_limit(), &s.initial_move_limit);
+    positive("convergence_objective_tolerance", p.convergence_objective_tolerance(),
+             &s.convergence_objective_tolerance);
+    positive("convergence_violation_tolerance", p.convergence_violation_tolerance(),
+             &s.convergence_violation_tolerance);
+    positive("finite_difference_relative_step", p.finite_difference_relative_step(),
+             &s.finite_difference_relative_step);
+    if (p.max_cycles() < 0) {
+      errors->Add(w, "max_cycles", "must be positive (0 for the default)");
+    } else if (p.max_cycles() > 0) {
+      s.max_cycles = p.max_cycles();
+    }
+    if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
+    s.central_differences = p.finite_difference() == v1::FINITE_DIFFERENCE_CENTRAL;
+  }
+
+  study.scene = std::move(scene);
+  if (errors->empty()) {
+    // Catch what only the layout sees (e.g. minimize on a multi-series output).
+    absl::StatusOr<StudyLayout> layout = MakeStudyLayout(study);
+    if (!layout.ok()) errors->AddRaw(std::string(layout.status().message()));
+  }
+  return study;
+}
+
+}  // namespace mbopt::spec::io

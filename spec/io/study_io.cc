@@ -1,0 +1,186 @@
+#include "spec/io/study_io.h"
+
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/text_format.h>
+#include <google/protobuf/util/json_util.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "common/status_macros.h"
+#include "spec/io/locator.h"
+#include "spec/io/scene_convert.h"
+#include "spec/io/study_convert.h"
+
+namespace mbopt::spec::io {
+namespace {
+
+using google::protobuf::TextFormat;
+
+class CollectErrors : public google::protobuf::io::ErrorCollector {
+ public:
+  explicit CollectErrors(std::string file) : file_(std::move(file)) {}
+  void AddError(int line, google::protobuf::io::ColumnNumber column,
+                const std::string& message) override {
+    messages_.push_back(Format(line, column, message));
+  }
+  void AddWarning(int line, google::protobuf::io::ColumnNumber column,
+                  const std::string& message) override {
+    messages_.push_back(Format(line, column, absl::StrCat("warning: ", message)));
+  }
+  const std::vector<std::string>& messages() const { return messages_; }
+
+ private:
+  std::string Format(int line, int column, const std::string& message) const {
+    if (line < 0) return absl::StrCat(file_, ": ", message);
+    return absl::StrCat(file_, ":", line + 1, ":", column + 1, ": ", message);
+  }
+  std::string file_;
+  std::vector<std::string> messages_;
+};
+
+absl::StatusOr<std::string> ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open file"));
+  std::ostringstream content;
+  content << in.rdbuf();
+  if (in.bad()) return absl::DataLossError(absl::StrCat(path, ": read error"));
+  return content.str();
+}
+
+bool IsJson(const std::string& path) { return std::filesystem::path(path).extension() == ".json"; }
+
+// Parses `path` into `message`; `tree` receives field locations (text only).
+absl::Status ParseFile(const std::string& path, google::protobuf::Message* message,
+                       TextFormat::ParseInfoTree* tree) {
+  MBOPT_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
+  if (IsJson(path)) {
+    google::protobuf::util::JsonParseOptions options;
+    const auto status = google::protobuf::util::JsonStringToMessage(text, message, options);
+    if (!status.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(path, ": not a valid ",
+                                                     message->GetDescriptor()->name(),
+                                                     " in JSON: ", status.message().as_string()));
+    }
+    return absl::OkStatus();
+  }
+  CollectErrors collector(path);
+  TextFormat::Parser parser;
+  parser.RecordErrorsTo(&collector);
+  parser.WriteLocationsTo(tree);
+  if (!parser.ParseFromString(text, message) || !collector.messages().empty()) {
+    std::string all = absl::StrJoin(collector.messages(), "\n");
+    if (all.empty()) all = absl::StrCat(path, ": could not parse");
+    return absl::InvalidArgumentError(all);
+  }
+  return absl::OkStatus();
+}
+
+// A study file and its scene, parsed, with locations for both.
+struct ParsedStudy {
+  v1::Study study;
+  TextFormat::ParseInfoTree study_tree;
+  v1::Scene scene;  // from scene_file, or a copy of the inline one
+  TextFormat::ParseInfoTree scene_file_tree;
+  std::string scene_file;  // resolved path, empty if inline
+};
+
+absl::Status ParseStudy(const std::string& path, ParsedStudy* parsed) {
+  MBOPT_RETURN_IF_ERROR(ParseFile(path, &parsed->study, &parsed->study_tree));
+  switch (parsed->study.scene_source_case()) {
+    case v1::Study::kSceneFile: {
+      std::filesystem::path scene_path(parsed->study.scene_file());
+      if (scene_path.is_relative()) {
+        scene_path = std::filesystem::path(path).parent_path() / scene_path;
+      }
+      parsed->scene_file = scene_path.lexically_normal().string();
+      absl::Status s = ParseFile(parsed->scene_file, &parsed->scene, &parsed->scene_file_tree);
+      if (absl::IsNotFound(s)) {
+        Where where(path, v1::Study::descriptor(), &parsed->study_tree);
+        return absl::InvalidArgumentError(absl::StrCat(
+            where.Describe("scene_file"), ": cannot open scene file \"", parsed->scene_file, "\""));
+      }
+      return s;
+    }
+    case v1::Study::kScene:
+      parsed->scene = parsed->study.scene();
+      return absl::OkStatus();
+    case v1::Study::SCENE_SOURCE_NOT_SET:
+      return absl::InvalidArgumentError(
+          absl::StrCat(path,
+                       ": scene_file or scene: missing: expected `scene_file: "
+                       "\"name.scene.textproto\"` or an inline `scene { ... }`"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Study> ConvertParsed(const std::string& path, const ParsedStudy& parsed) {
+  Errors errors;
+  const Where study_where(path, v1::Study::descriptor(), &parsed.study_tree);
+  const Where scene_where =
+      parsed.scene_file.empty()
+          ? study_where.Child("scene")
+          : Where(parsed.scene_file, v1::Scene::descriptor(), &parsed.scene_file_tree);
+  Scene scene = ConvertScene(parsed.scene, scene_where, &errors);
+  if (!errors.empty()) return errors.ToStatus();
+  Study study = ConvertStudy(parsed.study, std::move(scene), study_where, &errors);
+  MBOPT_RETURN_IF_ERROR(errors.ToStatus());
+  return study;
+}
+
+}  // namespace
+
+absl::StatusOr<Scene> LoadSceneFile(const std::string& path) {
+  v1::Scene message;
+  TextFormat::ParseInfoTree tree;
+  MBOPT_RETURN_IF_ERROR(ParseFile(path, &message, &tree));
+  Errors errors;
+  Scene scene = ConvertScene(message, Where(path, v1::Scene::descriptor(), &tree), &errors);
+  MBOPT_RETURN_IF_ERROR(errors.ToStatus());
+  return scene;
+}
+
+absl::StatusOr<Study> LoadStudyFile(const std::string& path) {
+  ParsedStudy parsed;
+  MBOPT_RETURN_IF_ERROR(ParseStudy(path, &parsed));
+  return ConvertParsed(path, parsed);
+}
+
+absl::StatusOr<v1::Study> ReadStudyProto(const std::string& path) {
+  ParsedStudy parsed;
+  MBOPT_RETURN_IF_ERROR(ParseStudy(path, &parsed));
+  MBOPT_RETURN_IF_ERROR(ConvertParsed(path, parsed).status());
+  v1::Study inlined = parsed.study;
+  *inlined.mutable_scene() = parsed.scene;  // replaces scene_file (oneof)
+  return inlined;
+}
+
+absl::StatusOr<Scene> SceneFromProto(const v1::Scene& message, const std::string& source_name) {
+  Errors errors;
+  Scene scene =
+      ConvertScene(message, Where(source_name, v1::Scene::descriptor(), nullptr), &errors);
+  MBOPT_RETURN_IF_ERROR(errors.ToStatus());
+  return scene;
+}
+
+absl::StatusOr<Study> StudyFromProto(const v1::Study& message, const std::string& source_name) {
+  if (message.scene_source_case() != v1::Study::kScene) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(source_name,
+                     ": scene: missing: the study must carry its scene inline (a scene_file "
+                     "cannot be resolved here)"));
+  }
+  Errors errors;
+  const Where where(source_name, v1::Study::descriptor(), nullptr);
+  Scene scene = ConvertScene(message.scene(), where.Child("scene"), &errors);
+  if (!errors.empty()) return errors.ToStatus();
+  Study study = ConvertStudy(message, std::move(scene), where, &errors);
+  MBOPT_RETURN_IF_ERROR(errors.ToStatus());
+  return study;
+}
+
+}  // namespace mbopt::spec::io

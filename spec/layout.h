@@ -1,0 +1,112 @@
+// The optimization layout of a study: how the outputs of one analysis become
+// the objective terms and the one-sided constraint rows g_h <= c_h that the
+// SLP core sees. Computed from the study alone (no analysis needed), so the
+// server can build its problem before any worker has run; and applied to an
+// analysis' outputs by ComputeStudyValues.
+//
+// Conventions (also in docs/study.md):
+//  - Shapes: every output has `series` time series (a bending-stress output
+//    has one per stress node, see OutputShapeOf) of `instants` values: the
+//    grid's points, or 1 for a scalar output (mass).
+//  - Objective, minimize_max_of: min-max form. Terms, instant-major and then
+//    series: MAX gives f(t_i); MAX_ABS gives f(t_i) and -f(t_i) (two terms
+//    per instant and series). F = max of the terms.
+//  - Objective, minimize: scalar form, one term: the final value of the
+//    output (its only value for a scalar output); the output must have one
+//    series.
+//  - Objective, target_distance: scalar form, one term:
+//    F = sqrt(sum_k w_k (o_k(final) / unit_k - target_k)^2).
+//  - Objective values (terms and F) are reported in objective.unit, except
+//    target_distance, whose F is in the terms' own units.
+//  - Constraint rows, for every instant (instant-major, then series):
+//    MAX: f <= c ("upper"); MIN: -f <= -c ("lower"); MAX_ABS: f <= c
+//    ("upper") and -f <= c ("lower"); FINAL: f(t_last) <= c ("upper").
+//    g and c are SI; scale = |c| (1 when c = 0), so the normalized value
+//    (g - c) / scale is docs/method.md's g/c - 1.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "spec/study.h"
+#include "spec/units.h"
+
+namespace mbopt::spec {
+
+struct OutputShape {
+  int series = 1;
+  int instants = 1;
+  std::vector<std::string> series_labels;  // one per series
+};
+
+// What the engine produces for scene output `output`. Bending stress: the
+// link's stations are the nodes of its beam elements (flexible.elements
+// elements, or 6 for a rigid link), numbered 0..n from joint_a; a series is
+// reported for every node where the moment is not zero by a pin: interior
+// nodes, plus the end at the driver's pivot when the link is the driven one
+// (clamped to the drive). Labels are "node j".
+OutputShape OutputShapeOf(const Scene& scene, int output);
+
+// Number of stress stations (elements) of a rigid link; see OutputShapeOf.
+inline constexpr int kRigidLinkStressElements = 6;
+
+// The physical dimension of an output's values (for unit checks).
+Dimension OutputDimension(const Output& output);
+
+enum class ObjectiveForm { kScalar, kMinMax };
+
+// A reference to one value of an analysis: output, series, instant, sign.
+struct ValueRef {
+  int output = -1;
+  int series = 0;
+  int instant = 0;
+  double sign = 1.0;
+};
+
+struct ConstraintRow {
+  std::string name;     // e.g. "s1@t=1.750s upper"
+  int constraint = -1;  // index into study.constraints
+  ValueRef value;       // g_h = sign * f (SI)
+  double limit_si = 0;  // c_h
+  double scale = 1;     // > 0
+  double time_s = 0;    // the instant (0 for scalar outputs)
+};
+
+struct StudyLayout {
+  ObjectiveForm objective_form = ObjectiveForm::kScalar;
+  // kMinMax: one per term. kScalar with minimize: the one value. kScalar
+  // with target_distance: empty (the term combines several outputs).
+  std::vector<ValueRef> objective_terms;
+  std::vector<ConstraintRow> rows;
+  std::vector<OutputShape> outputs;  // one per scene output
+  std::vector<double> instants_s;    // the grid
+
+  int num_objective_terms() const {
+    return objective_form == ObjectiveForm::kMinMax ? static_cast<int>(objective_terms.size()) : 1;
+  }
+  int num_constraints() const { return static_cast<int>(rows.size()); }
+};
+
+// InvalidArgument (naming the study file and the field) if the study's
+// objective or constraints cannot be laid out, e.g. minimize_max_of with
+// reduction MIN, or minimize on a multi-series output.
+absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study);
+
+// The study's values at one analysis.
+struct StudyValues {
+  std::vector<double> objective_terms;    // num_objective_terms, objective unit
+  std::vector<double> constraint_values;  // g_h, SI, aligned with layout.rows
+  double objective = 0;                   // F, objective unit
+  double max_violation = 0;               // max_h (g_h - c_h) / scale_h; > 0 violated; 0 if no rows
+  int worst_row = -1;                     // row of max_violation; -1 if no rows
+};
+
+// `outputs_si[o]` points at output o's series, [series][instant], SI (as
+// engine::OutputValues::series). InvalidArgument if a shape differs from the
+// layout's; a non-finite value is passed through (the optimizer rejects it).
+absl::StatusOr<StudyValues> ComputeStudyValues(
+    const Study& study, const StudyLayout& layout,
+    const std::vector<const std::vector<std::vector<double>>*>& outputs_si);
+
+}  // namespace mbopt::spec

@@ -1,0 +1,149 @@
+// Unit tests of the CLI's and the worker's pure helpers: JSON writing,
+// argument parsing, result formats, the server's readiness line, and the
+// reconnection backoff.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "client/args.h"
+#include "client/job_format.h"
+#include "client/json_writer.h"
+#include "client/local_cluster.h"
+#include "worker/service/backoff.h"
+
+namespace mbopt {
+namespace {
+
+TEST(JsonWriter, WritesNestedDocumentsWithCommas) {
+  client::JsonWriter w(0);
+  w.BeginObject();
+  w.Field("a", 1);
+  w.Key("b");
+  w.BeginArray();
+  w.Number(0.5);
+  w.String("x\"y");
+  w.EndArray();
+  w.Key("c");
+  w.BeginObject();
+  w.EndObject();
+  w.EndObject();
+  EXPECT_EQ(w.str(), R"({"a":1,"b":[0.5,"x\"y"],"c":{}})");
+}
+
+TEST(JsonWriter, DoublesRoundTripBitForBitAndNonFiniteIsNull) {
+  const double third = 1.0 / 3.0;
+  const std::string text = client::JsonWriter::FormatDouble(third);
+  EXPECT_EQ(std::strtod(text.c_str(), nullptr), third);  // bit identity is the point
+  EXPECT_EQ(client::JsonWriter::FormatDouble(std::numeric_limits<double>::quiet_NaN()), "null");
+  EXPECT_EQ(client::JsonWriter::FormatDouble(INFINITY), "null");
+}
+
+TEST(JsonWriter, EscapesControlCharacters) {
+  EXPECT_EQ(client::JsonWriter::Quote("a\nb\x01"), "\"a\\nb\\u0001\"");
+}
+
+TEST(ParseArgs, SeparatesPositionalOptionsAndFlags) {
+  auto parsed = client::ParseArgs({"file.textproto", "--workers", "3", "--json", "--db=x.db"},
+                                  {{"--workers", "--db"}, {"--json"}});
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  EXPECT_EQ(parsed->positional, std::vector<std::string>{"file.textproto"});
+  EXPECT_EQ(parsed->Value("--db"), "x.db");
+  EXPECT_TRUE(parsed->Has("--json"));
+  auto workers = parsed->IntValue("--workers", 1);
+  ASSERT_TRUE(workers.ok());
+  EXPECT_EQ(workers->value(), 3);
+}
+
+TEST(ParseArgs, RejectsUnknownOptionsMissingValuesAndBadIntegers) {
+  EXPECT_FALSE(client::ParseArgs({"--bogus"}, {}).ok());
+  EXPECT_FALSE(client::ParseArgs({"--workers"}, {{"--workers"}, {}}).ok());
+  auto parsed = client::ParseArgs({"--workers", "0"}, {{"--workers"}, {}});
+  ASSERT_TRUE(parsed.ok());
+  EXPECT_FALSE(parsed->IntValue("--workers", 1).ok());
+}
+
+TEST(ReadinessLine, GivesTheAddress) {
+  auto address = client::ParseListeningLine("mbopt-server listening on 127.0.0.1:40123");
+  ASSERT_TRUE(address.ok());
+  EXPECT_EQ(*address, "127.0.0.1:40123");
+  EXPECT_FALSE(client::ParseListeningLine("error: cannot open db").ok());
+}
+
+v1::GetJobResponse SampleJob() {
+  v1::GetJobResponse job;
+  auto* s = job.mutable_summary();
+  s->set_job_id("j1");
+  s->set_state(v1::JOB_STATE_CONVERGED);
+  s->set_cycles(2);
+  s->set_objective(6.4);
+  s->set_objective_unit("m/s^2");
+  s->add_design_names("x1");
+  s->add_design(5.0);
+  s->add_design_units("lbf/in");
+  for (int c = 1; c <= 2; ++c) {
+    auto* rejected = job.add_cycles();
+    rejected->set_cycle(c);
+    rejected->set_accepted(false);
+    auto* r = job.add_cycles();
+    r->set_cycle(c);
+    r->set_attempt(1);
+    r->set_accepted(true);
+    r->set_objective_trial(7.0 - c);
+    r->add_move_limits(0.2);
+    r->add_x_trial_physical(5.0);
+  }
+  return job;
+}
+
+TEST(ResultsJson, HistoryHoldsOnlyAcceptedCyclesAndDesignIsByName) {
+  const std::string json = client::ResultsJson(SampleJob());
+  EXPECT_NE(json.find("\"status\": \"converged\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"x1\": 5"), std::string::npos) << json;
+  size_t entries = 0;
+  for (auto p = json.find("\"attempts\""); p != std::string::npos; p = json.find("\"attempts\"", p + 1)) {
+    ++entries;
+  }
+  EXPECT_EQ(entries, 2u) << json;
+}
+
+TEST(ResultsCsv, OneRowPerLpSolveWithDesignColumns) {
+  const std::string csv = client::ResultsCsv(SampleJob());
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);  // header + 4 records
+  EXPECT_NE(csv.find(",x1\n"), std::string::npos) << csv;
+}
+
+TEST(JobState, ExitCodesFollowTheOutcome) {
+  EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_CONVERGED), 0);
+  EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_STALLED), 1);
+  EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_MAX_CYCLES), 1);
+  EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_FAILED), 4);
+  EXPECT_EQ(client::StateName(v1::JOB_STATE_INTERRUPTED), "interrupted");
+}
+
+TEST(Backoff, GrowsGeometricallyUpToTheCapWithBoundedJitter) {
+  worker::BackoffOptions options;
+  options.initial = std::chrono::milliseconds(100);
+  options.max = std::chrono::milliseconds(1000);
+  options.multiplier = 2.0;
+  options.jitter = 0.5;
+  worker::Backoff backoff(options, 42);
+  const double expected_base_ms[] = {100, 200, 400, 800, 1000, 1000, 1000};
+  for (double base : expected_base_ms) {
+    const double ms = static_cast<double>(backoff.Next().count());
+    EXPECT_GE(ms, 0.5 * base - 1) << base;  // 1 ms: rounding to whole milliseconds
+    EXPECT_LE(ms, base + 1) << base;
+  }
+  backoff.Reset();
+  EXPECT_LE(backoff.Next().count(), 101);
+}
+
+TEST(Backoff, SameSeedGivesSameDelays) {
+  worker::Backoff a({}, 7), b({}, 7);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(a.Next(), b.Next());
+}
+
+}  // namespace
+}  // namespace mbopt

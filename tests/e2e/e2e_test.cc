@@ -1,0 +1,386 @@
+// End-to-end tests with real processes on loopback: mbopt-server,
+// mbopt-worker and the mbopt CLI, on the vehicle example (a full
+// optimization takes a few seconds). What "the same result" means: the
+// `results --json` document without job id and wall time, compared as text;
+// its numbers are printed with 17 significant digits, so equal text is
+// bit-identical doubles.
+#include <signal.h>
+
+#include <string>
+#include <vector>
+
+#include <google/protobuf/text_format.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+#include "mbopt/v1/service.grpc.pb.h"
+#include "spec/io/study_io.h"
+#include "tests/e2e/e2e_harness.h"
+
+namespace mbopt::e2e {
+namespace {
+
+using client::Subprocess;
+
+constexpr int kExitOk = 0, kExitNotConverged = 1, kExitBadInput = 2, kExitUnreachable = 3;
+constexpr int kKilledBySigkill = 128 + SIGKILL;
+// Short leases so that a lost worker's task is handed out again quickly.
+const std::vector<std::string> kFastLeases = {"--lease-ms", "1500", "--heartbeat-ms", "200"};
+
+// A job ended in a state that is an outcome of the optimization (not a crash
+// of the service): the exit codes of watch/results for it.
+bool IsOutcomeExitCode(int code) { return code == kExitOk || code == kExitNotConverged; }
+
+std::string Describe(const Subprocess::Output& out) {
+  return absl::StrCat("exit ", out.exit_code, "\nstdout:\n", out.stdout_text, "\nstderr:\n",
+                      out.stderr_text);
+}
+
+// Submits the vehicle study, follows it to its end and returns `results --json`.
+std::string SubmitWatchAndGetResults(const std::string& address) {
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", address});
+  EXPECT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto watched = Mbopt({"watch", job, "--server", address});
+  EXPECT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
+  auto results = Mbopt({"results", job, "--json", "--server", address});
+  EXPECT_TRUE(IsOutcomeExitCode(results.exit_code)) << Describe(results);
+  return results.stdout_text;
+}
+
+// The vehicle study on a fresh server with `workers` plain workers.
+std::string ReferenceResult(int workers) {
+  ScratchDir dir;
+  auto server = StartServer(dir.File("ref.db"), {}, "127.0.0.1:0", dir.File("server.log"));
+  EXPECT_TRUE(server.ok()) << server.status();
+  if (!server.ok()) return "";
+  std::vector<Subprocess> pool;
+  for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address));
+  std::string json = SubmitWatchAndGetResults(server->address);
+  for (auto& w : pool) w.Stop(kGuard);
+  EXPECT_EQ(server->process->Stop(kGuard), 0) << "server did not shut down cleanly";
+  return json;
+}
+
+// The "cycles:" line of `mbopt status`.
+int CyclesInStatus(const std::string& status_text) {
+  const std::string key = "cycles:";
+  auto pos = status_text.find(key);
+  return pos == std::string::npos ? -1 : std::atoi(status_text.c_str() + pos + key.size());
+}
+
+void ExpectConsecutiveHistory(const std::string& json) {
+  std::vector<int> cycles = HistoryCycles(json);
+  ASSERT_FALSE(cycles.empty()) << json;
+  for (size_t i = 0; i < cycles.size(); ++i) {
+    EXPECT_EQ(cycles[i], static_cast<int>(i) + 1) << "history entry " << i << " in\n" << json;
+  }
+}
+
+TEST(EndToEnd, SubmitWatchAndResultsOnLoopbackWithTwoWorkers) {
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), {}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  std::vector<Subprocess> pool;
+  for (int i = 0; i < 2; ++i) {
+    pool.push_back(StartWorker(server->address, {"--name", absl::StrCat("w", i)},
+                               dir.File(absl::StrCat("worker", i, ".log"))));
+  }
+  const std::string addr = server->address;
+
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", addr});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  ASSERT_FALSE(job.empty());
+  EXPECT_EQ(job.find('\n'), std::string::npos) << "submit prints only the job id";
+
+  auto watched = Mbopt({"watch", job, "--server", addr});
+  ASSERT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
+  EXPECT_NE(watched.stdout_text.find("cycle"), std::string::npos) << watched.stdout_text;
+  EXPECT_NE(watched.stdout_text.find("maxfout"), std::string::npos) << watched.stdout_text;
+  EXPECT_NE(watched.stdout_text.find(job + ": "), std::string::npos) << watched.stdout_text;
+  EXPECT_EQ(watched.stdout_text.find("\033["), std::string::npos)
+      << "no terminal control sequences when stdout is not a terminal";
+
+  auto results = Mbopt({"results", job, "--json", "--server", addr});
+  ASSERT_EQ(results.exit_code, watched.exit_code) << Describe(results);
+  const std::string& json = results.stdout_text;
+  for (const char* key : {"status", "cycles", "analyses", "objective", "objective_unit",
+                          "max_violation", "design", "wall_seconds", "history"}) {
+    EXPECT_NE(json.find(absl::StrCat("\"", key, "\":")), std::string::npos) << key << "\n" << json;
+  }
+  const std::string status = JsonField(json, "status");
+  EXPECT_TRUE(status == "converged" || status == "max_cycles" || status == "stalled") << json;
+  EXPECT_EQ(watched.exit_code, status == "converged" ? kExitOk : kExitNotConverged);
+  EXPECT_GT(std::stoi(JsonField(json, "cycles")), 0);
+  EXPECT_GT(std::stoll(JsonField(json, "analyses")), 0);
+  ExpectConsecutiveHistory(json);
+
+  auto csv = Mbopt({"results", job, "--csv", "--server", addr});
+  EXPECT_EQ(csv.stdout_text.rfind("cycle,attempt,accepted,objective", 0), 0u) << csv.stdout_text;
+  auto table = Mbopt({"results", job, "--server", addr});
+  EXPECT_NE(table.stdout_text.find("status:        " + status), std::string::npos)
+      << table.stdout_text;
+  auto st = Mbopt({"status", job, "--server", addr});
+  EXPECT_EQ(st.exit_code, kExitOk) << Describe(st);
+  EXPECT_NE(st.stdout_text.find(job), std::string::npos);
+  auto listed = Mbopt({"list", "--server", addr});
+  EXPECT_EQ(listed.exit_code, kExitOk) << Describe(listed);
+  EXPECT_NE(listed.stdout_text.find(job), std::string::npos) << listed.stdout_text;
+  auto from_env = Mbopt({"status", job}, {"MBOPT_SERVER=" + addr});
+  EXPECT_EQ(from_env.exit_code, kExitOk) << "MBOPT_SERVER selects the server\n"
+                                         << Describe(from_env);
+
+  auto submit_watch = Mbopt({"submit", VehicleStudy(), "--watch", "--server", addr});
+  EXPECT_EQ(submit_watch.exit_code, watched.exit_code) << Describe(submit_watch);
+  EXPECT_NE(submit_watch.stdout_text.find("maxfout"), std::string::npos) << submit_watch.stdout_text;
+
+  for (auto& w : pool) EXPECT_EQ(w.Stop(kGuard), 0) << "workers exit cleanly on SIGTERM";
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
+TEST(EndToEnd, ResultsAreIdenticalWithOneTwoAndFourWorkers) {
+  const std::string one = Comparable(ReferenceResult(1));
+  ASSERT_FALSE(one.empty());
+  EXPECT_EQ(Comparable(ReferenceResult(2)), one);
+  EXPECT_EQ(Comparable(ReferenceResult(4)), one);
+}
+
+TEST(EndToEnd, WorkerKilledMidCycleDoesNotChangeTheResult) {
+  const std::string reference = Comparable(ReferenceResult(1));
+  ASSERT_FALSE(reference.empty());
+
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), kFastLeases, "127.0.0.1:0",
+                            dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  // The doomed worker takes tasks alone first, so that it surely receives its
+  // third task while the first cycle's batch is in progress.
+  Subprocess doomed = StartWorker(server->address, {"--die-after-tasks", "3", "--name", "doomed"},
+                                  dir.File("doomed.log"));
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto died = doomed.Wait(kGuard);
+  ASSERT_TRUE(died.ok()) << died.status();
+  EXPECT_EQ(*died, kKilledBySigkill);
+  Subprocess survivor = StartWorker(server->address, {"--name", "survivor"},
+                                    dir.File("survivor.log"));
+
+  auto watched = Mbopt({"watch", job, "--server", server->address});
+  ASSERT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
+  auto results = Mbopt({"results", job, "--json", "--server", server->address});
+  EXPECT_EQ(Comparable(results.stdout_text), reference);
+  survivor.Stop(kGuard);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
+TEST(EndToEnd, ServerKilledMidJobResumesBitIdentically) {
+  const std::string reference = Comparable(ReferenceResult(2));
+  ASSERT_FALSE(reference.empty());
+
+  ScratchDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::vector<std::string> crash_args = kFastLeases;
+  crash_args.insert(crash_args.end(), {"--crash-after-cycles", "2"});
+  auto first = StartServer(db, crash_args, "127.0.0.1:0", dir.File("server1.log"));
+  ASSERT_TRUE(first.ok()) << first.status();
+  std::vector<Subprocess> pool;
+  for (int i = 0; i < 2; ++i) {
+    pool.push_back(StartWorker(first->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
+  }
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", first->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto crashed = first->process->Wait(kGuard);
+  ASSERT_TRUE(crashed.ok()) << crashed.status();
+  ASSERT_EQ(*crashed, kKilledBySigkill) << "--crash-after-cycles kills the server";
+
+  // Same database, same port: the running workers reconnect by themselves.
+  auto second = StartServer(db, kFastLeases, absl::StrCat("127.0.0.1:", first->port),
+                            dir.File("server2.log"));
+  ASSERT_TRUE(second.ok()) << second.status();
+  auto st = Mbopt({"status", job, "--server", second->address});
+  ASSERT_EQ(st.exit_code, kExitOk) << Describe(st);
+  if (st.stdout_text.find("interrupted") != std::string::npos) {
+    auto resumed = Mbopt({"resume", job, "--server", second->address});
+    ASSERT_EQ(resumed.exit_code, kExitOk) << Describe(resumed);
+  }
+  auto watched = Mbopt({"watch", job, "--server", second->address});
+  ASSERT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
+  auto results = Mbopt({"results", job, "--json", "--server", second->address});
+  ExpectConsecutiveHistory(results.stdout_text);
+  // The crash really was in the middle of the job.
+  const int cycles_at_restart = CyclesInStatus(st.stdout_text);
+  EXPECT_GE(cycles_at_restart, 2) << st.stdout_text;
+  EXPECT_LT(cycles_at_restart, std::stoi(JsonField(results.stdout_text, "cycles")));
+  EXPECT_EQ(Comparable(results.stdout_text), reference);
+  for (auto& w : pool) EXPECT_EQ(w.Stop(kGuard), 0);
+  EXPECT_EQ(second->process->Stop(kGuard), 0);
+}
+
+TEST(EndToEnd, RunJsonStartsEverythingAndPrintsOneJsonObject) {
+  const std::string reference = Comparable(ReferenceResult(2));
+  auto run = Mbopt({"run", VehicleStudy(), "--workers", "2", "--json"},
+                   {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()});
+  ASSERT_TRUE(IsOutcomeExitCode(run.exit_code)) << Describe(run);
+  const std::string json = Trim(run.stdout_text);
+  ASSERT_FALSE(json.empty());
+  EXPECT_EQ(json.front(), '{');
+  EXPECT_EQ(json.back(), '}');
+  EXPECT_EQ(json.find("\n}"), json.size() - 2) << "exactly one object on stdout";
+  EXPECT_EQ(Comparable(run.stdout_text), reference);
+}
+
+// ------------------------------------------------------------- bad input --
+
+TEST(BadInput, MalformedStudyFileNamesFileAndLine) {
+  ScratchDir dir;
+  const std::string path = dir.Write("broken.study.textproto",
+                                     "name: \"broken\"\nvariables {\n  name: \"x1\"\n  lower: 1.0\n");
+  auto out = Mbopt({"submit", path, "--server", "127.0.0.1:1"});
+  EXPECT_EQ(out.exit_code, kExitBadInput) << Describe(out);
+  EXPECT_NE(out.stderr_text.find("broken.study.textproto:"), std::string::npos) << out.stderr_text;
+}
+
+// The vehicle study with its scene inlined, as text (a self-contained file).
+std::string InlinedVehicleStudy(v1::Study* study) {
+  auto read = spec::io::ReadStudyProto(VehicleStudy());
+  EXPECT_TRUE(read.ok()) << read.status();
+  if (!read.ok()) return "";
+  *study = *read;
+  std::string text;
+  google::protobuf::TextFormat::PrintToString(*study, &text);
+  return text;
+}
+
+TEST(BadInput, UnknownFieldIsNamed) {
+  ScratchDir dir;
+  v1::Study study;
+  const std::string text = InlinedVehicleStudy(&study);
+  ASSERT_FALSE(text.empty());
+  const std::string path = dir.Write("unknown.study.textproto", text + "bogus_setting: 3\n");
+  auto out = Mbopt({"submit", path, "--server", "127.0.0.1:1"});
+  EXPECT_EQ(out.exit_code, kExitBadInput) << Describe(out);
+  EXPECT_NE(out.stderr_text.find("bogus_setting"), std::string::npos) << out.stderr_text;
+  EXPECT_NE(out.stderr_text.find("unknown.study.textproto"), std::string::npos) << out.stderr_text;
+  auto run = Mbopt({"run", path}, {"MBOPT_SERVER_BIN=" + ServerBinary()});
+  EXPECT_EQ(run.exit_code, kExitBadInput) << "run checks the file before starting anything\n"
+                                          << Describe(run);
+}
+
+TEST(BadInput, ReversedBoundsAreNamed) {
+  ScratchDir dir;
+  v1::Study study;
+  ASSERT_FALSE(InlinedVehicleStudy(&study).empty());
+  ASSERT_GT(study.variables_size(), 0);
+  auto* v = study.mutable_variables(0);
+  const double lower = v->lower();
+  v->set_lower(v->upper());
+  v->set_upper(lower);
+  std::string text;
+  google::protobuf::TextFormat::PrintToString(study, &text);
+  const std::string path = dir.Write("reversed.study.textproto", text);
+  auto out = Mbopt({"submit", path, "--server", "127.0.0.1:1"});
+  EXPECT_EQ(out.exit_code, kExitBadInput) << Describe(out);
+  EXPECT_NE(out.stderr_text.find("reversed.study.textproto"), std::string::npos) << out.stderr_text;
+  EXPECT_TRUE(out.stderr_text.find("lower") != std::string::npos ||
+              out.stderr_text.find("upper") != std::string::npos)
+      << out.stderr_text;
+}
+
+TEST(BadInput, UnknownJobIdIsAClearError) {
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), {}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  for (const char* command : {"status", "watch", "results", "cancel", "resume"}) {
+    auto out = Mbopt({command, "no-such-job", "--server", server->address});
+    EXPECT_EQ(out.exit_code, kExitBadInput) << command << "\n" << Describe(out);
+    EXPECT_NE(out.stderr_text.find("no-such-job"), std::string::npos)
+        << command << "\n" << out.stderr_text;
+  }
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
+TEST(BadInput, UnreachableServerIsAClearError) {
+  auto out = Mbopt({"list", "--server", "127.0.0.1:1"});
+  EXPECT_EQ(out.exit_code, kExitUnreachable) << Describe(out);
+  EXPECT_NE(out.stderr_text.find("cannot reach server at 127.0.0.1:1"), std::string::npos)
+      << out.stderr_text;
+}
+
+TEST(BadInput, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(Mbopt({}).exit_code, kExitBadInput);
+  EXPECT_EQ(Mbopt({"frobnicate"}).exit_code, kExitBadInput);
+  EXPECT_EQ(Mbopt({"status"}).exit_code, kExitBadInput);
+  EXPECT_EQ(Mbopt({"run", VehicleStudy(), "--workers", "zero"}).exit_code, kExitBadInput);
+  EXPECT_EQ(Mbopt({"results", "j", "--csv", "--json"}).exit_code, kExitBadInput);
+}
+
+// A worker that reports wrong-size vectors: the server refuses the result or
+// treats it as a failed analysis, and keeps serving; a job run by real
+// workers next to it completes with the undisturbed result.
+TEST(BadInput, GarbageResultsDoNotStopTheServer) {
+  const std::string reference = Comparable(ReferenceResult(2));
+  ASSERT_FALSE(reference.empty());
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), kFastLeases, "127.0.0.1:0",
+                            dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  auto victim = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  ASSERT_EQ(victim.exit_code, kExitOk) << Describe(victim);
+  const std::string victim_job = Trim(victim.stdout_text);
+
+  auto channel = grpc::CreateChannel(server->address, grpc::InsecureChannelCredentials());
+  auto stub = v1::WorkerService::NewStub(channel);
+  v1::RegisterWorkerRequest reg;
+  reg.set_name("garbage");
+  reg.set_slots(4);
+  v1::RegisterWorkerResponse registered;
+  {
+    grpc::ClientContext context;
+    ASSERT_TRUE(stub->Register(&context, reg, &registered).ok());
+  }
+  v1::AcquireTasksRequest acquire;
+  acquire.set_worker_id(registered.worker_id());
+  acquire.set_max_tasks(4);
+  acquire.set_wait_ms(30000);
+  v1::AcquireTasksResponse tasks;
+  {
+    grpc::ClientContext context;
+    ASSERT_TRUE(stub->AcquireTasks(&context, acquire, &tasks).ok());
+  }
+  ASSERT_GT(tasks.tasks_size(), 0);
+  for (const auto& task : tasks.tasks()) {
+    v1::TaskResult garbage;
+    garbage.set_worker_id(registered.worker_id());
+    garbage.set_task_id(task.task_id());
+    garbage.set_job_id(task.job_id());
+    garbage.set_request_id(task.request_id());
+    garbage.set_ok(true);
+    garbage.add_objective_terms(1.0);  // far too few terms and rows
+    garbage.add_constraint_values(2.0);
+    garbage.add_constraint_values(3.0);
+    v1::ReportResultResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub->ReportResult(&context, garbage, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+        << "a result that does not fit its task is refused: " << status.error_message();
+  }
+  ASSERT_TRUE(server->process->running()) << "the server survived garbage";
+
+  std::vector<Subprocess> pool;
+  for (int i = 0; i < 2; ++i) pool.push_back(StartWorker(server->address));
+  const std::string json = SubmitWatchAndGetResults(server->address);
+  EXPECT_EQ(Comparable(json), reference) << "another job is served normally";
+  auto victim_end = Mbopt({"watch", victim_job, "--server", server->address});
+  EXPECT_TRUE(victim_end.exit_code == kExitOk || victim_end.exit_code == kExitNotConverged ||
+              victim_end.exit_code == 4)
+      << "the job that got garbage ends too\n" << Describe(victim_end);
+  for (auto& w : pool) w.Stop(kGuard);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
+}  // namespace
+}  // namespace mbopt::e2e

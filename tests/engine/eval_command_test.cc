@@ -1,0 +1,102 @@
+// `mbopt-worker eval`: output, --set semantics and exit codes.
+#include "worker/main/eval_command.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace mbopt::worker {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr char kVehicle[] = "examples/vehicle/vehicle.study.textproto";
+
+struct EvalRun {
+  int code;
+  std::string out, err;
+};
+
+EvalRun Eval(const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  const int code = RunEval(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+TEST(EvalCommand, TextReportShowsObjectiveWorstRowOutputsAndCounters) {
+  const EvalRun r = Eval({kVehicle});
+  EXPECT_EQ(r.code, kExitOk) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("formulation  dynamic"));
+  EXPECT_THAT(r.out, HasSubstr("objective    8.448"));
+  EXPECT_THAT(r.out, HasSubstr("m/s^2"));
+  EXPECT_THAT(r.out, HasSubstr("worst row    s1@t=1.800s upper"));
+  EXPECT_THAT(r.out, HasSubstr("seat_acceleration"));
+  EXPECT_THAT(r.out, HasSubstr("counters     steps"));
+}
+
+TEST(EvalCommand, JsonIsOneObjectWithTheRequiredKeys) {
+  const EvalRun r = Eval({kVehicle, "--json"});
+  EXPECT_EQ(r.code, kExitOk) << r.err;
+  ASSERT_FALSE(r.out.empty());
+  EXPECT_EQ(r.out.front(), '{');
+  EXPECT_EQ(r.out.substr(r.out.size() - 2), "}\n");
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1);
+  for (const char* key : {"\"objective\": ", "\"max_violation\": ", "\"status\": \"ok\"",
+                          "\"counters\": {", "\"formulation\": \"dynamic\"",
+                          "\"worst_constraint\": {"}) {
+    EXPECT_THAT(r.out, HasSubstr(key));
+  }
+}
+
+TEST(EvalCommand, SetAcceptsScaledVariablesAndParametersInTheirUnits) {
+  // The report's optimum, with c2 = 2 x5 = 77.06 lbf s/in given as a parameter.
+  const EvalRun r = Eval({kVehicle, "--set", "x1=5", "--set", "x2=10", "--set", "x3=10", "--set",
+                      "x4=41.54", "--set", "c2=77.06", "--set=x6=40"});
+  EXPECT_EQ(r.code, kExitOk) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("x5=38.53"));
+  EXPECT_THAT(r.out, HasSubstr("objective    6.3957"));  // 251.80 in/s^2 = 6.3957 m/s^2
+}
+
+TEST(EvalCommand, BadInputIsExitCodeTwoWithAMessage) {
+  EvalRun r = Eval({kVehicle, "--set", "x9=1"});
+  EXPECT_EQ(r.code, kExitBadInput);
+  EXPECT_THAT(r.err, HasSubstr("\"x9\" is neither a design variable"));
+  r = Eval({kVehicle, "--set", "x1=soft"});
+  EXPECT_EQ(r.code, kExitBadInput);
+  EXPECT_THAT(r.err, HasSubstr("not a finite number"));
+  r = Eval({});
+  EXPECT_EQ(r.code, kExitBadInput);
+  r = Eval({"no/such.study.textproto"});
+  EXPECT_EQ(r.code, kExitBadInput);
+  EXPECT_THAT(r.err, HasSubstr("no/such.study.textproto"));
+  r = Eval({kVehicle, "--frobnicate"});
+  EXPECT_EQ(r.code, kExitBadInput);
+}
+
+TEST(EvalCommand, FailedAnalysisIsExitCodeOneWithTheReason) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "eval_failed";
+  std::filesystem::create_directories(dir);
+  std::ifstream in("examples/vehicle/vehicle.scene.textproto");
+  std::stringstream scene;
+  scene << in.rdbuf();
+  std::string text = scene.str();
+  const std::string from = "integrator { relative_tolerance";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "integrator { max_steps: 5 relative_tolerance");
+  std::ofstream(dir / "vehicle.scene.textproto") << text;
+  std::ifstream study_in(kVehicle);
+  std::stringstream study;
+  study << study_in.rdbuf();
+  std::ofstream(dir / "vehicle.study.textproto") << study.str();
+  const EvalRun r = Eval({(dir / "vehicle.study.textproto").string(), "--json"});
+  EXPECT_EQ(r.code, kExitAnalysisFailed);
+  EXPECT_THAT(r.out, HasSubstr("\"status\": \"failed\""));
+  EXPECT_THAT(r.out, HasSubstr("step budget"));
+  EXPECT_THAT(r.out, HasSubstr("\"objective\": null"));
+}
+
+}  // namespace
+}  // namespace mbopt::worker

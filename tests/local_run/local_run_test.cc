@@ -1,0 +1,102 @@
+// RunStudyLocally and EvaluateDesign on the vehicle suspension study
+// (examples/vehicle, METHOD.md section 4.1).
+#include "server/local_run/local_run.h"
+
+#include <cmath>
+#include <iostream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "server/local_run/evaluate_design.h"
+#include "spec/io/study_io.h"
+
+namespace mbopt::local_run {
+namespace {
+
+constexpr char kVehicleStudy[] = "examples/vehicle/vehicle.study.textproto";
+
+// The report reaches 6.40 m/s^2 and Haug & Arora 6.46; the optimum is bounded
+// by the report's rounding of its table (METHOD.md 4.1).
+constexpr double kMaxSeatAccelerationAtOptimum = 6.45;  // m/s^2
+// "a constraint violation below 0.2 %" at the report's optimum.
+constexpr double kMaxViolationAtOptimum = 0.002;
+
+spec::Study LoadVehicle() {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kVehicleStudy);
+  EXPECT_TRUE(study.ok()) << study.status();
+  return study.ok() ? *study : spec::Study{};
+}
+
+TEST(EvaluateDesign, VehicleInitialDesignIsInfeasibleWithFiniteValues) {
+  const spec::Study study = LoadVehicle();
+  ASSERT_FALSE(study.variables.empty());
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  Eigen::VectorXd x0(static_cast<Eigen::Index>(study.variables.size()));
+  for (size_t k = 0; k < study.variables.size(); ++k) x0[static_cast<Eigen::Index>(k)] = study.variables[k].initial;
+
+  absl::StatusOr<DesignEvaluation> evaluation = EvaluateDesign(study, *layout, x0);
+  ASSERT_TRUE(evaluation.ok()) << evaluation.status();
+  ASSERT_TRUE(evaluation->ok()) << evaluation->failure_reason;
+  ASSERT_TRUE(evaluation->values.has_value());
+  EXPECT_TRUE(std::isfinite(evaluation->values->objective));
+  // x0 exceeds the seat-chassis displacement limit about fourfold (METHOD.md 4.1).
+  EXPECT_GT(evaluation->values->max_violation, 1.0);
+  EXPECT_GT(evaluation->counters.time_steps, 0);
+
+  const slp::AnalysisResult result = ToAnalysisResult(*evaluation);
+  EXPECT_EQ(result.outcome, slp::AnalysisOutcome::kOk);
+  EXPECT_EQ(result.objective_terms.size(), layout->num_objective_terms());
+  EXPECT_EQ(result.constraint_values.size(), layout->num_constraints());
+}
+
+TEST(EvaluateDesign, RejectsDesignOfWrongSize) {
+  const spec::Study study = LoadVehicle();
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const absl::StatusOr<DesignEvaluation> evaluation = EvaluateDesign(study, *layout, Eigen::VectorXd::Ones(2));
+  EXPECT_EQ(evaluation.status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(RunStudyLocally, VehicleReachesReportOptimum) {
+  const spec::Study study = LoadVehicle();
+  ASSERT_FALSE(study.variables.empty());
+  int records_seen = 0;
+  LocalRunOptions options;
+  options.on_record = [&records_seen](const slp::CycleRecord&) { ++records_seen; };
+  absl::StatusOr<LocalRunResult> result = RunStudyLocally(study, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  const slp::RunOutcome& run = result->outcome;
+  EXPECT_EQ(run.state, slp::RunState::kConverged) << slp::RunStateName(run.state) << " " << result->end_reason;
+  EXPECT_LE(run.objective, kMaxSeatAccelerationAtOptimum);
+  EXPECT_LT(run.max_violation, kMaxViolationAtOptimum);
+  EXPECT_EQ(records_seen, static_cast<int>(run.records.size()));
+  EXPECT_EQ(result->analyses_run, run.analyses);
+  ASSERT_EQ(result->design_physical.size(), study.variables.size());
+  for (size_t k = 0; k < study.variables.size(); ++k) {
+    EXPECT_DOUBLE_EQ(result->design_physical[k], study.variables[k].scale * result->design_scaled[k]);
+  }
+  std::cout << "vehicle: state " << slp::RunStateName(run.state) << " F " << run.objective << " maxg "
+            << run.max_violation << " cycles " << run.cycles << " analyses " << run.analyses << " wall "
+            << result->wall_seconds << " s\n  design (scaled):";
+  for (double x : result->design_scaled) std::cout << " " << x;
+  std::cout << "\n";
+}
+
+TEST(RunStudyLocally, InjectedFailureOfFirstDesignEndsRunFailed) {
+  const spec::Study study = LoadVehicle();
+  ASSERT_FALSE(study.variables.empty());
+  LocalRunOptions options;
+  options.inject_failure = [](const slp::AnalysisRequest&) -> std::optional<std::string> {
+    return std::string("every analysis fails");
+  };
+  absl::StatusOr<LocalRunResult> result = RunStudyLocally(study, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->outcome.state, slp::RunState::kFailed);
+  EXPECT_EQ(result->analyses_run, 0);
+  EXPECT_GE(result->analyses_failed, 1);
+}
+
+}  // namespace
+}  // namespace mbopt::local_run

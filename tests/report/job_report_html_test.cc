@@ -1,0 +1,291 @@
+#include "client/report/job_report_html.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <regex>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "client/report/history_plots.h"
+#include "client/report/report_tables.h"
+#include "tests/report/markup_checker.h"
+#include "tests/report/synthetic_report.h"
+
+namespace mbopt::report {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+int Count(const std::string& haystack, const std::string& needle) {
+  int n = 0;
+  for (std::size_t p = haystack.find(needle); p != std::string::npos; p = haystack.find(needle, p + 1)) ++n;
+  return n;
+}
+
+// The table row of a design variable, from its name cell to the row end.
+std::string DesignRow(const std::string& html, const std::string& name) {
+  const std::size_t table = html.find("<table class=\"design\">");
+  const std::size_t start = html.find("<tr><td>" + name + "</td>", table);
+  if (table == std::string::npos || start == std::string::npos) return "";
+  return html.substr(start, html.find("</tr>", start) - start);
+}
+
+void ExpectWellFormedWithCleanCoordinates(const std::string& html) {
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  static const std::regex kNumbers("^[-0-9., ]*$");
+  for (const std::string& svg : testing::SvgFragments(html)) {
+    EXPECT_EQ(testing::CheckMarkup(svg, /*xml_strict=*/true), "");
+    for (const std::string& v : testing::NumericAttributeValues(svg)) {
+      EXPECT_TRUE(std::regex_match(v, kNumbers)) << "attribute value '" << v << "'";
+    }
+  }
+}
+
+TEST(JobReportHtml, IsWellFormedAndSelfContained) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  ExpectWellFormedWithCleanCoordinates(html);
+  EXPECT_EQ(testing::SvgFragments(html).size(), 5u);
+  EXPECT_THAT(html, Not(HasSubstr("<script")));
+  EXPECT_THAT(html, Not(HasSubstr("http://www.w3.org/1999")));  // no other namespaces than SVG's
+  EXPECT_THAT(html, Not(HasSubstr("src=")));
+  EXPECT_THAT(html, Not(HasSubstr("href=")));
+  EXPECT_THAT(html, Not(HasSubstr("url(")));
+  EXPECT_THAT(html, Not(HasSubstr("@import")));
+}
+
+TEST(JobReportHtml, EscapesTheStudyName) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  EXPECT_THAT(html, HasSubstr("<h1>vehicle &lt;suspension&gt; &amp; &quot;seat&quot;</h1>"));
+  EXPECT_THAT(html, Not(HasSubstr(testing::kSyntheticStudyName)));
+}
+
+TEST(JobReportHtml, EscapesVariableAndConstraintNamesEverywhere) {
+  ReportData data = testing::SyntheticVehicleReport();
+  data.variables[0].name = "k<1>&\"x\"";
+  for (ReportCycle& r : data.records) {
+    if (!r.worst_constraint.empty()) r.worst_constraint = "g<&>";
+  }
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  EXPECT_THAT(html, Not(HasSubstr("k<1>")));
+  EXPECT_THAT(html, Not(HasSubstr("g<&>")));
+  EXPECT_GE(Count(html, "k&lt;1&gt;&amp;&quot;x&quot;"), 3);  // two legends and the design table
+  EXPECT_THAT(html, HasSubstr("g&lt;&amp;&gt;"));
+}
+
+TEST(JobReportHtml, ShowsTheSummary) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  EXPECT_THAT(html, HasSubstr("<strong>converged</strong>"));
+  EXPECT_THAT(html, HasSubstr("<th>cycles</th><td>11</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>final objective F</th><td>252 in/s^2</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>max violation maxg</th><td>0.00025 (violated)</td>"));
+}
+
+TEST(JobReportHtml, FailedAnalysesLeaveNoNanInThePlots) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  for (const std::string& svg : testing::SvgFragments(html)) {
+    EXPECT_THAT(svg, Not(HasSubstr("nan")));
+    EXPECT_THAT(svg, Not(HasSubstr("inf\"")));
+  }
+  EXPECT_THAT(html, HasSubstr("analysis failed"));  // the table says what happened
+}
+
+TEST(JobReportHtml, MarksRejectedTrialPoints) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  const std::string objective_plot = testing::SvgFragments(html)[0];
+  // Cycle 2's rejected trial has F(x*) = 380; cycle 5's failed and has no point.
+  EXPECT_EQ(Count(objective_plot, "fill=\"white\" stroke=\"#d62728\""), 1 + 1);  // point and legend
+  EXPECT_THAT(objective_plot, HasSubstr("rejected trial F(x*)"));
+  EXPECT_EQ(Count(html, "<tr class=\"rejected\">"), 2);
+  EXPECT_THAT(html, HasSubstr("rejected: maxfout 0.62 &gt; 0.40"));
+}
+
+TEST(JobReportHtml, DrawsTheErrorThresholds) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  const std::string errors = testing::SvgFragments(html)[2];
+  EXPECT_THAT(errors, HasSubstr("0.10 widen below"));
+  EXPECT_THAT(errors, HasSubstr("0.25 narrow above"));
+  EXPECT_THAT(errors, HasSubstr("0.40 reject above"));
+  EXPECT_EQ(Count(errors, "stroke-dasharray=\"6 4\""), 3);
+}
+
+TEST(JobReportHtml, ErrorsSpanningDecadesGetALogAxisWithZerosOnTheFloor) {
+  const ReportData data = testing::SyntheticVehicleReport();
+  const PlotSpec errors = ApproximationErrorPlot(data);
+  EXPECT_TRUE(errors.log_y);  // e_o falls from 0.3 to 0.0025
+  const std::string svg = RenderLinePlotSvg(errors);
+  EXPECT_THAT(svg, HasSubstr("<polygon"));  // e_o = 0 in cycle 6
+}
+
+TEST(JobReportHtml, ObjectiveGetsALogAxisOnlyWhenPositiveAndSpanningDecades) {
+  ReportData data = testing::SyntheticVehicleReport();
+  EXPECT_FALSE(ObjectivePlot(data).log_y);  // 252 ... 380
+  for (ReportCycle& r : data.records) r.objective_trial /= 1000.0 * r.cycle;
+  EXPECT_TRUE(ObjectivePlot(data).log_y);   // 333 down to ~0.02
+  data.records.back().objective_trial = -1.0;
+  EXPECT_FALSE(ObjectivePlot(data).log_y);
+}
+
+TEST(JobReportHtml, LinearScaleCanBeForced) {
+  ReportData data = testing::SyntheticVehicleReport();
+  data.error_scale = ScaleChoice::kLinear;
+  EXPECT_FALSE(ApproximationErrorPlot(data).log_y);
+  data.violation_scale = ScaleChoice::kLog;
+  EXPECT_TRUE(ViolationPlot(data).log_y);
+}
+
+TEST(JobReportHtml, PlotsOneLinePerDesignVariableWithItsName) {
+  const ReportData data = testing::SyntheticVehicleReport();
+  const PlotSpec design = DesignVariablePlot(data);
+  ASSERT_EQ(design.series.size(), 6u);
+  EXPECT_EQ(design.series[3].name, "c1");
+  EXPECT_EQ(design.series[3].x.size(), 12u);  // initial design and 11 cycles
+  const PlotSpec limits = MoveLimitPlot(data);
+  int in_legend = 0;
+  for (const PlotSeries& s : limits.series) in_legend += s.in_legend ? 1 : 0;
+  EXPECT_EQ(in_legend, 6 + 1);  // six variables and the key for rejected attempts
+}
+
+TEST(JobReportHtml, FlagsVariablesOnTheirBounds) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  EXPECT_THAT(DesignRow(html, "k1"), HasSubstr("at lower bound"));
+  EXPECT_THAT(DesignRow(html, "k2"), HasSubstr("at lower bound"));
+  EXPECT_THAT(DesignRow(html, "k3"), HasSubstr("at lower bound"));
+  EXPECT_THAT(DesignRow(html, "c1"), Not(HasSubstr("bound</td>")));
+  EXPECT_THAT(DesignRow(html, "c2"), Not(HasSubstr("bound</td>")));
+  EXPECT_THAT(DesignRow(html, "c3"), HasSubstr("at upper bound"));
+  // Physical units: k1 = 10 x1 with x1 = 5 on its lower bound.
+  EXPECT_THAT(DesignRow(html, "k1"), HasSubstr("<td class=\"num\">50</td><td>lb/in</td><td class=\"num\">50</td>"));
+}
+
+TEST(DesignBoundFlag, UsesTheScaledRangeAsTolerance) {
+  const ReportVariable v{"a", "m", 2.0, true, 1.0, 3.0};
+  EXPECT_EQ(DesignBoundFlag(v, 2.0), BoundFlag::kAtLower);
+  EXPECT_EQ(DesignBoundFlag(v, 2.0 * (1 + 1e-9)), BoundFlag::kAtLower);
+  EXPECT_EQ(DesignBoundFlag(v, 2.01), BoundFlag::kNone);
+  EXPECT_EQ(DesignBoundFlag(v, 6.0), BoundFlag::kAtUpper);
+  EXPECT_EQ(DesignBoundFlag(v, std::nan("")), BoundFlag::kUnknown);
+  const ReportVariable negative_scale{"b", "", -1.0, true, 1.0, 3.0};
+  EXPECT_EQ(DesignBoundFlag(negative_scale, -3.0), BoundFlag::kAtUpper);
+  const ReportVariable no_bounds{"c", "", 1.0, false, 0, 0};
+  EXPECT_EQ(DesignBoundFlag(no_bounds, 0.0), BoundFlag::kUnknown);
+}
+
+TEST(JobReportHtml, NamesTheActiveConstraintHonestly) {
+  const std::string html = RenderJobReportHtml(testing::SyntheticVehicleReport());
+  EXPECT_THAT(html, HasSubstr("<td>seat-chassis@t=0.42s upper</td>"));
+  EXPECT_THAT(html, HasSubstr("keeps only the most critical row"));
+}
+
+TEST(JobReportHtml, SaysWhenTheWorstRowIsNotActive) {
+  ReportData data = testing::SyntheticVehicleReport();
+  data.records.back().max_violation_trial = -0.2;
+  const std::string html = RenderJobReportHtml(data);
+  EXPECT_THAT(html, Not(HasSubstr("<table class=\"active\">")));
+  EXPECT_THAT(html, HasSubstr("No row is known to be active"));
+}
+
+TEST(JobReportHtml, ListsExtraActiveRowsWhenGiven) {
+  ReportData data = testing::SyntheticVehicleReport();
+  data.active_constraints.push_back({"rear wheel-road@t=0.10s lower", -0.001});
+  data.active_constraints.push_back({"front wheel-road@t=0.10s lower", -0.4});  // not active
+  const std::string html = RenderJobReportHtml(data);
+  EXPECT_THAT(html, HasSubstr("rear wheel-road@t=0.10s lower"));
+  EXPECT_THAT(html, Not(HasSubstr("front wheel-road")));
+  EXPECT_THAT(html, Not(HasSubstr("keeps only the most critical row")));
+}
+
+TEST(JobReportHtml, AJobWithoutCyclesShowsItsSummaryAndNoPlots) {
+  ReportData data;
+  data.study_name = "empty";
+  data.state = "queued";
+  data.objective = std::nan("");
+  data.variables.push_back({"x1", "m", 1.0, true, 0.0, 1.0});
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  EXPECT_EQ(testing::SvgFragments(html).size(), 0u);
+  EXPECT_THAT(html, HasSubstr("No cycle has been recorded for this job yet"));
+  EXPECT_THAT(html, HasSubstr("<th>final objective F</th><td>not known</td>"));
+}
+
+TEST(JobReportHtml, AStudyWithoutConstraintsGetsNoViolationPlot) {
+  ReportData data = testing::SyntheticVehicleReport();
+  for (ReportCycle& r : data.records) {
+    r.worst_constraint.clear();
+    r.max_violation_x0 = 0.0;
+    if (std::isfinite(r.max_violation_trial)) r.max_violation_trial = 0.0;
+  }
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  EXPECT_EQ(testing::SvgFragments(html).size(), 4u);
+  EXPECT_THAT(html, HasSubstr("The study has no constraint rows: maxg is 0 throughout"));
+}
+
+TEST(JobReportHtml, AJobWithOneCycleDrawsItsPoints) {
+  ReportData data = testing::SyntheticVehicleReport();
+  data.records.resize(1);
+  data.cycles = 1;
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  const std::vector<std::string> svgs = testing::SvgFragments(html);
+  ASSERT_EQ(svgs.size(), 5u);
+  EXPECT_EQ(Count(svgs[0], "<polyline"), 1);  // initial design to cycle 1
+  // The move-limit plot has one point per variable: markers, no lines.
+  EXPECT_EQ(Count(svgs[3], "<polyline"), 0);
+  EXPECT_THAT(svgs[3], Not(HasSubstr("no data to plot")));
+}
+
+TEST(JobReportHtml, AFirstTrialThatFailedStillRenders) {
+  ReportData data = testing::SyntheticVehicleReport();
+  data.records.resize(1);
+  ReportCycle& r = data.records[0];
+  r.accepted = false;
+  r.rejection_reason = "trial analysis failed";
+  r.objective_trial = r.max_violation_trial = r.objective_error = r.max_approximation_error = std::nan("");
+  data.final_design_physical.clear();
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  EXPECT_THAT(html, HasSubstr("No trial point has been accepted: this is the initial design."));
+  EXPECT_THAT(html, HasSubstr("No trial point has been accepted, so the rows active"));
+  // The final design falls back to x0 of cycle 1: k1 = 10 * 10.
+  EXPECT_THAT(DesignRow(html, "k1"), HasSubstr("<td class=\"num\">100</td>"));
+}
+
+TEST(JobReportHtml, SurvivesExtremeAndMissingValues) {
+  // Every double of every record drawn from awkward values, 200 times over
+  // (fixed seed: the same pages every run).
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> awkward = {std::nan(""), inf, -inf, 0.0, -0.0, 1e-300, 1e300, -1e300, 5.0, -3.0};
+  std::mt19937 random(20261122);
+  std::uniform_int_distribution<std::size_t> pick(0, awkward.size() - 1);
+  for (int round = 0; round < 200; ++round) {
+    ReportData data = testing::SyntheticVehicleReport();
+    auto any = [&]() { return awkward[pick(random)]; };
+    for (ReportCycle& r : data.records) {
+      for (double* v : {&r.objective_x0, &r.objective_trial, &r.objective_predicted, &r.max_violation_x0,
+                        &r.max_violation_trial, &r.objective_error, &r.max_approximation_error}) {
+        *v = any();
+      }
+      for (double& v : r.x0_scaled) v = any();
+      for (double& v : r.x_trial_scaled) v = any();
+      for (double& v : r.move_limits) v = any();
+    }
+    data.objective = any();
+    data.max_violation = any();
+    for (double& v : data.final_design_physical) v = any();
+    data.error_scale = round % 3 == 0 ? ScaleChoice::kLog : ScaleChoice::kAuto;
+    const std::string html = RenderJobReportHtml(data);
+    ExpectWellFormedWithCleanCoordinates(html);
+    if (::testing::Test::HasFailure()) {
+      ADD_FAILURE() << "round " << round;
+      break;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mbopt::report

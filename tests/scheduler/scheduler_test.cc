@@ -1,0 +1,275 @@
+// The task queue: fairness between jobs, leases and their expiry, heartbeats
+// and the retry limit, on a fake clock (no test waits for real time).
+#include "server/scheduler/scheduler.h"
+
+#include <map>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+namespace mbopt::scheduler {
+namespace {
+
+constexpr std::int64_t kLeaseMs = 1000;
+
+SchedulerOptions Options() {
+  SchedulerOptions options;
+  options.lease_ms = kLeaseMs;
+  options.heartbeat_interval_ms = 200;
+  options.max_attempts = 3;
+  return options;
+}
+
+TEST(Scheduler, HandsOutTasksRoundRobinBetweenJobs) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  for (int r = 0; r < 10; ++r) scheduler.Enqueue("job-1", r, {1.0});
+  for (int r = 0; r < 2; ++r) scheduler.Enqueue("job-2", r, {2.0});
+  for (int r = 0; r < 2; ++r) scheduler.Enqueue("job-3", r, {3.0});
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  auto tasks = scheduler.Acquire(worker, 6);
+  ASSERT_TRUE(tasks.ok());
+  ASSERT_EQ(tasks->size(), 6u);
+  std::map<std::string, int> per_job;
+  for (const Task& t : *tasks) per_job[t.job_id] += 1;
+  // Each of the three jobs gets two of the first six tasks, although job-1
+  // queued five times as many.
+  EXPECT_EQ(per_job["job-1"], 2);
+  EXPECT_EQ(per_job["job-2"], 2);
+  EXPECT_EQ(per_job["job-3"], 2);
+  // Consecutive tasks come from different jobs.
+  for (size_t i = 1; i < tasks->size(); ++i) EXPECT_NE((*tasks)[i].job_id, (*tasks)[i - 1].job_id);
+  // Then the long job gets the rest, in request order.
+  auto rest = scheduler.Acquire(worker, 100);
+  ASSERT_TRUE(rest.ok());
+  ASSERT_EQ(rest->size(), 8u);
+  for (size_t i = 0; i < rest->size(); ++i) {
+    EXPECT_EQ((*rest)[i].job_id, "job-1");
+    EXPECT_EQ((*rest)[i].request_id, static_cast<std::int64_t>(i + 2));
+  }
+}
+
+TEST(Scheduler, FairnessHoldsAcrossSeparateAcquireCalls) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  for (int r = 0; r < 4; ++r) scheduler.Enqueue("job-1", r, {});
+  for (int r = 0; r < 4; ++r) scheduler.Enqueue("job-2", r, {});
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  std::string previous;
+  for (int i = 0; i < 8; ++i) {
+    auto tasks = scheduler.Acquire(worker, 1);
+    ASSERT_TRUE(tasks.ok());
+    ASSERT_EQ(tasks->size(), 1u);
+    EXPECT_NE(tasks->front().job_id, previous);
+    previous = tasks->front().job_id;
+  }
+}
+
+TEST(Scheduler, EnqueueIgnoresRequestsAlreadyQueuedLeasedOrFinished) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  EXPECT_TRUE(scheduler.Enqueue("job-1", 0, {}));
+  EXPECT_FALSE(scheduler.Enqueue("job-1", 0, {}));
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  auto tasks = scheduler.Acquire(worker, 1);
+  ASSERT_TRUE(tasks.ok());
+  EXPECT_FALSE(scheduler.Enqueue("job-1", 0, {}));
+  ASSERT_TRUE(scheduler.Complete(worker, tasks->front().task_id).ok());
+  EXPECT_FALSE(scheduler.Enqueue("job-1", 0, {}));
+  EXPECT_EQ(scheduler.QueuedCount(), 0);
+}
+
+TEST(Scheduler, ExpiredLeaseRequeuesTheTaskForAnotherWorker) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 5, {0.5});
+  const std::string lost = scheduler.RegisterWorker("lost", 1);
+  const std::string other = scheduler.RegisterWorker("other", 1);
+  auto first = scheduler.Acquire(lost, 1);
+  ASSERT_TRUE(first.ok());
+  ASSERT_EQ(first->size(), 1u);
+  EXPECT_EQ(first->front().lease_deadline_ms, clock.NowMs() + kLeaseMs);
+
+  clock.Advance(kLeaseMs - 1);
+  EXPECT_TRUE(scheduler.ExpireLeases().empty());
+  EXPECT_EQ(scheduler.QueuedCount(), 0);
+  clock.Advance(1);
+  EXPECT_TRUE(scheduler.ExpireLeases().empty());  // re-queued, not given up
+  EXPECT_EQ(scheduler.QueuedCount(), 1);
+  EXPECT_EQ(scheduler.LeasedCount(), 0);
+
+  // The worker that lost it is passed over while another is alive.
+  auto again_lost = scheduler.Acquire(lost, 1);
+  ASSERT_TRUE(again_lost.ok());
+  EXPECT_TRUE(again_lost->empty());
+  auto second = scheduler.Acquire(other, 1);
+  ASSERT_TRUE(second.ok());
+  ASSERT_EQ(second->size(), 1u);
+  EXPECT_EQ(second->front().request_id, 5);
+  EXPECT_EQ(second->front().attempt, 2);
+  EXPECT_NE(second->front().task_id, first->front().task_id);
+}
+
+TEST(Scheduler, RetryGoesToTheSameWorkerWhenItIsTheOnlyOne) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {});
+  const std::string only = scheduler.RegisterWorker("only", 1);
+  ASSERT_EQ(scheduler.Acquire(only, 1)->size(), 1u);
+  clock.Advance(kLeaseMs);
+  scheduler.ExpireLeases();
+  auto retry = scheduler.Acquire(only, 1);
+  ASSERT_TRUE(retry.ok());
+  EXPECT_EQ(retry->size(), 1u);
+}
+
+TEST(Scheduler, HeartbeatExtendsTheLease) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {});
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  auto tasks = scheduler.Acquire(worker, 1);
+  ASSERT_TRUE(tasks.ok());
+  const std::string task_id = tasks->front().task_id;
+  for (int beat = 0; beat < 5; ++beat) {
+    clock.Advance(kLeaseMs - 100);
+    HeartbeatReply reply = scheduler.Heartbeat(worker, {task_id});
+    EXPECT_TRUE(reply.known);
+    EXPECT_TRUE(reply.cancelled_task_ids.empty());
+    EXPECT_TRUE(scheduler.ExpireLeases().empty());
+    EXPECT_EQ(scheduler.LeasedCount(), 1);
+  }
+  // Silence after the last heartbeat: the lease runs out.
+  clock.Advance(kLeaseMs);
+  scheduler.ExpireLeases();
+  EXPECT_EQ(scheduler.LeasedCount(), 0);
+  EXPECT_EQ(scheduler.QueuedCount(), 1);
+}
+
+TEST(Scheduler, HeartbeatOfUnknownWorkerAsksToRegisterAndCancelsStaleTasks) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  EXPECT_FALSE(scheduler.Heartbeat("w-99", {}).known);
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  HeartbeatReply reply = scheduler.Heartbeat(worker, {"job-1/0/1"});
+  EXPECT_TRUE(reply.known);
+  ASSERT_EQ(reply.cancelled_task_ids.size(), 1u);
+  EXPECT_EQ(reply.cancelled_task_ids[0], "job-1/0/1");
+}
+
+TEST(Scheduler, TaskIsGivenUpAfterThreeFailedAttempts) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 3, {0.25});
+  const std::string a = scheduler.RegisterWorker("a", 1);
+  const std::string b = scheduler.RegisterWorker("b", 1);
+  const std::string c = scheduler.RegisterWorker("c", 1);
+
+  auto t1 = scheduler.Acquire(a, 1);
+  ASSERT_EQ(t1->size(), 1u);
+  auto fail1 = scheduler.Fail(a, t1->front().task_id, "out of memory");
+  ASSERT_TRUE(fail1.ok());
+  EXPECT_FALSE(fail1->has_value());
+
+  auto t2 = scheduler.Acquire(b, 1);
+  ASSERT_EQ(t2->size(), 1u);
+  clock.Advance(kLeaseMs);
+  EXPECT_TRUE(scheduler.ExpireLeases().empty());
+
+  auto t3 = scheduler.Acquire(c, 1);
+  ASSERT_EQ(t3->size(), 1u);
+  EXPECT_EQ(t3->front().attempt, 3);
+  clock.Advance(kLeaseMs);
+  std::vector<FinishedTask> given_up = scheduler.ExpireLeases();
+  ASSERT_EQ(given_up.size(), 1u);
+  EXPECT_EQ(given_up[0].job_id, "job-1");
+  EXPECT_EQ(given_up[0].request_id, 3);
+  EXPECT_EQ(given_up[0].attempts, 3);
+  EXPECT_NE(given_up[0].failure_reason.find("3 failed attempts"), std::string::npos);
+  EXPECT_EQ(scheduler.QueuedCount(), 0);
+  EXPECT_EQ(scheduler.LeasedCount(), 0);
+  EXPECT_FALSE(scheduler.Enqueue("job-1", 3, {}));  // never retried again
+}
+
+TEST(Scheduler, LateResultIsTakenIfNoOtherAttemptFinished) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {});
+  const std::string slow = scheduler.RegisterWorker("slow", 1);
+  const std::string fast = scheduler.RegisterWorker("fast", 1);
+  auto first = scheduler.Acquire(slow, 1);
+  clock.Advance(kLeaseMs);
+  scheduler.ExpireLeases();
+  auto second = scheduler.Acquire(fast, 1);
+  ASSERT_EQ(second->size(), 1u);
+  auto done = scheduler.Complete(slow, first->front().task_id);
+  ASSERT_TRUE(done.ok()) << done.status();
+  EXPECT_EQ(done->worker_id, slow);
+  // The second attempt is now unwanted: its result is refused and its
+  // worker is told to stop.
+  EXPECT_EQ(scheduler.Complete(fast, second->front().task_id).status().code(), absl::StatusCode::kNotFound);
+  HeartbeatReply reply = scheduler.Heartbeat(fast, {second->front().task_id});
+  ASSERT_EQ(reply.cancelled_task_ids.size(), 1u);
+}
+
+TEST(Scheduler, UnknownTaskAndUnknownWorkerAreNotFound) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  EXPECT_EQ(scheduler.Complete(worker, "garbage").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(scheduler.Complete(worker, "job-1/x/1").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(scheduler.Acquire("w-42", 1).status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST(Scheduler, DroppedJobLosesItsTasksAndOthersContinue) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {});
+  scheduler.Enqueue("job-1", 1, {});
+  scheduler.Enqueue("job-2", 0, {});
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  auto leased = scheduler.Acquire(worker, 1);
+  ASSERT_EQ(leased->front().job_id, "job-1");
+  scheduler.DropJob("job-1");
+  EXPECT_EQ(scheduler.Complete(worker, leased->front().task_id).status().code(), absl::StatusCode::kNotFound);
+  auto rest = scheduler.Acquire(worker, 10);
+  ASSERT_EQ(rest->size(), 1u);
+  EXPECT_EQ(rest->front().job_id, "job-2");
+}
+
+TEST(Scheduler, LongPollWakesWhenATaskIsQueued) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  // Generous: the guard only matters if the wake-up is broken.
+  constexpr std::int64_t kFailureGuardMs = 60'000;
+  std::vector<Task> got;
+  std::thread poller([&] { got = *scheduler.AcquireWait(worker, 1, kFailureGuardMs); });
+  scheduler.Enqueue("job-1", 0, {});
+  poller.join();
+  // Either the poll started before the enqueue and was woken, or after and
+  // found the task at once: both end with the task, never a timeout.
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].job_id, "job-1");
+}
+
+TEST(Scheduler, ShutdownEndsLongPolls) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  const std::string worker = scheduler.RegisterWorker("w", 1);
+  constexpr std::int64_t kFailureGuardMs = 60'000;
+  std::thread poller([&] { EXPECT_TRUE(scheduler.AcquireWait(worker, 1, kFailureGuardMs)->empty()); });
+  scheduler.Shutdown();
+  poller.join();
+}
+
+TEST(SchedulerOptions, HeartbeatMustBeShorterThanLease) {
+  SchedulerOptions options;
+  options.lease_ms = 100;
+  options.heartbeat_interval_ms = 100;
+  EXPECT_EQ(options.Validate().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace mbopt::scheduler

@@ -1,0 +1,62 @@
+// A worker for server tests, driven synchronously by the test: it takes every
+// task on offer, answers them in a shuffled order with the analytic values of
+// test_study.h, and repeats until the queue is empty. The server queues a
+// job's next analyses inside the call that reports the previous result, so
+// an empty queue after a round means every job it serves has ended (or is
+// waiting for someone else). No threads, no sleeps.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+
+#include <grpcpp/grpcpp.h>
+
+#include "mbopt/v1/service.grpc.pb.h"
+
+namespace mbopt::testing {
+
+class FakeWorker {
+ public:
+  FakeWorker(std::shared_ptr<grpc::Channel> channel, std::uint32_t seed, const std::string& name = "fake");
+
+  const std::string& worker_id() const { return worker_id_; }
+  v1::WorkerService::Stub& stub() { return *stub_; }
+
+  // Answers tasks until none is on offer or `max_results` results were
+  // reported (< 0: no limit). Tasks taken but not answered when the limit
+  // is reached are answered first by the next call. Returns the number of
+  // results reported; fails the test on any RPC error.
+  int Run(int max_results = -1);
+
+  // Long-polls for tasks (waiting up to `wait_ms` each time) and answers
+  // them until `stop` is set; for several workers on their own threads.
+  int RunUntil(const std::atomic<bool>& stop, int wait_ms);
+
+  // Instead of failing the test, an RPC error ends Run() and sets failed():
+  // for tests that kill the server under the worker.
+  void TolerateServerLoss() { tolerate_errors_ = true; }
+  bool failed() const { return failed_; }
+
+  // Takes up to `max_tasks` tasks without answering them.
+  std::vector<v1::AnalysisTask> Acquire(int max_tasks, int wait_ms = 0);
+  // Answers one task with its analytic values; returns the RPC status.
+  grpc::Status Answer(const v1::AnalysisTask& task, bool* accepted = nullptr);
+
+ private:
+  const v1::Study& StudyOf(const std::string& job_id);
+
+  std::unique_ptr<v1::WorkerService::Stub> stub_;
+  std::string worker_id_;
+  std::mt19937 rng_;
+  std::map<std::string, v1::Study> studies_;
+  std::vector<v1::AnalysisTask> backlog_;
+  bool tolerate_errors_ = false;
+  bool failed_ = false;  // taken, not answered yet
+};
+
+}  // namespace mbopt::testing

@@ -1,0 +1,195 @@
+// A job's optimizer driven directly (no server): the cycle-record byte
+// format, and replay of a logged run, which resume relies on.
+#include "server/jobs/job.h"
+
+#include <cstring>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "server/jobs/job_state.h"
+#include "server/jobs/record_codec.h"
+#include "spec/io/study_io.h"
+#include "tests/server/test_study.h"
+
+namespace mbopt::jobs {
+namespace {
+
+slp::CycleRecord SampleRecord() {
+  slp::CycleRecord r;
+  r.cycle = 3;
+  r.attempt = 1;
+  r.accepted = false;
+  r.rejection_reason = "maxfout 0.52 > 0.40";
+  r.x0 = Eigen::Vector2d(1.0 / 3.0, -0.0);
+  r.x_trial = Eigen::Vector2d(0.1, 7e-310);
+  r.objective_x0 = 2.5;
+  r.objective_trial = std::numeric_limits<double>::quiet_NaN();
+  r.objective_predicted = -1e300;
+  r.worst_constraint_trial = 4;
+  r.worst_approximation_row = -1;
+  r.lp_feasible = false;
+  r.infeasibility = 0.125;
+  r.lp_status = "optimal";
+  r.lp_iterations = 17;
+  r.rows_screened_in = 2;
+  r.move_limits = Eigen::Vector2d(0.2, 0.2);
+  r.move_limits_next = Eigen::Vector2d(0.1, 0.1);
+  r.on_move_limit = {true, false};
+  r.on_bound = {false, true};
+  r.analyses_total = 123456789012LL;
+  r.converged = false;
+  return r;
+}
+
+TEST(RecordCodec, RoundTripIsBitExact) {
+  const slp::CycleRecord r = SampleRecord();
+  const std::string bytes = EncodeCycleRecord(r);
+  absl::StatusOr<slp::CycleRecord> back = DecodeCycleRecord(bytes);
+  ASSERT_TRUE(back.ok()) << back.status();
+  // Equal encodings of the decoded record mean every field survived bit for bit.
+  EXPECT_EQ(EncodeCycleRecord(*back), bytes);
+  EXPECT_EQ(back->rejection_reason, r.rejection_reason);
+  EXPECT_EQ(back->on_bound, r.on_bound);
+  EXPECT_EQ(back->analyses_total, r.analyses_total);
+  const double x = back->x_trial[1];
+  EXPECT_EQ(std::memcmp(&x, &r.x_trial[1], sizeof x), 0);
+}
+
+TEST(RecordCodec, TruncatedOrForeignBytesAreDataLoss) {
+  const std::string bytes = EncodeCycleRecord(SampleRecord());
+  EXPECT_EQ(DecodeCycleRecord(bytes.substr(0, bytes.size() - 1)).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(DecodeCycleRecord(bytes + "x").status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(DecodeCycleRecord("\x07garbage").status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(DecodeCycleRecord("").status().code(), absl::StatusCode::kDataLoss);
+}
+
+TEST(JobState, NamesRoundTrip) {
+  for (int s = 1; s <= 8; ++s) {
+    const JobState state = static_cast<JobState>(s);
+    EXPECT_EQ(ParseJobState(JobStateName(state)), state);
+  }
+  EXPECT_FALSE(ParseJobState("SLEEPING").has_value());
+}
+
+// A run driven to its end in process, with everything a server would log.
+struct LoggedRun {
+  std::vector<LoggedAnalysis> analyses;
+  std::vector<std::string> records;
+  slp::RunState state = slp::RunState::kRunning;
+  Eigen::VectorXd design;
+};
+
+std::unique_ptr<Job> NewJob(const v1::Study& proto) {
+  absl::StatusOr<spec::Study> study = spec::io::StudyFromProto(proto, "test");
+  EXPECT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<std::unique_ptr<Job>> job = Job::Create(*study);
+  EXPECT_TRUE(job.ok()) << job.status();
+  return job.ok() ? *std::move(job) : nullptr;
+}
+
+LoggedRun RunAndLog(const v1::Study& proto) {
+  LoggedRun run;
+  std::unique_ptr<Job> job = NewJob(proto);
+  while (true) {
+    std::vector<slp::AnalysisRequest> pending = job->PendingRequests();
+    if (pending.empty()) break;
+    // Answer the batch last-first, to differ from the replay's order.
+    for (auto it = pending.rbegin(); it != pending.rend(); ++it) {
+      const std::vector<double> x(it->x.data(), it->x.data() + it->x.size());
+      absl::StatusOr<testing::FakeValues> values = testing::EvaluateAnalytically(proto, x);
+      EXPECT_TRUE(values.ok());
+      LoggedAnalysis a;
+      a.x_scaled = x;
+      a.result.request_id = it->id;
+      a.result.objective_terms = Eigen::Map<const Eigen::VectorXd>(values->objective_terms.data(),
+                                                                    static_cast<Eigen::Index>(values->objective_terms.size()));
+      a.result.constraint_values = Eigen::Map<const Eigen::VectorXd>(
+          values->constraint_values.data(), static_cast<Eigen::Index>(values->constraint_values.size()));
+      absl::StatusOr<std::vector<slp::CycleRecord>> records = job->Submit(a.result);
+      EXPECT_TRUE(records.ok()) << records.status();
+      for (const slp::CycleRecord& r : *records) run.records.push_back(EncodeCycleRecord(r));
+      run.analyses.push_back(std::move(a));
+    }
+  }
+  run.state = job->optimizer().state();
+  run.design = job->optimizer().current_design();
+  return run;
+}
+
+TEST(JobReplay, ReplayOfAWholeRunRebuildsTheFinalState) {
+  const v1::Study proto = testing::OscillatorStudy();
+  LoggedRun run = RunAndLog(proto);
+  ASSERT_EQ(run.state, slp::RunState::kConverged);
+  std::unique_ptr<Job> job = NewJob(proto);
+  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = job->Replay(run.analyses, run.records);
+  ASSERT_TRUE(unlogged.ok()) << unlogged.status();
+  EXPECT_TRUE(unlogged->empty());
+  EXPECT_EQ(job->optimizer().state(), slp::RunState::kConverged);
+  EXPECT_TRUE(job->PendingRequests().empty());
+  ASSERT_EQ(job->optimizer().current_design().size(), run.design.size());
+  EXPECT_EQ(std::memcmp(job->optimizer().current_design().data(), run.design.data(),
+                        sizeof(double) * static_cast<size_t>(run.design.size())),
+            0);
+}
+
+TEST(JobReplay, RecordsMissingFromTheLogAreReturnedForLogging) {
+  // A crash after an analysis was committed but before its cycle's records.
+  const v1::Study proto = testing::OscillatorStudy();
+  LoggedRun run = RunAndLog(proto);
+  ASSERT_GE(run.records.size(), 2u);
+  const size_t kept = run.records.size() - 1;
+  std::vector<std::string> logged(run.records.begin(), run.records.begin() + static_cast<std::ptrdiff_t>(kept));
+  std::unique_ptr<Job> job = NewJob(proto);
+  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = job->Replay(run.analyses, logged);
+  ASSERT_TRUE(unlogged.ok()) << unlogged.status();
+  ASSERT_EQ(unlogged->size(), 1u);
+  EXPECT_EQ(EncodeCycleRecord(unlogged->front()), run.records.back());
+}
+
+TEST(JobReplay, PartialLogLeavesOnlyTheMissingAnalysesPending) {
+  const v1::Study proto = testing::OscillatorStudy();
+  LoggedRun run = RunAndLog(proto);
+  std::unique_ptr<Job> reference = NewJob(proto);
+  const size_t kept = run.analyses.size() / 2;
+  std::vector<LoggedAnalysis> half(run.analyses.begin(), run.analyses.begin() + static_cast<std::ptrdiff_t>(kept));
+  std::unique_ptr<Job> job = NewJob(proto);
+  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = job->Replay(half, {});
+  ASSERT_TRUE(unlogged.ok()) << unlogged.status();
+  for (const slp::AnalysisRequest& request : job->PendingRequests()) {
+    for (const LoggedAnalysis& a : half) EXPECT_NE(a.result.request_id, request.id);
+  }
+  EXPECT_FALSE(job->PendingRequests().empty());
+}
+
+TEST(JobReplay, DifferingRecordIsDataLoss) {
+  const v1::Study proto = testing::OscillatorStudy();
+  LoggedRun run = RunAndLog(proto);
+  ASSERT_FALSE(run.records.empty());
+  absl::StatusOr<slp::CycleRecord> first = DecodeCycleRecord(run.records[0]);
+  ASSERT_TRUE(first.ok());
+  first->objective_x0 = std::nextafter(first->objective_x0, 1e300);
+  run.records[0] = EncodeCycleRecord(*first);
+  std::unique_ptr<Job> job = NewJob(proto);
+  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = job->Replay(run.analyses, run.records);
+  EXPECT_EQ(unlogged.status().code(), absl::StatusCode::kDataLoss);
+}
+
+TEST(JobReplay, DifferingDesignPointIsDataLoss) {
+  const v1::Study proto = testing::OscillatorStudy();
+  LoggedRun run = RunAndLog(proto);
+  run.analyses[0].x_scaled[0] += 1e-12;
+  std::unique_ptr<Job> job = NewJob(proto);
+  EXPECT_EQ(job->Replay(run.analyses, run.records).status().code(), absl::StatusCode::kDataLoss);
+}
+
+TEST(JobReplay, MoreLoggedRecordsThanTheReplayGivesIsDataLoss) {
+  const v1::Study proto = testing::OscillatorStudy();
+  LoggedRun run = RunAndLog(proto);
+  run.records.push_back(run.records.back());
+  std::unique_ptr<Job> job = NewJob(proto);
+  EXPECT_EQ(job->Replay(run.analyses, run.records).status().code(), absl::StatusCode::kDataLoss);
+}
+
+}  // namespace
+}  // namespace mbopt::jobs

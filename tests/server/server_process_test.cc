@@ -1,0 +1,211 @@
+// The mbopt-server executable as a process: its readiness line and port
+// file, a clean stop on SIGTERM, and recovery from a SIGKILL in the middle of
+// a job (--crash-after-cycles), checked bit for bit against an in-process run.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include "mbopt/v1/service.grpc.pb.h"
+#include "server/service/server.h"
+#include "server/store/store.h"
+#include "tests/server/fake_worker.h"
+#include "tests/server/test_study.h"
+
+namespace mbopt {
+namespace {
+
+using ::mbopt::testing::FakeWorker;
+using ::mbopt::testing::OscillatorStudy;
+using ::testing::StartsWith;
+
+// A started mbopt-server and the first line it printed.
+struct ServerProcess {
+  pid_t pid = -1;
+  std::string ready_line;
+  int port = 0;
+
+  // Waits for the process to end; returns its wait status.
+  int Wait() {
+    int status = 0;
+    EXPECT_EQ(::waitpid(pid, &status, 0), pid);
+    pid = -1;
+    return status;
+  }
+  ~ServerProcess() {
+    if (pid > 0) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+std::unique_ptr<ServerProcess> StartServer(const std::vector<std::string>& args) {
+  int out[2];
+  EXPECT_EQ(::pipe(out), 0);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::dup2(out[1], STDOUT_FILENO);
+    ::close(out[0]);
+    ::close(out[1]);
+    std::vector<char*> argv;
+    static std::string binary = MBOPT_SERVER_BINARY;
+    argv.push_back(binary.data());
+    std::vector<std::string> copies = args;
+    for (std::string& a : copies) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(binary.c_str(), argv.data());
+    ::_exit(127);
+  }
+  ::close(out[1]);
+  auto process = std::make_unique<ServerProcess>();
+  process->pid = pid;
+  // Readiness: the one line on stdout (blocks until printed or the process ends).
+  FILE* stream = ::fdopen(out[0], "r");
+  char line[256] = {0};
+  if (std::fgets(line, sizeof line, stream) != nullptr) process->ready_line = line;
+  std::fclose(stream);
+  const size_t colon = process->ready_line.rfind(':');
+  if (colon != std::string::npos) process->port = std::atoi(process->ready_line.c_str() + colon + 1);
+  return process;
+}
+
+class ServerProcessTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           (std::string("mbopt_server_process_") + info->name() + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    db_ = (dir_ / "jobs.db").string();
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  static std::shared_ptr<grpc::Channel> Connect(int port) {
+    return grpc::CreateChannel("127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials());
+  }
+
+  static std::string Submit(const std::shared_ptr<grpc::Channel>& channel) {
+    auto stub = v1::JobService::NewStub(channel);
+    grpc::ClientContext context;
+    v1::SubmitJobRequest request;
+    *request.mutable_study() = OscillatorStudy();
+    v1::SubmitJobResponse response;
+    grpc::Status status = stub->Submit(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response.job_id();
+  }
+
+  static v1::GetJobResponse Get(const std::shared_ptr<grpc::Channel>& channel, const std::string& id) {
+    auto stub = v1::JobService::NewStub(channel);
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(id);
+    v1::GetJobResponse response;
+    grpc::Status status = stub->Get(&context, ref, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response;
+  }
+
+  std::filesystem::path dir_;
+  std::string db_;
+};
+
+TEST_F(ServerProcessTest, PrintsReadinessWritesPortFileAndStopsCleanlyOnSigterm) {
+  const std::string port_file = (dir_ / "port").string();
+  auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_, "--port-file", port_file});
+  EXPECT_THAT(server->ready_line, StartsWith("mbopt-server listening on 127.0.0.1:"));
+  ASSERT_GT(server->port, 0);
+  std::ifstream in(port_file);
+  int written = 0;
+  in >> written;
+  EXPECT_EQ(written, server->port);
+
+  auto channel = Connect(server->port);
+  const std::string id = Submit(channel);
+  FakeWorker worker(channel, 1);
+  EXPECT_EQ(worker.Run(4), 4);
+  ASSERT_EQ(::kill(server->pid, SIGTERM), 0);
+  const int status = server->Wait();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+
+  auto store = store::Store::Open(db_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto job = (*store)->GetJob(id);
+  ASSERT_TRUE(job.ok()) << job.status();
+  EXPECT_EQ(job->state, "INTERRUPTED");
+}
+
+TEST_F(ServerProcessTest, RefusesAGarbageDatabaseWithAClearError) {
+  { std::ofstream(db_) << std::string(4096, 'z'); }
+  auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_});
+  EXPECT_EQ(server->ready_line, "");
+  const int status = server->Wait();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+}
+
+TEST_F(ServerProcessTest, KilledMidJobResumesOnRestartWithBitIdenticalRecords) {
+  // Reference: the same study, uninterrupted, in process.
+  v1::GetJobResponse reference;
+  {
+    service::ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.db_path = (dir_ / "reference.db").string();
+    auto server = service::MboptServer::Start(options);
+    ASSERT_TRUE(server.ok()) << server.status();
+    auto channel = (*server)->InProcessChannel();
+    const std::string id = Submit(channel);
+    FakeWorker worker(channel, 1);
+    worker.Run();
+    reference = Get(channel, id);
+    ASSERT_EQ(reference.summary().state(), v1::JOB_STATE_CONVERGED);
+    ASSERT_GT(reference.cycles_size(), 3);
+    (*server)->Shutdown();
+  }
+  std::string id;
+  {
+    auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_, "--crash-after-cycles", "3"});
+    ASSERT_GT(server->port, 0);
+    auto channel = Connect(server->port);
+    id = Submit(channel);
+    FakeWorker worker(channel, 2);
+    worker.TolerateServerLoss();
+    worker.Run();
+    EXPECT_TRUE(worker.failed());
+    const int status = server->Wait();
+    ASSERT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(WTERMSIG(status), SIGKILL);
+  }
+  auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_});
+  ASSERT_GT(server->port, 0);
+  auto channel = Connect(server->port);
+  EXPECT_GE(Get(channel, id).cycles_size(), 3);
+  FakeWorker worker(channel, 3);
+  worker.Run();
+  v1::GetJobResponse finished = Get(channel, id);
+  EXPECT_EQ(finished.summary().state(), v1::JOB_STATE_CONVERGED);
+  ASSERT_EQ(finished.cycles_size(), reference.cycles_size());
+  for (int i = 0; i < finished.cycles_size(); ++i) {
+    EXPECT_EQ(finished.cycles(i).SerializeAsString(), reference.cycles(i).SerializeAsString()) << "record " << i;
+  }
+  ::kill(server->pid, SIGTERM);
+  const int status = server->Wait();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
+}  // namespace
+}  // namespace mbopt

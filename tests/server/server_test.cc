@@ -1,0 +1,547 @@
+// The optimizer server in process: real gRPC services, store and scheduler
+// on a temporary database, a fake clock for leases, and fake workers that
+// answer with closed-form values (test_study.h).
+#include "server/service/server.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <set>
+#include <string>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "mbopt/v1/service.grpc.pb.h"
+#include "server/scheduler/clock.h"
+#include "tests/server/fake_worker.h"
+#include "tests/server/test_study.h"
+
+namespace mbopt::service {
+namespace {
+
+using ::mbopt::testing::FakeWorker;
+using ::mbopt::testing::OscillatorStudy;
+using ::testing::HasSubstr;
+
+constexpr std::int64_t kLeaseMs = 10'000;
+// The analytic problem's optimum is x = (1, 1); the SLP stops within its
+// relative objective tolerance (0.5 %), which allows a design error of the
+// order of sqrt(0.005) on this quadratic; 0.05 is a loose bound on that.
+constexpr double kDesignTolerance = 0.05;
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           (std::string("mbopt_server_") + info->name() + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::unique_ptr<MboptServer> StartServer(const std::string& db_name, JobManagerOptions manager = {}) {
+    ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.db_path = (dir_ / db_name).string();
+    options.lease_ms = kLeaseMs;
+    options.heartbeat_ms = kLeaseMs / 4;
+    options.clock = &clock_;
+    options.manager = std::move(manager);
+    absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
+    EXPECT_TRUE(server.ok()) << server.status();
+    return server.ok() ? *std::move(server) : nullptr;
+  }
+
+  static std::string Submit(MboptServer& server, const v1::Study& study) {
+    auto stub = v1::JobService::NewStub(server.InProcessChannel());
+    grpc::ClientContext context;
+    v1::SubmitJobRequest request;
+    *request.mutable_study() = study;
+    request.set_source_name(study.name() + ".study.textproto");
+    v1::SubmitJobResponse response;
+    grpc::Status status = stub->Submit(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response.job_id();
+  }
+
+  static v1::GetJobResponse Get(MboptServer& server, const std::string& job_id) {
+    auto stub = v1::JobService::NewStub(server.InProcessChannel());
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(job_id);
+    v1::GetJobResponse response;
+    grpc::Status status = stub->Get(&context, ref, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response;
+  }
+
+  // Runs the study to its end on a fresh database; returns the final Get.
+  v1::GetJobResponse RunToEnd(const std::string& db_name, std::uint32_t seed) {
+    auto server = StartServer(db_name);
+    const std::string id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), seed);
+    worker.Run();
+    return Get(*server, id);
+  }
+
+  scheduler::FakeClock clock_;
+  std::filesystem::path dir_;
+};
+
+// Records compared as bytes: bit-identical doubles or a failure.
+void ExpectSameCycles(const v1::GetJobResponse& a, const v1::GetJobResponse& b) {
+  ASSERT_EQ(a.cycles_size(), b.cycles_size());
+  for (int i = 0; i < a.cycles_size(); ++i) {
+    EXPECT_EQ(a.cycles(i).SerializeAsString(), b.cycles(i).SerializeAsString()) << "record " << i;
+  }
+  ASSERT_EQ(a.summary().design_size(), b.summary().design_size());
+  for (int i = 0; i < a.summary().design_size(); ++i) {
+    const double da = a.summary().design(i), db = b.summary().design(i);
+    EXPECT_EQ(std::memcmp(&da, &db, sizeof da), 0) << "design " << i << ": " << da << " vs " << db;
+  }
+}
+
+TEST_F(ServerTest, SubmittedStudyConvergesToTheAnalyticOptimum) {
+  v1::GetJobResponse job = RunToEnd("a.db", 1);
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
+  ASSERT_EQ(job.summary().design_size(), 2);
+  EXPECT_NEAR(job.summary().design(0) / testing::kStiffnessScale, 1.0, kDesignTolerance);
+  EXPECT_NEAR(job.summary().design(1) / testing::kDampingScale, 1.0, kDesignTolerance);
+  EXPECT_EQ(job.summary().design_names(0), "x1");
+  EXPECT_EQ(job.summary().design_units(0), "N/m");
+  EXPECT_GT(job.cycles_size(), 0);
+  EXPECT_TRUE(job.cycles(job.cycles_size() - 1).converged());
+  EXPECT_EQ(job.summary().cycles(), job.cycles(job.cycles_size() - 1).cycle());
+  EXPECT_EQ(job.study().name(), "oscillator");
+  // Physical trial design = scale * scaled.
+  const v1::CycleRecord& last = job.cycles(job.cycles_size() - 1);
+  EXPECT_EQ(last.x_trial_physical(0), testing::kStiffnessScale * last.x_trial_scaled(0));
+}
+
+TEST_F(ServerTest, ResultsDoNotDependOnTheOrderOfAnswers) {
+  v1::GetJobResponse first = RunToEnd("a.db", 1);
+  v1::GetJobResponse second = RunToEnd("b.db", 12345);
+  ExpectSameCycles(first, second);
+}
+
+TEST_F(ServerTest, ConcurrentWorkersGiveTheSameResultAsOne) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  auto server = StartServer("concurrent.db");
+  const std::string first = Submit(*server, OscillatorStudy("first"));
+  const std::string second = Submit(*server, OscillatorStudy("second"));
+  std::atomic<bool> stop{false};
+  // Each long poll returns within this bound once the jobs have ended; it
+  // is not a wait for anything to happen.
+  constexpr int kPollMs = 100;
+  std::vector<std::thread> workers;
+  for (std::uint32_t seed = 20; seed < 24; ++seed) {
+    workers.emplace_back([&, seed] {
+      FakeWorker worker(server->InProcessChannel(), seed);
+      worker.RunUntil(stop, kPollMs);
+    });
+  }
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  for (const std::string& id : {first, second}) {
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(id);
+    auto reader = stub->Watch(&context, ref);
+    v1::JobEvent event;
+    while (reader->Read(&event)) {
+    }
+    EXPECT_TRUE(reader->Finish().ok());
+  }
+  stop = true;
+  for (std::thread& t : workers) t.join();
+  for (const std::string& id : {first, second}) {
+    v1::GetJobResponse job = Get(*server, id);
+    EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << id;
+    ExpectSameCycles(reference, job);
+  }
+}
+
+TEST_F(ServerTest, RestartAfterCrashResumesBitIdentically) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  ASSERT_EQ(reference.summary().state(), v1::JOB_STATE_CONVERGED);
+  // Stop after a number of results that ends in the middle of a cycle.
+  const int kResultsBeforeCrash = 7;
+  std::string id;
+  {
+    auto server = StartServer("crash.db");
+    id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 99);
+    ASSERT_EQ(worker.Run(kResultsBeforeCrash), kResultsBeforeCrash);
+    v1::GetJobResponse partial = Get(*server, id);
+    ASSERT_EQ(partial.summary().state(), v1::JOB_STATE_RUNNING);
+    // Destroyed without Shutdown: the database says RUNNING, as after a crash.
+  }
+  auto server = StartServer("crash.db");
+  v1::GetJobResponse resumed = Get(*server, id);
+  EXPECT_EQ(resumed.summary().state(), v1::JOB_STATE_RUNNING);
+  FakeWorker worker(server->InProcessChannel(), 3);
+  worker.Run();
+  v1::GetJobResponse finished = Get(*server, id);
+  EXPECT_EQ(finished.summary().state(), v1::JOB_STATE_CONVERGED);
+  ExpectSameCycles(reference, finished);
+}
+
+TEST_F(ServerTest, GracefulStopInterruptsAndNextStartResumesBitIdentically) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  std::string id;
+  {
+    auto server = StartServer("stop.db");
+    id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 5);
+    worker.Run(11);
+    server->Shutdown();
+  }
+  {
+    auto store = store::Store::Open((dir_ / "stop.db").string());
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto row = (*store)->GetJob(id);
+    ASSERT_TRUE(row.ok());
+    EXPECT_EQ(row->state, "INTERRUPTED");
+  }
+  auto server = StartServer("stop.db");
+  FakeWorker worker(server->InProcessChannel(), 6);
+  worker.Run();
+  ExpectSameCycles(reference, Get(*server, id));
+}
+
+TEST_F(ServerTest, RestartRightAfterACycleCommitResumesBitIdentically) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  std::string id;
+  std::int64_t records_committed = 0;
+  {
+    JobManagerOptions manager;
+    manager.after_record_commit = [&records_committed](std::int64_t n) { records_committed = n; };
+    auto server = StartServer("hook.db", manager);
+    id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 8);
+    while (records_committed < 2) ASSERT_EQ(worker.Run(1), 1);
+  }
+  EXPECT_EQ(records_committed, 2);
+  auto server = StartServer("hook.db");
+  EXPECT_EQ(Get(*server, id).cycles_size(), 2);
+  FakeWorker worker(server->InProcessChannel(), 9);
+  worker.Run();
+  ExpectSameCycles(reference, Get(*server, id));
+}
+
+TEST_F(ServerTest, CancelThenResumeGivesTheSameResult) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  auto server = StartServer("cancel.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  {
+    FakeWorker worker(server->InProcessChannel(), 10);
+    worker.Run(5);  // leaves taken tasks unanswered, as a busy worker would
+  }
+  FakeWorker worker(server->InProcessChannel(), 11);
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  v1::JobRef ref;
+  ref.set_job_id(id);
+  {
+    grpc::ClientContext context;
+    v1::JobSummary summary;
+    ASSERT_TRUE(stub->Cancel(&context, ref, &summary).ok());
+    EXPECT_EQ(summary.state(), v1::JOB_STATE_CANCELLED);
+  }
+  EXPECT_EQ(worker.Run(), 0);  // nothing is offered for a cancelled job
+  {
+    grpc::ClientContext context;
+    v1::JobSummary summary;
+    ASSERT_TRUE(stub->Resume(&context, ref, &summary).ok());
+    EXPECT_EQ(summary.state(), v1::JOB_STATE_RUNNING);
+  }
+  worker.Run();
+  ExpectSameCycles(reference, Get(*server, id));
+  grpc::ClientContext context;
+  v1::JobSummary summary;
+  grpc::Status status = stub->Resume(&context, ref, &summary);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+}
+
+TEST_F(ServerTest, FinishedJobIsServedFromTheLogAfterRestart) {
+  std::string id;
+  v1::GetJobResponse before;
+  {
+    auto server = StartServer("a.db");
+    id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 1);
+    worker.Run();
+    before = Get(*server, id);
+    server->Shutdown();
+  }
+  auto server = StartServer("a.db");
+  v1::GetJobResponse after = Get(*server, id);
+  EXPECT_EQ(after.summary().state(), v1::JOB_STATE_CONVERGED);
+  EXPECT_EQ(after.summary().cycles(), before.summary().cycles());
+  EXPECT_EQ(after.summary().analyses(), before.summary().analyses());
+  EXPECT_EQ(after.summary().objective(), before.summary().objective());
+  EXPECT_EQ(after.summary().max_violation(), before.summary().max_violation());
+  ExpectSameCycles(before, after);
+  // Nothing is rescheduled for an ended job.
+  FakeWorker worker(server->InProcessChannel(), 2);
+  EXPECT_TRUE(worker.Acquire(100).empty());
+}
+
+TEST_F(ServerTest, JobsAreListedInSubmissionOrder) {
+  auto server = StartServer("a.db");
+  std::vector<std::string> ids;
+  for (int i = 0; i < 11; ++i) ids.push_back(Submit(*server, OscillatorStudy("s" + std::to_string(i))));
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::ListJobsResponse jobs;
+  ASSERT_TRUE(stub->List(&context, v1::ListJobsRequest(), &jobs).ok());
+  ASSERT_EQ(jobs.jobs_size(), 11);
+  for (int i = 0; i < 11; ++i) {
+    EXPECT_EQ(jobs.jobs(i).job_id(), ids[static_cast<size_t>(i)]);
+    EXPECT_EQ(jobs.jobs(i).state(), v1::JOB_STATE_RUNNING);
+  }
+}
+
+TEST_F(ServerTest, WorkerForgottenByARestartIsAskedToRegisterAgain) {
+  std::string worker_id;
+  {
+    auto server = StartServer("a.db");
+    FakeWorker worker(server->InProcessChannel(), 1);
+    worker_id = worker.worker_id();
+  }
+  auto server = StartServer("a.db");
+  auto stub = v1::WorkerService::NewStub(server->InProcessChannel());
+  {
+    grpc::ClientContext context;
+    v1::HeartbeatRequest request;
+    request.set_worker_id(worker_id);
+    v1::HeartbeatResponse response;
+    ASSERT_TRUE(stub->Heartbeat(&context, request, &response).ok());
+    EXPECT_FALSE(response.known());
+  }
+  grpc::ClientContext context;
+  v1::AcquireTasksRequest request;
+  request.set_worker_id(worker_id);
+  v1::AcquireTasksResponse response;
+  EXPECT_EQ(stub->AcquireTasks(&context, request, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(ServerTest, SubmitWithoutStudyIsInvalidArgument) {
+  auto server = StartServer("a.db");
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::SubmitJobResponse response;
+  grpc::Status status = stub->Submit(&context, v1::SubmitJobRequest(), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("study"));
+}
+
+TEST_F(ServerTest, BadStudyIsInvalidArgumentNamingTheField) {
+  auto server = StartServer("a.db");
+  v1::Study study = OscillatorStudy();
+  study.mutable_variables(1)->set_parameter("no_such_parameter");
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::SubmitJobRequest request;
+  *request.mutable_study() = study;
+  request.set_source_name("bad.study.textproto");
+  v1::SubmitJobResponse response;
+  grpc::Status status = stub->Submit(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("bad.study.textproto"));
+  EXPECT_THAT(status.error_message(), HasSubstr("no_such_parameter"));
+  grpc::ClientContext list_context;
+  v1::ListJobsResponse jobs;
+  ASSERT_TRUE(stub->List(&list_context, v1::ListJobsRequest(), &jobs).ok());
+  EXPECT_EQ(jobs.jobs_size(), 0);
+}
+
+TEST_F(ServerTest, UnknownJobIsNotFoundNamingTheId) {
+  auto server = StartServer("a.db");
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  v1::JobRef ref;
+  ref.set_job_id("job-404");
+  {
+    grpc::ClientContext context;
+    v1::GetJobResponse response;
+    grpc::Status status = stub->Get(&context, ref, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_THAT(status.error_message(), HasSubstr("job-404"));
+  }
+  {
+    grpc::ClientContext context;
+    v1::JobSummary response;
+    EXPECT_EQ(stub->Cancel(&context, ref, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  {
+    grpc::ClientContext context;
+    auto reader = stub->Watch(&context, ref);
+    v1::JobEvent event;
+    EXPECT_FALSE(reader->Read(&event));
+    EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+}
+
+TEST_F(ServerTest, GarbageResultIsRejectedWhileAnotherJobContinues) {
+  auto server = StartServer("a.db");
+  const std::string first = Submit(*server, OscillatorStudy("first"));
+  const std::string second = Submit(*server, OscillatorStudy("second"));
+  FakeWorker worker(server->InProcessChannel(), 11);
+  std::vector<v1::AnalysisTask> tasks = worker.Acquire(1);
+  ASSERT_EQ(tasks.size(), 1u);
+  // Wrong vector sizes.
+  v1::TaskResult garbage;
+  garbage.set_worker_id(worker.worker_id());
+  garbage.set_task_id(tasks[0].task_id());
+  garbage.set_job_id(tasks[0].job_id());
+  garbage.set_request_id(tasks[0].request_id());
+  garbage.set_ok(true);
+  garbage.add_objective_terms(1.0);
+  for (int i = 0; i < 5; ++i) garbage.add_constraint_values(1.0);
+  {
+    grpc::ClientContext context;
+    v1::ReportResultResponse response;
+    grpc::Status status = worker.stub().ReportResult(&context, garbage, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("constraint values"));
+  }
+  // An unknown task of a known job, and a task of an unknown job.
+  {
+    v1::TaskResult unknown = garbage;
+    unknown.set_task_id(tasks[0].job_id() + "/999/1");
+    unknown.set_request_id(999);
+    unknown.clear_constraint_values();
+    unknown.add_constraint_values(1.0);
+    grpc::ClientContext context;
+    v1::ReportResultResponse response;
+    grpc::Status status = worker.stub().ReportResult(&context, unknown, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    EXPECT_FALSE(response.accepted());
+  }
+  {
+    v1::TaskResult unknown = garbage;
+    unknown.set_job_id("job-77");
+    grpc::ClientContext context;
+    v1::ReportResultResponse response;
+    EXPECT_EQ(worker.stub().ReportResult(&context, unknown, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  // The rejected attempt is retried and both jobs run to the same end as
+  // a clean run.
+  worker.Run();
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  for (const std::string& id : {first, second}) {
+    v1::GetJobResponse job = Get(*server, id);
+    EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << id;
+    ExpectSameCycles(reference, job);
+  }
+}
+
+TEST_F(ServerTest, FailedAnalysisGoesToTheOptimizerWithoutRetry) {
+  auto server = StartServer("a.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  FakeWorker worker(server->InProcessChannel(), 12);
+  // The first cycle: x0 (request 0) and its perturbations.
+  std::vector<v1::AnalysisTask> tasks = worker.Acquire(100);
+  ASSERT_FALSE(tasks.empty());
+  for (const v1::AnalysisTask& task : tasks) {
+    if (task.request_id() != 0) {
+      ASSERT_TRUE(worker.Answer(task).ok());
+      continue;
+    }
+    v1::TaskResult failure;
+    failure.set_worker_id(worker.worker_id());
+    failure.set_task_id(task.task_id());
+    failure.set_job_id(id);
+    failure.set_request_id(task.request_id());
+    failure.set_ok(false);
+    failure.set_failure_reason("integrator failed at t = 0.3 s");
+    grpc::ClientContext context;
+    v1::ReportResultResponse response;
+    ASSERT_TRUE(worker.stub().ReportResult(&context, failure, &response).ok());
+    EXPECT_TRUE(response.accepted());
+  }
+  // Not retried: nothing more is offered.
+  EXPECT_TRUE(worker.Acquire(100).empty());
+  v1::GetJobResponse job = Get(*server, id);
+  // The initial design cannot be analysed: the run fails, with the reason.
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_FAILED);
+  EXPECT_THAT(job.summary().message(), HasSubstr("integrator failed"));
+}
+
+std::set<std::int64_t> RequestIds(const std::vector<v1::AnalysisTask>& tasks) {
+  std::set<std::int64_t> ids;
+  for (const v1::AnalysisTask& t : tasks) ids.insert(t.request_id());
+  return ids;
+}
+
+TEST_F(ServerTest, LostWorkersTasksAreRetriedElsewhereThenGivenUpAfterThreeAttempts) {
+  auto server = StartServer("a.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  FakeWorker a(server->InProcessChannel(), 1, "a");
+  FakeWorker b(server->InProcessChannel(), 2, "b");
+  FakeWorker c(server->InProcessChannel(), 3, "c");
+  std::vector<v1::AnalysisTask> first = a.Acquire(100);
+  ASSERT_FALSE(first.empty());
+  clock_.Advance(kLeaseMs);
+  server->manager().ExpireLeases();
+  EXPECT_TRUE(a.Acquire(100).empty());  // b and c, who have not failed them, are preferred
+  std::vector<v1::AnalysisTask> second = b.Acquire(100);
+  EXPECT_EQ(RequestIds(second), RequestIds(first));
+  clock_.Advance(kLeaseMs);
+  server->manager().ExpireLeases();
+  std::vector<v1::AnalysisTask> third = c.Acquire(100);
+  EXPECT_EQ(RequestIds(third), RequestIds(first));
+  EXPECT_EQ(Get(*server, id).summary().state(), v1::JOB_STATE_RUNNING);
+  clock_.Advance(kLeaseMs);
+  server->manager().ExpireLeases();
+  // Three attempts lost: the analyses are reported failed; x0 of the first
+  // cycle is among them, so the run fails.
+  v1::GetJobResponse job = Get(*server, id);
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_FAILED);
+  EXPECT_THAT(job.summary().message(), HasSubstr("3 failed attempts"));
+  // A late answer of a given-up task is dropped.
+  bool accepted = true;
+  EXPECT_TRUE(a.Answer(first[0], &accepted).ok());
+  EXPECT_FALSE(accepted);
+}
+
+TEST_F(ServerTest, WatchReplaysPastRecordsThenStreamsUntilTheJobEnds) {
+  auto server = StartServer("a.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  FakeWorker worker(server->InProcessChannel(), 13);
+  worker.Run(6);
+  const int records_before = Get(*server, id).cycles_size();
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::JobRef ref;
+  ref.set_job_id(id);
+  auto reader = stub->Watch(&context, ref);
+  // The replay: the records so far, then a summary.
+  v1::JobEvent event;
+  for (int i = 0; i < records_before; ++i) {
+    ASSERT_TRUE(reader->Read(&event));
+    ASSERT_TRUE(event.has_cycle());
+  }
+  ASSERT_TRUE(reader->Read(&event));
+  ASSERT_TRUE(event.has_summary());
+  // The rest of the run, answered on another thread while this one reads.
+  std::thread answering([&] { worker.Run(); });
+  int streamed = 0;
+  v1::JobSummary last;
+  while (reader->Read(&event)) {
+    if (event.has_cycle()) ++streamed;
+    if (event.has_summary()) last = event.summary();
+  }
+  answering.join();
+  EXPECT_TRUE(reader->Finish().ok());
+  EXPECT_EQ(last.state(), v1::JOB_STATE_CONVERGED);
+  EXPECT_EQ(records_before + streamed, Get(*server, id).cycles_size());
+}
+
+}  // namespace
+}  // namespace mbopt::service

@@ -1,0 +1,375 @@
+// spec/io: good files load; every kind of bad input gives an InvalidArgument
+// that names the file, the line and the field path, and says what was
+// expected.
+#include "spec/io/study_io.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <google/protobuf/util/json_util.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace mbopt::spec::io {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A one-body scene; tests replace pieces of it to break one thing at a time.
+const char kScene[] = R"pb(name: "oscillator"
+parameters { name: "k" value: 100 unit: "N/m" }
+parameters { name: "mass" value: 2 unit: "kg" }
+lumped {
+  bodies { name: "body" mass_kg { param: "mass" } dofs: DOF_Y }
+  elements {
+    name: "spring"
+    a { body: "body" }
+    b { input: "road" }
+    direction { y { value: 1 } }
+    stiffness_n_per_m { param: "k" }
+    damping_n_s_per_m { value: 0.5 }
+  }
+  inputs {
+    name: "road"
+    cosine_bump {
+      height_m { value: 0.01 }
+      length_m { value: 1 }
+      speed_m_per_s { value: 2 }
+      start_time_s { value: 0.1 }
+    }
+    direction { y { value: 1 } }
+  }
+}
+outputs { name: "x" element_deflection { element: "spring" } }
+outputs { name: "acc" body_acceleration { body: "body" axis: AXIS_Y } }
+time_grid { start_s: 0 end_s: 1 points: 11 }
+)pb";
+
+const char kStudy[] = R"pb(name: "oscillator study"
+scene_file: "oscillator.scene.textproto"
+variables { name: "x1" parameter: "k" scale: 10 lower: 5 upper: 20 }
+objective { minimize_max_of: "acc" reduction: REDUCTION_MAX_ABS unit: "m/s^2" }
+constraints { name: "travel" output: "x" reduction: REDUCTION_MAX_ABS limit: 5 unit: "mm" }
+)pb";
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test setup: \"" << from << "\" not in the text";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// 1-based line of the first occurrence of `needle`.
+int LineOf(const std::string& text, const std::string& needle) {
+  const size_t at = text.find(needle);
+  EXPECT_NE(at, std::string::npos);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+}
+
+class StudyFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    dir_ = std::filesystem::path(::testing::TempDir()) / ("spec_io_" + test);
+    std::filesystem::create_directories(dir_);
+  }
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  // Loads the study with the given scene and study texts; expects failure.
+  std::string LoadError(const std::string& scene, const std::string& study) {
+    Write("oscillator.scene.textproto", scene);
+    auto loaded = LoadStudyFile(Write("oscillator.study.textproto", study));
+    EXPECT_FALSE(loaded.ok());
+    if (loaded.ok()) return "";
+    EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument) << loaded.status();
+    return std::string(loaded.status().message());
+  }
+  std::string ScenePath() const { return (dir_ / "oscillator.scene.textproto").string(); }
+  std::string StudyPath() const { return (dir_ / "oscillator.study.textproto").string(); }
+  std::string SceneAt(const std::string& needle, const std::string& scene = kScene) const {
+    return ScenePath() + ":" + std::to_string(LineOf(scene, needle)) + ":";
+  }
+  std::string StudyAt(const std::string& needle, const std::string& study = kStudy) const {
+    return StudyPath() + ":" + std::to_string(LineOf(study, needle)) + ":";
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(StudyFiles, GoodStudyLoadsWithUnitsConvertedAndSceneResolvedRelativeToIt) {
+  Write("oscillator.scene.textproto", kScene);
+  auto study = LoadStudyFile(Write("oscillator.study.textproto", kStudy));
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->name, "oscillator study");
+  ASSERT_EQ(study->variables.size(), 1u);
+  EXPECT_EQ(study->variables[0].parameter, 0);
+  EXPECT_DOUBLE_EQ(study->variables[0].initial, 10.0);  // 100 N/m / scale 10
+  EXPECT_DOUBLE_EQ(study->constraints[0].si_per_unit, 1e-3);
+  EXPECT_EQ(study->scene.outputs.size(), 2u);
+  const auto& lumped = std::get<LumpedModel>(study->scene.model);
+  EXPECT_EQ(lumped.elements[0].a.kind, Attachment::Kind::kBody);
+  EXPECT_EQ(lumped.elements[0].b.kind, Attachment::Kind::kInput);
+  EXPECT_EQ(lumped.bodies[0].mass_kg.param, 1);
+  // x = 12 (scaled) -> k = 120 N/m in SI.
+  EXPECT_DOUBLE_EQ(study->ParameterValuesAt({12.0})[0], 120.0);
+}
+
+TEST_F(StudyFiles, OverridesApplyToTheScene) {
+  Write("oscillator.scene.textproto", kScene);
+  auto study = LoadStudyFile(Write(
+      "oscillator.study.textproto",
+      std::string(kStudy) + "analysis { time_grid_points: 21 relative_tolerance: 1e-9 }\n"));
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->scene.time_grid.points, 21);
+  EXPECT_EQ(study->scene.integrator.relative_tolerance, 1e-9);
+}
+
+TEST_F(StudyFiles, ReadStudyProtoInlinesTheSceneAndStudyFromProtoAgrees) {
+  Write("oscillator.scene.textproto", kScene);
+  auto message = ReadStudyProto(Write("oscillator.study.textproto", kStudy));
+  ASSERT_TRUE(message.ok()) << message.status();
+  EXPECT_TRUE(message->has_scene());
+  EXPECT_EQ(message->scene().name(), "oscillator");
+  auto study = StudyFromProto(*message, "submitted");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->scene.outputs.size(), 2u);
+  EXPECT_EQ(study->source_file, "submitted");
+}
+
+TEST_F(StudyFiles, StudyFromProtoNamesTheFieldWithoutLineNumbers) {
+  Write("oscillator.scene.textproto", kScene);
+  auto message = ReadStudyProto(Write("oscillator.study.textproto", kStudy));
+  ASSERT_TRUE(message.ok());
+  message->mutable_variables(0)->set_lower(30);
+  auto study = StudyFromProto(*message, "request");
+  ASSERT_FALSE(study.ok());
+  EXPECT_THAT(std::string(study.status().message()), HasSubstr("request: variables[0].upper"));
+  message->clear_scene();
+  EXPECT_THAT(std::string(StudyFromProto(*message, "request").status().message()),
+              HasSubstr("inline"));
+}
+
+TEST_F(StudyFiles, VehicleExampleLoads) {
+  auto study = LoadStudyFile("examples/vehicle/vehicle.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->variables.size(), 6u);
+  EXPECT_EQ(study->constraints.size(), 5u);
+  EXPECT_EQ(study->scene.time_grid.points, 101);
+  EXPECT_FALSE(study->scene.effects.gravity_m_per_s2.has_value());
+}
+
+TEST_F(StudyFiles, SyntaxErrorNamesFileLineAndColumn) {
+  const std::string scene = Replace(kScene, "dofs: DOF_Y }", "dofs: DOF_Y ");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(ScenePath() + ":"));
+  EXPECT_THAT(error, ::testing::ContainsRegex(":[0-9]+:[0-9]+: "));
+}
+
+TEST_F(StudyFiles, UnknownFieldIsASyntaxErrorWithItsLine) {
+  const std::string scene = Replace(kScene, "dofs: DOF_Y", "dofs: DOF_Y colour: 3");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("colour", scene)));
+  EXPECT_THAT(error, HasSubstr("colour"));
+}
+
+TEST_F(StudyFiles, UnknownParameterNameIsReportedAtItsField) {
+  const std::string scene = Replace(kScene, "{ param: \"k\" }", "{ param: \"kx\" }");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("stiffness_n_per_m", scene)));
+  EXPECT_THAT(error, HasSubstr("lumped.elements[0].stiffness_n_per_m"));
+  EXPECT_THAT(error, HasSubstr("unknown parameter \"kx\""));
+}
+
+TEST_F(StudyFiles, ParameterWithTheWrongKindOfUnitIsRejected) {
+  const std::string scene = Replace(kScene, "unit: \"N/m\"", "unit: \"mm\"");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("lumped.elements[0].stiffness_n_per_m"));
+  EXPECT_THAT(error, HasSubstr("\"mm\" (length)"));
+}
+
+TEST_F(StudyFiles, UnknownUnitIsReportedAtTheParameter) {
+  const std::string scene = Replace(kScene, "unit: \"N/m\"", "unit: \"N/furlong\"");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("N/furlong", scene)));
+  EXPECT_THAT(error, HasSubstr("parameters[0].unit"));
+  EXPECT_THAT(error, HasSubstr("unknown unit \"N/furlong\""));
+}
+
+TEST_F(StudyFiles, ReversedBoundsAreReportedAtTheVariable) {
+  const std::string study = Replace(kStudy, "lower: 5 upper: 20", "lower: 20 upper: 5");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr(StudyAt("x1", study)));
+  EXPECT_THAT(error, HasSubstr("variables[0].upper"));
+  EXPECT_THAT(error, HasSubstr("bounds reversed"));
+}
+
+TEST_F(StudyFiles, InitialOutsideBoundsIsReported) {
+  const std::string study = Replace(kStudy, "lower: 5", "initial: 50 lower: 5");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr("variables[0].initial"));
+  EXPECT_THAT(error, HasSubstr("outside the bounds [5, 20]"));
+}
+
+TEST_F(StudyFiles, DefaultInitialFromTheParameterMustAlsoBeInsideTheBounds) {
+  const std::string study = Replace(kStudy, "lower: 5 upper: 20", "lower: 15 upper: 20");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr("variables[0].parameter"));
+  EXPECT_THAT(error, HasSubstr("initial value 10"));
+}
+
+TEST_F(StudyFiles, UnknownDesignParameterIsReported) {
+  const std::string study = Replace(kStudy, "parameter: \"k\"", "parameter: \"stiffness\"");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr(StudyAt("parameter:", study)));
+  EXPECT_THAT(error, HasSubstr("variables[0].parameter"));
+  EXPECT_THAT(error, HasSubstr("unknown scene parameter \"stiffness\""));
+}
+
+TEST_F(StudyFiles, MissingBodyReferenceIsReportedAtTheAttachment) {
+  const std::string scene = Replace(kScene, "a { body: \"body\" }", "a { body: \"chassis\" }");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("chassis", scene)));
+  EXPECT_THAT(error, HasSubstr("lumped.elements[0].a.body"));
+  EXPECT_THAT(error, HasSubstr("unknown body \"chassis\""));
+}
+
+TEST_F(StudyFiles, MissingInputAndElementReferencesAreReported) {
+  std::string scene = Replace(kScene, "b { input: \"road\" }", "b { input: \"track\" }");
+  scene = Replace(scene, "element: \"spring\"", "element: \"coil\"");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("lumped.elements[0].b.input: unknown input \"track\""));
+  EXPECT_THAT(error, HasSubstr("outputs[0].element_deflection.element: unknown element \"coil\""));
+}
+
+TEST_F(StudyFiles, ZeroDirectionIsRejected) {
+  const std::string scene = Replace(kScene, "direction { y { value: 1 } }\n    stiffness",
+                                    "direction { }\n    stiffness");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("lumped.elements[0].direction"));
+  EXPECT_THAT(error, HasSubstr("zero direction vector"));
+}
+
+TEST_F(StudyFiles, NegativeMassIsRejected) {
+  const std::string scene = Replace(kScene, "name: \"mass\" value: 2", "name: \"mass\" value: -2");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("mass_kg", scene)));
+  EXPECT_THAT(error, HasSubstr("lumped.bodies[0].mass_kg: must be positive, got -2"));
+}
+
+TEST_F(StudyFiles, TimeGridWithoutPointsOrRunningBackwardsIsRejected) {
+  std::string scene = Replace(kScene, "points: 11", "points: 0");
+  std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("time_grid", scene)));
+  EXPECT_THAT(error, HasSubstr("time_grid.points: must be at least 1, got 0"));
+  scene = Replace(kScene, "end_s: 1", "end_s: -1");
+  error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("time_grid.end_s: must be >= start_s"));
+}
+
+TEST_F(StudyFiles, MissingModelIsRejected) {
+  const size_t begin = std::string(kScene).find("lumped {");
+  const size_t end = std::string(kScene).find("outputs {");
+  std::string scene = kScene;
+  scene.erase(begin, end - begin);
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("no model"));
+}
+
+TEST_F(StudyFiles, UnknownOutputInConstraintListsTheSceneOutputs) {
+  const std::string study = Replace(kStudy, "output: \"x\"", "output: \"travel\"");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr(StudyAt("constraints", study)));
+  EXPECT_THAT(error, HasSubstr("constraints[0].output: unknown output \"travel\""));
+  EXPECT_THAT(error, HasSubstr("\"x\", \"acc\""));
+}
+
+TEST_F(StudyFiles, ConstraintUnitMustFitTheOutput) {
+  const std::string study = Replace(kStudy, "unit: \"mm\"", "unit: \"m/s^2\"");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr("constraints[0].unit"));
+  EXPECT_THAT(error, HasSubstr("acceleration but the output is a length"));
+}
+
+TEST_F(StudyFiles, ObjectiveNeedsAReductionThatMakesAMaximum) {
+  const std::string study = Replace(kStudy, "reduction: REDUCTION_MAX_ABS unit: \"m/s^2\"",
+                                    "reduction: REDUCTION_MIN unit: \"m/s^2\"");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr(StudyAt("objective", study)));
+  EXPECT_THAT(error, HasSubstr("objective.reduction"));
+}
+
+TEST_F(StudyFiles, OutputOfTheWrongModelKindIsRejected) {
+  const std::string scene = std::string(kScene) + "outputs { name: \"m\" mass {} }\n";
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("outputs[2]"));
+  EXPECT_THAT(error, HasSubstr("needs a linkage model"));
+}
+
+TEST_F(StudyFiles, MissingSceneFileIsReportedAtTheStudyField) {
+  const std::string study =
+      Replace(kStudy, "oscillator.scene.textproto", "nowhere.scene.textproto");
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr(StudyAt("scene_file", study)));
+  EXPECT_THAT(error, HasSubstr("cannot open scene file"));
+}
+
+TEST_F(StudyFiles, SeveralErrorsAreReportedTogether) {
+  std::string scene = Replace(kScene, "{ param: \"k\" }", "{ param: \"kx\" }");
+  scene = Replace(scene, "points: 11", "points: 0");
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr("unknown parameter \"kx\""));
+  EXPECT_THAT(error, HasSubstr("time_grid.points"));
+}
+
+TEST_F(StudyFiles, LinkageReferencesAreChecked) {
+  const std::string scene = R"pb(name: "bad linkage"
+linkage {
+  joints { name: "O2" ground: true position_m { x { value: 0 } y { value: 0 } } }
+  joints { name: "A" position_m { x { value: 0 } y { value: 0.1 } } }
+  links { name: "crank" joint_a: "O2" joint_b: "B" }
+  driver { link: "crank" pivot_joint: "A" angular_velocity_rad_per_s { value: 10 } }
+}
+outputs { name: "angle" link_rotation { link: "rocker" } }
+time_grid { start_s: 0 end_s: 1 points: 2 }
+)pb";
+  Write("linkage.scene.textproto", scene);
+  auto loaded = LoadSceneFile((dir_ / "linkage.scene.textproto").string());
+  ASSERT_FALSE(loaded.ok());
+  const std::string error(loaded.status().message());
+  EXPECT_THAT(error, HasSubstr("linkage.links[0].joint_b: unknown joint \"B\""));
+  EXPECT_THAT(error, HasSubstr("linkage.driver.pivot_joint"));
+  EXPECT_THAT(error, HasSubstr("outputs[0].link_rotation.link: unknown link \"rocker\""));
+}
+
+TEST_F(StudyFiles, JsonStudyLoadsLikeTheTextOne) {
+  auto message = ReadStudyProto("examples/vehicle/vehicle.study.textproto");
+  ASSERT_TRUE(message.ok()) << message.status();
+  std::string json;
+  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(*message, &json).ok());
+  auto study = LoadStudyFile(Write("vehicle.study.json", json));
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->variables.size(), 6u);
+  EXPECT_EQ(study->scene.outputs.size(), 6u);
+  auto broken = LoadStudyFile(Write("broken.study.json", "{\"name\": 3"));
+  ASSERT_FALSE(broken.ok());
+  EXPECT_THAT(std::string(broken.status().message()), HasSubstr("broken.study.json"));
+}
+
+TEST_F(StudyFiles, GravityInALumpedSceneIsRejectedNotIgnored) {
+  const std::string gravity =
+      "effects { gravity { acceleration_m_per_s2 { y { value: -9.81 } } } }\n";
+  const std::string scene = std::string(kScene) + gravity;
+  const std::string error = LoadError(scene, kStudy);
+  EXPECT_THAT(error, HasSubstr(SceneAt("effects", scene)));
+  EXPECT_THAT(error, HasSubstr("effects.gravity"));
+}
+
+TEST_F(StudyFiles, MissingFileIsNotFound) {
+  auto loaded = LoadSceneFile((dir_ / "absent.scene.textproto").string());
+  EXPECT_EQ(loaded.status().code(), absl::StatusCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace mbopt::spec::io

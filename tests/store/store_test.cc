@@ -1,0 +1,287 @@
+// The job database: exact round trips, reopening, and refusing files it
+// cannot trust (newer schema, other applications, garbage), with crash
+// atomicity of transactions.
+#include "server/store/store.h"
+
+#include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "server/store/double_blob.h"
+
+namespace mbopt::store {
+namespace {
+
+using ::testing::HasSubstr;
+
+class StoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           (std::string("mbopt_store_") + info->name() + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    path_ = (dir_ / "jobs.db").string();
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  static JobRow SampleJob() {
+    JobRow job;
+    job.study_name = "oscillator";
+    job.source_name = "oscillator.study.textproto";
+    job.study = std::string("\x00\x01\x02study bytes\xff", 15);
+    job.state = "RUNNING";
+    return job;
+  }
+
+  std::filesystem::path dir_;
+  std::string path_;
+};
+
+// Values chosen to catch any decimal round trip or float narrowing.
+std::vector<double> AwkwardDoubles() {
+  return {0.1, -0.0, 1.0 / 3.0, std::numeric_limits<double>::denorm_min(),
+          std::numeric_limits<double>::max(), -std::numeric_limits<double>::infinity(),
+          std::nextafter(1.0, 2.0), 6.02214076e23};
+}
+
+bool BitIdentical(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(DoubleBlob, RoundTripIsBitExactIncludingNaNPayloadAndNegativeZero) {
+  std::vector<double> values = AwkwardDoubles();
+  std::uint64_t nan_bits = 0x7ff8000000012345ULL;
+  double nan;
+  std::memcpy(&nan, &nan_bits, sizeof nan);
+  values.push_back(nan);
+  absl::StatusOr<std::vector<double>> back = DecodeDoubles(EncodeDoubles(values));
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(BitIdentical(values, *back));
+}
+
+TEST(DoubleBlob, RejectsLengthNotMultipleOfEight) {
+  EXPECT_EQ(DecodeDoubles("abc").status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto job = (*store)->CreateJob(SampleJob());
+  ASSERT_TRUE(job.ok()) << job.status();
+  AnalysisRow a;
+  a.job_id = job->id;
+  a.request_id = 7;
+  a.x_scaled = {1.0 / 7.0, 2.0 / 3.0};
+  a.ok = true;
+  a.objective_terms = AwkwardDoubles();
+  a.constraint_values = {std::sqrt(2.0), -1e-300};
+  a.worker = "w-1";
+  a.counters.time_steps = 1234;
+  ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+  auto rows = (*store)->LoadAnalyses(job->id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 1u);
+  EXPECT_EQ((*rows)[0].request_id, 7);
+  EXPECT_TRUE(BitIdentical((*rows)[0].x_scaled, a.x_scaled));
+  EXPECT_TRUE(BitIdentical((*rows)[0].objective_terms, a.objective_terms));
+  EXPECT_TRUE(BitIdentical((*rows)[0].constraint_values, a.constraint_values));
+  EXPECT_EQ((*rows)[0].counters.time_steps, 1234);
+  EXPECT_EQ((*rows)[0].worker, "w-1");
+}
+
+TEST_F(StoreTest, SecondResultForTheSameRequestIsRefused) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok());
+  auto job = (*store)->CreateJob(SampleJob());
+  ASSERT_TRUE(job.ok());
+  AnalysisRow a;
+  a.job_id = job->id;
+  a.request_id = 0;
+  ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+  EXPECT_EQ((*store)->AddAnalysis(a).code(), absl::StatusCode::kAlreadyExists);
+}
+
+TEST_F(StoreTest, EverythingSurvivesCloseAndReopen) {
+  std::string job_id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto job = (*store)->CreateJob(SampleJob());
+    ASSERT_TRUE(job.ok());
+    job_id = job->id;
+    AnalysisRow a;
+    a.job_id = job_id;
+    a.request_id = 0;
+    a.ok = false;
+    a.failure_reason = "integrator failed";
+    ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+    JobProgress progress{"CONVERGED", "", 3, 12, 1.5};
+    ASSERT_TRUE((*store)->CommitCycle(job_id, {{0, 1, 0, "r1"}, {0, 1, 1, std::string("r\0 2", 4)}}, progress).ok());
+    ASSERT_TRUE((*store)->AddEvent(job_id, "converged", "after 3 cycles").ok());
+  }
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto job = (*store)->GetJob(job_id);
+  ASSERT_TRUE(job.ok()) << job.status();
+  EXPECT_EQ(job->study, SampleJob().study);
+  EXPECT_EQ(job->state, "CONVERGED");
+  EXPECT_EQ(job->cycles, 3);
+  EXPECT_EQ(job->analyses, 12);
+  EXPECT_EQ(job->records, 2);
+  auto cycles = (*store)->LoadCycles(job_id);
+  ASSERT_TRUE(cycles.ok());
+  ASSERT_EQ(cycles->size(), 2u);
+  EXPECT_EQ((*cycles)[1].index, 1);
+  EXPECT_EQ((*cycles)[1].attempt, 1);
+  EXPECT_EQ((*cycles)[1].record, std::string("r\0 2", 4));
+  auto analyses = (*store)->LoadAnalyses(job_id);
+  ASSERT_TRUE(analyses.ok());
+  ASSERT_EQ(analyses->size(), 1u);
+  EXPECT_EQ((*analyses)[0].failure_reason, "integrator failed");
+  auto events = (*store)->LoadEvents(job_id);
+  ASSERT_TRUE(events.ok());
+  ASSERT_EQ(events->size(), 1u);
+  EXPECT_EQ((*events)[0].kind, "converged");
+  auto second = (*store)->CreateJob(SampleJob());
+  ASSERT_TRUE(second.ok());
+  EXPECT_NE(second->id, job_id);
+}
+
+TEST_F(StoreTest, UnknownJobIsNotFoundNamingTheId) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok());
+  absl::StatusOr<JobRow> job = (*store)->GetJob("job-42");
+  EXPECT_EQ(job.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(job.status().message()), HasSubstr("job-42"));
+}
+
+void RunSql(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
+TEST_F(StoreTest, NewerSchemaVersionIsRefused) {
+  { ASSERT_TRUE(Store::Open(path_).ok()); }
+  RunSql(path_, "UPDATE schema_version SET version = " + std::to_string(kSchemaVersion + 1));
+  auto store = Store::Open(path_);
+  ASSERT_FALSE(store.ok());
+  EXPECT_EQ(store.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(std::string(store.status().message()), HasSubstr("newer"));
+  EXPECT_THAT(std::string(store.status().message()), HasSubstr(path_));
+}
+
+TEST_F(StoreTest, GarbageFileIsRefusedWithClearError) {
+  {
+    std::ofstream out(path_, std::ios::binary);
+    for (int i = 0; i < 4096; ++i) out.put(static_cast<char>((i * 37 + 11) & 0xff));
+  }
+  auto store = Store::Open(path_);
+  ASSERT_FALSE(store.ok());
+  EXPECT_EQ(store.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(std::string(store.status().message()), HasSubstr("not a database"));
+  EXPECT_THAT(std::string(store.status().message()), HasSubstr(path_));
+}
+
+TEST_F(StoreTest, ShortTextFileIsRefused) {
+  { std::ofstream(path_) << "hello, I am a text file\n"; }
+  auto store = Store::Open(path_);
+  ASSERT_FALSE(store.ok());
+  EXPECT_THAT(std::string(store.status().message()), HasSubstr(path_));
+}
+
+TEST_F(StoreTest, SqliteDatabaseOfAnotherApplicationIsRefused) {
+  RunSql(path_, "CREATE TABLE customers(name TEXT)");
+  auto store = Store::Open(path_);
+  ASSERT_FALSE(store.ok());
+  EXPECT_EQ(store.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(std::string(store.status().message()), HasSubstr("another application"));
+}
+
+TEST_F(StoreTest, UncommittedTransactionLeavesThePreviousState) {
+  std::string job_id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok());
+    auto job = (*store)->CreateJob(SampleJob());
+    ASSERT_TRUE(job.ok());
+    job_id = job->id;
+    ASSERT_TRUE((*store)->CommitCycle(job_id, {{0, 1, 0, "first"}}, {"RUNNING", "", 1, 3, 0.1}).ok());
+  }
+  // Begin, write, close without commit.
+  RunSql(path_, "BEGIN; INSERT INTO cycles(job_id, idx, cycle, attempt, record) VALUES ('" + job_id +
+                    "', 1, 2, 0, x'00'); UPDATE jobs SET cycles = 2, records = 2;");
+  // Begin, write, die without closing (a crash of the process).
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    sqlite3* db = nullptr;
+    sqlite3_open(path_.c_str(), &db);
+    sqlite3_exec(db, "BEGIN; UPDATE jobs SET state = 'CONVERGED', cycles = 9;", nullptr, nullptr, nullptr);
+    ::_exit(0);
+  }
+  int wstatus = 0;
+  ASSERT_EQ(::waitpid(child, &wstatus, 0), child);
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto job = (*store)->GetJob(job_id);
+  ASSERT_TRUE(job.ok());
+  EXPECT_EQ(job->state, "RUNNING");
+  EXPECT_EQ(job->cycles, 1);
+  EXPECT_EQ(job->records, 1);
+  auto cycles = (*store)->LoadCycles(job_id);
+  ASSERT_TRUE(cycles.ok());
+  ASSERT_EQ(cycles->size(), 1u);
+  EXPECT_EQ((*cycles)[0].record, "first");
+}
+
+TEST_F(StoreTest, CycleCommitOfUnknownJobChangesNothing) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok());
+  EXPECT_EQ((*store)->CommitCycle("job-9", {{0, 1, 0, "x"}}, {"RUNNING", "", 1, 1, 0}).code(),
+            absl::StatusCode::kNotFound);
+  auto cycles = (*store)->LoadCycles("job-9");
+  ASSERT_TRUE(cycles.ok());
+  EXPECT_TRUE(cycles->empty());
+}
+
+TEST_F(StoreTest, SecondOpenWhileTheFirstIsOpenIsRefused) {
+  auto first = Store::Open(path_);
+  ASSERT_TRUE(first.ok()) << first.status();
+  auto second = Store::Open(path_);
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(std::string(second.status().message()), HasSubstr("another process"));
+  first->reset();
+  EXPECT_TRUE(Store::Open(path_).ok());
+}
+
+TEST_F(StoreTest, DatabaseUsesWalJournal) {
+  { ASSERT_TRUE(Store::Open(path_).ok()); }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "PRAGMA journal_mode", -1, &stmt, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+  EXPECT_STREQ(reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0)), "wal");
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+}
+
+}  // namespace
+}  // namespace mbopt::store

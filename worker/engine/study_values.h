@@ -1,0 +1,19 @@
+// The study's values (objective terms, constraint values, F, worst row) of
+// one analysis: spec::ComputeStudyValues applied to an engine report. Used by
+// the worker and by `mbopt-worker eval`; depends on no solver.
+#pragma once
+
+#include "absl/status/statusor.h"
+#include "spec/layout.h"
+#include "spec/study.h"
+#include "worker/engine/analysis.h"
+
+namespace mbopt::engine {
+
+// FailedPrecondition if the analysis failed (its reason in the message);
+// InvalidArgument if its outputs do not have the layout's shape.
+absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
+                                                     const spec::StudyLayout& layout,
+                                                     const AnalysisReport& report);
+
+}  // namespace mbopt::engine

@@ -1,0 +1,325 @@
+#include "worker/main/eval_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <ostream>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "spec/io/study_io.h"
+#include "spec/layout.h"
+#include "worker/engine/analysis.h"
+#include "worker/engine/study_values.h"
+
+namespace mbopt::worker {
+namespace {
+
+const char kUsage[] =
+    "usage: mbopt-worker eval STUDY [--set NAME=VALUE ...] [--json]\n"
+    "  Runs one analysis of STUDY (a .study.textproto) at its initial design and\n"
+    "  prints the objective, the worst constraint row, per-output summaries,\n"
+    "  the formulation and the counters.\n"
+    "  --set NAME=VALUE  NAME is a design variable (VALUE scaled, as in the study's\n"
+    "                    bounds) or a scene parameter (VALUE in the parameter's own\n"
+    "                    unit); repeatable\n"
+    "  --json            print one JSON object instead of text\n"
+    "  exit status: 0 ok, 1 analysis failed, 2 bad input\n";
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += absl::StrFormat("\\u%04x", static_cast<int>(c));
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string JsonNumber(double v) { return std::isfinite(v) ? absl::StrFormat("%.17g", v) : "null"; }
+
+struct SeriesSummary {
+  std::string label;
+  double min = 0, max = 0, t_min = 0, t_max = 0;
+};
+
+SeriesSummary Summarize(const std::string& label, const std::vector<double>& values,
+                        const std::vector<double>& times) {
+  SeriesSummary s;
+  s.label = label;
+  if (values.empty()) return s;
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  s.min = *lo;
+  s.max = *hi;
+  const auto at = [&](auto it) {
+    const size_t i = static_cast<size_t>(it - values.begin());
+    return i < times.size() && values.size() == times.size() ? times[i] : 0.0;
+  };
+  s.t_min = at(lo);
+  s.t_max = at(hi);
+  return s;
+}
+
+// Applies one --set: a design variable (scaled) or a parameter (its unit).
+absl::Status ApplySet(const spec::Study& study, const std::string& assignment,
+                      std::vector<double>* x, std::vector<double>* parameters_si,
+                      std::vector<std::pair<int, double>>* parameter_overrides) {
+  const size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--set expects NAME=VALUE, got \"", assignment, "\""));
+  }
+  const std::string name = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end == nullptr || *end != '\0' || !std::isfinite(value)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--set ", name, ": \"", text, "\" is not a finite number"));
+  }
+  for (size_t k = 0; k < study.variables.size(); ++k) {
+    if (study.variables[k].name == name) {
+      (*x)[k] = value;
+      return absl::OkStatus();
+    }
+  }
+  const int p = study.scene.FindParameter(name);
+  if (p < 0) {
+    std::vector<std::string> names;
+    for (const auto& v : study.variables) names.push_back(v.name);
+    return absl::InvalidArgumentError(
+        absl::StrCat("--set: \"", name, "\" is neither a design variable (",
+                     absl::StrJoin(names, ", "), ") nor a scene parameter"));
+  }
+  for (size_t k = 0; k < study.variables.size(); ++k) {
+    if (study.variables[k].parameter == p) {
+      // A bound parameter moves its variable, so the design stays consistent.
+      (*x)[k] = value / study.variables[k].scale;
+      return absl::OkStatus();
+    }
+  }
+  parameter_overrides->emplace_back(p, value * study.scene.parameters[p].si_per_unit);
+  (void)parameters_si;
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+const char* EvalUsage() { return kUsage; }
+
+int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  std::string study_path;
+  std::vector<std::string> sets;
+  bool json = false;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--json") {
+      json = true;
+    } else if (a == "--set") {
+      if (i + 1 >= args.size()) {
+        err << "mbopt-worker eval: --set needs NAME=VALUE\n" << kUsage;
+        return kExitBadInput;
+      }
+      sets.push_back(args[++i]);
+    } else if (a.rfind("--set=", 0) == 0) {
+      sets.push_back(a.substr(6));
+    } else if (a == "--help" || a == "-h") {
+      out << kUsage;
+      return kExitOk;
+    } else if (!a.empty() && a[0] == '-') {
+      err << "mbopt-worker eval: unknown option \"" << a << "\"\n" << kUsage;
+      return kExitBadInput;
+    } else if (study_path.empty()) {
+      study_path = a;
+    } else {
+      err << "mbopt-worker eval: more than one study file given\n" << kUsage;
+      return kExitBadInput;
+    }
+  }
+  if (study_path.empty()) {
+    err << "mbopt-worker eval: no study file given\n" << kUsage;
+    return kExitBadInput;
+  }
+
+  absl::StatusOr<spec::Study> loaded = spec::io::LoadStudyFile(study_path);
+  if (!loaded.ok()) {
+    err << loaded.status().message() << "\n";
+    return kExitBadInput;
+  }
+  const spec::Study& study = *loaded;
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  if (!layout.ok()) {
+    err << layout.status().message() << "\n";
+    return kExitBadInput;
+  }
+
+  std::vector<double> x;
+  for (const auto& v : study.variables) x.push_back(v.initial);
+  std::vector<std::pair<int, double>> overrides;
+  for (const std::string& s : sets) {
+    if (absl::Status st = ApplySet(study, s, &x, nullptr, &overrides); !st.ok()) {
+      err << "mbopt-worker eval: " << st.message() << "\n";
+      return kExitBadInput;
+    }
+  }
+  std::vector<double> parameters = study.ParameterValuesAt(x);
+  for (const auto& [p, value] : overrides) parameters[static_cast<size_t>(p)] = value;
+  std::vector<std::string> outside;
+  for (size_t k = 0; k < x.size(); ++k) {
+    const auto& v = study.variables[k];
+    if (x[k] < v.lower || x[k] > v.upper) {
+      outside.push_back(
+          absl::StrFormat("%s = %g outside [%g, %g]", v.name, x[k], v.lower, v.upper));
+    }
+  }
+
+  const engine::AnalysisReport report = engine::Analyze(study.scene, parameters);
+  const bool ok = report.status == engine::AnalysisStatus::kOk;
+  absl::StatusOr<spec::StudyValues> values =
+      ok ? engine::ComputeStudyValues(study, *layout, report)
+         : absl::StatusOr<spec::StudyValues>(absl::FailedPreconditionError(report.failure_reason));
+  if (ok && !values.ok()) {
+    err << "mbopt-worker eval: " << values.status().message() << "\n";
+    return kExitAnalysisFailed;
+  }
+  const std::string objective_unit =
+      study.objective.form == spec::Objective::Form::kTargetDistance
+          ? ""
+          : (study.objective.unit.empty() ? "SI" : study.objective.unit);
+
+  std::vector<std::vector<SeriesSummary>> summaries;
+  for (const auto& o : report.outputs) {
+    std::vector<SeriesSummary> per_series;
+    for (size_t s = 0; s < o.series.size(); ++s) {
+      per_series.push_back(
+          Summarize(s < o.series_labels.size() ? o.series_labels[s] : absl::StrCat(s), o.series[s],
+                    report.times_s));
+    }
+    summaries.push_back(std::move(per_series));
+  }
+  const auto& c = report.counters;
+
+  if (json) {
+    out << "{";
+    out << "\"study\": " << JsonString(study.name);
+    out << ", \"status\": " << JsonString(ok ? "ok" : "failed");
+    if (!ok) out << ", \"failure_reason\": " << JsonString(report.failure_reason);
+    out << ", \"formulation\": " << JsonString(engine::FormulationName(report.formulation));
+    out << ", \"design\": {";
+    for (size_t k = 0; k < x.size(); ++k) {
+      out << (k ? ", " : "") << JsonString(study.variables[k].name) << ": " << JsonNumber(x[k]);
+    }
+    out << "}";
+    if (ok) {
+      out << ", \"objective\": " << JsonNumber(values->objective);
+      out << ", \"objective_unit\": " << JsonString(objective_unit);
+      out << ", \"objective_terms\": " << values->objective_terms.size();
+      out << ", \"max_violation\": " << JsonNumber(values->max_violation);
+      out << ", \"constraint_rows\": " << layout->rows.size();
+      if (values->worst_row >= 0) {
+        const spec::ConstraintRow& row = layout->rows[static_cast<size_t>(values->worst_row)];
+        out << ", \"worst_constraint\": {\"row\": " << values->worst_row
+            << ", \"name\": " << JsonString(row.name)
+            << ", \"value_si\": " << JsonNumber(values->constraint_values[values->worst_row])
+            << ", \"limit_si\": " << JsonNumber(row.limit_si)
+            << ", \"time_s\": " << JsonNumber(row.time_s) << "}";
+      } else {
+        out << ", \"worst_constraint\": null";
+      }
+    } else {
+      out << ", \"objective\": null, \"max_violation\": null, \"worst_constraint\": null";
+    }
+    out << ", \"outputs\": [";
+    for (size_t o = 0; o < summaries.size(); ++o) {
+      out << (o ? ", " : "") << "{\"name\": " << JsonString(report.outputs[o].name)
+          << ", \"series\": [";
+      for (size_t s = 0; s < summaries[o].size(); ++s) {
+        const SeriesSummary& m = summaries[o][s];
+        out << (s ? ", " : "") << "{\"label\": " << JsonString(m.label)
+            << ", \"min_si\": " << JsonNumber(m.min) << ", \"t_min_s\": " << JsonNumber(m.t_min)
+            << ", \"max_si\": " << JsonNumber(m.max) << ", \"t_max_s\": " << JsonNumber(m.t_max)
+            << "}";
+      }
+      out << "]}";
+    }
+    out << "]";
+    out << ", \"counters\": {\"time_steps\": " << c.time_steps
+        << ", \"rhs_evaluations\": " << c.rhs_evaluations
+        << ", \"jacobian_evaluations\": " << c.jacobian_evaluations
+        << ", \"newton_iterations\": " << c.newton_iterations
+        << ", \"position_solves\": " << c.position_solves
+        << ", \"wall_seconds\": " << JsonNumber(c.wall_seconds) << "}";
+    if (!outside.empty()) {
+      out << ", \"warnings\": [";
+      for (size_t i = 0; i < outside.size(); ++i) out << (i ? ", " : "") << JsonString(outside[i]);
+      out << "]";
+    }
+    out << "}\n";
+    return ok ? kExitOk : kExitAnalysisFailed;
+  }
+
+  out << "study        " << study.name << " (" << study.source_file << ")\n";
+  std::vector<std::string> design;
+  for (size_t k = 0; k < x.size(); ++k) {
+    design.push_back(absl::StrFormat("%s=%g", study.variables[k].name, x[k]));
+  }
+  out << "design       " << absl::StrJoin(design, " ") << "\n";
+  for (const std::string& w : outside) out << "warning      " << w << "\n";
+  out << "formulation  " << engine::FormulationName(report.formulation) << "\n";
+  if (!ok) {
+    out << "status       FAILED: " << report.failure_reason << "\n";
+  } else {
+    out << "status       ok\n";
+    out << absl::StrFormat("objective    %.6g %s (%d term%s)\n", values->objective, objective_unit,
+                           values->objective_terms.size(),
+                           values->objective_terms.size() == 1 ? "" : "s");
+    if (values->worst_row >= 0) {
+      const spec::ConstraintRow& row = layout->rows[static_cast<size_t>(values->worst_row)];
+      out << absl::StrFormat(
+          "worst row    %s: g = %.6g, limit %.6g (SI), normalized %+.4g (%s) of %d rows\n",
+          row.name, values->constraint_values[values->worst_row], row.limit_si,
+          values->max_violation, values->max_violation > 0 ? "violated" : "satisfied",
+          layout->rows.size());
+    } else {
+      out << "worst row    (no constraints)\n";
+    }
+  }
+  out << "outputs      (SI; min and max over the grid)\n";
+  for (size_t o = 0; o < summaries.size(); ++o) {
+    for (const SeriesSummary& m : summaries[o]) {
+      const std::string label = summaries[o].size() > 1
+                                    ? absl::StrCat(report.outputs[o].name, "[", m.label, "]")
+                                    : report.outputs[o].name;
+      out << absl::StrFormat("  %-24s min %-13.6g at t=%-8.4g max %-13.6g at t=%.4g\n", label,
+                             m.min, m.t_min, m.max, m.t_max);
+    }
+  }
+  out << absl::StrFormat(
+      "counters     steps %d, rhs %d, jacobians %d, newton %d, position solves %d, wall %.3f ms\n",
+      c.time_steps, c.rhs_evaluations, c.jacobian_evaluations, c.newton_iterations,
+      c.position_solves, c.wall_seconds * 1e3);
+  return ok ? kExitOk : kExitAnalysisFailed;
+}
+
+}  // namespace mbopt::worker

@@ -1,0 +1,439 @@
+#include "worker/service/worker_service.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+
+#include "absl/strings/str_cat.h"
+#include "mbopt/v1/service.grpc.pb.h"
+#include "worker/service/task_evaluator.h"
+
+namespace mbopt::worker {
+namespace {
+
+using Clock = std::chrono::system_clock;
+
+constexpr int kDefaultHeartbeatMs = 1000;
+constexpr auto kShortCallDeadline = std::chrono::seconds(10);
+// How long a finished result is retried while the server is unreachable; past
+// that its lease has long expired and the task runs elsewhere.
+constexpr auto kReportRetryWindow = std::chrono::seconds(60);
+constexpr size_t kMaxCachedStudies = 64;
+
+std::string DefaultName() {
+  char host[256] = {0};
+  if (gethostname(host, sizeof host - 1) != 0) std::snprintf(host, sizeof host, "worker");
+  return absl::StrCat(host, ":", getpid());
+}
+
+bool Retryable(const grpc::Status& s) {
+  return s.error_code() == grpc::StatusCode::UNAVAILABLE ||
+         s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED ||
+         s.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
+}
+
+// Blocking calls in progress; cancelled all at once when the worker stops.
+class CallRegistry {
+ public:
+  void Add(grpc::ClientContext* context) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (cancelled_) context->TryCancel();
+    active_.insert(context);
+  }
+  void Remove(grpc::ClientContext* context) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    active_.erase(context);
+  }
+  void CancelAll() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+    for (auto* c : active_) c->TryCancel();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::set<grpc::ClientContext*> active_;
+  bool cancelled_ = false;
+};
+
+class ScopedCall {
+ public:
+  ScopedCall(CallRegistry& registry, grpc::ClientContext* context)
+      : registry_(registry), context_(context) {
+    registry_.Add(context_);
+  }
+  ~ScopedCall() { registry_.Remove(context_); }
+
+ private:
+  CallRegistry& registry_;
+  grpc::ClientContext* context_;
+};
+
+struct QueuedTask {
+  v1::AnalysisTask task;
+  std::string worker_id;  // the registration it was acquired under
+};
+
+class Worker : public std::enable_shared_from_this<Worker> {
+ public:
+  Worker(const WorkerOptions& options, StopSignal& stop)
+      : options_(options),
+        stop_(stop),
+        backoff_seed_(static_cast<std::uint64_t>(
+                          std::chrono::steady_clock::now().time_since_epoch().count()) ^
+                      static_cast<std::uint64_t>(getpid())) {
+    if (options_.name.empty()) options_.name = DefaultName();
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(256 * 1024 * 1024);
+    stub_ = v1::WorkerService::NewStub(grpc::CreateCustomChannel(
+        options_.server_address, grpc::InsecureChannelCredentials(), args));
+  }
+
+  void Run() {
+    std::weak_ptr<Worker> weak = weak_from_this();
+    stop_.OnStop([weak] {
+      if (auto self = weak.lock()) self->HandleStop();
+    });
+    std::vector<std::thread> threads;
+    for (int i = 0; i < options_.slots; ++i) threads.emplace_back([this] { SlotLoop(); });
+    threads.emplace_back([this] { HeartbeatLoop(); });
+    AcquireLoop();
+    HandleStop();
+    for (auto& t : threads) t.join();
+    Log(absl::StrCat("stopped after ", tasks_received_, " tasks"));
+  }
+
+ private:
+  void Log(const std::string& message) {
+    std::fprintf(stderr, "mbopt-worker %s: %s\n", options_.name.c_str(), message.c_str());
+  }
+
+  void HandleStop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    cv_.notify_all();
+    calls_.CancelAll();
+  }
+
+  bool Register() {
+    v1::RegisterWorkerRequest request;
+    request.set_name(options_.name);
+    request.set_slots(options_.slots);
+    v1::RegisterWorkerResponse response;
+    grpc::ClientContext context;
+    context.set_deadline(Clock::now() + kShortCallDeadline);
+    ScopedCall scoped(calls_, &context);
+    grpc::Status status = stub_->Register(&context, request, &response);
+    if (!status.ok()) {
+      if (!unreachable_logged_ && !stop_.stopped()) {
+        Log(absl::StrCat("cannot reach server at ", options_.server_address, ": ",
+                         status.error_message(), "; retrying"));
+        unreachable_logged_ = true;
+      }
+      return false;
+    }
+    unreachable_logged_ = false;
+    std::lock_guard<std::mutex> lock(mutex_);
+    worker_id_ = response.worker_id();
+    heartbeat_ms_ = response.heartbeat_interval_ms() > 0 ? response.heartbeat_interval_ms()
+                                                         : kDefaultHeartbeatMs;
+    registered_ = true;
+    Log(absl::StrCat("registered with ", options_.server_address, " as ", worker_id_, " (",
+                     options_.slots, " slots)"));
+    return true;
+  }
+
+  void AcquireLoop() {
+    Backoff backoff(options_.backoff, backoff_seed_);
+    while (!stop_.stopped()) {
+      bool registered;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        registered = registered_;
+      }
+      if (!registered) {
+        if (!Register()) {
+          if (stop_.WaitFor(backoff.Next())) break;
+          continue;
+        }
+        backoff.Reset();
+      }
+      int free_slots;
+      std::string worker_id;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return stopping_ || busy_ < options_.slots; });
+        if (stopping_) break;
+        free_slots = options_.slots - busy_;
+        worker_id = worker_id_;
+      }
+      v1::AcquireTasksRequest request;
+      request.set_worker_id(worker_id);
+      request.set_max_tasks(free_slots);
+      request.set_wait_ms(options_.acquire_wait_ms);
+      v1::AcquireTasksResponse response;
+      grpc::ClientContext context;
+      context.set_deadline(Clock::now() + std::chrono::milliseconds(options_.acquire_wait_ms) +
+                           kShortCallDeadline);
+      grpc::Status status;
+      {
+        ScopedCall scoped(calls_, &context);
+        status = stub_->AcquireTasks(&context, request, &response);
+      }
+      if (!status.ok()) {
+        if (stop_.stopped()) break;
+        if (status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED) {
+          // The server restarted, forgot us, or is gone: register again
+          // (which waits for it to come back).
+          Log(absl::StrCat("lost the server (", status.error_message(), "); reconnecting"));
+          std::lock_guard<std::mutex> lock(mutex_);
+          registered_ = false;
+        }
+        if (stop_.WaitFor(backoff.Next())) break;
+        continue;
+      }
+      backoff.Reset();
+      for (const auto& task : response.tasks()) {
+        ++tasks_received_;
+        if (options_.die_after_tasks > 0 && tasks_received_ == options_.die_after_tasks) {
+          Log(absl::StrCat("--die-after-tasks ", options_.die_after_tasks,
+                           ": killing this process with task ", task.task_id(), " in hand"));
+          std::fflush(stderr);
+          raise(SIGKILL);
+        }
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          queue_.push_back({task, worker_id});
+          cancelled_[task.task_id()] = false;
+          ++busy_;
+        }
+        cv_.notify_all();
+      }
+    }
+  }
+
+  void SlotLoop() {
+    while (true) {
+      QueuedTask item;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+        // On stop, tasks not yet started are left to their leases.
+        if (stopping_) return;
+        item = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      const v1::AnalysisTask& task = item.task;
+      v1::TaskResult result;
+      result.set_worker_id(item.worker_id);
+      result.set_task_id(task.task_id());
+      result.set_job_id(task.job_id());
+      result.set_request_id(task.request_id());
+      std::string study_error;
+      auto study = StudyFor(task.job_id(), &study_error);
+      bool deliver = true;
+      if (study != nullptr) {
+        EvaluateTask(*study, task, &result);
+      } else if (!study_error.empty()) {
+        // Not the design point's fault: let another worker try.
+        result.set_ok(false);
+        result.set_retry(true);
+        result.set_failure_reason(study_error);
+      } else {
+        deliver = false;  // the job is gone or the server unreachable
+      }
+      if (options_.verbose) {
+        Log(absl::StrCat("task ", task.task_id(), result.ok() ? " ok" : " failed: ",
+                         result.ok() ? "" : result.failure_reason()));
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (cancelled_[task.task_id()]) deliver = false;
+      }
+      if (deliver) Report(result);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        cancelled_.erase(task.task_id());
+        --busy_;
+      }
+      cv_.notify_all();
+    }
+  }
+
+  // The job's prepared study, fetched once. nullptr with an empty `error`
+  // if it cannot be fetched (job gone, server unreachable); nullptr with a
+  // message if the study does not convert here (the task is then reported
+  // with retry = true, for another worker to try).
+  std::shared_ptr<const PreparedStudy> StudyFor(const std::string& job_id, std::string* error) {
+    std::lock_guard<std::mutex> lock(study_mutex_);
+    if (auto it = studies_.find(job_id); it != studies_.end()) return it->second;
+    if (auto it = study_errors_.find(job_id); it != study_errors_.end()) {
+      *error = it->second;
+      return nullptr;
+    }
+    Backoff backoff(options_.backoff, backoff_seed_ + 1);
+    const auto give_up = Clock::now() + kReportRetryWindow;
+    v1::GetStudyResponse response;
+    while (true) {
+      v1::GetStudyRequest request;
+      request.set_job_id(job_id);
+      grpc::ClientContext context;
+      context.set_deadline(Clock::now() + kShortCallDeadline);
+      grpc::Status status;
+      {
+        ScopedCall scoped(calls_, &context);
+        status = stub_->GetStudy(&context, request, &response);
+      }
+      if (status.ok()) break;
+      if (!Retryable(status) || stop_.stopped() || Clock::now() > give_up) {
+        Log(absl::StrCat("cannot get the study of job ", job_id, ": ", status.error_message()));
+        return nullptr;
+      }
+      if (stop_.WaitFor(backoff.Next())) return nullptr;
+    }
+    if (studies_.size() + study_errors_.size() >= kMaxCachedStudies) {
+      studies_.clear();
+      study_errors_.clear();
+    }
+    auto prepared = PrepareStudy(response.study(), job_id);
+    if (!prepared.ok()) {
+      *error = absl::StrCat("the study of job ", job_id,
+                            " cannot be prepared: ", prepared.status().message());
+      study_errors_[job_id] = *error;
+      return nullptr;
+    }
+    studies_[job_id] = *prepared;
+    return *prepared;
+  }
+
+  void Report(const v1::TaskResult& result) {
+    Backoff backoff(options_.backoff, backoff_seed_ + 2);
+    const auto give_up = Clock::now() + kReportRetryWindow;
+    while (true) {
+      v1::ReportResultResponse response;
+      grpc::ClientContext context;
+      context.set_deadline(Clock::now() + kShortCallDeadline);
+      // Not registered for cancellation: a result finished while stopping is
+      // still worth delivering.
+      grpc::Status status = stub_->ReportResult(&context, result, &response);
+      if (status.ok()) {
+        if (!response.accepted() && options_.verbose) {
+          Log(absl::StrCat("result of task ", result.task_id(), " was not accepted"));
+        }
+        return;
+      }
+      if (!Retryable(status) || stop_.stopped() || Clock::now() > give_up) {
+        Log(absl::StrCat("result of task ", result.task_id(),
+                         " not delivered: ", status.error_message()));
+        return;
+      }
+      if (stop_.WaitFor(backoff.Next())) return;
+    }
+  }
+
+  void HeartbeatLoop() {
+    while (true) {
+      int interval_ms;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        interval_ms = heartbeat_ms_;
+      }
+      if (stop_.WaitFor(std::chrono::milliseconds(interval_ms))) return;
+      v1::HeartbeatRequest request;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!registered_) continue;
+        request.set_worker_id(worker_id_);
+        for (const auto& [task_id, cancelled] : cancelled_) {
+          if (!cancelled) request.add_task_ids(task_id);
+        }
+      }
+      v1::HeartbeatResponse response;
+      grpc::ClientContext context;
+      context.set_deadline(Clock::now() + kShortCallDeadline);
+      grpc::Status status;
+      {
+        ScopedCall scoped(calls_, &context);
+        status = stub_->Heartbeat(&context, request, &response);
+      }
+      if (!status.ok()) continue;  // the acquiring thread handles reconnection
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!response.known() && worker_id_ == request.worker_id()) {
+        Log("the server no longer knows this worker; registering again");
+        registered_ = false;
+      }
+      for (const auto& task_id : response.cancelled_task_ids()) {
+        auto it = cancelled_.find(task_id);
+        if (it == cancelled_.end()) continue;
+        it->second = true;
+        auto queued = std::find_if(queue_.begin(), queue_.end(), [&](const QueuedTask& q) {
+          return q.task.task_id() == task_id;
+        });
+        if (queued != queue_.end()) {
+          queue_.erase(queued);
+          cancelled_.erase(it);
+          --busy_;
+          cv_.notify_all();
+        }
+      }
+    }
+  }
+
+  WorkerOptions options_;
+  StopSignal& stop_;
+  const std::uint64_t backoff_seed_;
+  std::unique_ptr<v1::WorkerService::Stub> stub_;
+  CallRegistry calls_;
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stopping_ = false;
+  bool registered_ = false;
+  std::string worker_id_;
+  int heartbeat_ms_ = kDefaultHeartbeatMs;
+  std::deque<QueuedTask> queue_;
+  int busy_ = 0;                          // tasks queued or being evaluated
+  std::map<std::string, bool> cancelled_; // task id -> cancelled, for tasks in hand
+
+  std::mutex study_mutex_;
+  std::map<std::string, std::shared_ptr<const PreparedStudy>> studies_;
+  std::map<std::string, std::string> study_errors_;
+
+  int tasks_received_ = 0;  // acquiring thread only
+  bool unreachable_logged_ = false;  // acquiring thread only
+};
+
+}  // namespace
+
+absl::Status RunWorker(const WorkerOptions& options, StopSignal& stop) {
+  if (options.server_address.empty()) {
+    return absl::InvalidArgumentError("--server ADDRESS is required");
+  }
+  if (options.slots < 1) {
+    return absl::InvalidArgumentError(absl::StrCat("--slots must be >= 1, got ", options.slots));
+  }
+  if (options.die_after_tasks < 0) {
+    return absl::InvalidArgumentError("--die-after-tasks must be >= 0");
+  }
+  auto worker = std::make_shared<Worker>(options, stop);
+  worker->Run();
+  return absl::OkStatus();
+}
+
+}  // namespace mbopt::worker

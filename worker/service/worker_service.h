@@ -1,0 +1,41 @@
+// The worker process' connection to an mbopt server: register, long-poll for
+// tasks, evaluate them (task_evaluator.h) on `slots` threads, report results,
+// and heartbeat so the server extends the leases of tasks in progress and can
+// tell the worker which tasks to drop. When the server goes away the worker
+// keeps trying to reconnect, with capped exponential backoff, until it is
+// stopped; a task whose result cannot be delivered is simply lost (its lease
+// expires and the server hands it to another worker).
+//
+// Threads: one long-polling thread (the caller's), one per slot, one for
+// heartbeats. A running analysis cannot be interrupted (the engine has no
+// cancellation point); a cancelled task's result is dropped instead.
+#pragma once
+
+#include <string>
+
+#include "absl/status/status.h"
+#include "worker/service/backoff.h"
+#include "worker/service/stop_signal.h"
+
+namespace mbopt::worker {
+
+struct WorkerOptions {
+  std::string server_address;  // host:port
+  int slots = 1;               // analyses at once
+  std::string name;            // shown on the server; empty: host:pid
+  // Long-poll length of AcquireTasks.
+  int acquire_wait_ms = 5000;
+  BackoffOptions backoff;
+  // Testing only: raise SIGKILL on this process right after receiving the
+  // N-th task, before evaluating or reporting it (0: never). Recovery tests
+  // use it to lose a worker in the middle of a cycle.
+  int die_after_tasks = 0;
+  bool verbose = false;  // a line on stderr per task
+};
+
+// Runs until `stop` is requested; then lets running analyses finish, reports
+// their results if the server is there, and returns OK. InvalidArgument for
+// bad options.
+absl::Status RunWorker(const WorkerOptions& options, StopSignal& stop);
+
+}  // namespace mbopt::worker

@@ -1,0 +1,391 @@
+#include "worker/solve/cvodes_integrator.h"
+
+#include <cvodes/cvodes.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "common/status_macros.h"
+
+namespace mbopt::solve {
+
+struct CvodesIntegrator::Sundials {
+  SUNContext context = nullptr;
+  void* cvode = nullptr;
+  N_Vector y = nullptr;
+  N_Vector abstol = nullptr;
+  SUNMatrix matrix = nullptr;
+  SUNLinearSolver linear_solver = nullptr;
+  SUNNonlinearSolver nonlinear_solver = nullptr;
+
+  ~Sundials() {
+    // CVodeFree first: it may still reference the solvers.
+    if (cvode != nullptr) CVodeFree(&cvode);
+    if (nonlinear_solver != nullptr) SUNNonlinSolFree(nonlinear_solver);
+    if (linear_solver != nullptr) SUNLinSolFree(linear_solver);
+    if (matrix != nullptr) SUNMatDestroy(matrix);
+    if (abstol != nullptr) N_VDestroy(abstol);
+    if (y != nullptr) N_VDestroy(y);
+    if (context != nullptr) SUNContext_Free(&context);
+  }
+};
+
+// The C side of the callbacks: each turns an exception or a non-finite value
+// into a SUNDIALS return code and remembers why.
+struct CvodesCallbacks {
+  static int Rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) {
+    auto* self = static_cast<CvodesIntegrator*>(user_data);
+    if (self->options_.max_wall_seconds > 0.0) {
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - self->start_).count();
+      if (elapsed > self->options_.max_wall_seconds) {
+        self->wall_time_exceeded_ = true;
+        return -1;
+      }
+    }
+    try {
+      const int flag = self->rhs_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+      if (flag != 0) {
+        if (flag < 0) {
+          self->callback_failure_ = absl::StrFormat(
+              "right-hand side reported an unrecoverable error (%d) at t = %.9g", flag, t);
+        }
+        return flag;
+      }
+      const double* out = N_VGetArrayPointer(ydot);
+      for (int i = 0; i < self->num_states_; ++i) {
+        if (!std::isfinite(out[i])) {
+          self->callback_failure_ =
+              absl::StrFormat("right-hand side is not finite at t = %.9g (state %d)", t, i);
+          return -1;
+        }
+      }
+      return 0;
+    } catch (const std::exception& e) {
+      self->callback_failure_ = absl::StrCat("right-hand side threw: ", e.what());
+    } catch (...) {
+      self->callback_failure_ = "right-hand side threw a non-standard exception";
+    }
+    return -1;
+  }
+
+  static int Jacobian(realtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void* user_data, N_Vector,
+                      N_Vector, N_Vector) {
+    auto* self = static_cast<CvodesIntegrator*>(user_data);
+    try {
+      SUNMatZero(jac);
+      const int flag = self->jacobian_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(fy),
+                                       SUNDenseMatrix_Data(jac));
+      if (flag < 0) {
+        self->callback_failure_ =
+            absl::StrFormat("Jacobian reported an unrecoverable error (%d) at t = %.9g", flag, t);
+      }
+      return flag;
+    } catch (const std::exception& e) {
+      self->callback_failure_ = absl::StrCat("Jacobian threw: ", e.what());
+    } catch (...) {
+      self->callback_failure_ = "Jacobian threw a non-standard exception";
+    }
+    return -1;
+  }
+
+  static void Error(int code, const char* module, const char* function, char* message,
+                    void* user_data) {
+    auto* self = static_cast<CvodesIntegrator*>(user_data);
+    self->last_sundials_message_ = absl::StrFormat(
+        "%s %s (code %d): %s", module != nullptr ? module : "CVODES",
+        function != nullptr ? function : "", code, message != nullptr ? message : "");
+  }
+};
+
+absl::Status CvodesOptions::Validate(int num_states) const {
+  if (num_states <= 0) {
+    return absl::InvalidArgumentError(absl::StrCat("ODE size must be positive, got ", num_states));
+  }
+  if (!(relative_tolerance > 0.0) || !std::isfinite(relative_tolerance)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("relative_tolerance must be positive, got ", relative_tolerance));
+  }
+  if (absolute_tolerances.size() == 0) {
+    if (!(absolute_tolerance > 0.0) || !std::isfinite(absolute_tolerance)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("absolute_tolerance must be positive, got ", absolute_tolerance));
+    }
+  } else {
+    if (absolute_tolerances.size() != num_states) {
+      return absl::InvalidArgumentError(absl::StrCat("absolute_tolerances has ",
+                                                     absolute_tolerances.size(), " entries for ",
+                                                     num_states, " states"));
+    }
+    if (!(absolute_tolerances.array() > 0.0).all() || !absolute_tolerances.allFinite()) {
+      return absl::InvalidArgumentError("every absolute tolerance must be positive and finite");
+    }
+  }
+  if (max_steps <= 0) {
+    return absl::InvalidArgumentError(absl::StrCat("max_steps must be positive, got ", max_steps));
+  }
+  if (max_wall_seconds < 0.0 || max_step_size < 0.0 || initial_step_size < 0.0) {
+    return absl::InvalidArgumentError(
+        "max_wall_seconds, max_step_size and initial_step_size must not be negative");
+  }
+  return absl::OkStatus();
+}
+
+CvodesIntegrator::CvodesIntegrator(int num_states, RhsFunction rhs, JacobianFunction jacobian,
+                                   const CvodesOptions& options)
+    : num_states_(num_states),
+      rhs_(std::move(rhs)),
+      jacobian_(std::move(jacobian)),
+      options_(options),
+      sundials_(std::make_unique<Sundials>()),
+      start_(std::chrono::steady_clock::now()) {}
+
+CvodesIntegrator::~CvodesIntegrator() = default;
+
+absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::Create(
+    int num_states, RhsFunction rhs, JacobianFunction jacobian, const CvodesOptions& options,
+    double t0, const Eigen::VectorXd& y0) {
+  if (absl::Status s = options.Validate(num_states); !s.ok()) return s;
+  if (!rhs) return absl::InvalidArgumentError("CvodesIntegrator needs a right-hand side");
+  if (y0.size() != num_states) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("initial state has ", y0.size(), " entries for ", num_states, " states"));
+  }
+  if (!y0.allFinite() || !std::isfinite(t0)) {
+    return absl::InvalidArgumentError("initial time and state must be finite");
+  }
+  std::unique_ptr<CvodesIntegrator> integrator(
+      new CvodesIntegrator(num_states, std::move(rhs), std::move(jacobian), options));
+  if (absl::Status s = integrator->Init(t0, y0); !s.ok()) return s;
+  return integrator;
+}
+
+absl::Status CvodesIntegrator::Check(int flag, const char* call) {
+  if (flag >= 0) return absl::OkStatus();
+  std::string message = absl::StrFormat("%s failed (%d)", call, flag);
+  if (!last_sundials_message_.empty()) absl::StrAppend(&message, ": ", last_sundials_message_);
+  return absl::InternalError(message);
+}
+
+absl::Status CvodesIntegrator::Init(double t0, const Eigen::VectorXd& y0) {
+  Sundials& s = *sundials_;
+  if (SUNContext_Create(nullptr, &s.context) != 0 || s.context == nullptr) {
+    return absl::InternalError("SUNContext_Create failed");
+  }
+  s.y = N_VNew_Serial(num_states_, s.context);
+  if (s.y == nullptr) return absl::InternalError("N_VNew_Serial failed");
+  std::copy(y0.data(), y0.data() + num_states_, N_VGetArrayPointer(s.y));
+  // Fused vector operations: fewer passes over the (small) state vectors per
+  // step; CVODES' internal vectors are cloned from this one and inherit it.
+  if (N_VEnableFusedOps_Serial(s.y, SUNTRUE) != 0) {
+    return absl::InternalError("N_VEnableFusedOps_Serial failed");
+  }
+  s.cvode =
+      CVodeCreate(options_.method == CvodesOptions::Method::kBdf ? CV_BDF : CV_ADAMS, s.context);
+  if (s.cvode == nullptr) return absl::InternalError("CVodeCreate failed");
+  MBOPT_RETURN_IF_ERROR(
+      Check(CVodeSetErrHandlerFn(s.cvode, &CvodesCallbacks::Error, this), "CVodeSetErrHandlerFn"));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeInit(s.cvode, &CvodesCallbacks::Rhs, t0, s.y), "CVodeInit"));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeSetUserData(s.cvode, this), "CVodeSetUserData"));
+  if (options_.absolute_tolerances.size() == 0) {
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSStolerances(s.cvode, options_.relative_tolerance, options_.absolute_tolerance),
+              "CVodeSStolerances"));
+  } else {
+    s.abstol = N_VNew_Serial(num_states_, s.context);
+    if (s.abstol == nullptr) return absl::InternalError("N_VNew_Serial failed");
+    std::copy(options_.absolute_tolerances.data(),
+              options_.absolute_tolerances.data() + num_states_, N_VGetArrayPointer(s.abstol));
+    MBOPT_RETURN_IF_ERROR(Check(CVodeSVtolerances(s.cvode, options_.relative_tolerance, s.abstol),
+                                "CVodeSVtolerances"));
+  }
+  if (options_.iteration == CvodesOptions::Iteration::kFixedPoint) {
+    s.nonlinear_solver = SUNNonlinSol_FixedPoint(s.y, 0, s.context);
+    if (s.nonlinear_solver == nullptr) return absl::InternalError("SUNNonlinSol_FixedPoint failed");
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSetNonlinearSolver(s.cvode, s.nonlinear_solver), "CVodeSetNonlinearSolver"));
+  } else {
+    MBOPT_RETURN_IF_ERROR(InitLinearSolver());
+  }
+  if (options_.max_step_size > 0.0) {
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSetMaxStep(s.cvode, options_.max_step_size), "CVodeSetMaxStep"));
+  }
+  if (options_.initial_step_size > 0.0) {
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSetInitStep(s.cvode, options_.initial_step_size), "CVodeSetInitStep"));
+  }
+  t_ = t0;
+  return absl::OkStatus();
+}
+
+absl::Status CvodesIntegrator::InitLinearSolver() {
+  Sundials& s = *sundials_;
+  s.matrix = SUNDenseMatrix(num_states_, num_states_, s.context);
+  if (s.matrix == nullptr) return absl::InternalError("SUNDenseMatrix failed");
+  s.linear_solver = SUNLinSol_Dense(s.y, s.matrix, s.context);
+  if (s.linear_solver == nullptr) return absl::InternalError("SUNLinSol_Dense failed");
+  MBOPT_RETURN_IF_ERROR(
+      Check(CVodeSetLinearSolver(s.cvode, s.linear_solver, s.matrix), "CVodeSetLinearSolver"));
+  if (jacobian_) {
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSetJacFn(s.cvode, &CvodesCallbacks::Jacobian), "CVodeSetJacFn"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CvodesIntegrator::SetStopTime(double t_stop) {
+  if (!(t_stop > t_)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("stop time %.9g is not ahead of the current time %.9g", t_stop, t_));
+  }
+  MBOPT_RETURN_IF_ERROR(Check(CVodeSetStopTime(sundials_->cvode, t_stop), "CVodeSetStopTime"));
+  stop_time_ = t_stop;
+  stop_time_set_ = true;
+  return absl::OkStatus();
+}
+
+absl::Status CvodesIntegrator::Restart(double t, const Eigen::VectorXd& y) {
+  if (y.size() != num_states_ || !y.allFinite()) {
+    return absl::InvalidArgumentError("restart state has the wrong size or is not finite");
+  }
+  AccumulateCounters();
+  std::copy(y.data(), y.data() + num_states_, N_VGetArrayPointer(sundials_->y));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeReInit(sundials_->cvode, t, sundials_->y), "CVodeReInit"));
+  if (stop_time_set_ && stop_time_ <= t) {
+    // CVODES 6.4 keeps a stop time across CVodeReInit and has no call to
+    // clear it; one at or behind the restart time would fail the next step,
+    // so it is moved out of reach.
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSetStopTime(sundials_->cvode, std::numeric_limits<double>::max()),
+              "CVodeSetStopTime"));
+    stop_time_set_ = false;
+  }
+  ++carried_.restarts;
+  t_ = t;
+  return absl::OkStatus();
+}
+
+void CvodesIntegrator::AccumulateCounters() {
+  const CvodesCounters now = counters();
+  const std::int64_t restarts = carried_.restarts;
+  carried_ = now;
+  carried_.restarts = restarts;
+}
+
+CvodesCounters CvodesIntegrator::counters() const {
+  CvodesCounters c = carried_;
+  void* mem = sundials_->cvode;
+  if (mem == nullptr) return c;
+  long value = 0;
+  if (CVodeGetNumSteps(mem, &value) == CV_SUCCESS) c.steps += value;
+  if (CVodeGetNumRhsEvals(mem, &value) == CV_SUCCESS) c.rhs_evaluations += value;
+  if (CVodeGetNumLinRhsEvals(mem, &value) == CV_SUCCESS) c.rhs_evaluations += value;
+  if (CVodeGetNumJacEvals(mem, &value) == CV_SUCCESS) c.jacobian_evaluations += value;
+  if (CVodeGetNumNonlinSolvIters(mem, &value) == CV_SUCCESS) c.nonlinear_iterations += value;
+  if (CVodeGetNumNonlinSolvConvFails(mem, &value) == CV_SUCCESS) {
+    c.nonlinear_convergence_failures += value;
+  }
+  if (CVodeGetNumErrTestFails(mem, &value) == CV_SUCCESS) c.error_test_failures += value;
+  return c;
+}
+
+absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
+  if (y == nullptr) return absl::InvalidArgumentError("IntegrateTo needs an output vector");
+  if (!(t_out >= t_)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("output time %.9g is behind the current time %.9g", t_out, t_));
+  }
+  Sundials& s = *sundials_;
+  y->resize(num_states_);
+  if (t_out == t_) {
+    // CVODES refuses a zero-length request; the state is already known.
+    const double* data = N_VGetArrayPointer(s.y);
+    std::copy(data, data + num_states_, y->data());
+    return absl::OkStatus();
+  }
+  // CVODES may already have stepped to (or past) t_out while producing the
+  // previous output; then the answer is an interpolation within its last
+  // step. Asking CVode instead would fail when that step ended exactly on a
+  // stop time ("tstop is behind current t").
+  double t_internal = t_;
+  MBOPT_RETURN_IF_ERROR(Check(CVodeGetCurrentTime(s.cvode, &t_internal), "CVodeGetCurrentTime"));
+  if (t_out <= t_internal) {
+    MBOPT_RETURN_IF_ERROR(Check(CVodeGetDky(s.cvode, t_out, 0, s.y), "CVodeGetDky"));
+    const double* data = N_VGetArrayPointer(s.y);
+    std::copy(data, data + num_states_, y->data());
+    t_ = t_out;
+    if (!y->allFinite()) {
+      return absl::AbortedError(absl::StrFormat("state is not finite at t = %.9g", t_));
+    }
+    return absl::OkStatus();
+  }
+  const std::int64_t used = counters().steps;
+  const std::int64_t remaining = options_.max_steps - used;
+  if (remaining <= 0) {
+    return absl::AbortedError(
+        absl::StrFormat("step budget of %d exhausted at t = %.9g", options_.max_steps, t_));
+  }
+  MBOPT_RETURN_IF_ERROR(
+      Check(CVodeSetMaxNumSteps(s.cvode, static_cast<long>(remaining)), "CVodeSetMaxNumSteps"));
+  last_sundials_message_.clear();
+  callback_failure_.clear();
+  double t_reached = t_;
+  const int flag = CVode(s.cvode, t_out, s.y, &t_reached, CV_NORMAL);
+  if (flag < 0) {
+    if (wall_time_exceeded_) {
+      return absl::DeadlineExceededError(
+          absl::StrFormat("integration exceeded its wall-time limit of %g s near t = %.9g",
+                          options_.max_wall_seconds, t_reached));
+    }
+    std::string reason;
+    switch (flag) {
+      case CV_TOO_MUCH_WORK:
+        reason = absl::StrFormat("step budget of %d exhausted", options_.max_steps);
+        break;
+      case CV_TOO_MUCH_ACC:
+        reason = "the requested accuracy cannot be reached";
+        break;
+      case CV_ERR_FAILURE:
+        reason = "repeated error test failures";
+        break;
+      case CV_CONV_FAILURE:
+        reason = "repeated nonlinear convergence failures";
+        break;
+      case CV_RHSFUNC_FAIL:
+      case CV_FIRST_RHSFUNC_ERR:
+      case CV_REPTD_RHSFUNC_ERR:
+      case CV_UNREC_RHSFUNC_ERR:
+        reason = "the right-hand side failed";
+        break;
+      default:
+        reason = absl::StrFormat("CVode returned %d", flag);
+    }
+    std::string message = absl::StrFormat("integrator failed near t = %.9g (target %.9g): %s",
+                                          t_reached, t_out, reason);
+    if (!callback_failure_.empty()) absl::StrAppend(&message, ": ", callback_failure_);
+    if (!last_sundials_message_.empty())
+      absl::StrAppend(&message, " [", last_sundials_message_, "]");
+    t_ = t_reached;
+    return absl::AbortedError(message);
+  }
+  t_ = t_reached;
+  const double* data = N_VGetArrayPointer(s.y);
+  std::copy(data, data + num_states_, y->data());
+  if (!y->allFinite()) {
+    return absl::AbortedError(absl::StrFormat("state is not finite at t = %.9g", t_));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace mbopt::solve

@@ -1,0 +1,133 @@
+// CvodesIntegrator: an RAII wrapper over SUNDIALS CVODES (6.x) for one ODE
+// system y' = f(t, y) of fixed size, with a dense direct linear solver.
+//
+// Owns the SUNContext, the CVODE memory, the state N_Vector, the dense matrix
+// and the linear solver; nothing leaks on any path. Every SUNDIALS return code
+// is checked; SUNDIALS' own error messages are captured (never printed) and
+// end up in the returned status. No exception crosses the C callbacks: a
+// callback that throws is reported as a failed integration.
+//
+// Outcomes of IntegrateTo:
+//  - OK: *y holds the state at t_out.
+//  - kAborted: the integrator gave up (too many steps, error test or
+//    convergence failures, a callback returned an unrecoverable error, NaN);
+//    the message says which and at what time. Callers that treat integrator
+//    failure as data (an analysis result) convert this into their result enum.
+//  - kDeadlineExceeded: max_wall_seconds elapsed.
+//  - kInvalidArgument: misuse (t_out behind the current time, wrong size).
+//
+// Not thread-safe; one integrator per analysis. Units are the caller's.
+#pragma once
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+
+namespace mbopt::solve {
+
+struct CvodesOptions {
+  enum class Method {
+    kBdf,    // stiff problems: BDF + Newton + dense direct solver
+    kAdams,  // non-stiff problems: Adams-Moulton + Newton + dense solver
+  };
+  Method method = Method::kBdf;
+  // Newton with the dense linear solver (and the Jacobian, if given), or
+  // fixed-point (functional) iteration without any linear solve: cheaper per
+  // step for non-stiff problems with Adams.
+  enum class Iteration { kNewton, kFixedPoint };
+  Iteration iteration = Iteration::kNewton;
+  double relative_tolerance = 1e-6;
+  double absolute_tolerance = 1e-9;     // used when absolute_tolerances is empty
+  Eigen::VectorXd absolute_tolerances;  // per state; empty: the scalar above
+  // Budget of internal steps over the integrator's whole life (summed over
+  // every IntegrateTo and Restart), not per call.
+  std::int64_t max_steps = 100000;
+  double max_wall_seconds = 0.0;   // 0: no limit; checked in the rhs
+  double max_step_size = 0.0;      // 0: no limit
+  double initial_step_size = 0.0;  // 0: CVODES' estimate
+
+  absl::Status Validate(int num_states) const;
+};
+
+struct CvodesCounters {
+  std::int64_t steps = 0;
+  std::int64_t rhs_evaluations = 0;  // including those for finite-difference Jacobians
+  std::int64_t jacobian_evaluations = 0;
+  std::int64_t nonlinear_iterations = 0;
+  std::int64_t nonlinear_convergence_failures = 0;
+  std::int64_t error_test_failures = 0;
+  std::int64_t restarts = 0;
+};
+
+class CvodesIntegrator {
+ public:
+  // y' = f(t, y): writes ydot (length N) from y (length N). Returns 0 on
+  // success, > 0 for a recoverable error (CVODES retries with a smaller step),
+  // < 0 for an unrecoverable one.
+  using RhsFunction = std::function<int(double t, const double* y, double* ydot)>;
+  // df/dy at (t, y) into `jacobian` (N x N, column-major, leading dimension
+  // N, zeroed before the call). Same return convention as RhsFunction.
+  using JacobianFunction =
+      std::function<int(double t, const double* y, const double* ydot, double* jacobian)>;
+
+  // Starts at (t0, y0). Without `jacobian` CVODES uses difference quotients.
+  static absl::StatusOr<std::unique_ptr<CvodesIntegrator>> Create(int num_states, RhsFunction rhs,
+                                                                  JacobianFunction jacobian,
+                                                                  const CvodesOptions& options,
+                                                                  double t0,
+                                                                  const Eigen::VectorXd& y0);
+
+  ~CvodesIntegrator();
+  CvodesIntegrator(const CvodesIntegrator&) = delete;
+  CvodesIntegrator& operator=(const CvodesIntegrator&) = delete;
+
+  // Advances to t_out >= current time and writes y(t_out). With a stop time
+  // set and t_out beyond it, stops there instead (see current_time()).
+  absl::Status IntegrateTo(double t_out, Eigen::VectorXd* y);
+
+  // The integrator never steps past t_stop (it would otherwise overshoot and
+  // interpolate back). Cleared by CVODES once reached.
+  absl::Status SetStopTime(double t_stop);
+
+  // Restarts at (t, y) with a fresh history (order 1, new step size): the
+  // way to cross a kink of f in time without losing accuracy. Counters and
+  // the step budget carry over.
+  absl::Status Restart(double t, const Eigen::VectorXd& y);
+
+  double current_time() const { return t_; }
+  int num_states() const { return num_states_; }
+  // Counters summed over the whole life, across restarts.
+  CvodesCounters counters() const;
+
+ private:
+  struct Sundials;  // the C handles
+  CvodesIntegrator(int num_states, RhsFunction rhs, JacobianFunction jacobian,
+                   const CvodesOptions& options);
+  absl::Status Init(double t0, const Eigen::VectorXd& y0);
+  absl::Status InitLinearSolver();
+  absl::Status Check(int flag, const char* call);
+  void AccumulateCounters();
+  friend struct CvodesCallbacks;  // the C callbacks, in the .cc
+
+  int num_states_;
+  RhsFunction rhs_;
+  JacobianFunction jacobian_;
+  CvodesOptions options_;
+  std::unique_ptr<Sundials> sundials_;
+  double t_ = 0.0;
+  std::string last_sundials_message_;
+  std::string callback_failure_;
+  bool wall_time_exceeded_ = false;
+  double stop_time_ = 0.0;
+  bool stop_time_set_ = false;
+  std::chrono::steady_clock::time_point start_;
+  CvodesCounters carried_;  // counters of histories ended by Restart
+};
+
+}  // namespace mbopt::solve

@@ -1,0 +1,52 @@
+// Elastodynamic analysis of a driven linkage whose moving links are planar
+// Euler-Bernoulli beams (worker/model/beam_element.h): small elastic
+// deformation superposed on the large rigid motion of the kinematic solution
+// (the kineto-elastodynamic, floating-frame approach).
+//
+// Unknowns: elastic nodal displacements in the global frame. The two joints
+// of a pin share their elastic translations; each link keeps its own end
+// rotations; ground joints have none; the driven link's root rotation is
+// clamped to the driver. Each element's matrices follow its link's rigid
+// orientation, so M(t) and K(t) change with the motion:
+//   M(t) u'' + C(t) u' + K(t) u = M(t) (g - a_rigid(t)),   C = sum_i beta_i K_i,
+// beta_i = 2 zeta / omega_i (omega_i: lowest bending frequency of link i with
+// its ends pinned, the driven root clamped), only if the scene declares
+// structural damping. Terms of second order in the frame rotation (Coriolis,
+// centrifugal softening of the elastic displacements) are neglected; their
+// relative size is (crank speed / lowest link frequency)^2.
+// Integrated with CVODES BDF from the undeformed state (elastic velocities
+// zero: the links start with their rigid-body velocities).
+//
+// Bending moments at the nodes are recovered from the element end forces
+// (K d + C d' + M (a - g) in the element frame, the moment EI w'' a node
+// transmits), averaged between the two elements that meet at an inner node.
+#pragma once
+
+#include <vector>
+
+#include "spec/scene.h"
+#include "worker/model/linkage_model.h"
+#include "worker/solve/cvodes_integrator.h"
+#include "worker/solve/kinematic_solver.h"
+
+namespace mbopt::solve {
+
+struct ElastodynamicResult {
+  std::vector<LinkageState> rigid_states;  // [instant]: the rigid reference motion
+  // [instant][link][node] bending moment, N m (same sign convention as the
+  // kinetostatic solver).
+  std::vector<std::vector<std::vector<double>>> node_moment_n_m;
+  std::vector<double> drive_torque_n_m;  // [instant]
+  CvodesCounters counters;
+  double lowest_link_frequency_rad_per_s = 0.0;
+};
+
+// `kinematics` must have been Start()ed (t = 0); it is advanced to the last
+// instant. Fails (with a reason naming the time, or the rigid link) if a link
+// is rigid, the mechanism locks, or the integrator gives up.
+KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
+                                  const spec::IntegratorSettings& integrator,
+                                  const std::vector<double>& times_s,
+                                  KinematicSolver* kinematics, ElastodynamicResult* result);
+
+}  // namespace mbopt::solve

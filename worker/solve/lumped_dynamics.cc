@@ -1,0 +1,177 @@
+#include "worker/solve/lumped_dynamics.h"
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <variant>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "worker/solve/cvodes_integrator.h"
+
+namespace mbopt::solve {
+namespace {
+
+engine::AnalysisReport Failed(engine::AnalysisReport report, std::string reason) {
+  report.status = engine::AnalysisStatus::kFailed;
+  report.failure_reason = std::move(reason);
+  report.outputs.clear();  // partial series must not pass for results
+  return report;
+}
+
+// What to evaluate for one requested output at each instant.
+struct OutputPlan {
+  enum class Kind { kDeflection, kAcceleration } kind = Kind::kDeflection;
+  int element = -1;
+  int body = -1;
+  double offset_x_m = 0, offset_y_m = 0;
+  spec::Axis axis = spec::Axis::kY;
+};
+
+}  // namespace
+
+std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<double>& instants_s,
+                            const spec::IntegratorSettings& settings,
+                            const LumpedDynamicsOptions& options,
+                            const LumpedInstantCallback& at_instant,
+                            engine::AnalysisCounters* counters) {
+  const int n = m.num_coordinates();
+  // y' = A y + (0, M^-1 f(t)) with A = [0 I; -M^-1 K  -M^-1 C].
+  const Eigen::VectorXd inverse_mass = m.mass_diagonal().cwiseInverse();
+  const Eigen::MatrixXd minv_k = inverse_mass.asDiagonal() * m.stiffness();
+  const Eigen::MatrixXd minv_c = inverse_mass.asDiagonal() * m.damping();
+  Eigen::VectorXd force(n);
+  auto rhs = [&](double t, const double* y, double* ydot) -> int {
+    Eigen::Map<const Eigen::VectorXd> q(y, n), v(y + n, n);
+    Eigen::Map<Eigen::VectorXd> qdot(ydot, n), vdot(ydot + n, n);
+    qdot = v;
+    m.Forcing(t, &force);
+    vdot = inverse_mass.cwiseProduct(force);
+    vdot.noalias() -= minv_k * q;
+    vdot.noalias() -= minv_c * v;
+    return 0;
+  };
+  auto jacobian = [&](double, const double*, const double*, double* jac) -> int {
+    Eigen::Map<Eigen::MatrixXd> j(jac, 2 * n, 2 * n);
+    j.topRightCorner(n, n).setIdentity();
+    j.bottomLeftCorner(n, n) = -minv_k;
+    j.bottomRightCorner(n, n) = -minv_c;
+    return 0;
+  };
+
+  CvodesOptions cv;
+  cv.method = options.adams ? CvodesOptions::Method::kAdams : CvodesOptions::Method::kBdf;
+  if (options.adams && options.fixed_point) cv.iteration = CvodesOptions::Iteration::kFixedPoint;
+  cv.relative_tolerance = settings.relative_tolerance;
+  cv.absolute_tolerance = settings.absolute_tolerance;
+  cv.max_steps = settings.max_steps;
+  cv.max_wall_seconds = settings.max_wall_seconds;
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(2 * n);
+  if (options.initial_q.size() == n) y.head(n) = options.initial_q;
+  if (options.initial_qdot.size() == n) y.tail(n) = options.initial_qdot;
+  absl::StatusOr<std::unique_ptr<CvodesIntegrator>> created =
+      CvodesIntegrator::Create(2 * n, rhs, jacobian, cv, 0.0, y);
+  if (!created.ok()) return absl::StrCat("integrator setup: ", created.status().message());
+  CvodesIntegrator& integrator = **created;
+
+  std::string failure;
+  auto check = [&](const absl::Status& status) {
+    if (!status.ok() && failure.empty()) failure = std::string(status.message());
+    return status.ok();
+  };
+  const double t_last = instants_s.empty() ? 0.0 : instants_s.back();
+  const std::vector<double> kinks = m.KinkTimes(0.0, t_last);
+  size_t next_kink = 0;
+  if (next_kink < kinks.size()) check(integrator.SetStopTime(kinks[next_kink]));
+  Eigen::VectorXd q(n), v(n);
+  for (size_t i = 0; failure.empty() && i < instants_s.size(); ++i) {
+    const double t = instants_s[i];
+    // Cross every kink up to t with a stop and a fresh start.
+    while (failure.empty() && next_kink < kinks.size() && kinks[next_kink] <= t) {
+      const double kink = kinks[next_kink++];
+      if (!check(integrator.IntegrateTo(kink, &y)) || !check(integrator.Restart(kink, y))) break;
+      if (next_kink < kinks.size()) check(integrator.SetStopTime(kinks[next_kink]));
+    }
+    if (!failure.empty() || !check(integrator.IntegrateTo(t, &y))) break;
+    q = y.head(n);
+    v = y.tail(n);
+    failure = at_instant(t, q, v);
+  }
+  const CvodesCounters c = integrator.counters();
+  counters->time_steps = c.steps;
+  counters->rhs_evaluations = c.rhs_evaluations;
+  counters->jacobian_evaluations = c.jacobian_evaluations;
+  counters->newton_iterations = c.nonlinear_iterations;
+  return failure;
+}
+
+engine::AnalysisReport SimulateLumped(const spec::Scene& scene,
+                                      const std::vector<double>& parameter_values_si,
+                                      const LumpedDynamicsOptions& options) {
+  engine::AnalysisReport report;
+  report.formulation = engine::Formulation::kDynamic;
+  report.times_s = scene.time_grid.Instants();
+  const auto* spec_model = std::get_if<spec::LumpedModel>(&scene.model);
+  if (spec_model == nullptr) return Failed(report, "scene has no lumped model");
+  if (parameter_values_si.size() != scene.parameters.size()) {
+    return Failed(report, absl::StrCat("got ", parameter_values_si.size(), " parameter values for ",
+                                       scene.parameters.size(), " scene parameters"));
+  }
+  absl::StatusOr<model::LumpedModel> assembled =
+      model::LumpedModel::Assemble(*spec_model, parameter_values_si);
+  if (!assembled.ok()) return Failed(report, std::string(assembled.status().message()));
+  const model::LumpedModel& m = *assembled;
+
+  std::vector<OutputPlan> plans;
+  bool needs_acceleration = false;
+  for (const spec::Output& out : scene.outputs) {
+    OutputPlan plan;
+    if (const auto* d = std::get_if<spec::ElementDeflectionOutput>(&out.kind)) {
+      plan.kind = OutputPlan::Kind::kDeflection;
+      plan.element = d->element;
+    } else if (const auto* a = std::get_if<spec::BodyAccelerationOutput>(&out.kind)) {
+      plan.kind = OutputPlan::Kind::kAcceleration;
+      plan.body = a->body;
+      plan.offset_x_m = a->offset_m.x.Resolve(parameter_values_si);
+      plan.offset_y_m = a->offset_m.y.Resolve(parameter_values_si);
+      plan.axis = a->axis;
+      needs_acceleration = true;
+    } else {
+      return Failed(report, absl::StrCat("output \"", out.name,
+                                         "\" is not available for a lumped scene (only "
+                                         "element_deflection and body_acceleration are)"));
+    }
+    plans.push_back(plan);
+    engine::OutputValues values;
+    values.name = out.name;
+    values.series_labels = {out.name};
+    values.series.assign(1, std::vector<double>());
+    values.series[0].reserve(report.times_s.size());
+    report.outputs.push_back(std::move(values));
+  }
+  if (plans.empty()) return report;  // nothing requested: nothing computed
+
+  Eigen::VectorXd a(m.num_coordinates());
+  auto at_instant = [&](double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+    if (needs_acceleration) m.Acceleration(t, q, v, &a);
+    for (size_t o = 0; o < plans.size(); ++o) {
+      const OutputPlan& plan = plans[o];
+      const double value =
+          plan.kind == OutputPlan::Kind::kDeflection
+              ? m.Deflection(plan.element, q, t)
+              : m.PointAcceleration(plan.body, plan.offset_x_m, plan.offset_y_m, plan.axis, a);
+      if (!std::isfinite(value)) {
+        return absl::StrFormat("output \"%s\" is not finite at t = %.9g s", scene.outputs[o].name,
+                               t);
+      }
+      report.outputs[o].series[0].push_back(value);
+    }
+    return std::string();
+  };
+  std::string failure =
+      IntegrateLumped(m, report.times_s, scene.integrator, options, at_instant, &report.counters);
+  if (!failure.empty()) return Failed(report, std::move(failure));
+  return report;
+}
+
+}  // namespace mbopt::solve
