@@ -3,12 +3,15 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
 
 #include "client/args.h"
 #include "client/connection.h"
 #include "client/exit_codes.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
+#include "client/report/job_report_html.h"
+#include "client/report/report_from_proto.h"
 #include "client/study_file.h"
 #include "client/watch.h"
 
@@ -47,8 +50,8 @@ int FailRpc(const grpc::Status& status, const std::string& address) {
 
 // Follows a job to its end, printing the table; returns the exit code of its
 // final state.
+// Interrupts::Install() must have been called before the connection was made.
 int Follow(Connection& c, const std::string& job_id) {
-  Interrupts::Install();
   WatchOptions options;
   options.progress_line = isatty(STDOUT_FILENO) != 0;
   WatchOutcome outcome = WatchJob(*c.stub, c.address, job_id, options);
@@ -81,6 +84,7 @@ int SubmitCommand(const Args& args) {
   const std::string path = parsed->positional[0];
   auto study = ReadStudyForSubmission(path);
   if (!study.ok()) return Fail(std::string(study.status().message()), kExitBadInput);
+  if (parsed->Has("--watch")) Interrupts::Install();  // before gRPC starts threads
   Connection c = Connect(*parsed);
   v1::SubmitJobRequest request;
   *request.mutable_study() = *std::move(study);
@@ -99,6 +103,7 @@ int SubmitCommand(const Args& args) {
 int WatchCommand(const Args& args) {
   auto parsed = Parse(args, kServerOnly, 1, "mbopt watch JOB [--server ADDRESS]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  Interrupts::Install();  // before gRPC starts threads
   Connection c = Connect(*parsed);
   return Follow(c, parsed->positional[0]);
 }
@@ -180,6 +185,35 @@ int ResultsCommand(const Args& args) {
     std::fputs(ResultsTable(response).c_str(), stdout);
   }
   return ExitCodeForState(response.summary().state());
+}
+
+int ReportCommand(const Args& args) {
+  // `-o` is the one short option mbopt takes: the usual spelling for an output file.
+  Args spelled = args;
+  for (std::string& a : spelled) {
+    if (a == "-o") a = "--output";
+  }
+  auto parsed = Parse(spelled, {{"--server", "--output"}, {}}, 1,
+                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  const std::string job_id = parsed->positional[0];
+  std::string path = parsed->Value("--output");
+  if (path.empty()) path = job_id + ".html";
+  Connection c = Connect(*parsed);
+  v1::JobRef ref;
+  ref.set_job_id(job_id);
+  v1::GetJobResponse response;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = c.stub->Get(&context, ref, &response);
+  if (!status.ok()) return FailRpc(status, c.address);
+  const std::string html = report::RenderJobReportHtml(report::ReportDataFromJob(response));
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << html;
+  out.close();
+  if (!out) return Fail("cannot write the report to " + path, kExitBadInput);
+  std::printf("wrote %s\n", path.c_str());
+  return kExitOk;
 }
 
 }  // namespace mbopt::client

@@ -17,6 +17,7 @@ int ListCommand(const Args& args);
 int CancelCommand(const Args& args);
 int ResumeCommand(const Args& args);
 int ResultsCommand(const Args& args);
+int ReportCommand(const Args& args);   // `mbopt report`: HTML page of a job
 int RunCommandMain(const Args& args);  // `mbopt run`
 
 // Prints "mbopt: <message>" on stderr and returns `exit_code`.

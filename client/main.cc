@@ -25,6 +25,8 @@ constexpr char kUsage[] =
     "  resume JOB            continue an interrupted job\n"
     "  results JOB [--csv|--json]\n"
     "                        a job's result and cycle history\n"
+    "  report JOB [-o FILE]  write a self-contained HTML page of the job's history\n"
+    "                        (default FILE: JOB.html)\n"
     "\n"
     "every command but run takes --server HOST:PORT (default $MBOPT_SERVER, else\n"
     "127.0.0.1:50051). See docs/cli.md for the exit codes.\n";
@@ -51,6 +53,7 @@ int main(int argc, char** argv) {
   if (command == "cancel") return CancelCommand(args);
   if (command == "resume") return ResumeCommand(args);
   if (command == "results") return ResultsCommand(args);
+  if (command == "report") return ReportCommand(args);
   std::fprintf(stderr, "mbopt: unknown command '%s'\n\n%s", command.c_str(), kUsage);
   return kExitBadInput;
 }

@@ -28,6 +28,12 @@ const SettingResult* SolverBaseline(const ProblemSweep& s) {
   return s.plan.reference_is_default_model ? &s.reference : DefaultRun(s);
 }
 
+// A solver knob may not make the found design violate more than the
+// tolerance beyond what the baseline does (a feasible design always passes).
+double SolverViolationLimit(const SettingResult& baseline, const Acceptance& a) {
+  return std::max(a.true_violation, baseline.true_max_violation + a.true_violation);
+}
+
 std::string Why(const ProblemSweep& s, const SettingResult& r, const Acceptance& a) {
   std::vector<std::string> why;
   if (!r.recheck_ok) why.push_back("re-check failed");
@@ -38,7 +44,7 @@ std::string Why(const ProblemSweep& s, const SettingResult& r, const Acceptance&
       why.push_back(absl::StrFormat("F off by %.2g %% from the %s run", 100 * change,
                                     s.plan.reference_is_default_model ? "reference" : "default"));
     }
-    if (r.recheck_ok && r.true_max_violation > def->true_max_violation + a.true_violation) {
+    if (r.recheck_ok && r.true_max_violation > SolverViolationLimit(*def, a)) {
       why.push_back(absl::StrFormat("true violation %.2g %%", 100 * r.true_max_violation));
     }
   } else {
@@ -81,13 +87,19 @@ bool Acceptable(const ProblemSweep& s, const SettingResult& r, const Acceptance&
   const SettingResult* def = SolverBaseline(s);
   if (r.setting.kind == KnobKind::kSolver && def != nullptr) {
     return std::abs(r.objective - def->objective) / Scale(s) <= a.objective_error &&
-           r.true_max_violation <= def->true_max_violation + a.true_violation;
+           r.true_max_violation <= SolverViolationLimit(*def, a);
   }
   return ObjectiveError(s, r.objective) <= a.objective_error && r.true_max_violation <= a.true_violation;
 }
 
-Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& a, std::vector<std::string>* why) {
+Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& full, std::vector<std::string>* why,
+                           Setting* model_only) {
+  // Each knob gets half the tolerances: the errors of the chosen values add
+  // up in the combination, which is then checked against the full ones.
+  const Acceptance a{full.objective_error / 2, full.true_violation / 2};
   Setting out{KnobKind::kDefault, "recommended", "", {}, {}};
+  *model_only = Setting{KnobKind::kDefault, "recommended (model knobs only)", "", {}, {}};
+  std::vector<std::string> model_values;
   const SettingResult* def = DefaultRun(s);
   std::vector<std::string> knobs;
   std::map<std::string, const SettingResult*> fastest;
@@ -110,8 +122,10 @@ Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& a, std::vect
     if (kind[k] == KnobKind::kModel) {
       if (f != nullptr && !(default_model_ok && def->wall_seconds <= f->wall_seconds)) {
         out.analysis.MergeFrom(f->setting.analysis);
+        model_only->analysis.MergeFrom(f->setting.analysis);
         values.push_back(absl::StrCat(k, " ", f->setting.value));
-        why->push_back(absl::StrFormat("%s: %s, the fastest value within the tolerances of the reference (%.2f s).",
+        model_values.push_back(values.back());
+        why->push_back(absl::StrFormat("%s: %s, the fastest value within half the tolerances of the reference (%.2f s).",
                                        k, f->setting.value, f->wall_seconds));
       } else if (default_model_ok) {
         why->push_back(absl::StrCat(k, ": the study's own value (acceptable and at least as fast)."));
@@ -121,10 +135,12 @@ Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& a, std::vect
         if (k == "time grid points") r.set_time_grid_points(s.plan.reference.analysis.time_grid_points());
         if (k == "elements per link") r.set_elements_per_flexible_link(s.plan.reference.analysis.elements_per_flexible_link());
         out.analysis.MergeFrom(r);
+        model_only->analysis.MergeFrom(r);
         values.push_back(absl::StrCat(k, " as the reference"));
-        why->push_back(absl::StrCat(k, ": no measured value is within the tolerances; the reference's value."));
+        model_values.push_back(values.back());
+        why->push_back(absl::StrCat(k, ": no measured value is within half the tolerances; the reference's value."));
       } else {
-        why->push_back(absl::StrCat(k, ": no alternative value is within the tolerances; the study's own."));
+        why->push_back(absl::StrCat(k, ": no alternative value is within half the tolerances; the study's own."));
       }
     } else {
       // The default's own value stays unless a passing value is faster, or
@@ -134,7 +150,7 @@ Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& a, std::vect
         out.analysis.MergeFrom(f->setting.analysis);
         out.optimizer.MergeFrom(f->setting.optimizer);
         values.push_back(absl::StrCat(k, " ", f->setting.value));
-        why->push_back(absl::StrFormat("%s: %s, the fastest value within %.2g %% of the %s run's F "
+        why->push_back(absl::StrFormat("%s: %s, the fastest value within half the tolerances (F within %.2g %%) of the %s run "
                                        "(%.2f s; the default %.2f s).",
                                        k, f->setting.value, 100 * a.objective_error,
                                        s.plan.reference_is_default_model ? "reference" : "default",
@@ -145,6 +161,7 @@ Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& a, std::vect
     }
   }
   out.value = values.empty() ? "study's own" : absl::StrJoin(values, ", ");
+  model_only->value = model_values.empty() ? "study's own" : absl::StrJoin(model_values, ", ");
   return out;
 }
 
@@ -166,6 +183,7 @@ std::vector<PlotPoint> PlotPoints(const ProblemSweep& sweep, const Acceptance& a
   };
   for (const SettingResult& r : sweep.results) add(r);
   if (sweep.recommended.has_value()) add(*sweep.recommended);
+  if (sweep.fallback.has_value()) add(*sweep.fallback);
   return points;
 }
 
@@ -186,6 +204,7 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
                   "|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n");
   for (const SettingResult& r : s.results) absl::StrAppend(&out, Row(s, r));
   if (s.recommended.has_value()) absl::StrAppend(&out, Row(s, *s.recommended));
+  if (s.fallback.has_value()) absl::StrAppend(&out, Row(s, *s.fallback));
   if (!s.plan.not_swept.empty()) {
     absl::StrAppend(&out, "\nNot swept here: ", absl::StrJoin(s.plan.not_swept, "; "), ".\n");
   }
@@ -195,8 +214,10 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
   const std::vector<PlotPoint> points = PlotPoints(s, a);
   std::vector<std::string> front_labels;
   for (const int i : ParetoFront(points)) {
-    front_labels.push_back(static_cast<size_t>(i) < s.results.size() ? Label(s.results[i])
-                                                                     : std::string("recommended"));
+    const size_t k = static_cast<size_t>(i);
+    front_labels.push_back(k < s.results.size()                                   ? Label(s.results[k])
+                           : k == s.results.size() && s.recommended.has_value() ? std::string("recommended")
+                                                                                  : std::string("model knobs only"));
   }
   absl::StrAppend(&out, "\nPareto front (fastest first): ", absl::StrJoin(front_labels, "; "), ".\n");
 
@@ -232,7 +253,8 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
     absl::StrAppend(&out, "- ", k, ": pass ", ok[k].empty() ? "none" : absl::StrJoin(ok[k], ", "),
                     bad[k].empty() ? "" : absl::StrCat("; fail ", absl::StrJoin(bad[k], ", ")), ".\n");
   }
-  absl::StrAppend(&out, "\n**Recommended default.**\n\n");
+  absl::StrAppend(&out, "\n**Recommended default.** Per knob, the fastest value that passes with half the "
+                        "tolerances (the chosen values' errors add up in the combination):\n\n");
   for (const std::string& w : recommendation_why) absl::StrAppend(&out, "- ", w, "\n");
   if (s.recommended.has_value()) {
     const SettingResult& r = *s.recommended;
@@ -240,13 +262,24 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
                       r.true_max_violation <= a.true_violation;
     absl::StrAppendFormat(
         &out,
-        "\nThe combination (%s) was run to check it (the last table row): error %.2g %% against F_ref, "
+        "\nThe combination (%s) was run to check it (table row \"recommended\"): error %.2g %% against F_ref, "
         "true violation %.2g %%, %.2f s (the default: %.2f s). %s\n\n",
         r.setting.value, 100 * ObjectiveError(s, r.objective), 100 * r.true_max_violation, r.wall_seconds,
         def != nullptr ? def->wall_seconds : NAN,
         pass ? "It is within both tolerances of the reference: recommended as this problem's default."
-             : "It is NOT within both tolerances of the reference; the knobs interact, so no combination is "
-               "recommended from this sweep: use the reference settings for final answers.");
+             : "It is NOT within both tolerances of the reference: the knobs interact.");
+  }
+  if (s.fallback.has_value()) {
+    const SettingResult& r = *s.fallback;
+    const bool pass = r.recheck_ok && ObjectiveError(s, r.objective) <= a.objective_error &&
+                      r.true_max_violation <= a.true_violation;
+    absl::StrAppendFormat(
+        &out,
+        "The model knobs alone (%s; solver knobs at the study's own) were run as well: error %.2g %%, "
+        "true violation %.2g %%, %.2f s. %s\n\n",
+        r.setting.value, 100 * ObjectiveError(s, r.objective), 100 * r.true_max_violation, r.wall_seconds,
+        pass ? "Within both tolerances: recommended as this problem's default instead."
+             : "Not within both tolerances either: use the reference settings for final answers.");
   }
   return out;
 }

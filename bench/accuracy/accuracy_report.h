@@ -27,6 +27,9 @@ struct ProblemSweep {
   SettingResult reference;
   std::vector<SettingResult> results;  // plan.settings order
   std::optional<SettingResult> recommended;  // the verified combination
+  // Run when the combination fails and changes solver knobs: the model
+  // knobs' values alone.
+  std::optional<SettingResult> fallback;
 };
 
 // Model knobs: error vs F_ref and true violation within the tolerances.
@@ -39,8 +42,9 @@ bool Acceptable(const ProblemSweep& sweep, const SettingResult& r, const Accepta
 // (the reference's value when none is acceptable), per solver knob the
 // fastest acceptable value if it is faster than the default. `why` gets one
 // line per knob.
+// `model_only` gets the same choice restricted to the model knobs.
 Setting RecommendedSetting(const ProblemSweep& sweep, const Acceptance& acceptance,
-                           std::vector<std::string>* why);
+                           std::vector<std::string>* why, Setting* model_only);
 
 // |F - F_ref| / max(|F_ref|, 1 % |F(x0)|): relative, with a floor for
 // problems whose optimum is near zero.

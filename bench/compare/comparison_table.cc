@@ -79,6 +79,10 @@ std::string Verdict(const StudyComparison& c, const TargetRule& rule) {
     }
   }
   std::string out;
+  const MethodRun* slp = nullptr;
+  for (const MethodRun& r : c.runs) {
+    if (r.evaluations == 0) slp = &r;  // the SLP is the method without NLopt evaluations
+  }
   if (fastest == nullptr) {
     absl::StrAppend(&out, "No method reached the target.");
   } else {
@@ -89,6 +93,30 @@ std::string Verdict(const StudyComparison& c, const TargetRule& rule) {
                           lowest->method, lowest->final_objective);
   } else {
     absl::StrAppend(&out, " No method ended at a design feasible within the tolerance.");
+  }
+  if (slp != nullptr) {
+    const std::optional<std::int64_t> slp_reach = AnalysesToTarget(*slp, c, rule);
+    absl::StrAppendFormat(&out, " The SLP ran %d cycles (%d trial points rejected).", slp->cycles,
+                          slp->rejected_trials);
+    if (!slp_reach.has_value() && slp->final_max_violation <= rule.violation &&
+        slp->end.rfind("converged", 0) == 0) {
+      absl::StrAppendFormat(&out,
+                            " It stopped at F = %.6g, above the target %.6g: its convergence test (F "
+                            "changes by less than 0.5 %% in a cycle, METHOD.md section 3) ended the run "
+                            "while slow progress was still being made; a smaller "
+                            "convergence_objective_tolerance in the study continues it.",
+                            slp->final_objective, c.target_objective);
+    }
+    for (const MethodRun& r : c.runs) {
+      if (&r == slp) continue;
+      const std::optional<std::int64_t> reach = AnalysesToTarget(r, c, rule);
+      if (reach.has_value() && (!slp_reach.has_value() || *reach < *slp_reach)) {
+        absl::StrAppendFormat(&out, " %s wins on analyses to the target (%d against %s).", r.method, *reach,
+                              slp_reach.has_value() ? absl::StrCat(*slp_reach) : "not reached");
+      }
+      absl::StrAppendFormat(&out, " %s made %d evaluations (%d analyses each with the gradient).", r.method,
+                            r.evaluations, 1 + r.num_variables);
+    }
   }
   return out;
 }

@@ -35,6 +35,12 @@ struct MethodRun {
   std::int64_t failed_analyses = 0;
   double wall_seconds = 0;
   std::string end;  // how it ended, e.g. "converged", "cap reached"
+  // The SLP: cycles and rejected trial points. NLopt: its evaluations (each
+  // 1 + n analyses with the gradient).
+  int cycles = 0;
+  int rejected_trials = 0;
+  int evaluations = 0;
+  int num_variables = 0;
 };
 
 // The study's analyses as an optimizer sees them, counted: values at scaled

@@ -57,6 +57,7 @@ bool Ensure(PeerContext* c, const double* v, bool need_gradient) {
     }
     c->x = x;
     c->point = *std::move(p);
+    ++c->run->evaluations;
     c->have_jacobians = false;
     if (c->point.ok) {
       const Candidate cand{c->study->analyses(), c->point.objective, c->point.max_violation};
@@ -186,7 +187,7 @@ absl::StatusOr<MethodRun> RunNloptPeer(const spec::Study& study, PeerAlgorithm a
     ub[c.n] = 10;
     v[c.n] = p0.objective / c.objective_scale;
   }
-  std::vector<double> tol(m, 0.0);
+  std::vector<double> tol(m, options.constraint_tolerance);
   const bool set_ok = nlopt_set_lower_bounds(opt, lb.data()) == NLOPT_SUCCESS &&
                       nlopt_set_upper_bounds(opt, ub.data()) == NLOPT_SUCCESS &&
                       nlopt_set_min_objective(opt, Objective, &c) == NLOPT_SUCCESS &&
@@ -225,6 +226,7 @@ absl::StatusOr<MethodRun> RunNloptPeer(const spec::Study& study, PeerAlgorithm a
   run.final_objective = final_values->objective;
   run.final_max_violation = final_values->max_violation;
   run.failed_analyses = counted.failed();
+  run.num_variables = c.n;
   run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;
 }

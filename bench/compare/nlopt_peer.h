@@ -27,6 +27,11 @@ struct PeerOptions {
   // NLopt's own stopping tests (relative change of the objective / of x).
   double ftol_rel = 1e-6;
   double xtol_rel = 1e-6;
+  // Tolerance on each normalized constraint. NLopt returns the best point
+  // it saw that meets every constraint within it; with 0, finite-difference
+  // noise of 1e-12 at an active constraint makes NLopt fall back to an
+  // early, strictly feasible design.
+  double constraint_tolerance = 1e-6;
 };
 
 // `fd_options` supplies the finite-difference step rule (forward is forced).

@@ -16,6 +16,7 @@ absl::StatusOr<MethodRun> RunSlpMethod(const spec::Study& study) {
     if (r.cycle == 1 && r.attempt == 0) {
       run.candidates.push_back(Candidate{1, r.objective_x0, r.max_violation_x0});
     }
+    if (!r.accepted) ++run.rejected_trials;
     if (std::isfinite(r.objective_trial)) {
       run.candidates.push_back(Candidate{r.analyses_total, r.objective_trial, r.max_violation_trial});
     }
@@ -26,6 +27,8 @@ absl::StatusOr<MethodRun> RunSlpMethod(const spec::Study& study) {
   run.analyses = result.outcome.analyses;
   run.failed_analyses = result.analyses_failed;
   run.wall_seconds = result.wall_seconds;
+  run.cycles = result.outcome.cycles;
+  run.num_variables = static_cast<int>(study.variables.size());
   run.end = slp::RunStateName(result.outcome.state);
   if (!result.end_reason.empty()) run.end += " (" + result.end_reason + ")";
   return run;

@@ -6,9 +6,10 @@
 //
 // For tests, benchmarks and tools that want the method's answer for a study
 // file without the service. It owns nothing beyond one call: no threads, no
-// files, no clock other than the wall time it reports. The service runs the
-// same optimizer with the same problem, so a local run and a service run of
-// one study emit the same records (analyses are deterministic).
+// files, no clock other than the wall time it reports. The optimizer is built
+// as the server's jobs::Job builds it (same problem, settings and LP solver),
+// so with the same analysis results a local run follows the same designs as
+// a service run of the study.
 //
 // Failures of an analysis (engine kFailed, non-finite values, or a failure
 // injected by the caller) are handed to the optimizer as

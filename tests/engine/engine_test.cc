@@ -82,5 +82,47 @@ TEST(StudyValuesOfReport, VehicleInitialDesignViolatesTheSeatTravelLimitAboutFou
   EXPECT_NEAR(values->max_violation, 1.8332 / 0.456 - 1.0, 1e-3);
 }
 
+// A stress output may report every node; the layout's nodes are picked by
+// label (interior nodes of a rigid, undriven link: 1..5 of 0..6).
+TEST(StudyValuesOfReport, ExtraSeriesArePickedByLabel) {
+  spec::Study study;
+  spec::LinkageModel linkage;
+  linkage.joints.resize(3);
+  spec::Link link;
+  link.joint_a = 1;
+  link.joint_b = 2;
+  linkage.links = {link};
+  linkage.driver.link = -1;
+  study.scene.model = linkage;
+  spec::Output stress;
+  stress.name = "stress";
+  stress.kind = spec::BendingStressOutput{0};
+  study.scene.outputs = {stress};
+  study.scene.time_grid = {0.0, 1.0, 2};
+  study.objective.form = spec::Objective::Form::kMinimizeMaxOf;
+  study.objective.output = 0;
+  study.objective.reduction = spec::Reduction::kMax;
+  auto layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  ASSERT_EQ(layout->outputs[0].series, 5);
+  AnalysisReport r;
+  r.times_s = {0.0, 1.0};
+  OutputValues v;
+  v.name = "stress";
+  for (int node = 0; node <= 6; ++node) {
+    v.series_labels.push_back("node " + std::to_string(node));
+    v.series.push_back({1.0 * node, 10.0 * node});
+  }
+  r.outputs = {v};
+  auto values = ComputeStudyValues(study, *layout, r);
+  ASSERT_TRUE(values.ok()) << values.status();
+  ASSERT_EQ(values->objective_terms.size(), 10u);
+  EXPECT_DOUBLE_EQ(values->objective_terms[0], 1.0);  // node 1 at t = 0
+  EXPECT_DOUBLE_EQ(values->objective, 50.0);          // node 5 at t = 1, not node 6
+  r.outputs[0].series_labels[3] = "node x";
+  EXPECT_EQ(ComputeStudyValues(study, *layout, r).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace mbopt::engine

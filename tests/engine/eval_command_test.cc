@@ -1,12 +1,12 @@
 // `mbopt-worker eval`: output, --set semantics and exit codes.
 #include "worker/main/eval_command.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 namespace mbopt::worker {
 namespace {
@@ -44,9 +44,9 @@ TEST(EvalCommand, JsonIsOneObjectWithTheRequiredKeys) {
   EXPECT_EQ(r.out.front(), '{');
   EXPECT_EQ(r.out.substr(r.out.size() - 2), "}\n");
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1);
-  for (const char* key : {"\"objective\": ", "\"max_violation\": ", "\"status\": \"ok\"",
-                          "\"counters\": {", "\"formulation\": \"dynamic\"",
-                          "\"worst_constraint\": {"}) {
+  for (const char* key :
+       {"\"objective\": ", "\"max_violation\": ", "\"status\": \"ok\"", "\"counters\": {",
+        "\"formulation\": \"dynamic\"", "\"worst_constraint\": {"}) {
     EXPECT_THAT(r.out, HasSubstr(key));
   }
 }
@@ -54,7 +54,7 @@ TEST(EvalCommand, JsonIsOneObjectWithTheRequiredKeys) {
 TEST(EvalCommand, SetAcceptsScaledVariablesAndParametersInTheirUnits) {
   // The report's optimum, with c2 = 2 x5 = 77.06 lbf s/in given as a parameter.
   const EvalRun r = Eval({kVehicle, "--set", "x1=5", "--set", "x2=10", "--set", "x3=10", "--set",
-                      "x4=41.54", "--set", "c2=77.06", "--set=x6=40"});
+                          "x4=41.54", "--set", "c2=77.06", "--set=x6=40"});
   EXPECT_EQ(r.code, kExitOk) << r.err;
   EXPECT_THAT(r.out, HasSubstr("x5=38.53"));
   EXPECT_THAT(r.out, HasSubstr("objective    6.3957"));  // 251.80 in/s^2 = 6.3957 m/s^2

@@ -76,6 +76,17 @@ TEST(ElasticFourBar, RigidLinkInFlexibleLinkageIsReported) {
   EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("link 'rocker'"));
 }
 
+TEST(ElasticFourBar, IntegratorGivingUpIsAFailedAnalysisNamingTheTime) {
+  FourBarOptions o;
+  o.elements = 6;
+  spec::Scene scene = FourBarScene(o);
+  scene.integrator.max_steps = 50;  // far too few for 0.5 s
+  const engine::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  ASSERT_EQ(r.status, engine::AnalysisStatus::kFailed);
+  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("elastodynamic integration failed before t = 0.3 s"));
+  EXPECT_TRUE(r.outputs.empty());
+}
+
 TEST(ElasticFourBar, KinematicOutputsOfFlexibleLinkageNeedNoIntegration) {
   FourBarOptions o;
   o.elements = 6;

@@ -74,10 +74,12 @@ TEST(RigidFourBarStress, StressScalesAsInverseSquareRootOfUniformAreaScale) {
   EXPECT_NEAR(b.rocker / a.rocker, 2.0, 1e-9);
 }
 
-// Pinned ends carry no moment; the whole of each bar is in equilibrium; the
-// drive torque equals the power balance: T omega = d/dt (kinetic energy).
-TEST(Kinetostatics, PinnedEndsAreMomentFreeAndPowerBalances) {
-  const spec::Scene scene = FourBarScene();
+// Pinned ends carry no moment; the crank root carries the drive torque; the
+// drive torque balances the power: T omega = d/dt(kinetic energy) minus the
+// power of gravity (when the scene declares it).
+void CheckEquilibriumAndPower(bool gravity) {
+  spec::Scene scene = FourBarScene();
+  if (gravity) scene.effects.gravity_m_per_s2 = linkage_testing::At(0.0, -9.81);
   auto sys = model::ResolveLinkage(std::get<spec::LinkageModel>(scene.model), scene.effects,
                                    {0.01, 0.02, 0.03});
   ASSERT_TRUE(sys.ok());
@@ -86,6 +88,7 @@ TEST(Kinetostatics, PinnedEndsAreMomentFreeAndPowerBalances) {
   solve::KinetostaticSolver statics(*sys);
   solve::KinetostaticLoads loads;
   const double omega = 10 * std::numbers::pi;
+  const Eigen::Vector2d g = gravity ? Eigen::Vector2d(0.0, -9.81) : Eigen::Vector2d::Zero();
   for (int i = 1; i <= 40; ++i) {
     ASSERT_TRUE(kin.AdvanceTo(0.005 * i).ok);
     const solve::LinkageState& s = kin.state();
@@ -102,7 +105,8 @@ TEST(Kinetostatics, PinnedEndsAreMomentFreeAndPowerBalances) {
     EXPECT_NEAR(loads.node_moment_n_m[2].front(), 0.0, tol);  // rocker at O4
     EXPECT_NEAR(loads.node_moment_n_m[2].back(), 0.0, tol);   // rocker at B
     EXPECT_NEAR(loads.node_moment_n_m[0].front(), -loads.drive_torque_n_m, tol);  // crank root
-    // dT/dt of slender rods: sum over bars of m (v_a.a_a/3 + (v_a.a_b + v_b.a_a)/6 + v_b.a_b/3).
+    // Slender rods: dT/dt = m (v_a.a_a/3 + (v_a.a_b + v_b.a_a)/6 + v_b.a_b/3);
+    // gravity's power m g.(v_a + v_b)/2.
     double power = 0.0;
     for (const model::LinkageLink& l : sys->links) {
       const double mass = l.mass_per_length_kg_per_m() * l.length_m;
@@ -111,9 +115,29 @@ TEST(Kinetostatics, PinnedEndsAreMomentFreeAndPowerBalances) {
       const auto& aa = s.acceleration_m_per_s2[static_cast<size_t>(l.joint_a)];
       const auto& ab = s.acceleration_m_per_s2[static_cast<size_t>(l.joint_b)];
       power += mass * (va.dot(aa) / 3 + (va.dot(ab) + vb.dot(aa)) / 6 + vb.dot(ab) / 3);
+      power -= mass * g.dot(va + vb) / 2;
     }
-    EXPECT_NEAR(loads.drive_torque_n_m * omega, power, 1e-9 * std::abs(scale * omega));
+    EXPECT_NEAR(loads.drive_torque_n_m * omega, power, 1e-10 * scale * omega);
   }
+}
+
+TEST(Kinetostatics, PinnedEndsAreMomentFreeAndPowerBalances) { CheckEquilibriumAndPower(false); }
+
+TEST(Kinetostatics, GravityEntersOnlyWhenDeclaredAndBalancesPower) {
+  CheckEquilibriumAndPower(true);
+  // Declared gravity changes the drive torque; absent gravity does not exist.
+  spec::Scene with = FourBarScene();
+  with.effects.gravity_m_per_s2 = linkage_testing::At(0.0, -9.81);
+  const auto a = solve::AnalyzeLinkage(FourBarScene(), {0.01, 0.02, 0.03});
+  const auto b = solve::AnalyzeLinkage(with, {0.01, 0.02, 0.03});
+  ASSERT_EQ(a.status, engine::AnalysisStatus::kOk);
+  ASSERT_EQ(b.status, engine::AnalysisStatus::kOk);
+  double diff = 0.0;
+  for (size_t i = 0; i < 101; ++i) {
+    diff = std::max(diff, std::abs(a.outputs[4].series[0][i] - b.outputs[4].series[0][i]));
+  }
+  // Gravity torque of the crank alone is up to m g l / 2 = 4.1 N m here.
+  EXPECT_GT(diff, 1.0);
 }
 
 }  // namespace

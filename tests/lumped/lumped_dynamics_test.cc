@@ -224,6 +224,14 @@ TEST(LumpedDynamics, StepLimitIsAFailedAnalysisWithReason) {
   EXPECT_LE(r.counters.time_steps, 5);
 }
 
+TEST(LumpedDynamics, WallTimeLimitIsAFailedAnalysisWithReason) {
+  spec::Scene scene = OneDofScene(OneDof(), true);
+  scene.integrator.max_wall_seconds = 1e-12;  // over before the first step
+  const engine::AnalysisReport r = SimulateLumped(scene, {800.0});
+  EXPECT_EQ(r.status, engine::AnalysisStatus::kFailed);
+  EXPECT_THAT(r.failure_reason, HasSubstr("wall-time limit"));
+}
+
 TEST(LumpedDynamics, UnusableParameterValueIsAFailedAnalysisNamingTheElement) {
   const engine::AnalysisReport r = SimulateLumped(OneDofScene(OneDof(), true), {-5.0});
   EXPECT_EQ(r.status, engine::AnalysisStatus::kFailed);

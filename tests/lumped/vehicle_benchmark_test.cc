@@ -1,6 +1,8 @@
 // The vehicle example (examples/vehicle) reproduces the check values of the
-// benchmark definition (/docs: benchmarks/vehicle.md, "Check values",
-// computed there by an independent implementation at tight tolerances).
+// vehicle suspension benchmark definition: max |a1| on the grid at three
+// designs (332.60, 254.30, 251.80 in/s^2, i.e. the report's 8.45, 6.46, 6.40
+// m/s^2) and the peak relative displacements, computed there by an
+// independent implementation at tight tolerances.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 

@@ -10,9 +10,36 @@ absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
   if (report.status != AnalysisStatus::kOk) {
     return absl::FailedPreconditionError(absl::StrCat("analysis failed: ", report.failure_reason));
   }
-  std::vector<const std::vector<std::vector<double>>*> series;
-  series.reserve(report.outputs.size());
-  for (const OutputValues& output : report.outputs) series.push_back(&output.series);
+  if (report.outputs.size() != layout.outputs.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("analysis has ", report.outputs.size(),
+                                                   " outputs, the layout expects ",
+                                                   layout.outputs.size()));
+  }
+  std::vector<const std::vector<std::vector<double>>*> series(report.outputs.size());
+  std::vector<std::vector<std::vector<double>>> selected(report.outputs.size());
+  for (size_t o = 0; o < report.outputs.size(); ++o) {
+    const OutputValues& output = report.outputs[o];
+    const spec::OutputShape& shape = layout.outputs[o];
+    if (static_cast<int>(output.series.size()) == shape.series) {
+      series[o] = &output.series;
+      continue;
+    }
+    // More series than the layout uses (e.g. stress at pinned nodes, zero
+    // by construction): pick the layout's series by label.
+    for (const std::string& label : shape.series_labels) {
+      size_t found = output.series_labels.size();
+      for (size_t s = 0; s < output.series_labels.size() && s < output.series.size(); ++s) {
+        if (output.series_labels[s] == label) found = s;
+      }
+      if (found == output.series_labels.size()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "output \"", output.name, "\" has ", output.series.size(),
+            " series and none labelled \"", label, "\", which the study's layout needs"));
+      }
+      selected[o].push_back(output.series[found]);
+    }
+    series[o] = &selected[o];
+  }
   return spec::ComputeStudyValues(study, layout, series);
 }
 

@@ -11,7 +11,10 @@
 namespace mbopt::engine {
 
 // FailedPrecondition if the analysis failed (its reason in the message);
-// InvalidArgument if its outputs do not have the layout's shape.
+// InvalidArgument if its outputs do not have the layout's shape. An output
+// may report more series than the layout uses (e.g. a stress series at every
+// node, pinned ends included); the layout's series are then picked by their
+// labels (spec::OutputShapeOf).
 absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
                                                      const AnalysisReport& report);

@@ -308,10 +308,14 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
   }
   Sundials& s = *sundials_;
   y->resize(num_states_);
-  if (t_out == t_) {
-    // CVODES refuses a zero-length request; the state is already known.
+  constexpr double kNegligibleInterval = 1e-13;
+  if (t_out - t_ <= kNegligibleInterval * std::max(1.0, std::abs(t_))) {
+    // CVODES refuses a zero or rounding-size request ("tout too close to
+    // t0"), e.g. a grid instant one ulp after a restart; the state there is
+    // the current one to within rounding.
     const double* data = N_VGetArrayPointer(s.y);
     std::copy(data, data + num_states_, y->data());
+    t_ = t_out;
     return absl::OkStatus();
   }
   // CVODES may already have stepped to (or past) t_out while producing the

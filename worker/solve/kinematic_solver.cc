@@ -331,24 +331,20 @@ KinematicOutcome KinematicSolver::AdvanceTo(double t_s, std::vector<LinkageState
     predicted_ = q + qdot * (t_next - state_.time_s);
     q = predicted_;
     const NewtonResult result = Newton(&q, DriverAngle(t_next), kStepNewtonIterations);
-    bool accepted = false;
-    std::string why;
-    if ((q - predicted_).lpNorm<Eigen::Infinity>() > kMaxCorrectionFraction * length_scale_m_) {
-      lu_at_solution_ = false;
-    }
-    if (result == NewtonResult::kConverged &&
-        (q - predicted_).lpNorm<Eigen::Infinity>() <= kMaxCorrectionFraction * length_scale_m_) {
+    const bool jumped =
+        (q - predicted_).lpNorm<Eigen::Infinity>() > kMaxCorrectionFraction * length_scale_m_;
+    if (jumped) lu_at_solution_ = false;
+    enum class Rejection { kNone, kSingular, kBranch, kNoConvergence } why = Rejection::kNone;
+    if (result == NewtonResult::kConverged && !jumped) {
       if (!Complete(q, t_next, &next)) {
-        why = "singular";
+        why = Rejection::kSingular;
       } else if (next.branch_sign != state_.branch_sign) {
-        why = "branch";
-      } else {
-        accepted = true;
+        why = Rejection::kBranch;
       }
     } else {
-      why = result == NewtonResult::kSingular ? "singular" : "newton";
+      why = result == NewtonResult::kSingular ? Rejection::kSingular : Rejection::kNoConvergence;
     }
-    if (accepted) {
+    if (why == Rejection::kNone) {
       state_ = next;
       q_ = q;
       if (trail) trail->push_back(state_);
@@ -361,13 +357,13 @@ KinematicOutcome KinematicSolver::AdvanceTo(double t_s, std::vector<LinkageState
     FromState(state_, &q, &qdot);
     Jacobian(q, &jac_);
     const std::string joint = NullMotionJoint();
-    if (why == "branch") {
+    if (why == Rejection::kBranch) {
       return KinematicOutcome::Failed(absl::StrFormat(
           "the mechanism changes assembly branch at t = %.6g s (driver angle %.6g rad): it "
           "passes a locking position at %s",
           state_.time_s, state_.driver_angle_rad, joint));
     }
-    if (why == "singular") {
+    if (why == Rejection::kSingular) {
       return KinematicOutcome::Failed(absl::StrFormat(
           "the mechanism locks at t = %.6g s (driver angle %.6g rad): singular constraint "
           "Jacobian (dead-centre position) at %s",

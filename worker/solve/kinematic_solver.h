@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -50,7 +51,7 @@ struct KinematicOutcome {
 
 class KinematicSolver {
  public:
-  static constexpr double kMaxDriverStepRad = 2.0 * 3.14159265358979323846 / 180.0;
+  static constexpr double kMaxDriverStepRad = 2.0 * std::numbers::pi / 180.0;
 
   explicit KinematicSolver(const model::LinkageSystem& system);
 

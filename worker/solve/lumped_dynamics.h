@@ -7,7 +7,9 @@
 // integration, when the scene requests no output.
 //
 // The state is y = (q, q'). BDF uses the constant system matrix as its
-// dense Jacobian. The integrator stops exactly at every instant where an
+// dense Jacobian. The scene's absolute tolerance applies to the coordinates
+// (m, rad); the rates get it times the highest natural frequency of the
+// undamped system, so that both weigh alike in the error norm. The integrator stops exactly at every instant where an
 // input bump starts or ends and restarts there, so the kinks of the forcing
 // are never stepped across.
 //

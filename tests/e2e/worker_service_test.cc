@@ -1,0 +1,243 @@
+// The worker's evaluation of tasks and its conversation with a server, the
+// latter against a fake WorkerService on a real loopback port (port 0).
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include "mbopt/v1/service.grpc.pb.h"
+#include "spec/io/study_io.h"
+#include "worker/service/task_evaluator.h"
+#include "worker/service/worker_service.h"
+
+namespace mbopt::worker {
+namespace {
+
+constexpr auto kGuard = std::chrono::seconds(60);  // failure guard only
+
+std::string VehicleStudyPath() {
+  return std::string(MBOPT_TEST_SOURCE_DIR) + "/examples/vehicle/vehicle.study.textproto";
+}
+
+v1::Study VehicleStudyProto() {
+  auto study = spec::io::ReadStudyProto(VehicleStudyPath());
+  EXPECT_TRUE(study.ok()) << study.status();
+  return study.ok() ? *study : v1::Study();
+}
+
+v1::AnalysisTask TaskAt(const std::vector<double>& x) {
+  v1::AnalysisTask task;
+  task.set_task_id("job-1/0/0");
+  task.set_job_id("job-1");
+  for (double v : x) task.add_x_scaled(v);
+  return task;
+}
+
+std::vector<double> InitialDesign(const v1::Study& study) {
+  std::vector<double> x;
+  for (const auto& v : study.variables()) x.push_back(v.initial());
+  return x;
+}
+
+TEST(TaskEvaluator, ValuesAlignWithTheStudyLayout) {
+  const v1::Study proto = VehicleStudyProto();
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  v1::TaskResult result;
+  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), &result);
+  ASSERT_TRUE(result.ok()) << result.failure_reason();
+  EXPECT_EQ(result.objective_terms_size(), (*prepared)->layout.num_objective_terms());
+  EXPECT_EQ(result.constraint_values_size(), (*prepared)->layout.num_constraints());
+  EXPECT_FALSE(result.formulation().empty());
+  for (double v : result.objective_terms()) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(TaskEvaluator, WrongDimensionIsAFailedResultNotACrash) {
+  const v1::Study proto = VehicleStudyProto();
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  v1::TaskResult result;
+  EvaluateTask(**prepared, TaskAt({1.0}), &result);
+  EXPECT_FALSE(result.ok());
+  EXPECT_NE(result.failure_reason().find("design variables"), std::string::npos)
+      << result.failure_reason();
+}
+
+TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
+  const v1::Study proto = VehicleStudyProto();
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  std::vector<double> x = InitialDesign(proto);
+  x[0] = std::numeric_limits<double>::quiet_NaN();
+  v1::TaskResult result;
+  EvaluateTask(**prepared, TaskAt(x), &result);
+  EXPECT_FALSE(result.ok());
+  EXPECT_EQ(result.objective_terms_size(), 0);
+  // Absurd stiffnesses: the analysis either fails or overflows; both must
+  // come back as a failure with a reason, never as values.
+  std::vector<double> huge(x.size(), 1e300);
+  v1::TaskResult overflow;
+  EvaluateTask(**prepared, TaskAt(huge), &overflow);
+  EXPECT_FALSE(overflow.ok());
+  EXPECT_FALSE(overflow.failure_reason().empty());
+}
+
+TEST(TaskEvaluator, StudyThatDoesNotConvertIsAnError) {
+  v1::Study proto = VehicleStudyProto();
+  proto.mutable_variables(0)->set_parameter("no_such_parameter");
+  EXPECT_FALSE(PrepareStudy(proto, "job-1").ok());
+}
+
+// A WorkerService that hands out the tasks the test queues and records what
+// the worker sends back.
+class FakeWorkerService final : public v1::WorkerService::Service {
+ public:
+  explicit FakeWorkerService(v1::Study study) : study_(std::move(study)) {}
+
+  grpc::Status Register(grpc::ServerContext*, const v1::RegisterWorkerRequest* request,
+                        v1::RegisterWorkerResponse* response) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++registrations_;
+    slots_ = request->slots();
+    response->set_worker_id("w-" + std::to_string(registrations_));
+    response->set_heartbeat_interval_ms(20);
+    response->set_lease_ms(10000);
+    cv_.notify_all();
+    return grpc::Status::OK;
+  }
+
+  grpc::Status AcquireTasks(grpc::ServerContext* context, const v1::AcquireTasksRequest* request,
+                            v1::AcquireTasksResponse* response) override {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait_for(lock, std::chrono::milliseconds(request->wait_ms()),
+                 [&] { return !tasks_.empty() || context->IsCancelled(); });
+    while (!tasks_.empty() && response->tasks_size() < request->max_tasks()) {
+      *response->add_tasks() = tasks_.front();
+      tasks_.erase(tasks_.begin());
+    }
+    return grpc::Status::OK;
+  }
+
+  grpc::Status GetStudy(grpc::ServerContext*, const v1::GetStudyRequest*,
+                        v1::GetStudyResponse* response) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++study_fetches_;
+    *response->mutable_study() = study_;
+    return grpc::Status::OK;
+  }
+
+  grpc::Status ReportResult(grpc::ServerContext*, const v1::TaskResult* result,
+                            v1::ReportResultResponse* response) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    results_.push_back(*result);
+    response->set_accepted(true);
+    cv_.notify_all();
+    return grpc::Status::OK;
+  }
+
+  grpc::Status Heartbeat(grpc::ServerContext*, const v1::HeartbeatRequest*,
+                         v1::HeartbeatResponse* response) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++heartbeats_;
+    // The first heartbeat says "who are you?", as a restarted server would.
+    response->set_known(heartbeats_ > 1);
+    cv_.notify_all();
+    return grpc::Status::OK;
+  }
+
+  void Queue(const v1::AnalysisTask& task) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tasks_.push_back(task);
+    cv_.notify_all();
+  }
+
+  // Waits (guarded) until `predicate` holds under the lock.
+  template <typename P>
+  bool WaitUntil(P predicate) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, kGuard, [&] { return predicate(*this); });
+  }
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  v1::Study study_;
+  std::vector<v1::AnalysisTask> tasks_;
+  std::vector<v1::TaskResult> results_;
+  int registrations_ = 0;
+  int heartbeats_ = 0;
+  int study_fetches_ = 0;
+  int slots_ = 0;
+};
+
+TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgotten) {
+  const v1::Study proto = VehicleStudyProto();
+  FakeWorkerService fake(proto);
+  int port = 0;
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.RegisterService(&fake);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  ASSERT_NE(server, nullptr);
+  ASSERT_GT(port, 0);
+
+  WorkerOptions options;
+  options.server_address = "127.0.0.1:" + std::to_string(port);
+  options.slots = 2;
+  options.name = "test-worker";
+  options.acquire_wait_ms = 200;
+  StopSignal stop;
+  absl::Status run_status;
+  std::thread worker([&] { run_status = RunWorker(options, stop); });
+
+  const std::vector<double> x0 = InitialDesign(proto);
+  for (int i = 0; i < 3; ++i) {
+    v1::AnalysisTask task = TaskAt(x0);
+    task.set_task_id("job-1/" + std::to_string(i) + "/0");
+    task.set_request_id(i);
+    fake.Queue(task);
+  }
+  EXPECT_TRUE(fake.WaitUntil([](FakeWorkerService& f) {
+    return f.results_.size() == 3 && f.registrations_ >= 2;
+  })) << "results and a second registration after known = false";
+  stop.Stop();
+  worker.join();
+  EXPECT_TRUE(run_status.ok()) << run_status;
+
+  std::lock_guard<std::mutex> lock(fake.mutex_);
+  EXPECT_EQ(fake.slots_, 2);
+  EXPECT_EQ(fake.study_fetches_, 1) << "one study fetch per job";
+  for (const auto& r : fake.results_) {
+    EXPECT_TRUE(r.ok()) << r.failure_reason();
+    EXPECT_EQ(r.job_id(), "job-1");
+    // Identical inputs, identical outputs: bit identity is the point.
+    EXPECT_EQ(r.objective_terms(0), fake.results_[0].objective_terms(0));
+  }
+  server->Shutdown();
+}
+
+TEST(WorkerService, RejectsBadOptions) {
+  StopSignal stop;
+  WorkerOptions options;
+  EXPECT_FALSE(RunWorker(options, stop).ok()) << "no server address";
+  options.server_address = "127.0.0.1:1";
+  options.slots = 0;
+  EXPECT_FALSE(RunWorker(options, stop).ok()) << "zero slots";
+}
+
+TEST(WorkerService, StopsWhileTheServerIsUnreachable) {
+  WorkerOptions options;
+  options.server_address = "127.0.0.1:1";  // nothing listens there
+  StopSignal stop;
+  std::thread worker([&] { EXPECT_TRUE(RunWorker(options, stop).ok()); });
+  stop.Stop();
+  worker.join();  // returns: the backoff wait ends at the stop request
+}
+
+}  // namespace
+}  // namespace mbopt::worker
