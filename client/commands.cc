@@ -48,6 +48,15 @@ int FailRpc(const grpc::Status& status, const std::string& address) {
   return Fail(f.message, f.exit_code);
 }
 
+// One job with its cycle history and study, as the server keeps it.
+grpc::Status GetJob(Connection& c, const std::string& job_id, v1::GetJobResponse* response) {
+  v1::JobRef ref;
+  ref.set_job_id(job_id);
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  return c.stub->Get(&context, ref, response);
+}
+
 // Follows a job to its end, printing the table; returns the exit code of its
 // final state.
 // Interrupts::Install() must have been called before the connection was made.
@@ -112,14 +121,10 @@ int StatusCommand(const Args& args) {
   auto parsed = Parse(args, kServerOnly, 1, "mbopt status JOB [--server ADDRESS]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   Connection c = Connect(*parsed);
-  v1::JobRef ref;
-  ref.set_job_id(parsed->positional[0]);
   v1::GetJobResponse response;
-  grpc::ClientContext context;
-  SetUnaryDeadline(&context);
-  grpc::Status status = c.stub->Get(&context, ref, &response);
+  grpc::Status status = GetJob(c, parsed->positional[0], &response);
   if (!status.ok()) return FailRpc(status, c.address);
-  std::fputs(SummaryText(response.summary()).c_str(), stdout);
+  std::fputs(SummaryText(response.summary(), response.has_study() ? &response.study() : nullptr).c_str(), stdout);
   return kExitOk;
 }
 
@@ -170,12 +175,8 @@ int ResultsCommand(const Args& args) {
     return Fail("--csv and --json exclude each other", kExitBadInput);
   }
   Connection c = Connect(*parsed);
-  v1::JobRef ref;
-  ref.set_job_id(parsed->positional[0]);
   v1::GetJobResponse response;
-  grpc::ClientContext context;
-  SetUnaryDeadline(&context);
-  grpc::Status status = c.stub->Get(&context, ref, &response);
+  grpc::Status status = GetJob(c, parsed->positional[0], &response);
   if (!status.ok()) return FailRpc(status, c.address);
   if (parsed->Has("--json")) {
     std::fputs(ResultsJson(response).c_str(), stdout);
@@ -200,12 +201,8 @@ int ReportCommand(const Args& args) {
   std::string path = parsed->Value("--output");
   if (path.empty()) path = job_id + ".html";
   Connection c = Connect(*parsed);
-  v1::JobRef ref;
-  ref.set_job_id(job_id);
   v1::GetJobResponse response;
-  grpc::ClientContext context;
-  SetUnaryDeadline(&context);
-  grpc::Status status = c.stub->Get(&context, ref, &response);
+  grpc::Status status = GetJob(c, job_id, &response);
   if (!status.ok()) return FailRpc(status, c.address);
   const std::string html = report::RenderJobReportHtml(report::ReportDataFromJob(response));
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -22,16 +22,19 @@ std::string CycleTableHeader();
 std::string CycleTableRow(const v1::CycleRecord& record);
 
 // Several lines: id, study, state, cycles, analyses, objective, violation,
-// design, message.
-std::string SummaryText(const v1::JobSummary& summary);
+// design, message. With the job's study, each design line shows the scaled
+// variable and the parameter it sets: "x1 = 5  (k1 = 50 lbf/in)"; without
+// it, only the parameter value, which is all the summary carries.
+std::string SummaryText(const v1::JobSummary& summary, const v1::Study* study = nullptr);
 // One line for `list`.
 std::string ListHeader();
 std::string ListRow(const v1::JobSummary& summary);
 
 // `results` formats. The JSON is one object: status, cycles, analyses,
 // objective, objective_unit, max_violation, design (name -> physical value),
-// design_units, wall_seconds, message and history (one entry per accepted
-// cycle).
+// design_scaled (name -> scaled value), design_parameters (name -> the scene
+// parameter it sets), design_units, wall_seconds, message and history (one
+// entry per accepted cycle).
 std::string ResultsTable(const v1::GetJobResponse& job);
 std::string ResultsCsv(const v1::GetJobResponse& job);
 std::string ResultsJson(const v1::GetJobResponse& job);

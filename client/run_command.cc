@@ -134,7 +134,7 @@ int RunCommandMain(const Args& args) {
   if (json) {
     std::fputs(ResultsJson(job).c_str(), stdout);
   } else if (!quiet) {
-    std::printf("\n%s", SummaryText(job.summary()).c_str());
+    std::printf("\n%s", SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr).c_str());
   }
   return ExitCodeForState(job.summary().state());
 }

@@ -54,6 +54,9 @@ struct OptimizerSettings {
   double screening_threshold = -0.3;
   bool central_differences = false;
   double finite_difference_relative_step = 1e-4;
+  // Gradients from the simulator's forward sensitivity analysis instead of
+  // finite differences (lumped scenes only).
+  bool simulator_sensitivities = false;
 };
 
 struct AnalysisOverrides {

@@ -28,6 +28,11 @@ const SettingResult* SolverBaseline(const ProblemSweep& s) {
   return s.plan.reference_is_default_model ? &s.reference : DefaultRun(s);
 }
 
+// A solver knob replaces the study's own value only when it is faster than
+// this fraction of the default's time: smaller differences are timing noise
+// on a shared machine.
+constexpr double kSignificantSpeedup = 0.8;
+
 // A solver knob may not make the found design violate more than the
 // tolerance beyond what the baseline does (a feasible design always passes).
 double SolverViolationLimit(const SettingResult& baseline, const Acceptance& a) {
@@ -146,7 +151,8 @@ Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& full, std::v
       // The default's own value stays unless a passing value is faster, or
       // the default itself fails against a same-model reference.
       const bool default_fails = s.plan.reference_is_default_model && def != nullptr && !Acceptable(s, *def, a);
-      if (f != nullptr && def != nullptr && (default_fails || f->wall_seconds < def->wall_seconds)) {
+      if (f != nullptr && def != nullptr &&
+          (default_fails || f->wall_seconds < kSignificantSpeedup * def->wall_seconds)) {
         out.analysis.MergeFrom(f->setting.analysis);
         out.optimizer.MergeFrom(f->setting.optimizer);
         values.push_back(absl::StrCat(k, " ", f->setting.value));
@@ -156,7 +162,7 @@ Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& full, std::v
                                        s.plan.reference_is_default_model ? "reference" : "default",
                                        f->wall_seconds, def->wall_seconds));
       } else {
-        why->push_back(absl::StrCat(k, ": the study's own value (no acceptable value is faster)."));
+        why->push_back(absl::StrCat(k, ": the study's own value (no acceptable value is more than 20 % faster)."));
       }
     }
   }

@@ -59,11 +59,12 @@ re-check violates a constraint by more than 0.5 %; the square is the study's def
 
 const char kNotMeasured[] = R"(## Not yet measured
 
-- **Simulator sensitivities.** The engine has no analytic or forward/adjoint (CVODES) design
-  sensitivities yet; every gradient here is a finite difference, so the finite-difference rows
-  measure the only option there is. With sensitivities the per-cycle cost would drop from
-  1 + n analyses to about one analysis with sensitivity equations, and the step-size question
-  would disappear.
+- **Simulator sensitivities.** This sweep uses none: every gradient in it is a finite difference
+  (the optimizer asks for perturbed analyses), so the finite-difference rows measure the option
+  the local run has. Design sensitivities from the simulator (CVODES forward sensitivities,
+  analytic kinetostatic derivatives) would cut a cycle from 1 + n analyses to about one
+  analysis with sensitivity equations and remove the step-size question; their accuracy and
+  cost are not measured here.
 - **Knob interactions.** Knobs are varied one at a time; only the recommended combination per
   problem (and, when it fails, its model knobs alone) is run to check it. Other combinations are
   not measured.

@@ -97,14 +97,14 @@ bool MakeSweepPlan(const std::string& problem, SweepPlan* p) {
     return true;
   }
   if (problem == "fourbar_elastic") {
-    // The expensive one (about 1-2 s per analysis): a warm start near the
-    // report's optimum, fewer settings, and a reference at 201 points.
+    // The expensive one (time integration of beam elements): a warm start
+    // near the report's optimum, fewer settings, a reference at 201 points.
     p->study_file = "examples/fourbar/fourbar_elastic.study.textproto";
     p->initial_override = {1.0, 0.5, 0.3};
     p->initial_note =
         "warm start at x = (1.0, 0.5, 0.3), i.e. A = (10, 5, 3) cm^2 (2.73 kg), near the report's "
         "optimum x = (0.965, 0.392, 0.269), "
-        "instead of the study's x0 = 100: an analysis costs about 1-2 s here";
+        "instead of the study's x0 = 100, to keep the sweep short";
     p->settings.push_back(Grid(51));
     p->settings.push_back(Tolerance(1e-4));
     for (const int e : {2, 4}) p->settings.push_back(Elements(e));

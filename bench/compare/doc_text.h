@@ -35,22 +35,14 @@ inline constexpr char kProtocol[] = R"(## Protocol
   design each method returns. Wall time is the whole run on one core, analyses included.
 )";
 
-inline constexpr char kDiscussion[] = R"(## Not in the default set
-
-- **fourbar_elastic**: one elastic analysis (6 beam elements per link, CVODES) takes about 1-2 s
-  on this machine, against milliseconds for the others, so the three methods with a 2000-analysis
-  cap would take the better part of an hour. Run it with
-  `mbopt_compare --study examples/fourbar/fourbar_elastic.study.textproto --cap 300`.
-  docs/accuracy.md has an elastic SLP run from a warm start.
-
-## Why the methods differ
+inline constexpr char kDiscussion[] = R"(## Why the methods differ
 
 - **Cost of a gradient.** All three pay n analyses per forward-difference gradient. The SLP
   asks for one gradient per cycle and one analysis per trial point; a rejected trial costs one
   analysis. NLopt's SLSQP and MMA evaluate the gradient at every point they visit, including
   line-search points (SLSQP) and inner conservative iterations (MMA), so a step that the SLP
-  would reject for one analysis costs them 1 + n. With analytic sensitivities this difference
-  would disappear; the engine has none yet (see docs/accuracy.md).
+  would reject for one analysis costs them 1 + n. With simulator sensitivities this difference
+  would shrink; no method here uses them (see docs/accuracy.md).
 - **Many constraint rows.** The time-dependent constraints become hundreds to thousands of rows
   (vehicle: 1010 rows plus 202 objective terms; four-bar: 3232 rows). The SLP screens rows far
   from their limits out of each LP; SLSQP carries every row in its quadratic subproblem and MMA
@@ -66,6 +58,9 @@ inline constexpr char kDiscussion[] = R"(## Not in the default set
   improves on them. Where that model fits (responses monotone in each variable) it reaches the
   target in few outer iterations; its inner iterations each cost a full gradient here, so it
   wins on analyses only where it needs few of them.
+- **"FAILURE" and "ROUNDOFF_LIMITED"** in the end column are NLopt's own return codes: the
+  method gave up (SLSQP does so when its line search or its quadratic subproblem fails, which
+  inaccurate finite-difference gradients can cause) and returned the best point it had.
 - **Noise from the analyses.** Time-integrated outputs carry the integrator's error (relative
   tolerance 1e-8 in the vehicle scene, 1e-6 in the elastic four-bar), and forward differences
   with step 1e-4 amplify it. Quasi-Newton methods such as SLSQP build curvature from gradient

@@ -34,6 +34,7 @@ const std::vector<std::string> kDefaultStudies = {
     "examples/vehicle/vehicle.study.textproto",
     "examples/landing_gear/landing_gear.study.textproto",
     "examples/fourbar/fourbar_rigid.study.textproto",
+    "examples/fourbar/fourbar_elastic.study.textproto",
 };
 
 // Published values (METHOD.md section 4, docs of the benchmarks) for the reader.

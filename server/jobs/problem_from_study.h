@@ -16,6 +16,11 @@ namespace mbopt::jobs {
 absl::StatusOr<slp::ProblemSpec> ProblemSpecFromStudy(const spec::Study& study, const spec::StudyLayout& layout);
 
 // InvalidArgument (from SlpOptions::Validate) for settings out of range.
-absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study);
+// Simulator sensitivities (optimizer.sensitivity SENSITIVITY_METHOD_SIMULATOR)
+// set SlpOptions::analyses_provide_gradients when `in_process` (local runs,
+// whose analyses return gradients); the service's task results and result
+// log carry no gradients, so it gets InvalidArgument for them.
+absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study,
+                                                    bool in_process = false);
 
 }  // namespace mbopt::jobs

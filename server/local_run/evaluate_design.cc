@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "common/status_macros.h"
+#include "worker/engine/study_sensitivities.h"
 #include "worker/engine/study_values.h"
 
 namespace mbopt::local_run {
@@ -26,19 +28,19 @@ std::string FirstNonFinite(const spec::StudyLayout& layout, const spec::StudyVal
   return "";
 }
 
-}  // namespace
-
-absl::StatusOr<DesignEvaluation> EvaluateDesign(const spec::Study& study,
-                                                const spec::StudyLayout& layout,
-                                                const Eigen::VectorXd& x_scaled) {
+absl::Status CheckSize(const spec::Study& study, const Eigen::VectorXd& x_scaled) {
   if (x_scaled.size() != static_cast<Eigen::Index>(study.variables.size())) {
     return absl::InvalidArgumentError(absl::StrCat("design has ", x_scaled.size(), " values, study ",
                                                    study.name, " has ", study.variables.size(),
                                                    " variables"));
   }
-  const std::vector<double> x(x_scaled.data(), x_scaled.data() + x_scaled.size());
-  const engine::AnalysisReport report = engine::Analyze(study.scene, study.ParameterValuesAt(x));
+  return absl::OkStatus();
+}
 
+// The evaluation of one engine report.
+absl::StatusOr<DesignEvaluation> FromReport(const spec::Study& study,
+                                            const spec::StudyLayout& layout,
+                                            const engine::AnalysisReport& report) {
   DesignEvaluation evaluation;
   evaluation.status = report.status;
   evaluation.failure_reason = report.failure_reason;
@@ -60,6 +62,51 @@ absl::StatusOr<DesignEvaluation> EvaluateDesign(const spec::Study& study,
   return evaluation;
 }
 
+bool AllFinite(const std::vector<std::vector<double>>& rows) {
+  for (const auto& row : rows) {
+    for (double v : row) {
+      if (!std::isfinite(v)) return false;
+    }
+  }
+  return true;
+}
+
+Eigen::MatrixXd ToMatrix(const std::vector<std::vector<double>>& rows, Eigen::Index cols) {
+  Eigen::MatrixXd m(static_cast<Eigen::Index>(rows.size()), cols);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    for (Eigen::Index c = 0; c < cols; ++c) m(static_cast<Eigen::Index>(r), c) = rows[r][static_cast<size_t>(c)];
+  }
+  return m;
+}
+
+}  // namespace
+
+absl::StatusOr<DesignEvaluation> EvaluateDesign(const spec::Study& study,
+                                                const spec::StudyLayout& layout,
+                                                const Eigen::VectorXd& x_scaled) {
+  MBOPT_RETURN_IF_ERROR(CheckSize(study, x_scaled));
+  const std::vector<double> x(x_scaled.data(), x_scaled.data() + x_scaled.size());
+  return FromReport(study, layout, engine::Analyze(study.scene, study.ParameterValuesAt(x)));
+}
+
+absl::StatusOr<DesignEvaluation> EvaluateDesignWithGradients(const spec::Study& study,
+                                                             const spec::StudyLayout& layout,
+                                                             const Eigen::VectorXd& x_scaled) {
+  MBOPT_RETURN_IF_ERROR(CheckSize(study, x_scaled));
+  const std::vector<double> x(x_scaled.data(), x_scaled.data() + x_scaled.size());
+  engine::StudyAnalysisWithGradients analysis = engine::AnalyzeStudyWithGradients(study, layout, x);
+  MBOPT_ASSIGN_OR_RETURN(DesignEvaluation evaluation, FromReport(study, layout, analysis.report));
+  evaluation.gradients_unavailable = analysis.gradients_unavailable;
+  if (evaluation.ok() && analysis.gradients.has_value()) {
+    if (AllFinite(analysis.gradients->objective_terms) && AllFinite(analysis.gradients->constraint_rows)) {
+      evaluation.gradients = std::move(analysis.gradients);
+    } else {
+      evaluation.gradients_unavailable = "non-finite gradient";
+    }
+  }
+  return evaluation;
+}
+
 slp::AnalysisResult ToAnalysisResult(const DesignEvaluation& evaluation) {
   slp::AnalysisResult result;
   if (!evaluation.ok() || !evaluation.values.has_value()) {
@@ -73,6 +120,12 @@ slp::AnalysisResult ToAnalysisResult(const DesignEvaluation& evaluation) {
       Eigen::Map<const Eigen::VectorXd>(v.objective_terms.data(), static_cast<Eigen::Index>(v.objective_terms.size()));
   result.constraint_values = Eigen::Map<const Eigen::VectorXd>(
       v.constraint_values.data(), static_cast<Eigen::Index>(v.constraint_values.size()));
+  if (evaluation.gradients.has_value()) {
+    const auto cols = static_cast<Eigen::Index>(
+        evaluation.gradients->objective_terms.empty() ? 0 : evaluation.gradients->objective_terms[0].size());
+    result.objective_gradients = ToMatrix(evaluation.gradients->objective_terms, cols);
+    result.constraint_gradients = ToMatrix(evaluation.gradients->constraint_rows, cols);
+  }
   return result;
 }
 

@@ -21,6 +21,7 @@
 #include "server/slp/slp_optimizer.h"
 #include "spec/layout.h"
 #include "spec/study.h"
+#include "spec/study_gradients.h"
 #include "worker/engine/analysis.h"
 
 namespace mbopt::local_run {
@@ -34,6 +35,11 @@ struct DesignEvaluation {
   engine::AnalysisCounters counters;  // of this analysis, wall time included
   // Present exactly when status is kOk: every value in it is finite.
   std::optional<spec::StudyValues> values;
+  // EvaluateDesignWithGradients only: the values' gradients with respect to
+  // the scaled variables (absent when unavailable or not finite: why, in
+  // gradients_unavailable).
+  std::optional<spec::StudyGradients> gradients;
+  std::string gradients_unavailable;
 
   bool ok() const { return status == engine::AnalysisStatus::kOk; }
 };
@@ -44,8 +50,15 @@ absl::StatusOr<DesignEvaluation> EvaluateDesign(const spec::Study& study,
                                                 const spec::StudyLayout& layout,
                                                 const Eigen::VectorXd& x_scaled);
 
+// As EvaluateDesign, from one analysis that also carries the simulator's
+// sensitivities (engine::AnalyzeStudyWithGradients).
+absl::StatusOr<DesignEvaluation> EvaluateDesignWithGradients(const spec::Study& study,
+                                                             const spec::StudyLayout& layout,
+                                                             const Eigen::VectorXd& x_scaled);
+
 // The optimizer's view of an evaluation: kOk with the terms and the constraint
-// values, or kFailed with the reason. request_id is left 0.
+// values (and their gradients when present), or kFailed with the reason.
+// request_id is left 0.
 slp::AnalysisResult ToAnalysisResult(const DesignEvaluation& evaluation);
 
 }  // namespace mbopt::local_run

@@ -34,7 +34,7 @@ absl::StatusOr<LocalRunResult> RunStudyLocally(const spec::Study& study, const L
     slp_options = *options.slp_override;
     MBOPT_RETURN_IF_ERROR(slp_options.Validate());
   } else {
-    MBOPT_ASSIGN_OR_RETURN(slp_options, jobs::SlpOptionsFromStudy(study));
+    MBOPT_ASSIGN_OR_RETURN(slp_options, jobs::SlpOptionsFromStudy(study, /*in_process=*/true));
   }
   slp::SlpOptimizer optimizer(std::move(problem), slp_options, lp::MakeClpLpSolver());
 
@@ -56,7 +56,10 @@ absl::StatusOr<LocalRunResult> RunStudyLocally(const spec::Study& study, const L
         result.outcome = slp::AnalysisOutcome::kFailed;
         result.failure_reason = absl::StrCat("injected: ", *injected);
       } else {
-        MBOPT_ASSIGN_OR_RETURN(DesignEvaluation evaluation, EvaluateDesign(study, out.layout, request.x));
+        MBOPT_ASSIGN_OR_RETURN(DesignEvaluation evaluation,
+                               request.want_gradients
+                                   ? EvaluateDesignWithGradients(study, out.layout, request.x)
+                                   : EvaluateDesign(study, out.layout, request.x));
         ++out.analyses_run;
         Accumulate(evaluation.counters, &out.total_counters);
         result = ToAnalysisResult(evaluation);

@@ -43,6 +43,12 @@ struct SlpOptions {
   FiniteDifferenceScheme finite_difference = FiniteDifferenceScheme::kForward;
   double finite_difference_relative_step = 1e-4;
 
+  // Gradients come with the analyses (the simulator's sensitivities): each
+  // cycle then asks only for x0 and no perturbation, and every request
+  // carries want_gradients. A result without usable gradients (missing,
+  // NaN) falls back to the finite differences above for that cycle.
+  bool analyses_provide_gradients = false;
+
   // Acceptance and strategy thresholds (section 3).
   double reject_max_approximation_error = 0.40;
   double reject_max_violation = 0.10;

@@ -82,7 +82,7 @@ class SlpOptimizer::Impl {
     cycle_ = 1;
     phase_ = Phase::kStartAndPerturb;
     start_request_id_ = Request(RequestPurpose::kCycleStart, -1, 0.0, x0_);
-    PlanPerturbations();
+    if (!options_.analyses_provide_gradients) PlanPerturbations();
   }
 
   std::vector<AnalysisRequest> PendingRequests() const {
@@ -112,10 +112,31 @@ class SlpOptimizer::Impl {
         stored.outcome = AnalysisOutcome::kFailed;
         stored.failure_reason = "non-finite value in the analysis result";
       }
+      if (stored.has_gradients()) {
+        const int n = spec_.num_variables();
+        if (stored.objective_gradients.rows() != spec_.num_objective_terms ||
+            stored.objective_gradients.cols() != n ||
+            stored.constraint_gradients.rows() != spec_.num_constraints() ||
+            (stored.constraint_gradients.size() > 0 && stored.constraint_gradients.cols() != n)) {
+          return absl::InvalidArgumentError(absl::StrCat(
+              "analysis result for request ", result.request_id, " has gradients of shape ",
+              stored.objective_gradients.rows(), "x", stored.objective_gradients.cols(), " and ",
+              stored.constraint_gradients.rows(), "x", stored.constraint_gradients.cols(),
+              "; expected ", spec_.num_objective_terms, "x", n, " and ",
+              spec_.num_constraints(), "x", n));
+        }
+        if (!stored.objective_gradients.allFinite() || !stored.constraint_gradients.allFinite()) {
+          // Unusable, not a failed analysis: the values are fine.
+          stored.objective_gradients.resize(0, 0);
+          stored.constraint_gradients.resize(0, 0);
+        }
+      }
     }
     if (stored.outcome != AnalysisOutcome::kOk) {
       stored.objective_terms.resize(0);
       stored.constraint_values.resize(0);
+      stored.objective_gradients.resize(0, 0);
+      stored.constraint_gradients.resize(0, 0);
     }
     outstanding_.erase(it);
     received_.emplace(stored.request_id, std::move(stored));
@@ -154,6 +175,7 @@ class SlpOptimizer::Impl {
     r.perturbed_variable = variable;
     r.perturbation_step = step;
     r.x = x;
+    r.want_gradients = options_.analyses_provide_gradients && purpose != RequestPurpose::kPerturbation;
     outstanding_.emplace(r.id, r);
     batch_.emplace(r.id, std::move(r));
     return batch_.rbegin()->first;
@@ -191,6 +213,10 @@ class SlpOptimizer::Impl {
         }
         v0_ = MakePointValues(spec_, start);
         have_x0_ = true;
+        if (options_.analyses_provide_gradients) {
+          StartCycleFrom(start);
+          return;
+        }
         CollectPerturbations(requests, results);
         return;
       }
@@ -233,6 +259,28 @@ class SlpOptimizer::Impl {
       return;
     }
     BuildLinearization();
+    attempt_ = 0;
+    SolveAndRequestTrial();
+  }
+
+  // With analyses_provide_gradients: the cycle's linearization from x0's
+  // own gradients, or finite differences when it brought none.
+  void StartCycleFrom(const AnalysisResult& x0_result) {
+    if (!x0_result.has_gradients()) {
+      phase_ = Phase::kPerturb;
+      PlanPerturbations();
+      return;
+    }
+    const int n = spec_.num_variables();
+    lin_.x0 = x0_;
+    lin_.terms0 = v0_.terms;
+    lin_.constraints0 = v0_.constraints;
+    lin_.terms_gradient = x0_result.objective_gradients;
+    lin_.constraints_gradient = x0_result.constraint_gradients;
+    if (lin_.constraints_gradient.size() == 0) {
+      lin_.constraints_gradient = Eigen::MatrixXd::Zero(spec_.num_constraints(), n);
+    }
+    lin_.frozen.assign(n, false);
     attempt_ = 0;
     SolveAndRequestTrial();
   }
@@ -342,6 +390,10 @@ class SlpOptimizer::Impl {
       same.outcome = AnalysisOutcome::kOk;
       same.objective_terms = v0_.terms;
       same.constraint_values = v0_.constraints;
+      if (options_.analyses_provide_gradients && !AnyFrozen()) {
+        same.objective_gradients = lin_.terms_gradient;
+        same.constraint_gradients = lin_.constraints_gradient;
+      }
       EvaluateTrial(&same);
       return;
     }
@@ -479,6 +531,10 @@ class SlpOptimizer::Impl {
     }
     ++cycle_;
     attempt_ = 0;
+    if (options_.analyses_provide_gradients) {
+      StartCycleFrom(*result);
+      return;
+    }
     phase_ = Phase::kPerturb;
     PlanPerturbations();
   }

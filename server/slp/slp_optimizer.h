@@ -43,6 +43,10 @@ struct AnalysisRequest {
   int perturbed_variable = -1;   // for kPerturbation
   double perturbation_step = 0;  // signed scaled step, for kPerturbation
   Eigen::VectorXd x;             // scaled design point
+  // The analysis should also return the gradients of its values
+  // (SlpOptions::analyses_provide_gradients): on kCycleStart, and on kTrial
+  // because an accepted trial point becomes the next cycle's x0.
+  bool want_gradients = false;
 };
 
 enum class AnalysisOutcome {
@@ -57,6 +61,17 @@ struct AnalysisResult {
   std::string failure_reason;        // for kFailed
   Eigen::VectorXd objective_terms;   // num_objective_terms, for kOk
   Eigen::VectorXd constraint_values; // num_constraints (g_h, not normalized), for kOk
+  // Optional, for kOk: d(objective term)/dx (num_objective_terms x n) and
+  // d(g_h)/dx (num_constraints x n), with respect to the SCALED variables.
+  // Empty: none. A non-finite entry makes the pair unusable (the cycle then
+  // uses finite differences); a wrong shape is InvalidArgument.
+  Eigen::MatrixXd objective_gradients;
+  Eigen::MatrixXd constraint_gradients;
+
+  // Every problem has an objective term and a variable, so an empty
+  // objective_gradients means "no gradients" (constraint_gradients may be
+  // 0 x n).
+  bool has_gradients() const { return objective_gradients.size() > 0; }
 };
 
 enum class RunState {

@@ -4,6 +4,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <variant>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -277,6 +278,12 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     }
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
     s.central_differences = p.finite_difference() == v1::FINITE_DIFFERENCE_CENTRAL;
+    s.simulator_sensitivities = p.sensitivity() == v1::SENSITIVITY_METHOD_SIMULATOR;
+    if (s.simulator_sensitivities && !std::holds_alternative<LumpedModel>(scene.model)) {
+      errors->Add(w, "sensitivity",
+                  "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: only "
+                  "lumped scenes have simulator sensitivities; use finite differences");
+    }
   }
 
   study.scene = std::move(scene);

@@ -208,6 +208,9 @@ TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgot
   stop.Stop();
   worker.join();
   EXPECT_TRUE(run_status.ok()) << run_status;
+  // Before taking the fake's lock: Shutdown() waits for in-flight handlers,
+  // and a long poll the worker abandoned may still be waiting for that lock.
+  server->Shutdown();
 
   std::lock_guard<std::mutex> lock(fake.mutex_);
   EXPECT_EQ(fake.slots_, 2);
@@ -218,7 +221,6 @@ TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgot
     // Identical inputs, identical outputs: bit identity is the point.
     EXPECT_EQ(r.objective_terms(0), fake.results_[0].objective_terms(0));
   }
-  server->Shutdown();
 }
 
 TEST(WorkerService, RejectsBadOptions) {

@@ -76,6 +76,59 @@ TEST(CvodesIntegrator, HarmonicOscillatorMatchesClosedFormWithAdamsAndAnalyticJa
   }
 }
 
+// A damped oscillator q'' + 2 zeta w q' + w^2 q = 0 through a caller's
+// Newton solver that uses the second-order structure: (I - gamma J) x = b
+// reduces to the scalar (1 + gamma c + gamma^2 k) x_v = b_v - gamma k b_u.
+TEST(CvodesIntegrator, CallerNewtonSolverMatchesClosedFormDampedOscillator) {
+  constexpr double kOmega = 3.0, kZeta = 0.1;
+  constexpr double k = kOmega * kOmega, c = 2.0 * kZeta * kOmega;
+  auto rhs = [](double, const double* y, double* ydot) {
+    ydot[0] = y[1];
+    ydot[1] = -k * y[0] - c * y[1];
+    return 0;
+  };
+  int calls = 0;
+  auto newton = [&calls](double, double gamma, double* bx, bool* refactored) {
+    ++calls;
+    *refactored = true;
+    bx[1] = (bx[1] - gamma * k * bx[0]) / (1.0 + gamma * c + gamma * gamma * k);
+    bx[0] += gamma * bx[1];
+    return 0;
+  };
+  Eigen::VectorXd y0(2);
+  y0 << 1.0, 0.0;
+  for (auto refresh : {CvodesIntegrator::NewtonRefresh::kEveryIteration,
+                       CvodesIntegrator::NewtonRefresh::kCvodesSetups}) {
+    calls = 0;
+    auto integrator =
+        CvodesIntegrator::CreateWithNewtonSolver(2, rhs, newton, refresh, Tight(), 0.0, y0);
+    ASSERT_TRUE(integrator.ok()) << integrator.status();
+    Eigen::VectorXd y;
+    constexpr double kT = 2.0;
+    ASSERT_TRUE((*integrator)->IntegrateTo(kT, &y).ok());
+    const double wd = kOmega * std::sqrt(1.0 - kZeta * kZeta);
+    const double decay = std::exp(-kZeta * kOmega * kT);
+    const double q = decay * (std::cos(wd * kT) + kZeta * kOmega / wd * std::sin(wd * kT));
+    const double v = -decay * kOmega * kOmega / wd * std::sin(wd * kT);
+    EXPECT_NEAR(y[0], q, kClosedFormTolerance);
+    EXPECT_NEAR(y[1], v, kClosedFormTolerance);
+    EXPECT_GT(calls, 0);
+    EXPECT_EQ((*integrator)->counters().jacobian_evaluations, calls);
+  }
+}
+
+TEST(CvodesIntegrator, CallerNewtonSolverFailureIsAStatus) {
+  auto newton = [](double, double, double*, bool*) { return -3; };
+  auto integrator = CvodesIntegrator::CreateWithNewtonSolver(
+      1, Decay(), newton, CvodesIntegrator::NewtonRefresh::kCvodesSetups, Tight(), 0.0,
+      Eigen::VectorXd::Ones(1));
+  ASSERT_TRUE(integrator.ok()) << integrator.status();
+  Eigen::VectorXd y;
+  const absl::Status s = (*integrator)->IntegrateTo(1.0, &y);
+  EXPECT_FALSE(s.ok());
+  EXPECT_THAT(std::string(s.message()), HasSubstr("Newton solver"));
+}
+
 TEST(CvodesIntegrator, StopsExactlyAtStopTimeAndRestartsThere) {
   // y' = 0 before t = 1 and 1 after: a kink the integrator must not step across.
   auto rhs = [](double t, const double*, double* ydot) {

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "client/report/job_report_html.h"
+#include "tests/report/headless_chromium.h"
 #include "tests/report/png_decoder.h"
 #include "tests/report/synthetic_report.h"
 
@@ -22,11 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Debian's chromium; $MBOPT_CHROMIUM overrides it.
-std::string ChromiumPath() {
-  const char* env = std::getenv("MBOPT_CHROMIUM");
-  return env != nullptr && *env != '\0' ? env : "/usr/bin/chromium";
-}
 constexpr int kWidthPx = 1200;
 constexpr int kHeightPx = 2000;
 // A blank page is ~0 % ink; the report's first 2000 px (summary and four
@@ -38,18 +34,13 @@ constexpr double kMaxInkFraction = 0.5;
 // background, the core of a 1.8 px line keeps its colour within this.
 constexpr int kColorTolerance = 40;
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string ReadFile(const fs::path& path) { return testing::ReadWholeFile(path); }
 
 class ReportInBrowser : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_EQ(access(ChromiumPath().c_str(), X_OK), 0)
-        << ChromiumPath() << " is missing: install it with `bash deploy/install-deps.sh` (Debian package chromium)";
+    ASSERT_EQ(access(testing::ChromiumPath().c_str(), X_OK), 0)
+        << testing::ChromiumPath() << " is missing: install it with `bash deploy/install-deps.sh` (Debian package chromium)";
     std::string pattern = (fs::temp_directory_path() / "mbopt-report-XXXXXX").string();
     ASSERT_NE(mkdtemp(pattern.data()), nullptr);
     dir_ = pattern;
@@ -65,16 +56,7 @@ class ReportInBrowser : public ::testing::Test {
   // stderr in <name>.out and <name>.err.
   int RunChromium(const std::string& action, const std::string& name) { return RunChromium(action, name, page_); }
   int RunChromium(const std::string& action, const std::string& name, const fs::path& page) {
-    const fs::path profile = dir_ / ("profile-" + name);
-    const std::string command =
-        "timeout 120 " + ChromiumPath() +
-        " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
-        " --disable-background-networking --disable-component-update --disable-sync"
-        " --hide-scrollbars --enable-logging=stderr --v=0"
-        " --user-data-dir=" + profile.string() + " --window-size=" + std::to_string(kWidthPx) + "," +
-        std::to_string(kHeightPx) + " " + action + " file://" + page.string() + " >" +
-        (dir_ / (name + ".out")).string() + " 2>" + (dir_ / (name + ".err")).string();
-    return std::system(command.c_str());
+    return testing::RunHeadlessChromium(dir_, action, name, page, kWidthPx, kHeightPx);
   }
 
   fs::path dir_;
@@ -82,14 +64,7 @@ class ReportInBrowser : public ::testing::Test {
 };
 
 int CountNear(const testing::RgbImage& image, int r, int g, int b) {
-  int n = 0;
-  for (std::size_t i = 0; i + 2 < image.rgb.size(); i += 3) {
-    if (std::abs(image.rgb[i] - r) <= kColorTolerance && std::abs(image.rgb[i + 1] - g) <= kColorTolerance &&
-        std::abs(image.rgb[i + 2] - b) <= kColorTolerance) {
-      ++n;
-    }
-  }
-  return n;
+  return testing::CountPixelsNear(image, r, g, b, kColorTolerance);
 }
 
 TEST_F(ReportInBrowser, ScreenshotShowsThePlots) {

@@ -3,6 +3,7 @@
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
+#include <sundials/sundials_linearsolver.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
@@ -99,6 +100,62 @@ struct CvodesCallbacks {
     return -1;
   }
 
+  // The caller's Newton solver as a matrix-embedded SUNLinearSolver. CVODES
+  // then skips its own setup heuristics and calls only Solve, once per
+  // Newton iteration; t and gamma are those of the step being attempted.
+  static SUNLinearSolver_Type NewtonType(SUNLinearSolver ls) {
+    auto* self = static_cast<CvodesIntegrator*>(ls->content);
+    // A direct solver gets CVODES' setup calls (through LinSys below) and no
+    // iterative-solver tolerance bookkeeping in every solve.
+    return self->newton_refresh_ == CvodesIntegrator::NewtonRefresh::kCvodesSetups
+               ? SUNLINEARSOLVER_DIRECT
+               : SUNLINEARSOLVER_MATRIX_EMBEDDED;
+  }
+  // CVODES' setup with the caller's solver: only remembers the (t, gamma)
+  // that the following solves use. The caller's matrix is exact there.
+  static int LinSys(realtype t, N_Vector, N_Vector, SUNMatrix, booleantype, booleantype* jcur,
+                    realtype gamma, void* user_data, N_Vector, N_Vector, N_Vector) {
+    auto* self = static_cast<CvodesIntegrator*>(user_data);
+    self->setup_t_ = t;
+    self->setup_gamma_ = gamma;
+    *jcur = SUNTRUE;
+    return 0;
+  }
+  static SUNLinearSolver_ID NewtonId(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+  static int NewtonSolve(SUNLinearSolver ls, SUNMatrix, N_Vector x, N_Vector b, realtype) {
+    auto* self = static_cast<CvodesIntegrator*>(ls->content);
+    double t = self->setup_t_, gamma = self->setup_gamma_;
+    if (self->newton_refresh_ == CvodesIntegrator::NewtonRefresh::kEveryIteration &&
+        (CVodeGetCurrentTime(self->sundials_->cvode, &t) != CV_SUCCESS ||
+         CVodeGetCurrentGamma(self->sundials_->cvode, &gamma) != CV_SUCCESS)) {
+      self->callback_failure_ = "Newton solver could not read the step's time and gamma";
+      return SUNLS_PACKAGE_FAIL_UNREC;
+    }
+    try {
+      N_VScale(1.0, b, x);
+      bool refactored = false;
+      const int flag = self->newton_solve_(t, gamma, N_VGetArrayPointer(x), &refactored);
+      if (refactored) ++self->newton_refactorizations_;
+      if (flag == 0) return SUNLS_SUCCESS;
+      if (flag > 0) return SUNLS_PACKAGE_FAIL_REC;
+      self->callback_failure_ = absl::StrFormat(
+          "Newton solver reported an unrecoverable error (%d) at t = %.9g", flag, t);
+      return SUNLS_PACKAGE_FAIL_UNREC;
+    } catch (const std::exception& e) {
+      self->callback_failure_ = absl::StrCat("Newton solver threw: ", e.what());
+    } catch (...) {
+      self->callback_failure_ = "Newton solver threw a non-standard exception";
+    }
+    return SUNLS_PACKAGE_FAIL_UNREC;
+  }
+  // The content is the integrator, which outlives the solver; only the
+  // shell is freed.
+  static int NewtonFree(SUNLinearSolver ls) {
+    ls->content = nullptr;
+    SUNLinSolFreeEmpty(ls);
+    return SUNLS_SUCCESS;
+  }
+
   static void Error(int code, const char* module, const char* function, char* message,
                     void* user_data) {
     auto* self = static_cast<CvodesIntegrator*>(user_data);
@@ -170,6 +227,30 @@ absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::Create(
   return integrator;
 }
 
+absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::CreateWithNewtonSolver(
+    int num_states, RhsFunction rhs, NewtonSolveFunction newton_solve, NewtonRefresh refresh,
+    const CvodesOptions& options, double t0, const Eigen::VectorXd& y0) {
+  if (!newton_solve) return absl::InvalidArgumentError("CreateWithNewtonSolver needs a solver");
+  if (options.iteration != CvodesOptions::Iteration::kNewton) {
+    return absl::InvalidArgumentError("a Newton solver needs Newton iteration");
+  }
+  if (absl::Status s = options.Validate(num_states); !s.ok()) return s;
+  if (!rhs) return absl::InvalidArgumentError("CvodesIntegrator needs a right-hand side");
+  if (y0.size() != num_states) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("initial state has ", y0.size(), " entries for ", num_states, " states"));
+  }
+  if (!y0.allFinite() || !std::isfinite(t0)) {
+    return absl::InvalidArgumentError("initial time and state must be finite");
+  }
+  std::unique_ptr<CvodesIntegrator> integrator(
+      new CvodesIntegrator(num_states, std::move(rhs), nullptr, options));
+  integrator->newton_solve_ = std::move(newton_solve);
+  integrator->newton_refresh_ = refresh;
+  if (absl::Status s = integrator->Init(t0, y0); !s.ok()) return s;
+  return integrator;
+}
+
 absl::Status CvodesIntegrator::Check(int flag, const char* call) {
   if (flag >= 0) return absl::OkStatus();
   std::string message = absl::StrFormat("%s failed (%d)", call, flag);
@@ -231,6 +312,26 @@ absl::Status CvodesIntegrator::Init(double t0, const Eigen::VectorXd& y0) {
 
 absl::Status CvodesIntegrator::InitLinearSolver() {
   Sundials& s = *sundials_;
+  if (newton_solve_) {
+    s.linear_solver = SUNLinSolNewEmpty(s.context);
+    if (s.linear_solver == nullptr) return absl::InternalError("SUNLinSolNewEmpty failed");
+    s.linear_solver->content = this;
+    s.linear_solver->ops->gettype = &CvodesCallbacks::NewtonType;
+    s.linear_solver->ops->getid = &CvodesCallbacks::NewtonId;
+    s.linear_solver->ops->solve = &CvodesCallbacks::NewtonSolve;
+    s.linear_solver->ops->free = &CvodesCallbacks::NewtonFree;
+    if (newton_refresh_ == NewtonRefresh::kEveryIteration) {
+      return Check(CVodeSetLinearSolver(s.cvode, s.linear_solver, nullptr),
+                   "CVodeSetLinearSolver");
+    }
+    // CVODES' direct-solver interface wants a matrix; the caller owns the
+    // real one, so a 1 x 1 placeholder stands in and is never read.
+    s.matrix = SUNDenseMatrix(1, 1, s.context);
+    if (s.matrix == nullptr) return absl::InternalError("SUNDenseMatrix failed");
+    MBOPT_RETURN_IF_ERROR(
+        Check(CVodeSetLinearSolver(s.cvode, s.linear_solver, s.matrix), "CVodeSetLinearSolver"));
+    return Check(CVodeSetLinSysFn(s.cvode, &CvodesCallbacks::LinSys), "CVodeSetLinSysFn");
+  }
   s.matrix = SUNDenseMatrix(num_states_, num_states_, s.context);
   if (s.matrix == nullptr) return absl::InternalError("SUNDenseMatrix failed");
   s.linear_solver = SUNLinSol_Dense(s.y, s.matrix, s.context);
@@ -281,17 +382,24 @@ void CvodesIntegrator::AccumulateCounters() {
   const std::int64_t restarts = carried_.restarts;
   carried_ = now;
   carried_.restarts = restarts;
+  // counters() adds the life-long refactorization count itself.
+  carried_.jacobian_evaluations -= newton_refactorizations_;
 }
 
 CvodesCounters CvodesIntegrator::counters() const {
   CvodesCounters c = carried_;
+  c.jacobian_evaluations += newton_refactorizations_;
   void* mem = sundials_->cvode;
   if (mem == nullptr) return c;
   long value = 0;
   if (CVodeGetNumSteps(mem, &value) == CV_SUCCESS) c.steps += value;
   if (CVodeGetNumRhsEvals(mem, &value) == CV_SUCCESS) c.rhs_evaluations += value;
   if (CVodeGetNumLinRhsEvals(mem, &value) == CV_SUCCESS) c.rhs_evaluations += value;
-  if (CVodeGetNumJacEvals(mem, &value) == CV_SUCCESS) c.jacobian_evaluations += value;
+  // With the caller's Newton solver CVODES' count is of its setups, not of
+  // factorizations; those are counted above.
+  if (!newton_solve_ && CVodeGetNumJacEvals(mem, &value) == CV_SUCCESS) {
+    c.jacobian_evaluations += value;
+  }
   if (CVodeGetNumNonlinSolvIters(mem, &value) == CV_SUCCESS) c.nonlinear_iterations += value;
   if (CVodeGetNumNonlinSolvConvFails(mem, &value) == CV_SUCCESS) {
     c.nonlinear_convergence_failures += value;

@@ -1,5 +1,6 @@
 // CvodesIntegrator: an RAII wrapper over SUNDIALS CVODES (6.x) for one ODE
-// system y' = f(t, y) of fixed size, with a dense direct linear solver.
+// system y' = f(t, y) of fixed size, with a dense direct linear solver or a
+// caller-supplied solver of the Newton systems (CreateWithNewtonSolver).
 //
 // Owns the SUNContext, the CVODE memory, the state N_Vector, the dense matrix
 // and the linear solver; nothing leaks on any path. Every SUNDIALS return code
@@ -76,12 +77,41 @@ class CvodesIntegrator {
   using JacobianFunction =
       std::function<int(double t, const double* y, const double* ydot, double* jacobian)>;
 
+  // Solves the Newton system (I - gamma J(t)) x = b of the step being taken
+  // at time t, in place (b on entry, x on return; length N). The callee owns
+  // its matrices and decides when to refactor; it sets *refactored when it
+  // did (counted as a Jacobian evaluation). Any matrix close enough to
+  // I - gamma J converges; an exact one converges in one iteration. Same
+  // return convention as RhsFunction (> 0: CVODES retries with a smaller
+  // step).
+  using NewtonSolveFunction =
+      std::function<int(double t, double gamma, double* b_then_x, bool* refactored)>;
+
   // Starts at (t0, y0). Without `jacobian` CVODES uses difference quotients.
   static absl::StatusOr<std::unique_ptr<CvodesIntegrator>> Create(int num_states, RhsFunction rhs,
                                                                   JacobianFunction jacobian,
                                                                   const CvodesOptions& options,
                                                                   double t0,
                                                                   const Eigen::VectorXd& y0);
+  // When the Newton solver is handed a new (t, gamma):
+  enum class NewtonRefresh {
+    // Every Newton iteration gets the attempted step's own t and gamma: for
+    // Jacobians that change quickly in time (a matrix-embedded solver;
+    // CVODES' setup heuristics are off).
+    kEveryIteration,
+    // Only when CVODES' heuristics call for a linear-solver setup (a step
+    // count, a gamma change of 30 %, a convergence failure); in between,
+    // CVODES rescales the solution for the gamma change. Cheapest per step
+    // for constant or slowly varying Jacobians.
+    kCvodesSetups,
+  };
+  // The same with Newton iteration whose linear systems `newton_solve`
+  // solves: no dense N x N matrix. For structured systems, e.g.
+  // second-order ones where I - gamma J reduces to M + gamma C + gamma^2 K.
+  // options.iteration must be kNewton.
+  static absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CreateWithNewtonSolver(
+      int num_states, RhsFunction rhs, NewtonSolveFunction newton_solve, NewtonRefresh refresh,
+      const CvodesOptions& options, double t0, const Eigen::VectorXd& y0);
 
   ~CvodesIntegrator();
   CvodesIntegrator(const CvodesIntegrator&) = delete;
@@ -118,6 +148,10 @@ class CvodesIntegrator {
   int num_states_;
   RhsFunction rhs_;
   JacobianFunction jacobian_;
+  NewtonSolveFunction newton_solve_;
+  NewtonRefresh newton_refresh_ = NewtonRefresh::kEveryIteration;
+  double setup_t_ = 0.0, setup_gamma_ = 0.0;  // of the last CVODES setup (kCvodesSetups)
+  std::int64_t newton_refactorizations_ = 0;  // by newton_solve_, over the whole life
   CvodesOptions options_;
   std::unique_ptr<Sundials> sundials_;
   double t_ = 0.0;

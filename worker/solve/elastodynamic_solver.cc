@@ -136,6 +136,7 @@ class ElasticLinkage {
       }
     }
     f_.resize(n_);
+    newton_rhs_.resize(n_);
     return {};
   }
 
@@ -210,18 +211,33 @@ class ElasticLinkage {
     return dv.allFinite() ? 0 : 1;
   }
 
-  int Jacobian(double t, double* jac) {
+  // Solves (I - gamma J) x = b in place for y = (u, v), J = [0 I; -M^-1 K
+  // -M^-1 C]: eliminating x_u = b_u + gamma x_v leaves the symmetric
+  // positive definite (M + gamma C + gamma^2 K) x_v = M b_v - gamma K b_u,
+  // n x n instead of 2n x 2n and exact at the step's own t (the equations
+  // are linear in y, so Newton converges in one iteration).
+  int NewtonSolve(double t, double gamma, double* bx, bool* refactored) {
     if (!Prepare(t)) return -1;
-    const int nn = 2 * n_;
-    Eigen::Map<Eigen::MatrixXd> j(jac, nn, nn);
-    j.block(0, n_, n_, n_).setIdentity();
-    j.block(n_, 0, n_, n_) = -lu_.solve(k_);
-    if (uniform_beta_) {  // C = beta K: M^-1 C = beta M^-1 K
-      j.block(n_, n_, n_, n_) = beta_ * j.block(n_, 0, n_, n_);
-    } else {
-      j.block(n_, n_, n_, n_) = -lu_.solve(c_);
+    if (!(factored_ && t == factored_t_ && gamma == factored_gamma_)) {
+      newton_matrix_ = m_;
+      newton_matrix_.noalias() += gamma * c_;
+      newton_matrix_.noalias() += (gamma * gamma) * k_;
+      newton_.compute(newton_matrix_);
+      *refactored = true;
+      if (newton_.info() != Eigen::Success) {
+        factored_ = false;
+        return 1;
+      }
+      factored_ = true;
+      factored_t_ = t;
+      factored_gamma_ = gamma;
     }
-    return 0;
+    Eigen::Map<Eigen::VectorXd> bu(bx, n_), bv(bx + n_, n_);
+    newton_rhs_.noalias() = m_ * bv;
+    newton_rhs_.noalias() -= gamma * (k_ * bu);
+    bv = newton_.solve(newton_rhs_);
+    bu += gamma * bv;
+    return bv.allFinite() ? 0 : 1;
   }
 
   // Node moments of every link and the drive torque at t from y.
@@ -343,10 +359,14 @@ class ElasticLinkage {
   int n_ = 0;
   double lowest_frequency_ = 0.0;
   double beta_ = 0.0;  // the one stiffness-proportional damping coefficient, s
-  bool uniform_beta_ = true;  // every link has beta_ (so C = beta_ K)
   Eigen::MatrixXd m_, k_, c_;
   Eigen::VectorXd f_;
   Eigen::LLT<Eigen::MatrixXd> lu_;  // of M(t), symmetric positive definite
+  Eigen::MatrixXd newton_matrix_;    // M + gamma C + gamma^2 K
+  Eigen::LLT<Eigen::MatrixXd> newton_;
+  Eigen::VectorXd newton_rhs_;
+  bool factored_ = false;
+  double factored_t_ = 0.0, factored_gamma_ = 0.0;
   Eigen::MatrixXd m_inner_, k_inner_, c_inner_;
   LinkageState state_;
   bool prepared_ = false;
@@ -376,13 +396,13 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
   options.max_steps = integrator.max_steps;
   options.max_wall_seconds = integrator.max_wall_seconds;
   const Eigen::VectorXd y0 = Eigen::VectorXd::Zero(2 * n);
-  auto created = CvodesIntegrator::Create(
+  auto created = CvodesIntegrator::CreateWithNewtonSolver(
       2 * n,
       [&elastic](double t, const double* y, double* ydot) { return elastic.Rhs(t, y, ydot); },
-      [&elastic](double t, const double*, const double*, double* jac) {
-        return elastic.Jacobian(t, jac);
+      [&elastic](double t, double gamma, double* bx, bool* refactored) {
+        return elastic.NewtonSolve(t, gamma, bx, refactored);
       },
-      options, 0.0, y0);
+      CvodesIntegrator::NewtonRefresh::kEveryIteration, options, 0.0, y0);
   if (!created.ok()) {
     return KinematicOutcome::Failed(
         absl::StrFormat("elastodynamic integrator setup failed: %s", created.status().message()));

@@ -15,7 +15,10 @@
 // centrifugal softening of the elastic displacements) are neglected; their
 // relative size is (crank speed / lowest link frequency)^2.
 // Integrated with CVODES BDF from the undeformed state (elastic velocities
-// zero: the links start with their rigid-body velocities).
+// zero: the links start with their rigid-body velocities). Each Newton
+// system is solved through the second-order structure, a Cholesky
+// factorization of M + gamma C + gamma^2 K at the step's own t and gamma (the
+// matrices rotate with the links, so a reused Jacobian would not converge).
 //
 // Bending moments at the nodes are recovered from the element end forces
 // (K d + C d' + M (a - g) in the element frame, the moment EI w'' a node

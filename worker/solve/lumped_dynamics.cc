@@ -40,25 +40,49 @@ std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<doubl
   const int n = m.num_coordinates();
   // y' = A y + (0, M^-1 f(t)) with A = [0 I; -M^-1 K  -M^-1 C].
   const Eigen::VectorXd inverse_mass = m.mass_diagonal().cwiseInverse();
-  const Eigen::MatrixXd minv_k = inverse_mass.asDiagonal() * m.stiffness();
-  const Eigen::MatrixXd minv_c = inverse_mass.asDiagonal() * m.damping();
+  // M^-1 [K C] as one n x 2n block: a single product with y per call.
+  Eigen::MatrixXd minv_kc(n, 2 * n);
+  minv_kc << inverse_mass.asDiagonal() * m.stiffness(), inverse_mass.asDiagonal() * m.damping();
   Eigen::VectorXd force(n);
   auto rhs = [&](double t, const double* y, double* ydot) -> int {
-    Eigen::Map<const Eigen::VectorXd> q(y, n), v(y + n, n);
+    Eigen::Map<const Eigen::VectorXd> state(y, 2 * n), v(y + n, n);
     Eigen::Map<Eigen::VectorXd> qdot(ydot, n), vdot(ydot + n, n);
     qdot = v;
     m.Forcing(t, &force);
     vdot = inverse_mass.cwiseProduct(force);
-    vdot.noalias() -= minv_k * q;
-    vdot.noalias() -= minv_c * v;
+    vdot.noalias() -= minv_kc * state;
     return 0;
   };
-  auto jacobian = [&](double, const double*, const double*, double* jac) -> int {
-    Eigen::Map<Eigen::MatrixXd> j(jac, 2 * n, 2 * n);
-    j.topRightCorner(n, n).setIdentity();
-    j.bottomLeftCorner(n, n) = -minv_k;
-    j.bottomRightCorner(n, n) = -minv_c;
-    return 0;
+  // Newton systems (I - gamma J) x = b through the second-order structure:
+  // x_v = (M + gamma C + gamma^2 K)^-1 (M b_v - gamma K b_u), x_u = b_u +
+  // gamma x_v. The n x n matrix is exact for the constant J and changes only
+  // when CVODES sets up for a new gamma; it is small, so its action on
+  // (b_u, b_v) is kept as one n x 2n matrix and each solve is one product.
+  Eigen::MatrixXd newton_matrix(n, n), newton_operator(n, 2 * n), newton_rhs_map(n, 2 * n);
+  Eigen::PartialPivLU<Eigen::MatrixXd> newton_lu(n);
+  Eigen::VectorXd newton_v(n);
+  double factored_gamma = 0.0;
+  bool factored = false;
+  auto newton_solve = [&](double, double gamma, double* bx, bool* refactored) -> int {
+    if (!factored || gamma != factored_gamma) {
+      newton_matrix = m.damping();
+      newton_matrix *= gamma;
+      newton_matrix.noalias() += (gamma * gamma) * m.stiffness();
+      newton_matrix.diagonal() += m.mass_diagonal();
+      newton_lu.compute(newton_matrix);
+      newton_rhs_map.leftCols(n) = -gamma * m.stiffness();
+      newton_rhs_map.rightCols(n).setZero();
+      newton_rhs_map.rightCols(n).diagonal() = m.mass_diagonal();
+      newton_operator = newton_lu.solve(newton_rhs_map);
+      factored = true;
+      factored_gamma = gamma;
+      *refactored = true;
+    }
+    Eigen::Map<Eigen::VectorXd> b(bx, 2 * n), bu(bx, n), bv(bx + n, n);
+    newton_v.noalias() = newton_operator * b;
+    bv = newton_v;
+    bu += gamma * newton_v;
+    return newton_v.allFinite() ? 0 : 1;
   };
 
   CvodesOptions cv;
@@ -85,7 +109,10 @@ std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<doubl
   if (options.initial_q.size() == n) y.head(n) = options.initial_q;
   if (options.initial_qdot.size() == n) y.tail(n) = options.initial_qdot;
   absl::StatusOr<std::unique_ptr<CvodesIntegrator>> created =
-      CvodesIntegrator::Create(2 * n, rhs, jacobian, cv, 0.0, y);
+      cv.iteration == CvodesOptions::Iteration::kNewton
+          ? CvodesIntegrator::CreateWithNewtonSolver(
+                2 * n, rhs, newton_solve, CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv, 0.0, y)
+          : CvodesIntegrator::Create(2 * n, rhs, nullptr, cv, 0.0, y);
   if (!created.ok()) return absl::StrCat("integrator setup: ", created.status().message());
   CvodesIntegrator& integrator = **created;
 

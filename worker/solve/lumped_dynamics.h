@@ -6,8 +6,10 @@
 // motion (not by differencing), and nothing at all, not even the
 // integration, when the scene requests no output.
 //
-// The state is y = (q, q'). BDF uses the constant system matrix as its
-// dense Jacobian. The scene's absolute tolerance applies to the coordinates
+// The state is y = (q, q'). Newton iterations (BDF, or Adams with Newton)
+// solve their linear systems through the second-order structure, an n x n
+// factorization of M + gamma C + gamma^2 K, exact since the system matrix is
+// constant. The scene's absolute tolerance applies to the coordinates
 // (m, rad); the rates get it times the highest natural frequency of the
 // undamped system, so that both weigh alike in the error norm. The integrator stops exactly at every instant where an
 // input bump starts or ends and restarts there, so the kinks of the forcing

@@ -1,0 +1,106 @@
+#include "spec/study_gradients.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+
+namespace mbopt::spec {
+namespace {
+
+using Series = std::vector<std::vector<double>>;
+
+absl::Status CheckShapes(const Study& study, const StudyLayout& layout,
+                         const std::vector<const Series*>& outputs, const char* what) {
+  if (outputs.size() != layout.outputs.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", outputs.size(),
+                                                   " outputs, the layout expects ",
+                                                   layout.outputs.size()));
+  }
+  for (size_t o = 0; o < outputs.size(); ++o) {
+    const OutputShape& shape = layout.outputs[o];
+    bool ok = outputs[o] != nullptr && static_cast<int>(outputs[o]->size()) == shape.series;
+    for (size_t s = 0; ok && s < outputs[o]->size(); ++s) {
+      ok = static_cast<int>((*outputs[o])[s].size()) == shape.instants;
+    }
+    if (!ok) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          what, ": output \"", study.scene.outputs[o].name, "\" does not have the layout's shape (",
+          shape.series, " series of ", shape.instants, " values)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+double At(const std::vector<const Series*>& outputs, const ValueRef& ref) {
+  return ref.sign * (*outputs[static_cast<size_t>(ref.output)])[static_cast<size_t>(ref.series)]
+                                                               [static_cast<size_t>(ref.instant)];
+}
+
+}  // namespace
+
+std::vector<double> ParameterSiPerScaledVariable(const Study& study) {
+  std::vector<double> factors;
+  for (const DesignVariable& v : study.variables) {
+    factors.push_back(v.scale *
+                      study.scene.parameters[static_cast<size_t>(v.parameter)].si_per_unit);
+  }
+  return factors;
+}
+
+absl::StatusOr<StudyGradients> ComputeStudyGradients(
+    const Study& study, const StudyLayout& layout, const std::vector<const Series*>& outputs_si,
+    const std::vector<std::vector<const Series*>>& derivatives_si) {
+  const size_t n = study.variables.size();
+  if (derivatives_si.size() != n) {
+    return absl::InvalidArgumentError(absl::StrCat("derivatives for ", derivatives_si.size(),
+                                                   " variables, the study has ", n));
+  }
+  if (absl::Status s = CheckShapes(study, layout, outputs_si, "values"); !s.ok()) return s;
+  for (size_t i = 0; i < n; ++i) {
+    if (absl::Status s = CheckShapes(study, layout, derivatives_si[i], "derivatives"); !s.ok()) {
+      return s;
+    }
+  }
+  const std::vector<double> factor = ParameterSiPerScaledVariable(study);
+  StudyGradients out;
+  const Objective& objective = study.objective;
+  if (objective.form == Objective::Form::kTargetDistance) {
+    // F = sqrt(sum w (o/u - t)^2): dF = sum w (o/u - t) do/u / F.
+    double sum = 0.0;
+    for (const TargetTerm& term : objective.terms) {
+      const double o = (*outputs_si[static_cast<size_t>(term.output)])[0].back() / term.si_per_unit;
+      sum += term.weight * (o - term.target) * (o - term.target);
+    }
+    const double f = std::sqrt(sum);
+    if (!(f > 0.0)) {
+      return absl::FailedPreconditionError("target_distance objective is 0: no derivative");
+    }
+    std::vector<double> row(n, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      for (const TargetTerm& term : objective.terms) {
+        const size_t o_index = static_cast<size_t>(term.output);
+        const double o = (*outputs_si[o_index])[0].back() / term.si_per_unit;
+        const double d = (*derivatives_si[i][o_index])[0].back() / term.si_per_unit;
+        row[i] += term.weight * (o - term.target) * d / f;
+      }
+      row[i] *= factor[i];
+    }
+    out.objective_terms.push_back(std::move(row));
+  } else {
+    for (const ValueRef& ref : layout.objective_terms) {
+      std::vector<double> row(n);
+      for (size_t i = 0; i < n; ++i) {
+        row[i] = At(derivatives_si[i], ref) / objective.si_per_unit * factor[i];
+      }
+      out.objective_terms.push_back(std::move(row));
+    }
+  }
+  for (const ConstraintRow& c : layout.rows) {
+    std::vector<double> row(n);
+    for (size_t i = 0; i < n; ++i) row[i] = At(derivatives_si[i], c.value) * factor[i];
+    out.constraint_rows.push_back(std::move(row));
+  }
+  return out;
+}
+
+}  // namespace mbopt::spec

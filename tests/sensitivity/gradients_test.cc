@@ -1,0 +1,169 @@
+// Simulator sensitivities of the vehicle study (examples/vehicle) against
+// central finite differences of the same study values.
+#include <algorithm>
+#include <cstdint>
+#include <cmath>
+#include <iostream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "mbopt/v1/study.pb.h"
+#include "server/jobs/problem_from_study.h"
+#include "server/local_run/evaluate_design.h"
+#include "spec/io/study_io.h"
+
+namespace mbopt::local_run {
+namespace {
+
+constexpr char kVehicleStudy[] = "examples/vehicle/vehicle.study.textproto";
+constexpr char kFourbarStudy[] = "examples/fourbar/fourbar_rigid.study.textproto";
+
+// Central differences with this relative step on a tightly integrated model:
+// truncation error ~ h^2, integration noise ~ tolerance / h, both far below
+// the agreement asked for.
+constexpr double kRelativeStep = 1e-5;
+constexpr double kTightRelativeTolerance = 1e-11;
+constexpr double kTightAbsoluteTolerance = 1e-14;
+// Agreement, relative to the largest |derivative| of the same column.
+constexpr double kAgreement = 1e-4;
+
+spec::Study TightVehicle() {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kVehicleStudy);
+  EXPECT_TRUE(study.ok()) << study.status();
+  if (!study.ok()) return {};
+  study->scene.integrator.relative_tolerance = kTightRelativeTolerance;
+  study->scene.integrator.absolute_tolerance = kTightAbsoluteTolerance;
+  study->scene.integrator.max_steps = 1'000'000;
+  return *study;
+}
+
+Eigen::VectorXd Initial(const spec::Study& study) {
+  Eigen::VectorXd x(static_cast<Eigen::Index>(study.variables.size()));
+  for (size_t k = 0; k < study.variables.size(); ++k) {
+    x[static_cast<Eigen::Index>(k)] = study.variables[k].initial;
+  }
+  return x;
+}
+
+Eigen::VectorXd Stacked(const DesignEvaluation& e) {
+  const auto& v = *e.values;
+  Eigen::VectorXd out(static_cast<Eigen::Index>(v.objective_terms.size() + v.constraint_values.size()));
+  Eigen::Index i = 0;
+  for (double t : v.objective_terms) out[i++] = t;
+  for (double g : v.constraint_values) out[i++] = g;
+  return out;
+}
+
+TEST(SimulatorSensitivities, VehicleGradientsMatchCentralDifferences) {
+  const spec::Study study = TightVehicle();
+  ASSERT_FALSE(study.variables.empty());
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const Eigen::VectorXd x0 = Initial(study);
+  absl::StatusOr<DesignEvaluation> with = EvaluateDesignWithGradients(study, *layout, x0);
+  ASSERT_TRUE(with.ok()) << with.status();
+  ASSERT_TRUE(with->ok()) << with->failure_reason;
+  ASSERT_TRUE(with->gradients.has_value()) << with->gradients_unavailable;
+  const slp::AnalysisResult result = ToAnalysisResult(*with);
+  const Eigen::Index k = result.objective_terms.size();
+  const Eigen::Index m = result.constraint_values.size();
+  ASSERT_EQ(result.objective_gradients.rows(), k);
+  ASSERT_EQ(result.constraint_gradients.rows(), m);
+  Eigen::MatrixXd simulator(k + m, x0.size());
+  simulator << result.objective_gradients, result.constraint_gradients;
+
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < x0.size(); ++i) {
+    const double h = kRelativeStep * std::max(std::abs(x0[i]), 1.0);
+    Eigen::VectorXd plus = x0, minus = x0;
+    plus[i] += h;
+    minus[i] -= h;
+    absl::StatusOr<DesignEvaluation> ep = EvaluateDesign(study, *layout, plus);
+    absl::StatusOr<DesignEvaluation> em = EvaluateDesign(study, *layout, minus);
+    ASSERT_TRUE(ep.ok() && em.ok());
+    ASSERT_TRUE(ep->ok() && em->ok());
+    const Eigen::VectorXd fd = (Stacked(*ep) - Stacked(*em)) / (2 * h);
+    const double magnitude = fd.cwiseAbs().maxCoeff();
+    ASSERT_GT(magnitude, 0.0) << "variable " << i;
+    const double disagreement = (simulator.col(i) - fd).cwiseAbs().maxCoeff() / magnitude;
+    worst = std::max(worst, disagreement);
+    EXPECT_LT(disagreement, kAgreement) << "variable " << study.variables[static_cast<size_t>(i)].name;
+  }
+  std::cout << "worst relative disagreement simulator vs central differences: " << worst << "\n";
+}
+
+TEST(SimulatorSensitivities, GradientsComeWithTheValuesOfAPlainAnalysis) {
+  // The values of the sensitivity analysis are the plain analysis' values
+  // up to the integration tolerance.
+  const spec::Study study = TightVehicle();
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const Eigen::VectorXd x0 = Initial(study);
+  absl::StatusOr<DesignEvaluation> with = EvaluateDesignWithGradients(study, *layout, x0);
+  absl::StatusOr<DesignEvaluation> plain = EvaluateDesign(study, *layout, x0);
+  ASSERT_TRUE(with.ok() && plain.ok());
+  ASSERT_TRUE(with->ok() && plain->ok());
+  const Eigen::VectorXd a = Stacked(*with), b = Stacked(*plain);
+  constexpr double kValueAgreement = 1e-6;  // relative to max |value|; tolerances are 1e-11
+  EXPECT_LT((a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff(), kValueAgreement);
+}
+
+TEST(SimulatorSensitivities, AnalysesWithAndWithoutGradientsAreTimedAtTheSceneTolerances) {
+  // At the scene's own tolerances; wall time of repeated analyses at x0.
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kVehicleStudy);
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const Eigen::VectorXd x0 = Initial(*study);
+  constexpr int kRepetitions = 20;
+  double plain_s = 0, with_s = 0;
+  std::int64_t plain_steps = 0, with_steps = 0;
+  for (int r = 0; r < kRepetitions; ++r) {
+    absl::StatusOr<DesignEvaluation> plain = EvaluateDesign(*study, *layout, x0);
+    absl::StatusOr<DesignEvaluation> with = EvaluateDesignWithGradients(*study, *layout, x0);
+    ASSERT_TRUE(plain.ok() && with.ok());
+    ASSERT_TRUE(plain->ok() && with->ok() && with->gradients.has_value());
+    plain_s += plain->counters.wall_seconds;
+    with_s += with->counters.wall_seconds;
+    plain_steps = plain->counters.time_steps;
+    with_steps = with->counters.time_steps;
+  }
+  const double n = static_cast<double>(study->variables.size());
+  std::cout << "wall per analysis: plain " << plain_s / kRepetitions * 1e3 << " ms ("
+            << plain_steps << " steps), with sensitivities " << with_s / kRepetitions * 1e3
+            << " ms (" << with_steps << " steps), ratio " << with_s / plain_s
+            << "; forward differences need n + 1 = " << n + 1 << " analyses\n";
+  // The figures are reported in docs/method.md; wall times on shared
+  // machines are too noisy for a bound here.
+  EXPECT_GT(with_steps, 0);
+  EXPECT_GT(plain_steps, 0);
+}
+
+TEST(SimulatorSensitivities, LinkageStudyIsRejectedAtLoad) {
+  absl::StatusOr<v1::Study> proto = spec::io::ReadStudyProto(kFourbarStudy);
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  proto->mutable_optimizer()->set_sensitivity(v1::SENSITIVITY_METHOD_SIMULATOR);
+  absl::StatusOr<spec::Study> study = spec::io::StudyFromProto(*proto, kFourbarStudy);
+  ASSERT_EQ(study.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(study.status().message().find("sensitivity"), std::string::npos) << study.status();
+  EXPECT_NE(study.status().message().find("not available for this formulation"), std::string::npos);
+}
+
+TEST(SimulatorSensitivities, ServiceRejectsThemAndLocalRunsAcceptThem) {
+  absl::StatusOr<v1::Study> proto = spec::io::ReadStudyProto(kVehicleStudy);
+  ASSERT_TRUE(proto.ok()) << proto.status();
+  proto->mutable_optimizer()->set_sensitivity(v1::SENSITIVITY_METHOD_SIMULATOR);
+  absl::StatusOr<spec::Study> study = spec::io::StudyFromProto(*proto, kVehicleStudy);
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_TRUE(study->optimizer.simulator_sensitivities);
+  const absl::StatusOr<slp::SlpOptions> service = jobs::SlpOptionsFromStudy(*study);
+  EXPECT_EQ(service.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(service.status().message().find("optimizer.sensitivity"), std::string::npos);
+  const absl::StatusOr<slp::SlpOptions> local = jobs::SlpOptionsFromStudy(*study, true);
+  ASSERT_TRUE(local.ok()) << local.status();
+  EXPECT_TRUE(local->analyses_provide_gradients);
+}
+
+}  // namespace
+}  // namespace mbopt::local_run
