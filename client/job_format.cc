@@ -8,6 +8,7 @@
 
 #include "client/exit_codes.h"
 #include "client/json_writer.h"
+#include "client/report/report_from_proto.h"
 
 namespace mbopt::client {
 namespace {
@@ -65,19 +66,7 @@ std::string DesignLines(const v1::JobSummary& s, const v1::Study* study) {
 
 }  // namespace
 
-std::string StateName(v1::JobState state) {
-  switch (state) {
-    case v1::JOB_STATE_QUEUED: return "queued";
-    case v1::JOB_STATE_RUNNING: return "running";
-    case v1::JOB_STATE_CONVERGED: return "converged";
-    case v1::JOB_STATE_MAX_CYCLES: return "max_cycles";
-    case v1::JOB_STATE_STALLED: return "stalled";
-    case v1::JOB_STATE_FAILED: return "failed";
-    case v1::JOB_STATE_CANCELLED: return "cancelled";
-    case v1::JOB_STATE_INTERRUPTED: return "interrupted";
-    default: return "unknown";
-  }
-}
+std::string StateName(v1::JobState state) { return report::JobStateName(state); }
 
 bool IsTerminal(v1::JobState state) {
   switch (state) {

@@ -6,9 +6,8 @@
 #include <vector>
 
 namespace mbopt::report {
-namespace {
 
-std::string StateName(v1::JobState state) {
+std::string JobStateName(v1::JobState state) {
   switch (state) {
     case v1::JOB_STATE_QUEUED: return "queued";
     case v1::JOB_STATE_RUNNING: return "running";
@@ -21,6 +20,8 @@ std::string StateName(v1::JobState state) {
     default: return "unknown";
   }
 }
+
+namespace {
 
 template <typename T>
 std::vector<T> ToVector(const google::protobuf::RepeatedField<T>& values) {
@@ -62,7 +63,7 @@ ReportData ReportDataFromJob(const v1::GetJobResponse& job) {
   d.job_id = s.job_id();
   d.study_name = !s.study_name().empty() ? s.study_name() : job.study().name();
   d.description = job.study().description();
-  d.state = StateName(s.state());
+  d.state = JobStateName(s.state());
   d.message = s.message();
   d.cycles = s.cycles();
   d.analyses = s.analyses();

@@ -5,4 +5,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bash deploy/build.sh
-exec ./build/client/mbopt run examples/vehicle/vehicle.study.textproto "$@"
+exec ./build/client/mbopt run examples/vehicle/vehicle.study.textproto --workers 2 "$@"
