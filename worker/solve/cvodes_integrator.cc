@@ -209,9 +209,12 @@ CvodesIntegrator::CvodesIntegrator(int num_states, RhsFunction rhs, JacobianFunc
 
 CvodesIntegrator::~CvodesIntegrator() = default;
 
-absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::Create(
-    int num_states, RhsFunction rhs, JacobianFunction jacobian, const CvodesOptions& options,
-    double t0, const Eigen::VectorXd& y0) {
+namespace {
+
+// The checks both factories make before any SUNDIALS object exists.
+absl::Status ValidateCreateArguments(int num_states, const CvodesIntegrator::RhsFunction& rhs,
+                                     const CvodesOptions& options, double t0,
+                                     const Eigen::VectorXd& y0) {
   if (absl::Status s = options.Validate(num_states); !s.ok()) return s;
   if (!rhs) return absl::InvalidArgumentError("CvodesIntegrator needs a right-hand side");
   if (y0.size() != num_states) {
@@ -220,6 +223,17 @@ absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::Create(
   }
   if (!y0.allFinite() || !std::isfinite(t0)) {
     return absl::InvalidArgumentError("initial time and state must be finite");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::Create(
+    int num_states, RhsFunction rhs, JacobianFunction jacobian, const CvodesOptions& options,
+    double t0, const Eigen::VectorXd& y0) {
+  if (absl::Status s = ValidateCreateArguments(num_states, rhs, options, t0, y0); !s.ok()) {
+    return s;
   }
   std::unique_ptr<CvodesIntegrator> integrator(
       new CvodesIntegrator(num_states, std::move(rhs), std::move(jacobian), options));
@@ -234,14 +248,8 @@ absl::StatusOr<std::unique_ptr<CvodesIntegrator>> CvodesIntegrator::CreateWithNe
   if (options.iteration != CvodesOptions::Iteration::kNewton) {
     return absl::InvalidArgumentError("a Newton solver needs Newton iteration");
   }
-  if (absl::Status s = options.Validate(num_states); !s.ok()) return s;
-  if (!rhs) return absl::InvalidArgumentError("CvodesIntegrator needs a right-hand side");
-  if (y0.size() != num_states) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("initial state has ", y0.size(), " entries for ", num_states, " states"));
-  }
-  if (!y0.allFinite() || !std::isfinite(t0)) {
-    return absl::InvalidArgumentError("initial time and state must be finite");
+  if (absl::Status s = ValidateCreateArguments(num_states, rhs, options, t0, y0); !s.ok()) {
+    return s;
   }
   std::unique_ptr<CvodesIntegrator> integrator(
       new CvodesIntegrator(num_states, std::move(rhs), nullptr, options));
