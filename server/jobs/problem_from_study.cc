@@ -43,7 +43,7 @@ absl::StatusOr<slp::ProblemSpec> ProblemSpecFromStudy(const spec::Study& study, 
   return problem;
 }
 
-absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study, bool in_process) {
+absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study) {
   slp::SlpOptions options;
   const spec::OptimizerSettings& s = study.optimizer;
   options.initial_move_limit = s.initial_move_limit;
@@ -54,12 +54,6 @@ absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study, bo
   options.finite_difference =
       s.central_differences ? slp::FiniteDifferenceScheme::kCentral : slp::FiniteDifferenceScheme::kForward;
   options.finite_difference_relative_step = s.finite_difference_relative_step;
-  if (s.simulator_sensitivities && !in_process) {
-    return InStudy(study, absl::InvalidArgumentError(
-                              "optimizer.sensitivity: SENSITIVITY_METHOD_SIMULATOR is supported "
-                              "only by in-process runs (the service does not carry gradients in "
-                              "its task results and result log); use finite differences"));
-  }
   options.analyses_provide_gradients = s.simulator_sensitivities;
   absl::Status valid = InStudy(study, options.Validate());
   if (!valid.ok()) return valid;

@@ -17,10 +17,10 @@ absl::StatusOr<slp::ProblemSpec> ProblemSpecFromStudy(const spec::Study& study, 
 
 // InvalidArgument (from SlpOptions::Validate) for settings out of range.
 // Simulator sensitivities (optimizer.sensitivity SENSITIVITY_METHOD_SIMULATOR)
-// set SlpOptions::analyses_provide_gradients when `in_process` (local runs,
-// whose analyses return gradients); the service's task results and result
-// log carry no gradients, so it gets InvalidArgument for them.
-absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study,
-                                                    bool in_process = false);
+// set SlpOptions::analyses_provide_gradients, for local runs and the service
+// alike: their analyses return gradients where the engine has them (lumped
+// scenes; the study loader already refuses the option for linkage scenes),
+// and an analysis without them makes that cycle use finite differences.
+absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study);
 
 }  // namespace mbopt::jobs

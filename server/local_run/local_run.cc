@@ -34,7 +34,7 @@ absl::StatusOr<LocalRunResult> RunStudyLocally(const spec::Study& study, const L
     slp_options = *options.slp_override;
     MBOPT_RETURN_IF_ERROR(slp_options.Validate());
   } else {
-    MBOPT_ASSIGN_OR_RETURN(slp_options, jobs::SlpOptionsFromStudy(study, /*in_process=*/true));
+    MBOPT_ASSIGN_OR_RETURN(slp_options, jobs::SlpOptionsFromStudy(study));
   }
   slp::SlpOptimizer optimizer(std::move(problem), slp_options, lp::MakeClpLpSolver());
 

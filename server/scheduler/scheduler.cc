@@ -31,7 +31,8 @@ std::string Scheduler::RegisterWorker(const std::string& name, int slots) {
   return id;
 }
 
-bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled) {
+bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled,
+                        bool want_gradients) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const Key key{job_id, request_id};
@@ -40,6 +41,7 @@ bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std:
     entry.job_id = job_id;
     entry.request_id = request_id;
     entry.x_scaled = std::move(x_scaled);
+    entry.want_gradients = want_gradients;
     queues_[job_id].push_back(request_id);
   }
   task_available_.notify_all();
@@ -80,7 +82,7 @@ std::vector<Task> Scheduler::AcquireLocked(const std::string& worker_id, int max
         entry.lease_deadline_ms = now + options_.lease_ms;
         leases_[entry.task_id] = Key{job_id, entry.request_id};
         tasks.push_back(Task{entry.task_id, job_id, entry.request_id, entry.x_scaled, entry.attempts,
-                             entry.lease_deadline_ms});
+                             entry.lease_deadline_ms, entry.want_gradients});
         queue.erase(it);
         last_served_job_ = job_id;
         found = true;

@@ -56,6 +56,7 @@ struct Task {
   std::vector<double> x_scaled;
   int attempt = 1;                    // 1-based
   std::int64_t lease_deadline_ms = 0; // on the scheduler's clock
+  bool want_gradients = false;        // also compute d(values)/d(x_scaled)
 };
 
 // A task finished: its result was taken (Complete) or it was given up.
@@ -83,10 +84,12 @@ class Scheduler {
   // Returns the new worker's id ("w-<n>").
   std::string RegisterWorker(const std::string& name, int slots);
 
-  // Queues an analysis of `job_id`. A request already queued, leased or
-  // finished is ignored (returns false), so callers may offer the
-  // optimizer's whole pending list each time.
-  bool Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled);
+  // Queues an analysis of `job_id`; `want_gradients` is passed on to the
+  // worker with every attempt. A request already queued, leased or finished
+  // is ignored (returns false), so callers may offer the optimizer's whole
+  // pending list each time.
+  bool Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled,
+               bool want_gradients = false);
 
   // Up to `max_tasks` tasks for `worker_id`, fairly across jobs. NotFound
   // for an unknown worker (it must register again).
@@ -129,6 +132,7 @@ class Scheduler {
     std::string job_id;
     std::int64_t request_id = 0;
     std::vector<double> x_scaled;
+    bool want_gradients = false;
     int attempts = 0;                  // leases handed out
     int failures = 0;                  // failed attempts
     std::set<std::string> failed_workers;

@@ -118,6 +118,7 @@ grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext*, const v1::Acq
     task->set_request_id(t.request_id);
     for (double x : t.x_scaled) task->add_x_scaled(x);
     task->set_lease_deadline_unix_ms(unix_now + (t.lease_deadline_ms - clock_now));
+    task->set_want_gradients(t.want_gradients);
   }
   return grpc::Status::OK;
 }
@@ -151,6 +152,10 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::Tas
   result.failure_reason = request->failure_reason();
   result.objective_terms.assign(request->objective_terms().begin(), request->objective_terms().end());
   result.constraint_values.assign(request->constraint_values().begin(), request->constraint_values().end());
+  result.objective_gradients.assign(request->objective_gradients().begin(), request->objective_gradients().end());
+  result.constraint_gradients.assign(request->constraint_gradients().begin(),
+                                     request->constraint_gradients().end());
+  result.gradients_unavailable = request->gradients_unavailable();
   result.wall_seconds = request->counters().wall_seconds();
   result.counters.time_steps = request->counters().time_steps();
   result.counters.rhs_evaluations = request->counters().rhs_evaluations();

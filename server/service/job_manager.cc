@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
+#include "server/jobs/analysis_gradients.h"
 #include "server/jobs/record_codec.h"
 
 namespace mbopt::service {
@@ -45,6 +46,21 @@ Eigen::VectorXd ToEigen(const std::vector<double>& v) {
   Eigen::VectorXd e(static_cast<Eigen::Index>(v.size()));
   for (size_t i = 0; i < v.size(); ++i) e[static_cast<Eigen::Index>(i)] = v[i];
   return e;
+}
+
+// The optimizer's view of a logged analysis: live delivery and replay give
+// it exactly this, so a resumed job sees what the first run saw.
+slp::AnalysisResult ResultOf(const store::AnalysisRow& row, const slp::ProblemSpec& problem) {
+  slp::AnalysisResult result;
+  result.request_id = row.request_id;
+  result.outcome = row.ok ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
+  result.failure_reason = row.failure_reason;
+  if (row.ok) {
+    result.objective_terms = ToEigen(row.objective_terms);
+    result.constraint_values = ToEigen(row.constraint_values);
+    jobs::AttachGradients(problem, row.objective_gradients, row.constraint_gradients, &result);
+  }
+  return result;
 }
 
 void LogError(const std::string& job_id, const absl::Status& status) {
@@ -199,13 +215,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
   logged.reserve(analyses->size());
   for (const store::AnalysisRow& a : *analyses) {
     jobs::LoggedAnalysis l;
-    l.result.request_id = a.request_id;
-    l.result.outcome = a.ok ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
-    l.result.failure_reason = a.failure_reason;
-    if (a.ok) {
-      l.result.objective_terms = ToEigen(a.objective_terms);
-      l.result.constraint_values = ToEigen(a.constraint_values);
-    }
+    l.result = ResultOf(a, (*job)->problem());
     l.x_scaled = a.x_scaled;
     logged.push_back(std::move(l));
   }
@@ -251,7 +261,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
 void JobManager::ScheduleLocked(Entry& entry) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
   for (const slp::AnalysisRequest& request : entry.job->PendingRequests()) {
-    scheduler_->Enqueue(entry.row.id, request.id, ToVector(request.x));
+    scheduler_->Enqueue(entry.row.id, request.id, ToVector(request.x), request.want_gradients);
   }
 }
 
@@ -330,17 +340,8 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const store::AnalysisRow& r
     FailJobLocked(entry, absl::StrCat("cannot log analysis ", row.request_id, ": ", status.message()));
     return status;
   }
-  slp::AnalysisResult result;
-  result.request_id = row.request_id;
-  result.outcome = row.ok ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
-  result.failure_reason = row.failure_reason;
-  if (row.ok) {
-    result.objective_terms = ToEigen(row.objective_terms);
-    result.constraint_values = ToEigen(row.constraint_values);
-  } else {
-    entry.last_failure = row.failure_reason;
-  }
-  absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Submit(result);
+  if (!row.ok) entry.last_failure = row.failure_reason;
+  absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Submit(ResultOf(row, entry.job->problem()));
   if (!records.ok()) {
     FailJobLocked(entry, absl::StrCat("the optimizer refused analysis ", row.request_id, ": ",
                                       records.status().message()));
@@ -390,6 +391,10 @@ absl::StatusOr<bool> JobManager::ReportResult(const WorkerResult& r) {
       return absl::InvalidArgumentError(reason);
     }
   }
+  bool wanted_gradients = false;
+  for (const slp::AnalysisRequest& request : entry->job->PendingRequests()) {
+    if (request.id == r.request_id) wanted_gradients = request.want_gradients;
+  }
   absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(r.worker_id, r.task_id);
   if (!finished.ok()) return false;
   store::AnalysisRow row;
@@ -401,6 +406,20 @@ absl::StatusOr<bool> JobManager::ReportResult(const WorkerResult& r) {
   if (r.ok) {
     row.objective_terms = r.objective_terms;
     row.constraint_values = r.constraint_values;
+  }
+  if (r.ok && wanted_gradients) {
+    // Logged as the optimizer will get them: unusable gradients are none.
+    const std::string defect = jobs::GradientDefect(entry->job->problem(), r.objective_gradients,
+                                                    r.constraint_gradients);
+    if (!defect.empty()) {
+      row.gradients_unavailable = absl::StrCat("unusable gradients from the worker: ", defect);
+    } else if (r.objective_gradients.empty()) {
+      row.gradients_unavailable =
+          r.gradients_unavailable.empty() ? "the worker sent no gradients" : r.gradients_unavailable;
+    } else {
+      row.objective_gradients = r.objective_gradients;
+      row.constraint_gradients = r.constraint_gradients;
+    }
   }
   row.worker = r.worker_id;
   row.wall_seconds = r.wall_seconds;

@@ -84,6 +84,11 @@ struct WorkerResult {
   std::string failure_reason;
   std::vector<double> objective_terms;
   std::vector<double> constraint_values;
+  // When the task wanted gradients: row-major d(value)/d(x_scaled)
+  // (server/jobs/analysis_gradients.h), or both empty and the reason.
+  std::vector<double> objective_gradients;
+  std::vector<double> constraint_gradients;
+  std::string gradients_unavailable;
   double wall_seconds = 0;
   store::AnalysisCounters counters;
 };
@@ -120,8 +125,11 @@ class JobManager {
   // A worker's result. Returns whether it was taken (false: the task is not
   // outstanding any more, the result is dropped). InvalidArgument for a
   // result that does not fit its task (sizes, ids): the worker gets the
-  // error, the attempt counts as failed, the job goes on. NotFound for an
-  // unknown job. Unavailable after Shutdown.
+  // error, the attempt counts as failed, the job goes on. Gradients that do
+  // not fit (wrong size, non-finite) or that the task did not ask for are
+  // not an error: the values are taken without them (the reason is logged
+  // with the analysis) and the optimizer uses finite differences for that
+  // cycle. NotFound for an unknown job. Unavailable after Shutdown.
   absl::StatusOr<bool> ReportResult(const WorkerResult& result);
 
   // A worker could not run a task (not a failure of the analysis).

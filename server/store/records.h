@@ -46,6 +46,14 @@ struct AnalysisRow {
   std::string failure_reason;
   std::vector<double> objective_terms;
   std::vector<double> constraint_values;
+  // Simulator sensitivities, when the analysis was asked for them and gave
+  // them: d(value)/d(x_scaled), row-major (one row per objective term, resp.
+  // constraint row; one column per design variable). Both empty: none, and
+  // gradients_unavailable may say why. Kept bit for bit like the values:
+  // a replay hands the optimizer the same gradients again.
+  std::vector<double> objective_gradients;
+  std::vector<double> constraint_gradients;
+  std::string gradients_unavailable;
   std::string worker;           // worker id, or "" for a server-side failure
   double wall_seconds = 0;      // the analysis' own running time
   std::int32_t attempts = 1;    // attempts it took (leases given out)

@@ -22,7 +22,9 @@ std::int64_t NowUnixMs() {
       .count();
 }
 
-// Version 1. Changing a table means a new version and a migration in Open().
+// Version 1, as first released. A new database is created as version 1 and
+// then migrated step by step (kMigrations), so every migration runs on every
+// new database too. Changing a table means a new version and a new step.
 constexpr const char* kSchemaV1 = R"sql(
 CREATE TABLE schema_version (
   version INTEGER NOT NULL
@@ -78,6 +80,21 @@ CREATE TABLE events (
 );
 )sql";
 
+// kMigrations[v - 1] turns version v into version v + 1.
+constexpr const char* kMigrations[] = {
+    // 1 -> 2: the gradients of simulator sensitivities with each analysis
+    // (blobs of doubles like the values; empty: none) and why they are
+    // missing. Rows of version 1 had no gradients, which the defaults say.
+    R"sql(
+ALTER TABLE analyses ADD COLUMN objective_gradients BLOB NOT NULL DEFAULT x'';
+ALTER TABLE analyses ADD COLUMN constraint_gradients BLOB NOT NULL DEFAULT x'';
+ALTER TABLE analyses ADD COLUMN gradients_unavailable TEXT NOT NULL DEFAULT '';
+UPDATE schema_version SET version = 2;
+)sql",
+};
+static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kSchemaVersion - 1,
+              "one migration step per schema version after the first");
+
 absl::StatusOr<std::int64_t> QueryInt(sqlite3* db, const std::string& sql) {
   MBOPT_ASSIGN_OR_RETURN(Statement stmt, Statement::Prepare(db, sql));
   MBOPT_ASSIGN_OR_RETURN(bool row, stmt.Step());
@@ -98,14 +115,35 @@ absl::Status NotUsable(const std::string& path, const absl::Status& status) {
                                                   status.message()));
 }
 
-absl::Status CreateSchema(sqlite3* db) {
+// Brings a database of schema version `from` to kSchemaVersion in one
+// transaction: a crash in the middle leaves the old version intact.
+absl::Status Migrate(sqlite3* db, std::int64_t from) {
+  if (from >= kSchemaVersion) return absl::OkStatus();
   MBOPT_RETURN_IF_ERROR(Exec(db, "BEGIN IMMEDIATE"));
-  absl::Status status = Exec(db, kSchemaV1);
-  if (status.ok()) status = Exec(db, absl::StrCat("INSERT INTO schema_version(version) VALUES (", kSchemaVersion, ")"));
-  if (status.ok()) status = Exec(db, absl::StrCat("PRAGMA application_id = ", kApplicationId));
+  absl::Status status;
+  for (std::int64_t v = from; v < kSchemaVersion && status.ok(); ++v) {
+    status = Exec(db, kMigrations[v - 1]);
+    if (!status.ok()) {
+      status = absl::Status(status.code(), absl::StrCat("migrating schema version ", v, " to ", v + 1, ": ",
+                                                        status.message()));
+    }
+  }
   if (status.ok()) return Exec(db, "COMMIT");
   (void)Exec(db, "ROLLBACK");
   return status;
+}
+
+absl::Status CreateSchema(sqlite3* db) {
+  MBOPT_RETURN_IF_ERROR(Exec(db, "BEGIN IMMEDIATE"));
+  absl::Status status = Exec(db, kSchemaV1);
+  if (status.ok()) status = Exec(db, "INSERT INTO schema_version(version) VALUES (1)");
+  if (status.ok()) status = Exec(db, absl::StrCat("PRAGMA application_id = ", kApplicationId));
+  if (status.ok()) status = Exec(db, "COMMIT");
+  if (!status.ok()) {
+    (void)Exec(db, "ROLLBACK");
+    return status;
+  }
+  return Migrate(db, 1);
 }
 
 // Checks that `db` is an mbopt database this code can use, creating the
@@ -135,7 +173,7 @@ absl::Status CheckOrCreateSchema(sqlite3* db) {
   }
   MBOPT_ASSIGN_OR_RETURN(std::string check, QueryText(db, "PRAGMA quick_check"));
   if (check != "ok") return absl::DataLossError(absl::StrCat("integrity check failed: ", check));
-  return absl::OkStatus();
+  return Migrate(db, version);
 }
 
 JobRow ReadJob(const Statement& stmt) {
@@ -294,8 +332,9 @@ absl::Status Store::AddAnalysis(const AnalysisRow& a) {
       Statement::Prepare(db_,
                          "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
                          "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
-                         "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms) "
-                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
+                         "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
+                         "objective_gradients, constraint_gradients, gradients_unavailable) "
+                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
   stmt.BindText(1, a.job_id);
   stmt.BindInt(2, a.request_id);
   stmt.BindBlob(3, EncodeDoubles(a.x_scaled));
@@ -312,6 +351,9 @@ absl::Status Store::AddAnalysis(const AnalysisRow& a) {
   stmt.BindInt(14, a.counters.newton_iterations);
   stmt.BindInt(15, a.counters.position_solves);
   stmt.BindInt(16, a.committed_unix_ms != 0 ? a.committed_unix_ms : NowUnixMs());
+  stmt.BindBlob(17, EncodeDoubles(a.objective_gradients));
+  stmt.BindBlob(18, EncodeDoubles(a.constraint_gradients));
+  stmt.BindText(19, a.gradients_unavailable);
   absl::Status status = stmt.Run();
   if (absl::IsAlreadyExists(status)) {
     return absl::AlreadyExistsError(absl::StrCat("job '", a.job_id, "' already has a result for request ",
@@ -327,7 +369,8 @@ absl::StatusOr<std::vector<AnalysisRow>> Store::LoadAnalyses(const std::string& 
       Statement::Prepare(db_,
                          "SELECT request_id, x_scaled, ok, failure_reason, objective_terms, constraint_values, "
                          "worker, wall_seconds, attempts, time_steps, rhs_evaluations, jacobian_evaluations, "
-                         "newton_iterations, position_solves, committed_unix_ms "
+                         "newton_iterations, position_solves, committed_unix_ms, objective_gradients, "
+                         "constraint_gradients, gradients_unavailable "
                          "FROM analyses WHERE job_id = ? ORDER BY request_id"));
   stmt.BindText(1, job_id);
   std::vector<AnalysisRow> rows;
@@ -351,6 +394,9 @@ absl::StatusOr<std::vector<AnalysisRow>> Store::LoadAnalyses(const std::string& 
     a.counters.newton_iterations = stmt.ColumnInt(12);
     a.counters.position_solves = stmt.ColumnInt(13);
     a.committed_unix_ms = stmt.ColumnInt(14);
+    MBOPT_ASSIGN_OR_RETURN(a.objective_gradients, DecodeDoubles(stmt.ColumnBlob(15)));
+    MBOPT_ASSIGN_OR_RETURN(a.constraint_gradients, DecodeDoubles(stmt.ColumnBlob(16)));
+    a.gradients_unavailable = stmt.ColumnText(17);
     rows.push_back(std::move(a));
   }
   return rows;

@@ -19,6 +19,10 @@ std::string VehicleStudy() {
   return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/vehicle/vehicle.study.textproto";
 }
 
+std::string VehicleSensitivityStudy() {
+  return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/vehicle/vehicle_sensitivity.study.textproto";
+}
+
 ScratchDir::ScratchDir() {
   std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-e2e-XXXXXX").string();
   MBOPT_CHECK(mkdtemp(pattern.data()) != nullptr, "mkdtemp failed");

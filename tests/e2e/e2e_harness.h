@@ -23,6 +23,9 @@ std::string ServerBinary();
 std::string WorkerBinary();
 // The vehicle example (examples/vehicle/vehicle.study.textproto).
 std::string VehicleStudy();
+// The same problem with simulator sensitivities
+// (examples/vehicle/vehicle_sensitivity.study.textproto).
+std::string VehicleSensitivityStudy();
 
 // A fresh directory under the system's temporary directory, removed at
 // destruction.

@@ -6,6 +6,7 @@
 // bit-identical doubles.
 #include <signal.h>
 
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -37,9 +38,10 @@ std::string Describe(const Subprocess::Output& out) {
                       out.stderr_text);
 }
 
-// Submits the vehicle study, follows it to its end and returns `results --json`.
-std::string SubmitWatchAndGetResults(const std::string& address) {
-  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", address});
+// Submits a study (default: the vehicle), follows it to its end and returns
+// `results --json`.
+std::string SubmitWatchAndGetResults(const std::string& address, const std::string& study = VehicleStudy()) {
+  auto submitted = Mbopt({"submit", study, "--server", address});
   EXPECT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto watched = Mbopt({"watch", job, "--server", address});
@@ -49,15 +51,15 @@ std::string SubmitWatchAndGetResults(const std::string& address) {
   return results.stdout_text;
 }
 
-// The vehicle study on a fresh server with `workers` plain workers.
-std::string ReferenceResult(int workers) {
+// A study (default: the vehicle) on a fresh server with `workers` plain workers.
+std::string ReferenceResult(int workers, const std::string& study = VehicleStudy()) {
   ScratchDir dir;
   auto server = StartServer(dir.File("ref.db"), {}, "127.0.0.1:0", dir.File("server.log"));
   EXPECT_TRUE(server.ok()) << server.status();
   if (!server.ok()) return "";
   std::vector<Subprocess> pool;
   for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address));
-  std::string json = SubmitWatchAndGetResults(server->address);
+  std::string json = SubmitWatchAndGetResults(server->address, study);
   for (auto& w : pool) w.Stop(kGuard);
   EXPECT_EQ(server->process->Stop(kGuard), 0) << "server did not shut down cleanly";
   return json;
@@ -176,8 +178,11 @@ TEST(EndToEnd, WorkerKilledMidCycleDoesNotChangeTheResult) {
   EXPECT_EQ(server->process->Stop(kGuard), 0);
 }
 
-TEST(EndToEnd, ServerKilledMidJobResumesBitIdentically) {
-  const std::string reference = Comparable(ReferenceResult(2));
+// Runs `study` with 2 workers on a server that kills itself after its
+// second cycle commit, restarts it on the same database and port, and checks
+// that the resumed job ends with the uninterrupted run's result, bit for bit.
+void ExpectServerKilledMidJobResumesBitIdentically(const std::string& study) {
+  const std::string reference = Comparable(ReferenceResult(2, study));
   ASSERT_FALSE(reference.empty());
 
   ScratchDir dir;
@@ -190,7 +195,7 @@ TEST(EndToEnd, ServerKilledMidJobResumesBitIdentically) {
   for (int i = 0; i < 2; ++i) {
     pool.push_back(StartWorker(first->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
   }
-  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", first->address});
+  auto submitted = Mbopt({"submit", study, "--server", first->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto crashed = first->process->Wait(kGuard);
@@ -218,6 +223,52 @@ TEST(EndToEnd, ServerKilledMidJobResumesBitIdentically) {
   EXPECT_EQ(Comparable(results.stdout_text), reference);
   for (auto& w : pool) EXPECT_EQ(w.Stop(kGuard), 0);
   EXPECT_EQ(second->process->Stop(kGuard), 0);
+}
+
+TEST(EndToEnd, ServerKilledMidJobResumesBitIdentically) {
+  ExpectServerKilledMidJobResumesBitIdentically(VehicleStudy());
+}
+
+// ---------------------------------------------------- simulator gradients --
+
+// The report's optimum of the vehicle problem (section 4.1, Table 2): peak
+// seat acceleration 6.40 m/s^2 after 12 cycles.
+constexpr double kReportVehicleObjective = 6.40;
+// The study's convergence tolerance on maxg (docs/method.md).
+constexpr double kFeasibleViolation = 0.005;
+
+// `mbopt run` with 2 workers on the vehicle with simulator sensitivities:
+// the report's optimum, with one analysis per cycle (plus rejected trials)
+// where forward differences spend at least 1 + n = 7.
+TEST(EndToEnd, SimulatorSensitivitiesReachTheReportsOptimumWithFewerAnalyses) {
+  const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(),
+                                        "MBOPT_WORKER_BIN=" + WorkerBinary()};
+  auto sensitivity = Mbopt({"run", VehicleSensitivityStudy(), "--workers", "2", "--json"}, env);
+  ASSERT_EQ(sensitivity.exit_code, kExitOk) << Describe(sensitivity);
+  auto finite_differences = Mbopt({"run", VehicleStudy(), "--workers", "2", "--json"}, env);
+  ASSERT_EQ(finite_differences.exit_code, kExitOk) << Describe(finite_differences);
+  const std::string& json = sensitivity.stdout_text;
+  EXPECT_EQ(JsonField(json, "status"), "converged") << json;
+  EXPECT_LE(std::stod(JsonField(json, "objective")), kReportVehicleObjective) << json;
+  EXPECT_LE(std::stod(JsonField(json, "max_violation")), kFeasibleViolation) << json;
+  ExpectConsecutiveHistory(json);
+  const long long analyses = std::stoll(JsonField(json, "analyses"));
+  const long long fd_analyses = std::stoll(JsonField(finite_differences.stdout_text, "analyses"));
+  const int cycles = std::stoi(JsonField(json, "cycles"));
+  const int fd_cycles = std::stoi(JsonField(finite_differences.stdout_text, "cycles"));
+  std::cout << "simulator: " << cycles << " cycles, " << analyses << " analyses, F = "
+            << JsonField(json, "objective") << "; finite differences: " << fd_cycles << " cycles, "
+            << fd_analyses << " analyses, F = " << JsonField(finite_differences.stdout_text, "objective")
+            << "\n";
+  // Per cycle: forward differences at least 1 + n = 7 analyses, the
+  // simulator 1 (the accepted trial's gradients start the next cycle).
+  EXPECT_LE(analyses, 1 + 2LL * cycles) << "at most one rejected trial per cycle on average";
+  EXPECT_GE(fd_analyses, 7LL * fd_cycles);
+  EXPECT_LT(3 * analyses, fd_analyses) << "far fewer analyses than forward differences";
+}
+
+TEST(EndToEnd, SimulatorSensitivityJobKilledMidJobResumesBitIdentically) {
+  ExpectServerKilledMidJobResumesBitIdentically(VehicleSensitivityStudy());
 }
 
 TEST(EndToEnd, RunJsonStartsEverythingAndPrintsOneJsonObject) {

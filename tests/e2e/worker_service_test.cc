@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -13,6 +14,7 @@
 
 #include "mbopt/v1/service.grpc.pb.h"
 #include "spec/io/study_io.h"
+#include "worker/engine/study_sensitivities.h"
 #include "worker/service/task_evaluator.h"
 #include "worker/service/worker_service.h"
 
@@ -86,6 +88,90 @@ TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
   EvaluateTask(**prepared, TaskAt(huge), &overflow);
   EXPECT_FALSE(overflow.ok());
   EXPECT_FALSE(overflow.failure_reason().empty());
+}
+
+TEST(TaskEvaluator, NoGradientsUnlessTheTaskAsks) {
+  const v1::Study proto = VehicleStudyProto();
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  v1::TaskResult result;
+  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), &result);
+  ASSERT_TRUE(result.ok()) << result.failure_reason();
+  EXPECT_EQ(result.objective_gradients_size(), 0);
+  EXPECT_EQ(result.constraint_gradients_size(), 0);
+  EXPECT_EQ(result.gradients_unavailable(), "");
+}
+
+// The result carries the engine's gradients row-major, bit for bit, and
+// the same values as the engine's sensitivity analysis.
+TEST(TaskEvaluator, GradientsWhenAskedAreTheEnginesRowMajor) {
+  const v1::Study proto = VehicleStudyProto();
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  const std::vector<double> x = InitialDesign(proto);
+  v1::AnalysisTask task = TaskAt(x);
+  task.set_want_gradients(true);
+  v1::TaskResult result;
+  EvaluateTask(**prepared, task, &result);
+  ASSERT_TRUE(result.ok()) << result.failure_reason();
+  EXPECT_EQ(result.gradients_unavailable(), "");
+  const size_t n = x.size();
+  const auto& layout = (*prepared)->layout;
+  ASSERT_EQ(static_cast<size_t>(result.objective_gradients_size()),
+            static_cast<size_t>(layout.num_objective_terms()) * n);
+  ASSERT_EQ(static_cast<size_t>(result.constraint_gradients_size()),
+            static_cast<size_t>(layout.num_constraints()) * n);
+
+  const engine::StudyAnalysisWithGradients engine =
+      engine::AnalyzeStudyWithGradients((*prepared)->study, layout, x);
+  ASSERT_TRUE(engine.gradients.has_value()) << engine.gradients_unavailable;
+  for (size_t k = 0; k < engine.gradients->objective_terms.size(); ++k) {
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(result.objective_gradients(static_cast<int>(k * n + i)), engine.gradients->objective_terms[k][i])
+          << "term " << k << ", variable " << i;
+    }
+  }
+  for (size_t h = 0; h < engine.gradients->constraint_rows.size(); ++h) {
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(result.constraint_gradients(static_cast<int>(h * n + i)), engine.gradients->constraint_rows[h][i])
+          << "row " << h << ", variable " << i;
+    }
+  }
+  // Deterministic: the same task gives the same bits again.
+  v1::TaskResult again;
+  EvaluateTask(**prepared, task, &again);
+  ASSERT_EQ(again.objective_gradients_size(), result.objective_gradients_size());
+  ASSERT_EQ(again.constraint_gradients_size(), result.constraint_gradients_size());
+  EXPECT_EQ(std::memcmp(again.objective_gradients().data(), result.objective_gradients().data(),
+                        sizeof(double) * static_cast<size_t>(result.objective_gradients_size())),
+            0);
+  EXPECT_EQ(std::memcmp(again.constraint_gradients().data(), result.constraint_gradients().data(),
+                        sizeof(double) * static_cast<size_t>(result.constraint_gradients_size())),
+            0);
+}
+
+// A design variable that sets the vehicle's speed (a ground input) has no
+// simulator sensitivity: the task still gets its values, with the reason.
+TEST(TaskEvaluator, StudyWithoutSimulatorSensitivitiesGivesValuesAndTheReason) {
+  v1::Study proto = VehicleStudyProto();
+  auto* speed = proto.mutable_variables(0);
+  speed->set_name("v");
+  speed->set_parameter("speed");
+  speed->set_scale(100);
+  speed->set_initial(10.56);
+  speed->set_lower(5);
+  speed->set_upper(20);
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  v1::AnalysisTask task = TaskAt(InitialDesign(proto));
+  task.set_want_gradients(true);
+  v1::TaskResult result;
+  EvaluateTask(**prepared, task, &result);
+  ASSERT_TRUE(result.ok()) << result.failure_reason();
+  EXPECT_EQ(result.objective_terms_size(), (*prepared)->layout.num_objective_terms());
+  EXPECT_EQ(result.objective_gradients_size(), 0);
+  EXPECT_EQ(result.constraint_gradients_size(), 0);
+  EXPECT_NE(result.gradients_unavailable().find("speed"), std::string::npos) << result.gradients_unavailable();
 }
 
 TEST(TaskEvaluator, StudyThatDoesNotConvertIsAnError) {

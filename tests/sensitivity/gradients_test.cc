@@ -150,19 +150,16 @@ TEST(SimulatorSensitivities, LinkageStudyIsRejectedAtLoad) {
   EXPECT_NE(study.status().message().find("not available for this formulation"), std::string::npos);
 }
 
-TEST(SimulatorSensitivities, ServiceRejectsThemAndLocalRunsAcceptThem) {
+TEST(SimulatorSensitivities, OptionsAskAnalysesForGradients) {
   absl::StatusOr<v1::Study> proto = spec::io::ReadStudyProto(kVehicleStudy);
   ASSERT_TRUE(proto.ok()) << proto.status();
   proto->mutable_optimizer()->set_sensitivity(v1::SENSITIVITY_METHOD_SIMULATOR);
   absl::StatusOr<spec::Study> study = spec::io::StudyFromProto(*proto, kVehicleStudy);
   ASSERT_TRUE(study.ok()) << study.status();
   EXPECT_TRUE(study->optimizer.simulator_sensitivities);
-  const absl::StatusOr<slp::SlpOptions> service = jobs::SlpOptionsFromStudy(*study);
-  EXPECT_EQ(service.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(service.status().message().find("optimizer.sensitivity"), std::string::npos);
-  const absl::StatusOr<slp::SlpOptions> local = jobs::SlpOptionsFromStudy(*study, true);
-  ASSERT_TRUE(local.ok()) << local.status();
-  EXPECT_TRUE(local->analyses_provide_gradients);
+  const absl::StatusOr<slp::SlpOptions> options = jobs::SlpOptionsFromStudy(*study);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_TRUE(options->analyses_provide_gradients);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "tests/server/fake_worker.h"
 
 #include <algorithm>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -66,6 +67,23 @@ grpc::Status FakeWorker::Answer(const v1::AnalysisTask& task, bool* accepted) {
   if (values.ok()) {
     for (double v : values->objective_terms) result.add_objective_terms(v);
     for (double v : values->constraint_values) result.add_constraint_values(v);
+  }
+  (task.want_gradients() ? tasks_wanting_gradients_ : tasks_without_gradients_) += 1;
+  if (values.ok() && task.want_gradients()) {
+    if (gradient_mode_ == GradientMode::kNone) {
+      result.set_gradients_unavailable("this fake worker has no gradients");
+    } else {
+      absl::StatusOr<FakeGradients> gradients = GradientsAnalytically(study, x);
+      EXPECT_TRUE(gradients.ok()) << gradients.status();
+      if (gradients.ok()) {
+        for (double v : gradients->objective_gradients) result.add_objective_gradients(v);
+        for (double v : gradients->constraint_gradients) result.add_constraint_gradients(v);
+      }
+      if (gradient_mode_ == GradientMode::kWrongSize) result.mutable_objective_gradients()->RemoveLast();
+      if (gradient_mode_ == GradientMode::kNonFinite) {
+        result.set_constraint_gradients(0, std::numeric_limits<double>::quiet_NaN());
+      }
+    }
   }
   grpc::ClientContext context;
   v1::ReportResultResponse response;

@@ -37,6 +37,18 @@ class FakeWorker {
   // them until `stop` is set; for several workers on their own threads.
   int RunUntil(const std::atomic<bool>& stop, int wait_ms);
 
+  // What the worker answers to a task that wants gradients.
+  enum class GradientMode {
+    kExact,      // the closed-form gradients (test_study.h)
+    kNone,       // none, with a reason (as a worker whose engine has none)
+    kWrongSize,  // one entry too few: the server must take it as none
+    kNonFinite,  // a NaN entry: likewise
+  };
+  void SetGradientMode(GradientMode mode) { gradient_mode_ = mode; }
+  // Tasks answered so far that asked for gradients, and that did not.
+  int tasks_wanting_gradients() const { return tasks_wanting_gradients_; }
+  int tasks_without_gradients() const { return tasks_without_gradients_; }
+
   // Instead of failing the test, an RPC error ends Run() and sets failed():
   // for tests that kill the server under the worker.
   void TolerateServerLoss() { tolerate_errors_ = true; }
@@ -55,6 +67,9 @@ class FakeWorker {
   std::mt19937 rng_;
   std::map<std::string, v1::Study> studies_;
   std::vector<v1::AnalysisTask> backlog_;
+  GradientMode gradient_mode_ = GradientMode::kExact;
+  int tasks_wanting_gradients_ = 0;
+  int tasks_without_gradients_ = 0;
   bool tolerate_errors_ = false;
   bool failed_ = false;  // taken, not answered yet
 };

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "server/jobs/analysis_gradients.h"
 #include "server/jobs/job_state.h"
 #include "server/jobs/record_codec.h"
 #include "spec/io/study_io.h"
@@ -106,6 +107,13 @@ LoggedRun RunAndLog(const v1::Study& proto) {
                                                                     static_cast<Eigen::Index>(values->objective_terms.size()));
       a.result.constraint_values = Eigen::Map<const Eigen::VectorXd>(
           values->constraint_values.data(), static_cast<Eigen::Index>(values->constraint_values.size()));
+      if (it->want_gradients) {
+        absl::StatusOr<testing::FakeGradients> gradients = testing::GradientsAnalytically(proto, x);
+        EXPECT_TRUE(gradients.ok()) << gradients.status();
+        AttachGradients(job->problem(), gradients->objective_gradients, gradients->constraint_gradients,
+                        &a.result);
+        EXPECT_TRUE(a.result.has_gradients());
+      }
       absl::StatusOr<std::vector<slp::CycleRecord>> records = job->Submit(a.result);
       EXPECT_TRUE(records.ok()) << records.status();
       for (const slp::CycleRecord& r : *records) run.records.push_back(EncodeCycleRecord(r));
@@ -131,6 +139,80 @@ TEST(JobReplay, ReplayOfAWholeRunRebuildsTheFinalState) {
   EXPECT_EQ(std::memcmp(job->optimizer().current_design().data(), run.design.data(),
                         sizeof(double) * static_cast<size_t>(run.design.size())),
             0);
+}
+
+TEST(JobReplay, ReplayWithGradientsRebuildsTheFinalState) {
+  const v1::Study proto = testing::OscillatorStudyWithSensitivities();
+  LoggedRun run = RunAndLog(proto);
+  ASSERT_EQ(run.state, slp::RunState::kConverged);
+  // Gradients from every analysis: one for x0, then one per trial (record).
+  EXPECT_EQ(run.analyses.size(), run.records.size() + 1);
+  std::unique_ptr<Job> job = NewJob(proto);
+  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = job->Replay(run.analyses, run.records);
+  ASSERT_TRUE(unlogged.ok()) << unlogged.status();
+  EXPECT_TRUE(unlogged->empty());
+  EXPECT_EQ(job->optimizer().state(), slp::RunState::kConverged);
+  ASSERT_EQ(job->optimizer().current_design().size(), run.design.size());
+  EXPECT_EQ(std::memcmp(job->optimizer().current_design().data(), run.design.data(),
+                        sizeof(double) * static_cast<size_t>(run.design.size())),
+            0);
+}
+
+// A problem with 2 variables, 1 objective term and 3 constraint rows.
+slp::ProblemSpec ThreeRowProblem() {
+  slp::ProblemSpec problem;
+  problem.lower = Eigen::Vector2d(0, 0);
+  problem.upper = Eigen::Vector2d(1, 1);
+  problem.initial = Eigen::Vector2d(0.5, 0.5);
+  problem.variable_names = {"a", "b"};
+  problem.num_objective_terms = 1;
+  problem.constraint_names = {"r0", "r1", "r2"};
+  problem.constraint_limits = Eigen::Vector3d(1, 1, 1);
+  problem.constraint_scales = Eigen::Vector3d(1, 1, 1);
+  return problem;
+}
+
+TEST(AnalysisGradients, RowMajorVectorsBecomeTheResultsMatrices) {
+  const slp::ProblemSpec problem = ThreeRowProblem();
+  EXPECT_EQ(GradientDefect(problem, {1, 2}, {3, 4, 5, 6, 7, 8}), "");
+  slp::AnalysisResult result;
+  AttachGradients(problem, {1, 2}, {3, 4, 5, 6, 7, 8}, &result);
+  ASSERT_TRUE(result.has_gradients());
+  ASSERT_EQ(result.objective_gradients.rows(), 1);
+  ASSERT_EQ(result.objective_gradients.cols(), 2);
+  EXPECT_EQ(result.objective_gradients(0, 1), 2);
+  ASSERT_EQ(result.constraint_gradients.rows(), 3);
+  ASSERT_EQ(result.constraint_gradients.cols(), 2);
+  EXPECT_EQ(result.constraint_gradients(1, 0), 5);  // row r1, variable a
+  EXPECT_EQ(result.constraint_gradients(2, 1), 8);
+}
+
+TEST(AnalysisGradients, EmptyIsNoGradientsAndNoDefect) {
+  const slp::ProblemSpec problem = ThreeRowProblem();
+  EXPECT_EQ(GradientDefect(problem, {}, {}), "");
+  slp::AnalysisResult result;
+  AttachGradients(problem, {}, {}, &result);
+  EXPECT_FALSE(result.has_gradients());
+}
+
+TEST(AnalysisGradients, WrongSizeOrNonFiniteEntryIsADefectAndGivesNoGradients) {
+  const slp::ProblemSpec problem = ThreeRowProblem();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    std::vector<double> objective, constraints;
+    const char* mentions;
+  };
+  for (const Case& c : {Case{{1, 2}, {3, 4, 5, 6, 7}, "expected"}, Case{{1}, {3, 4, 5, 6, 7, 8}, "expected"},
+                        Case{{}, {3, 4, 5, 6, 7, 8}, "expected"}, Case{{1, nan}, {3, 4, 5, 6, 7, 8}, "objective"},
+                        Case{{1, 2}, {3, 4, 5, 6, -inf, 8}, "r2"}}) {
+    const std::string defect = GradientDefect(problem, c.objective, c.constraints);
+    EXPECT_NE(defect.find(c.mentions), std::string::npos) << defect;
+    slp::AnalysisResult result;
+    AttachGradients(problem, c.objective, c.constraints, &result);
+    EXPECT_FALSE(result.has_gradients()) << defect;
+    EXPECT_EQ(result.constraint_gradients.size(), 0);
+  }
 }
 
 TEST(JobReplay, RecordsMissingFromTheLogAreReturnedForLogging) {

@@ -17,8 +17,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "absl/strings/str_cat.h"
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
+#include "server/store/store.h"
 #include "tests/server/fake_worker.h"
 #include "tests/server/test_study.h"
 
@@ -27,6 +29,7 @@ namespace {
 
 using ::mbopt::testing::FakeWorker;
 using ::mbopt::testing::OscillatorStudy;
+using ::mbopt::testing::OscillatorStudyWithSensitivities;
 using ::testing::HasSubstr;
 
 constexpr std::int64_t kLeaseMs = 10'000;
@@ -83,9 +86,10 @@ class ServerTest : public ::testing::Test {
   }
 
   // Runs the study to its end on a fresh database; returns the final Get.
-  v1::GetJobResponse RunToEnd(const std::string& db_name, std::uint32_t seed) {
+  v1::GetJobResponse RunToEnd(const std::string& db_name, std::uint32_t seed,
+                              const v1::Study& study = OscillatorStudy()) {
     auto server = StartServer(db_name);
-    const std::string id = Submit(*server, OscillatorStudy());
+    const std::string id = Submit(*server, study);
     FakeWorker worker(server->InProcessChannel(), seed);
     worker.Run();
     return Get(*server, id);
@@ -233,6 +237,116 @@ TEST_F(ServerTest, RestartRightAfterACycleCommitResumesBitIdentically) {
   FakeWorker worker(server->InProcessChannel(), 9);
   worker.Run();
   ExpectSameCycles(reference, Get(*server, id));
+}
+
+// ---------------------------------------------------- simulator gradients --
+
+// The analysis log of a job (the server must be gone: it holds the lock).
+std::vector<store::AnalysisRow> LoggedAnalyses(const std::filesystem::path& db, const std::string& id) {
+  auto store = store::Store::Open(db.string());
+  EXPECT_TRUE(store.ok()) << store.status();
+  if (!store.ok()) return {};
+  auto rows = (*store)->LoadAnalyses(id);
+  EXPECT_TRUE(rows.ok()) << rows.status();
+  return rows.ok() ? *rows : std::vector<store::AnalysisRow>{};
+}
+
+TEST_F(ServerTest, SimulatorSensitivityJobTakesGradientsFromItsAnalyses) {
+  std::string id;
+  v1::GetJobResponse job;
+  {
+    auto server = StartServer("sens.db");
+    id = Submit(*server, OscillatorStudyWithSensitivities());
+    FakeWorker worker(server->InProcessChannel(), 1);
+    worker.Run();
+    job = Get(*server, id);
+    EXPECT_EQ(worker.tasks_without_gradients(), 0) << "no finite-difference perturbation was asked for";
+    EXPECT_EQ(worker.tasks_wanting_gradients(), job.summary().analyses());
+  }
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
+  ASSERT_EQ(job.summary().design_size(), 2);
+  EXPECT_NEAR(job.summary().design(0) / testing::kStiffnessScale, 1.0, kDesignTolerance);
+  EXPECT_NEAR(job.summary().design(1) / testing::kDampingScale, 1.0, kDesignTolerance);
+  // One analysis of the initial design, then one per trial point (one record
+  // each): an accepted trial's gradients linearize the next cycle.
+  EXPECT_EQ(job.summary().analyses(), 1 + job.cycles_size());
+  const v1::GetJobResponse finite_differences = RunToEnd("fd.db", 1);
+  EXPECT_LT(job.summary().analyses(), finite_differences.summary().analyses());
+
+  const std::vector<store::AnalysisRow> logged = LoggedAnalyses(dir_ / "sens.db", id);
+  ASSERT_EQ(static_cast<std::int64_t>(logged.size()), job.summary().analyses());
+  for (const store::AnalysisRow& row : logged) {
+    ASSERT_TRUE(row.ok) << row.failure_reason;
+    // 1 objective term x 2 variables; 1 constraint row x 2 variables.
+    EXPECT_EQ(row.objective_gradients.size(), 2u) << "request " << row.request_id;
+    EXPECT_EQ(row.constraint_gradients.size(), 2u) << "request " << row.request_id;
+    EXPECT_EQ(row.gradients_unavailable, "");
+  }
+}
+
+// Gradients that are missing, of the wrong size or not finite are no
+// gradients: the values count, and every cycle falls back to finite
+// differences, which gives exactly the finite-difference run.
+TEST_F(ServerTest, MissingOrUnusableGradientsFallBackToFiniteDifferences) {
+  const v1::GetJobResponse reference = RunToEnd("fd.db", 1);
+  ASSERT_EQ(reference.summary().state(), v1::JOB_STATE_CONVERGED);
+  struct Case {
+    FakeWorker::GradientMode mode;
+    const char* reason;
+  };
+  for (const Case& c : {Case{FakeWorker::GradientMode::kNone, "this fake worker has no gradients"},
+                        Case{FakeWorker::GradientMode::kWrongSize, "unusable gradients from the worker"},
+                        Case{FakeWorker::GradientMode::kNonFinite, "unusable gradients from the worker"}}) {
+    const std::string db = absl::StrCat("mode", static_cast<int>(c.mode), ".db");
+    std::string id;
+    v1::GetJobResponse job;
+    {
+      auto server = StartServer(db);
+      id = Submit(*server, OscillatorStudyWithSensitivities());
+      FakeWorker worker(server->InProcessChannel(), 1);
+      worker.SetGradientMode(c.mode);
+      worker.Run();
+      job = Get(*server, id);
+      EXPECT_GT(worker.tasks_without_gradients(), 0) << c.reason << ": perturbations were asked for";
+    }
+    EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
+    ExpectSameCycles(reference, job);
+    int without = 0;
+    for (const store::AnalysisRow& row : LoggedAnalyses(dir_ / db, id)) {
+      EXPECT_TRUE(row.objective_gradients.empty());
+      EXPECT_TRUE(row.constraint_gradients.empty());
+      if (!row.gradients_unavailable.empty()) {
+        ++without;
+        EXPECT_THAT(row.gradients_unavailable, HasSubstr(c.reason));
+      }
+    }
+    EXPECT_GT(without, 0) << "the log says why the gradients are missing";
+  }
+}
+
+TEST_F(ServerTest, SimulatorSensitivityJobResumesBitIdenticallyAfterACrash) {
+  const v1::GetJobResponse reference = RunToEnd("reference.db", 7, OscillatorStudyWithSensitivities());
+  ASSERT_EQ(reference.summary().state(), v1::JOB_STATE_CONVERGED);
+  ASSERT_GT(reference.summary().analyses(), 3);
+  const int kResultsBeforeCrash = 3;  // the third is a trial of cycle 2 at the latest
+  std::string id;
+  {
+    auto server = StartServer("crash.db");
+    id = Submit(*server, OscillatorStudyWithSensitivities());
+    FakeWorker worker(server->InProcessChannel(), 99);
+    ASSERT_EQ(worker.Run(kResultsBeforeCrash), kResultsBeforeCrash);
+    ASSERT_EQ(Get(*server, id).summary().state(), v1::JOB_STATE_RUNNING);
+    // Destroyed without Shutdown: the database says RUNNING, as after a crash.
+  }
+  auto server = StartServer("crash.db");
+  FakeWorker worker(server->InProcessChannel(), 3);
+  worker.Run();
+  // Replay handed the logged gradients back: no analysis was repeated.
+  EXPECT_EQ(worker.tasks_wanting_gradients(), reference.summary().analyses() - kResultsBeforeCrash);
+  EXPECT_EQ(worker.tasks_without_gradients(), 0);
+  v1::GetJobResponse finished = Get(*server, id);
+  EXPECT_EQ(finished.summary().state(), v1::JOB_STATE_CONVERGED);
+  ExpectSameCycles(reference, finished);
 }
 
 TEST_F(ServerTest, CancelThenResumeGivesTheSameResult) {

@@ -6,6 +6,7 @@
 #include "common/status_macros.h"
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
+#include "spec/study_gradients.h"
 
 namespace mbopt::testing {
 
@@ -59,6 +60,47 @@ absl::StatusOr<FakeValues> EvaluateAnalytically(const v1::Study& proto, const st
   outputs[static_cast<size_t>(study.scene.FindOutput("acc"))] = &acc;
   MBOPT_ASSIGN_OR_RETURN(spec::StudyValues values, spec::ComputeStudyValues(study, layout, outputs));
   return FakeValues{values.objective_terms, values.constraint_values};
+}
+
+v1::Study OscillatorStudyWithSensitivities(const std::string& name) {
+  v1::Study study = OscillatorStudy(name);
+  study.mutable_optimizer()->set_sensitivity(v1::SENSITIVITY_METHOD_SIMULATOR);
+  return study;
+}
+
+absl::StatusOr<FakeGradients> GradientsAnalytically(const v1::Study& proto, const std::vector<double>& x) {
+  MBOPT_ASSIGN_OR_RETURN(spec::Study study, spec::io::StudyFromProto(proto, "test study"));
+  MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
+  const size_t defl_index = static_cast<size_t>(study.scene.FindOutput("defl"));
+  const size_t acc_index = static_cast<size_t>(study.scene.FindOutput("acc"));
+  using Series = std::vector<std::vector<double>>;
+  const Series defl = {{x[0] * x[0] + x[1] * x[1]}};
+  const Series acc = {{x[0] + x[1]}};
+  std::vector<const Series*> outputs(study.scene.outputs.size(), nullptr);
+  outputs[defl_index] = &defl;
+  outputs[acc_index] = &acc;
+  // d output / d p_si = (d output / d x_i) / (d p_si / d x_i).
+  const std::vector<double> per_x = spec::ParameterSiPerScaledVariable(study);
+  std::vector<Series> d_defl, d_acc;
+  for (size_t i = 0; i < 2; ++i) {
+    d_defl.push_back({{2.0 * x[i] / per_x[i]}});
+    d_acc.push_back({{1.0 / per_x[i]}});
+  }
+  std::vector<std::vector<const Series*>> derivatives(2, std::vector<const Series*>(outputs.size(), nullptr));
+  for (size_t i = 0; i < 2; ++i) {
+    derivatives[i][defl_index] = &d_defl[i];
+    derivatives[i][acc_index] = &d_acc[i];
+  }
+  MBOPT_ASSIGN_OR_RETURN(spec::StudyGradients gradients,
+                         spec::ComputeStudyGradients(study, layout, outputs, derivatives));
+  FakeGradients out;
+  for (const auto& row : gradients.objective_terms) {
+    out.objective_gradients.insert(out.objective_gradients.end(), row.begin(), row.end());
+  }
+  for (const auto& row : gradients.constraint_rows) {
+    out.constraint_gradients.insert(out.constraint_gradients.end(), row.begin(), row.end());
+  }
+  return out;
 }
 
 }  // namespace mbopt::testing

@@ -32,4 +32,17 @@ struct FakeValues {
 // through the study's layout (spec/layout.h) from the closed-form outputs.
 absl::StatusOr<FakeValues> EvaluateAnalytically(const v1::Study& study, const std::vector<double>& x);
 
+// The oscillator study asking for simulator sensitivities.
+v1::Study OscillatorStudyWithSensitivities(const std::string& name = "oscillator");
+
+// What a worker would report as gradients for a task that wants them:
+// d(value)/d(x_scaled) of the closed-form outputs (d defl/dx = 2x,
+// d acc/dx = 1), through the layout's chain rule (spec/study_gradients.h),
+// row-major as in mbopt.v1.TaskResult.
+struct FakeGradients {
+  std::vector<double> objective_gradients;
+  std::vector<double> constraint_gradients;
+};
+absl::StatusOr<FakeGradients> GradientsAnalytically(const v1::Study& study, const std::vector<double>& x);
+
 }  // namespace mbopt::testing

@@ -87,6 +87,15 @@ TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
   a.ok = true;
   a.objective_terms = AwkwardDoubles();
   a.constraint_values = {std::sqrt(2.0), -1e-300};
+  // Gradients: 8 terms x 2 variables and 2 rows x 2 variables, row-major.
+  for (double v : AwkwardDoubles()) {
+    a.objective_gradients.push_back(v);
+    a.objective_gradients.push_back(-v / 3.0);
+  }
+  std::uint64_t nan_bits = 0x7ff8000000054321ULL;
+  double nan;
+  std::memcpy(&nan, &nan_bits, sizeof nan);
+  a.constraint_gradients = {nan, -0.0, std::nextafter(0.0, 1.0), 1.0 / 49.0};
   a.worker = "w-1";
   a.counters.time_steps = 1234;
   ASSERT_TRUE((*store)->AddAnalysis(a).ok());
@@ -97,8 +106,30 @@ TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
   EXPECT_TRUE(BitIdentical((*rows)[0].x_scaled, a.x_scaled));
   EXPECT_TRUE(BitIdentical((*rows)[0].objective_terms, a.objective_terms));
   EXPECT_TRUE(BitIdentical((*rows)[0].constraint_values, a.constraint_values));
+  EXPECT_TRUE(BitIdentical((*rows)[0].objective_gradients, a.objective_gradients));
+  EXPECT_TRUE(BitIdentical((*rows)[0].constraint_gradients, a.constraint_gradients));
   EXPECT_EQ((*rows)[0].counters.time_steps, 1234);
   EXPECT_EQ((*rows)[0].worker, "w-1");
+}
+
+TEST_F(StoreTest, AnalysisWithoutGradientsKeepsTheReason) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto job = (*store)->CreateJob(SampleJob());
+  ASSERT_TRUE(job.ok()) << job.status();
+  AnalysisRow a;
+  a.job_id = job->id;
+  a.request_id = 3;
+  a.ok = true;
+  a.objective_terms = {1.5};
+  a.gradients_unavailable = "design variable x3 sets an offset";
+  ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+  auto rows = (*store)->LoadAnalyses(job->id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 1u);
+  EXPECT_TRUE((*rows)[0].objective_gradients.empty());
+  EXPECT_TRUE((*rows)[0].constraint_gradients.empty());
+  EXPECT_EQ((*rows)[0].gradients_unavailable, a.gradients_unavailable);
 }
 
 TEST_F(StoreTest, SecondResultForTheSameRequestIsRefused) {
@@ -184,6 +215,79 @@ TEST_F(StoreTest, NewerSchemaVersionIsRefused) {
   EXPECT_EQ(store.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(store.status().message()), HasSubstr("newer"));
   EXPECT_THAT(std::string(store.status().message()), HasSubstr(path_));
+}
+
+std::int64_t SchemaVersionOf(const std::string& path) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) return -1;
+  sqlite3_stmt* stmt = nullptr;
+  std::int64_t version = -1;
+  if (sqlite3_prepare_v2(db, "SELECT max(version) FROM schema_version", -1, &stmt, nullptr) == SQLITE_OK &&
+      sqlite3_step(stmt) == SQLITE_ROW) {
+    version = sqlite3_column_int64(stmt, 0);
+  }
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  return version;
+}
+
+// A database written by the first release (schema version 1: analyses
+// without gradient columns) opens, is migrated to the current version, keeps
+// its analyses bit for bit (without gradients) and takes new ones with them.
+TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
+  std::string job_id;
+  AnalysisRow old_row;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto job = (*store)->CreateJob(SampleJob());
+    ASSERT_TRUE(job.ok());
+    job_id = job->id;
+    old_row.job_id = job_id;
+    old_row.request_id = 0;
+    old_row.ok = true;
+    old_row.x_scaled = {1.0 / 3.0};
+    old_row.objective_terms = AwkwardDoubles();
+    old_row.constraint_values = {-0.0};
+    ASSERT_TRUE((*store)->AddAnalysis(old_row).ok());
+  }
+  // Exactly the version 1 layout: the columns version 2 added are the last
+  // three of `analyses`.
+  RunSql(path_,
+         "ALTER TABLE analyses DROP COLUMN objective_gradients;"
+         "ALTER TABLE analyses DROP COLUMN constraint_gradients;"
+         "ALTER TABLE analyses DROP COLUMN gradients_unavailable;"
+         "UPDATE schema_version SET version = 1;");
+  ASSERT_EQ(SchemaVersionOf(path_), 1);
+
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto rows = (*store)->LoadAnalyses(job_id);
+    ASSERT_TRUE(rows.ok()) << rows.status();
+    ASSERT_EQ(rows->size(), 1u);
+    EXPECT_TRUE(BitIdentical((*rows)[0].objective_terms, old_row.objective_terms));
+    EXPECT_TRUE(BitIdentical((*rows)[0].constraint_values, old_row.constraint_values));
+    EXPECT_TRUE((*rows)[0].objective_gradients.empty());
+    EXPECT_TRUE((*rows)[0].constraint_gradients.empty());
+    EXPECT_EQ((*rows)[0].gradients_unavailable, "");
+    AnalysisRow with_gradients = old_row;
+    with_gradients.request_id = 1;
+    with_gradients.objective_gradients = {0.1, 0.2};
+    ASSERT_TRUE((*store)->AddAnalysis(with_gradients).ok());
+  }
+  EXPECT_EQ(SchemaVersionOf(path_), kSchemaVersion);
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto rows = (*store)->LoadAnalyses(job_id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 2u);
+  EXPECT_TRUE(BitIdentical((*rows)[1].objective_gradients, {0.1, 0.2}));
+}
+
+TEST_F(StoreTest, NewDatabaseHasTheCurrentSchemaVersion) {
+  { ASSERT_TRUE(Store::Open(path_).ok()); }
+  EXPECT_EQ(SchemaVersionOf(path_), kSchemaVersion);
 }
 
 TEST_F(StoreTest, GarbageFileIsRefusedWithClearError) {

@@ -5,6 +5,13 @@
 // way this can go wrong (the engine fails, a shape does not match, a value is
 // NaN or infinite) becomes a result with ok = false and a reason: the
 // optimizer decides what a failed analysis means.
+//
+// A task with want_gradients is analysed through the engine's sensitivity
+// entry point (worker/engine/study_sensitivities.h) and its result carries
+// the gradients of the values with respect to the scaled design variables,
+// row-major. When the engine has none for the study (e.g. a design variable
+// that sets an offset), or they are not finite, the result has the values
+// only and gradients_unavailable says why; that is not a failed analysis.
 #pragma once
 
 #include <memory>
