@@ -199,10 +199,11 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
   absl::StrAppendFormat(
       &out,
       "Study `%s`. Reference run (%s): F_ref = %.7g after %d analyses, %.2f s (%s); its design "
-      "re-checked: F = %.7g, max violation %.3g. F(x0) = %.6g on the re-check model.\n\n",
+      "re-checked: F = %.7g, max violation %.3g. F(x0) = %.6g on the re-check model (%s).\n\n",
       s.plan.study_file, s.reference.setting.value, s.reference.objective, s.reference.analyses,
       s.reference.wall_seconds, s.reference.end, s.reference.true_objective,
-      s.reference.true_max_violation, s.initial_objective);
+      s.reference.true_max_violation, s.initial_objective,
+      s.plan.recheck_note.empty() ? "the study's own model" : s.plan.recheck_note);
   if (!s.plan.initial_note.empty()) absl::StrAppend(&out, "Start: ", s.plan.initial_note, ".\n\n");
   absl::StrAppend(&out,
                   "| knob | value | F found | error vs F_ref | change vs default | F re-checked | "

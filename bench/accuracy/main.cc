@@ -47,7 +47,8 @@ For every setting:
   above the best known optimum on the vehicle).
 - **change vs default**: the same measure against the default run's F: the knob's own effect.
 - **F re-checked / true max violation**: the found design analysed once more on the fine
-  re-check model (1001 grid points where the grid matters, the reference's tolerance and mesh).
+  re-check model (a grid at least as fine as the reference's where the grid matters, the
+  reference's tolerance and mesh; named in each problem's first line).
   The violation is the largest normalized constraint value (g - c) / scale, > 0 violated: what
   the design really does between the grid points the optimizer saw.
 - **analyses, wall**: what the whole optimization cost (one core, analyses and LPs included).

@@ -34,9 +34,10 @@ struct SweepPlan {
   std::string study_file;  // relative to the repository root
   std::vector<Setting> settings;  // the default first
   Setting reference;       // finest grid, tightest tolerance, finest mesh
-  // The fine re-check of a found design: 1001 grid points (where the grid
-  // matters), the reference's tolerance and mesh.
+  // The fine re-check of a found design: a grid at least as fine as the
+  // reference's (where the grid matters), the reference's tolerance and mesh.
   v1::AnalysisOverrides recheck;
+  std::string recheck_note;  // what `recheck` is, for the page
   std::vector<std::string> not_swept;  // knobs that do not apply, with why
   // Scaled initial design replacing the study's (a warm start for a problem
   // too expensive to optimize from the study's start once per setting).

@@ -10,7 +10,10 @@ inline constexpr char kProtocol[] = R"(## Protocol
 - **Same problem for every method.** Each study file is loaded as the service loads it; every
   method analyses designs with the same engine call (`local_run::EvaluateDesign`) on the same
   scaled design variables and bounds, and sees the same constraint rows normalized as
-  (g - c) / scale <= 0 (METHOD.md's g/c - 1).
+  (g - c) / scale <= 0 (METHOD.md's g/c - 1). With `--scene-grid` (the command above) every
+  study runs on its scene's own time grid: the four-bars on the report's 101 instants, not the
+  1001 their study files use (MMA treats each of the 32 000 rows of the fine grid as its own
+  constraint and needs minutes per iteration there); docs/results.md has the 1001-point runs.
 - **mbopt SLP**: `local_run::RunStudyLocally` with the study's own optimizer settings (the
   defaults of METHOD.md section 3): adaptive move limits, forward differences, CLP for the LPs.
 - **NLopt SLSQP** (`NLOPT_LD_SLSQP`) and **NLopt MMA** (`NLOPT_LD_MMA`), NLopt 2.7 from Debian,

@@ -43,9 +43,23 @@ scene_dir=$(dirname "$study")
 status=0
 for n in "${grids[@]}"; do
   copy="$tmp/grid$n.study.textproto"
-  # The copy lives elsewhere: its scene_file must be absolute.
-  sed -E "s|^scene_file: \"([^/][^\"]*)\"|scene_file: \"$scene_dir/\\1\"|" "$study" > "$copy"
-  printf '\nanalysis { time_grid_points: %d }\n' "$n" >> "$copy"
+  # The copy lives elsewhere: its scene_file must be absolute. Its grid is
+  # N points: set in the study's one-line `analysis { ... }` block if it has
+  # one, else in a new block.
+  python3 -c '
+import re, sys
+study, scene_dir, n = sys.argv[1], sys.argv[2], sys.argv[3]
+text = open(study).read()
+text = re.sub(r"^scene_file: \"([^/][^\"]*)\"", lambda m: "scene_file: \"%s/%s\"" % (scene_dir, m.group(1)), text, flags=re.M)
+block = re.search(r"^analysis \{(.*)\}\s*$", text, flags=re.M)
+if block is None:
+    text += "\nanalysis { time_grid_points: %s }\n" % n
+else:
+    inner = re.sub(r"\s*time_grid_points:\s*\d+", "", block.group(1))
+    text = text[:block.start()] + "analysis { time_grid_points: %s%s}" % (n, inner.rstrip() + " ") + text[block.end():]
+    text += "\n"
+print(text, end="")
+' "$study" "$scene_dir" "$n" > "$copy"
   "$worker" eval "$copy" "${sets[@]}" --json > "$tmp/eval$n.json"
   python3 -c '
 import json, sys

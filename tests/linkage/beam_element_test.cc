@@ -1,5 +1,6 @@
 // Planar Euler-Bernoulli beam element: statics, natural frequencies against
-// the closed-form Euler-Bernoulli values, and energy of free vibration.
+// the closed-form Euler-Bernoulli values, buckling and beam-column bending
+// (geometric stiffness), and energy of free vibration.
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -14,7 +15,7 @@ namespace {
 
 // A straight beam along x of `n` equal elements, dofs (u, w, theta) per node.
 struct Beam {
-  Eigen::MatrixXd k, m;
+  Eigen::MatrixXd k, m, kg;  // kg: geometric stiffness of a unit tension
 };
 
 constexpr double kLength = 0.9144, kArea = 4e-4, kE = 6.895e10, kRho = 2757;
@@ -28,11 +29,13 @@ Beam Assemble(int n, double rotary_inertia = 0.0) {
   s.mass_per_length_kg_per_m = kRho * kArea;
   s.rotary_inertia_kg_m = rotary_inertia;
   const model::BeamMatrix ke = model::BeamStiffness(s), me = model::BeamConsistentMass(s);
+  const model::BeamMatrix kge = model::BeamGeometricStiffness(s.length_m, 1.0);
   const int nd = 3 * (n + 1);
-  Beam b{Eigen::MatrixXd::Zero(nd, nd), Eigen::MatrixXd::Zero(nd, nd)};
+  Beam b{Eigen::MatrixXd::Zero(nd, nd), Eigen::MatrixXd::Zero(nd, nd), Eigen::MatrixXd::Zero(nd, nd)};
   for (int e = 0; e < n; ++e) {
     b.k.block<6, 6>(3 * e, 3 * e) += ke;
     b.m.block<6, 6>(3 * e, 3 * e) += me;
+    b.kg.block<6, 6>(3 * e, 3 * e) += kge;
   }
   return b;
 }
@@ -113,6 +116,67 @@ TEST(BeamElement, CantileverFrequencyConvergesToEulerBernoulli) {
     previous_error = error;
   }
   EXPECT_LT(previous_error, 1e-5);
+}
+
+// Geometric stiffness, first check: K v = P Kg v gives the buckling loads.
+// Euler: P_cr = pi^2 EI / L^2 (pinned-pinned); Hermite elements with the
+// consistent geometric stiffness converge to it from above.
+TEST(BeamElement, BucklingLoadConvergesToEuler) {
+  const double euler = std::pow(std::numbers::pi / kLength, 2) * kE * kI;
+  double previous_error = 1.0;
+  for (int n : {1, 2, 4, 8}) {
+    const Beam b = Assemble(n);
+    // Bending dofs only (Kg is zero on the axial ones), both ends pinned.
+    std::vector<int> fixed = {1, 3 * n + 1};
+    for (int node = 0; node <= n; ++node) fixed.push_back(3 * node);
+    const std::vector<int> keep = Keep(n, fixed);
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Reduce(b.k, keep),
+                                                                  Reduce(b.kg, keep));
+    ASSERT_EQ(eig.info(), Eigen::Success);
+    const double error = (eig.eigenvalues()(0) - euler) / euler;
+    EXPECT_GT(error, -1e-12) << n;
+    EXPECT_LT(error, previous_error) << n;
+    previous_error = error;
+  }
+  EXPECT_LT(previous_error, 1e-4);  // 8 elements: 3.3e-5
+}
+
+// Second check: the P-delta effect on a pinned-pinned beam under a uniform
+// load q and an axial force P. Beam-column theory (Timoshenko & Gere,
+// Theory of Elastic Stability, 1.11) gives the mid-span deflection as the
+// linear one, 5 q L^4 / 384 EI, times 12 (2 sec v - 2 - v^2) / (5 v^4) in
+// compression and 12 (2 sech v - 2 + v^2) / (5 v^4) in tension, with
+// v = (L / 2) sqrt(|P| / EI).
+TEST(BeamElement, AxialForceScalesBendingAsBeamColumnTheory) {
+  const int n = 6;  // the four-bar's mesh
+  const double euler = std::pow(std::numbers::pi / kLength, 2) * kE * kI;
+  const double q = 100.0;  // N/m
+  const double h = kLength / n;
+  const Beam b = Assemble(n);
+  const std::vector<int> keep = Keep(n, {0, 1, 3 * n + 1});  // pinned; axial held at one end
+  Eigen::VectorXd f_full = Eigen::VectorXd::Zero(3 * (n + 1));
+  for (int e = 0; e < n; ++e) {  // consistent nodal loads of q
+    f_full(3 * e + 1) += q * h / 2;
+    f_full(3 * e + 2) += q * h * h / 12;
+    f_full(3 * e + 4) += q * h / 2;
+    f_full(3 * e + 5) -= q * h * h / 12;
+  }
+  Eigen::VectorXd f(static_cast<Eigen::Index>(keep.size()));
+  for (size_t i = 0; i < keep.size(); ++i) f(static_cast<Eigen::Index>(i)) = f_full(keep[i]);
+  const double linear = 5 * q * std::pow(kLength, 4) / (384 * kE * kI);
+  // Six elements resolve the amplified shape to ~1e-4 at 60 % of the
+  // buckling load (the cubic no longer interpolates the exact deflection).
+  constexpr double kMeshTolerance = 2e-4;
+  for (double ratio : {-0.6, -0.3, -0.05, 0.05, 0.3, 1.0, 3.0}) {  // P / P_cr, tension > 0
+    const double p = ratio * euler;
+    const double v = 0.5 * kLength * std::sqrt(std::abs(p) / (kE * kI));
+    const double factor = p < 0 ? 12 * (2 / std::cos(v) - 2 - v * v) / (5 * std::pow(v, 4))
+                                : 12 * (2 / std::cosh(v) - 2 + v * v) / (5 * std::pow(v, 4));
+    const Eigen::VectorXd u = Reduce(b.k + p * b.kg, keep).lu().solve(f);
+    // keep drops dofs 0 and 1, so the middle node's w is at 3 (n / 2) + 1 - 2.
+    const double mid = u(3 * (n / 2) - 1);
+    EXPECT_NEAR(mid / linear, factor, kMeshTolerance * factor) << "P / P_cr = " << ratio;
+  }
 }
 
 // Undamped free vibration of a pinned-pinned beam from a bent shape:

@@ -21,6 +21,8 @@ const std::vector<double> kReportOptimum = {9.65e-4, 3.92e-4, 2.69e-4};
 // With E x 100 the lowest link frequency is 10x higher (about 3300 rad/s
 // against a crank speed of 31.4 rad/s): the dynamic amplification
 // (omega / omega_1)^2 and the neglected second-order frame terms are ~1e-4,
+// the axial force's P-delta moment N / P_euler ~1e-3 at most (the coupler
+// reaches 10 % of its buckling load in tension at E),
 // the start-up transient (5 % damping) has decayed to ~e^-50 by t = 0.3 s.
 // The integrator tolerance (1e-6) and the moment recovery add less. So
 // every nodal stress must agree with the rigid one to 0.2 % of the link's
@@ -66,6 +68,32 @@ TEST(ElasticFourBar, StiffLinksApproachKinetostaticStresses) {
   }
 }
 
+// Published: at the report's optimum all three links are at the allowable
+// stress in its elastic model (section 4.3; benchmarks/fourbar_stress.md).
+// Ours, with the benchmark's model (6 elements, rotary inertia, 5 %
+// damping): 0.968 / 0.963 / 1.029 of the allowable. The report's own code is
+// not available; its model differs from ours in details the report does not
+// give (mass matrix, damping, how the axial force enters), so the check is
+// 5 %. Without the axial force's geometric stiffness the coupler was 6 %
+// over (1.061), which this test would catch.
+constexpr double kReportAgreement = 0.05;
+
+TEST(ElasticFourBar, ReportOptimumHasEveryLinkNearTheAllowableStress) {
+  FourBarOptions report;
+  report.elements = 6;
+  report.rotary_inertia = true;
+  report.damping = true;
+  const engine::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(report), kReportOptimum);
+  ASSERT_EQ(elastic.status, engine::AnalysisStatus::kOk) << elastic.failure_reason;
+  for (size_t link = 0; link < 3; ++link) {
+    double peak = 0.0;
+    for (const auto& node : elastic.outputs[link].series) {
+      for (double v : node) peak = std::max(peak, std::abs(v));
+    }
+    EXPECT_NEAR(peak / linkage_testing::kFourBarAllowablePa, 1.0, kReportAgreement) << "link " << link;
+  }
+}
+
 // Same inputs, same outputs to the last bit: the Newton solver keeps no
 // state that could leak from one analysis into the next.
 TEST(ElasticFourBar, RepeatedAnalysesAreBitIdentical) {
@@ -103,6 +131,22 @@ TEST(ElasticFourBar, IntegratorGivingUpIsAFailedAnalysisNamingTheTime) {
   const engine::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
   ASSERT_EQ(r.status, engine::AnalysisStatus::kFailed);
   EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("elastodynamic integration failed before t = 0.3 s"));
+  EXPECT_TRUE(r.outputs.empty());
+}
+
+// A coupler of 0.2 cm^2 (8 % of the report's) is compressed past its Euler
+// load by the mechanism's own inertia within 3 ms: with the geometric
+// stiffness the linear response then grows without bound, which must end as
+// a failed analysis that names the link, not as NaN stresses.
+TEST(ElasticFourBar, LinkBucklingIsAFailedAnalysisNamingTheLink) {
+  FourBarOptions o;
+  o.elements = 6;
+  o.rotary_inertia = true;
+  o.damping = true;
+  const engine::AnalysisReport r = solve::AnalyzeLinkage(FourBarScene(o), {1e-4, 2e-5, 2e-5});
+  ASSERT_EQ(r.status, engine::AnalysisStatus::kFailed);
+  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("link 'coupler'"));
+  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("Euler buckling load"));
   EXPECT_TRUE(r.outputs.empty());
 }
 

@@ -48,4 +48,17 @@ BeamMatrix BeamConsistentMass(const BeamSection& s) {
   return m;
 }
 
+BeamMatrix BeamGeometricStiffness(double length_m, double axial_force_n) {
+  const double h = length_m;
+  const double g = axial_force_n / (30.0 * h);
+  const double b[4][4] = {{36 * g, 3 * h * g, -36 * g, 3 * h * g},
+                          {3 * h * g, 4 * h * h * g, -3 * h * g, -h * h * g},
+                          {-36 * g, -3 * h * g, 36 * g, -3 * h * g},
+                          {3 * h * g, -h * h * g, -3 * h * g, 4 * h * h * g}};
+  BeamMatrix k = BeamMatrix::Zero();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) k(kBend[i], kBend[j]) = b[i][j];
+  return k;
+}
+
 }  // namespace mbopt::model

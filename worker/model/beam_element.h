@@ -24,5 +24,10 @@ BeamMatrix BeamStiffness(const BeamSection& s);
 // Consistent mass: linear shape functions for u, Hermite for w, plus the
 // rotary inertia of the section when rotary_inertia_kg_m > 0.
 BeamMatrix BeamConsistentMass(const BeamSection& s);
+// Geometric stiffness of an axial force (N, tension > 0) acting on the
+// bending dofs: the consistent matrix of (N/2) integral w'^2 with the Hermite
+// shape functions. Tension stiffens the element, compression softens it (the
+// P-delta moment N w); axial dofs are untouched.
+BeamMatrix BeamGeometricStiffness(double length_m, double axial_force_n);
 
 }  // namespace mbopt::model

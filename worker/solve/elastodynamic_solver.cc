@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "absl/strings/str_format.h"
@@ -13,6 +14,7 @@ namespace {
 
 using model::BeamMatrix;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+constexpr double kPi = std::numbers::pi;
 
 struct NodeDofs {
   int dof[3] = {-1, -1, -1};  // global x, global y, rotation; -1: fixed
@@ -23,6 +25,8 @@ struct LinkMesh {
   int elements = 0;
   double element_length_m = 0.0;
   BeamMatrix k, m;           // local element matrices
+  double axial_stiffness_n = 0.0;  // E A
+  double bending_stiffness_n_m2 = 0.0;  // E I
   double beta_s = 0.0;       // stiffness-proportional damping coefficient
   std::vector<NodeDofs> nodes;
   int clamped_node = -1;     // node whose rotation is the driver's
@@ -91,6 +95,8 @@ class ElasticLinkage {
       sec.mass_per_length_kg_per_m = l.mass_per_length_kg_per_m();
       sec.rotary_inertia_kg_m = l.rotary_inertia ? l.density_kg_per_m3 * l.second_moment_m4() : 0.0;
       mesh.k = model::BeamStiffness(sec);
+      mesh.axial_stiffness_n = sec.axial_stiffness_n;
+      mesh.bending_stiffness_n_m2 = sec.bending_stiffness_n_m2;
       mesh.m = model::BeamConsistentMass(sec);
       mesh.nodes.resize(static_cast<size_t>(mesh.elements + 1));
       const bool driven = static_cast<int>(i) == sys_.driver.link;
@@ -143,7 +149,10 @@ class ElasticLinkage {
   int num_dofs() const { return n_; }
   double lowest_frequency() const { return lowest_frequency_; }
   const LinkageState& rigid_state() const { return state_; }
-  const std::string& failure() const { return failure_; }
+  // Why the integration could not go on, if the model knows: a failed
+  // rigid motion, a singular mass matrix, or an elastic response that blew
+  // up (a link in compression beyond its buckling load).
+  std::string failure() const { return failure_.empty() ? divergence_ : failure_; }
 
   // Rigid motion and the assembled M, K, C, load at t (cached per t).
   bool Prepare(double t) {
@@ -207,15 +216,25 @@ class ElasticLinkage {
     Eigen::Map<const Eigen::VectorXd> u(y, n_), v(y + n_, n_);
     Eigen::Map<Eigen::VectorXd> du(ydot, n_), dv(ydot + n_, n_);
     du = v;
-    dv = lu_.solve(f_ - k_ * u - c_ * v);
-    return dv.allFinite() ? 0 : 1;
+    AddGeometricForces(u, &geometric_force_);
+    dv = lu_.solve(f_ - k_ * u - c_ * v - geometric_force_);
+    if (dv.allFinite()) {
+      divergence_.clear();
+      if (buckled_link_ < 0 && largest_compression_ratio_ > 1.0) {
+        buckled_link_ = most_compressed_link_;
+        buckled_t_ = t;
+      }
+      return 0;
+    }
+    divergence_ = DivergenceReason(t);
+    return 1;
   }
 
   // Solves (I - gamma J) x = b in place for y = (u, v), J = [0 I; -M^-1 K
   // -M^-1 C]: eliminating x_u = b_u + gamma x_v leaves the symmetric
   // positive definite (M + gamma C + gamma^2 K) x_v = M b_v - gamma K b_u,
-  // n x n instead of 2n x 2n and exact at the step's own t (the equations
-  // are linear in y, so Newton converges in one iteration).
+  // n x n instead of 2n x 2n and exact at the step's own t but for the
+  // geometric stiffness, which it leaves out (see AddGeometricForces).
   int NewtonSolve(double t, double gamma, double* bx, bool* refactored) {
     if (!Prepare(t)) return -1;
     if (!(factored_ && t == factored_t_ && gamma == factored_gamma_)) {
@@ -269,8 +288,9 @@ class ElasticLinkage {
         const BeamMatrix t6 = Transform(angle, e == 0, e + 1 == mesh.elements);
         const Vector6d rigid =
             ToLinkFrame(angle, RigidAcceleration(mesh, e, aa, ab, alpha) - GravityVector(g));
-        const Vector6d end = mesh.k * (t6 * d) + mesh.beta_s * (mesh.k * (t6 * dd)) +
-                             mesh.m * (t6 * acc + rigid);
+        const Vector6d local = t6 * d;
+        const Vector6d end = mesh.k * local + GeometricStiffness(mesh, local) * local +
+                             mesh.beta_s * (mesh.k * (t6 * dd)) + mesh.m * (t6 * acc + rigid);
         // The moment a node passes on: minus the left end moment of the
         // element to its right, the right end moment of the element to its left.
         out[static_cast<size_t>(e)] += -end(2);
@@ -286,6 +306,60 @@ class ElasticLinkage {
   }
 
  private:
+  // The element's geometric stiffness at its current axial force, the force
+  // of its own axial strain (tension > 0).
+  static BeamMatrix GeometricStiffness(const LinkMesh& mesh, const Vector6d& local) {
+    const double axial_force_n =
+        mesh.axial_stiffness_n * (local(3) - local(0)) / mesh.element_length_m;
+    return model::BeamGeometricStiffness(mesh.element_length_m, axial_force_n);
+  }
+
+  // Names the first link whose compression passed its Euler load (ends
+  // pinned): past that load the linear elastic response grows without bound.
+  std::string DivergenceReason(double t) const {
+    if (buckled_link_ < 0) return absl::StrFormat("elastic response diverged at t = %.6g s", t);
+    return absl::StrFormat(
+        "elastic response diverged at t = %.6g s after %s passed its Euler buckling load (ends "
+        "pinned) in compression at t = %.6g s: the link is too slender for the mechanism's inertia "
+        "loads",
+        t, sys_.LinkLabel(buckled_link_), buckled_t_);
+  }
+
+  // Internal forces of the axial force acting on the bending deflection (the
+  // P-delta effect), assembled in the unknowns. Second order in u, but of
+  // relative size N / P_euler, which is first order in the loads: a coupler in
+  // compression at a few per cent of its buckling load bends a few per cent
+  // more than a linear model says. Not in the Newton matrix: the few-per-cent
+  // difference only costs CVODES an extra Newton iteration now and then.
+  void AddGeometricForces(const Eigen::Ref<const Eigen::VectorXd>& u, Eigen::VectorXd* force) {
+    force->setZero(n_);
+    most_compressed_link_ = -1;
+    largest_compression_ratio_ = 0.0;
+    for (const LinkMesh& mesh : meshes_) {
+      const double angle = state_.LinkAngle(sys_.links[static_cast<size_t>(mesh.link)]);
+      const double length_m = mesh.element_length_m * mesh.elements;
+      const double euler_n = kPi * kPi * mesh.bending_stiffness_n_m2 / (length_m * length_m);
+      for (int e = 0; e < mesh.elements; ++e) {
+        int dofs[6];
+        ElementDofs(mesh, e, dofs);
+        Vector6d d;
+        for (int r = 0; r < 6; ++r) d(r) = dofs[r] < 0 ? 0.0 : u(dofs[r]);
+        const BeamMatrix t6 = Transform(angle, e == 0, e + 1 == mesh.elements);
+        const Vector6d local = t6 * d;
+        const double compression_n =
+            -mesh.axial_stiffness_n * (local(3) - local(0)) / mesh.element_length_m;
+        if (std::isfinite(compression_n) && compression_n / euler_n > largest_compression_ratio_) {
+          largest_compression_ratio_ = compression_n / euler_n;
+          most_compressed_link_ = mesh.link;
+        }
+        const Vector6d f = t6.transpose() * (GeometricStiffness(mesh, local) * local);
+        for (int r = 0; r < 6; ++r) {
+          if (dofs[r] >= 0) (*force)(dofs[r]) += f(r);
+        }
+      }
+    }
+  }
+
   static Vector6d GravityVector(const Eigen::Vector2d& g) {
     Vector6d v;
     v << g.x(), g.y(), 0.0, g.x(), g.y(), 0.0;
@@ -365,6 +439,7 @@ class ElasticLinkage {
   Eigen::MatrixXd newton_matrix_;    // M + gamma C + gamma^2 K
   Eigen::LLT<Eigen::MatrixXd> newton_;
   Eigen::VectorXd newton_rhs_;
+  Eigen::VectorXd geometric_force_;
   bool factored_ = false;
   double factored_t_ = 0.0, factored_gamma_ = 0.0;
   Eigen::MatrixXd m_inner_, k_inner_, c_inner_;
@@ -372,6 +447,11 @@ class ElasticLinkage {
   bool prepared_ = false;
   double prepared_t_ = 0.0;
   std::string failure_;
+  std::string divergence_;           // set while the right-hand side is not finite
+  int most_compressed_link_ = -1;    // of the last right-hand side, -1: none in compression
+  double largest_compression_ratio_ = 0.0;  // its compression / Euler load
+  int buckled_link_ = -1;  // the first link compressed beyond its Euler load, -1: none
+  double buckled_t_ = 0.0;
 };
 
 }  // namespace

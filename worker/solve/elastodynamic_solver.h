@@ -8,10 +8,12 @@
 // rotations; ground joints have none; the driven link's root rotation is
 // clamped to the driver. Each element's matrices follow its link's rigid
 // orientation, so M(t) and K(t) change with the motion:
-//   M(t) u'' + C(t) u' + K(t) u = M(t) (g - a_rigid(t)),   C = sum_i beta_i K_i,
-// beta_i = 2 zeta / omega_i (omega_i: lowest bending frequency of link i with
-// its ends pinned, the driven root clamped), only if the scene declares
-// structural damping. Terms of second order in the frame rotation (Coriolis,
+//   M(t) u'' + C(t) u' + (K(t) + K_G(u, t)) u = M(t) (g - a_rigid(t)),
+// K_G: geometric stiffness of each element's own axial force (the P-delta
+// effect, first order in N / P_euler); C = beta K, beta = 2 zeta / omega_1
+// (omega_1: the lowest bending frequency over the links, each with its ends
+// pinned, the driven root clamped), only if the scene declares structural
+// damping. Terms of second order in the frame rotation (Coriolis,
 // centrifugal softening of the elastic displacements) are neglected; their
 // relative size is (crank speed / lowest link frequency)^2.
 // Integrated with CVODES BDF from the undeformed state (elastic velocities
@@ -21,7 +23,7 @@
 // matrices rotate with the links, so a reused Jacobian would not converge).
 //
 // Bending moments at the nodes are recovered from the element end forces
-// (K d + C d' + M (a - g) in the element frame, the moment EI w'' a node
+// ((K + K_G) d + C d' + M (a - g) in the element frame, the moment a node
 // transmits), averaged between the two elements that meet at an inner node.
 #pragma once
 
