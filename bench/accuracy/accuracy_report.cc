@@ -181,6 +181,7 @@ std::vector<PlotPoint> PlotPoints(const ProblemSweep& sweep, const Acceptance& a
     if (r.setting.knob == "time grid points") p.label = absl::StrCat(r.setting.value, " pts");
     if (r.setting.knob == "elements per link") p.label = absl::StrCat(r.setting.value, " elem");
     if (r.setting.knob == "link model") p.label = "rigid links";
+    if (r.setting.knob == "sensitivity") p.label = "simulator sens.";
     p.wall_seconds = r.wall_seconds;
     p.error = ObjectiveError(sweep, r.objective);
     p.is_default = r.setting.knob == "default";

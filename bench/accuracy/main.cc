@@ -35,7 +35,8 @@ const char kIntro[] = R"(Each problem's study is optimized to its end in this pr
 analysis engine: `local_run::RunStudyLocally`) once per setting, varying **one knob at a time**
 around the study's own settings ("default"): the time grid, the integrator's relative tolerance
 (the absolute tolerance follows at 1e-3 times it), the elements per flexible link, rigid links
-instead of elastic ones, and the finite-difference scheme and relative step of the optimizer.
+instead of elastic ones, the finite-difference scheme and relative step of the optimizer, and
+(where the scene has them) gradients from the simulator's sensitivity equations instead.
 For every setting:
 
 - **F found**: the objective at the design the run ended with, as that run computed it.
@@ -58,14 +59,12 @@ front (no other setting is both faster and more accurate); hollow red points are
 re-check violates a constraint by more than 0.5 %; the square is the study's default.
 )";
 
-const char kNotMeasured[] = R"(## Not yet measured
+const char kNotMeasured[] = R"md(## Not yet measured
 
-- **Simulator sensitivities.** This sweep uses none: every gradient in it is a finite difference
-  (the optimizer asks for perturbed analyses), so the finite-difference rows measure the option
-  the local run has. Design sensitivities from the simulator (CVODES forward sensitivities,
-  analytic kinetostatic derivatives) would cut a cycle from 1 + n analyses to about one
-  analysis with sensitivity equations and remove the step-size question; their accuracy and
-  cost are not measured here.
+- **Simulator sensitivities on the linkages.** The "sensitivity: simulator (CVODES)" row is the
+  vehicle's (a lumped scene, CVODES forward sensitivities inside each analysis: one analysis per
+  cycle instead of 1 + n). The linkage scenes (four-bars, landing gear) have no simulator
+  sensitivities yet, so their gradients are finite differences only.
 - **Knob interactions.** Knobs are varied one at a time; only the recommended combination per
   problem (and, when it fails, its model knobs alone) is run to check it. Other combinations are
   not measured.
@@ -73,7 +72,7 @@ const char kNotMeasured[] = R"(## Not yet measured
   three for runs under 2 s); differences below about 20 % are not significant.
 - **Integrator choice and order limits**, the LP solver's tolerances and the move-limit
   thresholds of METHOD.md section 3 are not part of this sweep.
-)";
+)md";
 
 struct Args {
   std::vector<std::string> problems;

@@ -48,6 +48,14 @@ Setting Step(double h) {
   return s;
 }
 
+// Gradients from CVODES forward sensitivities inside each analysis instead
+// of perturbed analyses (lumped scenes only).
+Setting Simulator() {
+  Setting s{KnobKind::kSolver, "sensitivity", "simulator (CVODES)", {}, {}};
+  s.optimizer.set_sensitivity(v1::SENSITIVITY_METHOD_SIMULATOR);
+  return s;
+}
+
 void AddFiniteDifferenceKnobs(SweepPlan* p, const std::vector<double>& steps) {
   p->settings.push_back(Central());
   for (const double h : steps) p->settings.push_back(Step(h));
@@ -80,6 +88,7 @@ bool MakeSweepPlan(const std::string& problem, SweepPlan* p) {
     for (const int n : {26, 51, 201, 401, 1001}) p->settings.push_back(Grid(n));
     for (const double r : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-9, 1e-10}) p->settings.push_back(Tolerance(r));
     AddFiniteDifferenceKnobs(p, steps);
+    p->settings.push_back(Simulator());
     p->reference = Setting{KnobKind::kDefault, "reference", "1001 points, rtol 1e-10", Overrides(1001, 1e-10, 0), {}};
     p->recheck = Overrides(1001, 1e-10, 0);
     p->recheck_note = "1001 points, rtol 1e-10";
