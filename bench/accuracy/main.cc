@@ -56,7 +56,8 @@ For every setting:
 
 The plots put wall time against the objective error (log-log); the dashed staircase is the Pareto
 front (no other setting is both faster and more accurate); hollow red points are designs whose
-re-check violates a constraint by more than 0.5 %; the square is the study's default.
+re-check violates a constraint by more than 0.5 %; the square is the study's default. Where
+labels would overlap, the later ones (off the front) are left out; the tables name every point.
 )";
 
 const char kNotMeasured[] = R"md(## Not yet measured

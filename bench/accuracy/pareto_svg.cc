@@ -24,6 +24,16 @@ std::string Escape(const std::string& s) {
   return out;
 }
 
+// Text extent at font-size 10 in the generic sans-serif font, generous.
+constexpr double kLabelCharWidth = 6.0, kLabelHeight = 10.0;
+
+struct LabelBox {
+  double left = 0, top = 0, right = 0, bottom = 0;
+  bool Overlaps(const LabelBox& o) const {
+    return left < o.right && o.left < right && top < o.bottom && o.top < bottom;
+  }
+};
+
 struct LogAxis {
   double lo_decade = 0, hi_decade = 1;  // log10 range, whole decades
   double Fraction(double v) const { return (std::log10(v) - lo_decade) / (hi_decade - lo_decade); }
@@ -135,8 +145,33 @@ std::string ParetoSvg(const std::string& title, const std::vector<PlotPoint>& po
       absl::StrAppendFormat(&s, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4.5\" fill=\"%s\" stroke=\"%s\" stroke-width=\"1.5\"/>\n",
                             x, y, fill, stroke);
     }
-    absl::StrAppendFormat(&s, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" fill=\"#333\">%s</text>\n",
-                          x + 7, y - 5, Escape(p.label));
+  }
+  // Labels after the markers, the front, the default and violated points
+  // first; a label that would overlap one already placed (settings with the
+  // same error and similar times crowd into a row) tries the other corners
+  // of its point and is left out if none is free: the table lists them all.
+  std::vector<size_t> order(points.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    auto rank = [&](size_t i) { return on_front[i] || points[i].is_default || points[i].violated ? 0 : 1; };
+    return rank(a) < rank(b);
+  });
+  std::vector<LabelBox> placed;
+  for (const size_t i : order) {
+    const PlotPoint& p = points[i];
+    const double x = X(p.wall_seconds), y = Y(p.error);
+    const double w = kLabelCharWidth * static_cast<double>(p.label.size());
+    // Baseline positions: right above, right below, left above, left below.
+    const double corners[4][3] = {{x + 7, y - 5, 0}, {x + 7, y + 13, 0}, {x - 7 - w, y - 5, 1}, {x - 7 - w, y + 13, 1}};
+    for (const auto& c : corners) {
+      const LabelBox box{c[0], c[1] - kLabelHeight, c[0] + w, c[1] + 2};
+      if (box.left < kLeft || box.right > kLeft + pw || box.top < kTop) continue;
+      if (std::any_of(placed.begin(), placed.end(), [&](const LabelBox& o) { return box.Overlaps(o); })) continue;
+      placed.push_back(box);
+      absl::StrAppendFormat(&s, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" fill=\"#333\">%s</text>\n",
+                            c[0], c[1], Escape(p.label));
+      break;
+    }
   }
   // Legend.
   const double lx = kLeft + pw + 16;
