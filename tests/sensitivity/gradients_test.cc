@@ -25,8 +25,10 @@ constexpr char kFourbarStudy[] = "examples/fourbar/fourbar_rigid.study.textproto
 constexpr double kRelativeStep = 1e-5;
 constexpr double kTightRelativeTolerance = 1e-11;
 constexpr double kTightAbsoluteTolerance = 1e-14;
-// Agreement, relative to the largest |derivative| of the same column.
-constexpr double kAgreement = 1e-4;
+// Agreement, relative to the largest |derivative| of the same column:
+// measured 1.9e-7, with CVODES' sensitivity module and with the augmented
+// system alike; this leaves a factor of 5 for other platforms.
+constexpr double kAgreement = 1e-6;
 
 spec::Study TightVehicle() {
   absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kVehicleStudy);

@@ -10,6 +10,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "worker/solve/cvodes_integrator.h"
+#include "worker/solve/integrate_across_kinks.h"
+#include "worker/solve/lumped_newton_operator.h"
 
 namespace mbopt::solve {
 namespace {
@@ -53,36 +55,10 @@ std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<doubl
     vdot.noalias() -= minv_kc * state;
     return 0;
   };
-  // Newton systems (I - gamma J) x = b through the second-order structure:
-  // x_v = (M + gamma C + gamma^2 K)^-1 (M b_v - gamma K b_u), x_u = b_u +
-  // gamma x_v. The n x n matrix is exact for the constant J and changes only
-  // when CVODES sets up for a new gamma; it is small, so its action on
-  // (b_u, b_v) is kept as one n x 2n matrix and each solve is one product.
-  Eigen::MatrixXd newton_matrix(n, n), newton_operator(n, 2 * n), newton_rhs_map(n, 2 * n);
-  Eigen::PartialPivLU<Eigen::MatrixXd> newton_lu(n);
-  Eigen::VectorXd newton_v(n);
-  double factored_gamma = 0.0;
-  bool factored = false;
+  LumpedNewtonOperator newton(m);
   auto newton_solve = [&](double, double gamma, double* bx, bool* refactored) -> int {
-    if (!factored || gamma != factored_gamma) {
-      newton_matrix = m.damping();
-      newton_matrix *= gamma;
-      newton_matrix.noalias() += (gamma * gamma) * m.stiffness();
-      newton_matrix.diagonal() += m.mass_diagonal();
-      newton_lu.compute(newton_matrix);
-      newton_rhs_map.leftCols(n) = -gamma * m.stiffness();
-      newton_rhs_map.rightCols(n).setZero();
-      newton_rhs_map.rightCols(n).diagonal() = m.mass_diagonal();
-      newton_operator = newton_lu.solve(newton_rhs_map);
-      factored = true;
-      factored_gamma = gamma;
-      *refactored = true;
-    }
-    Eigen::Map<Eigen::VectorXd> b(bx, 2 * n), bu(bx, n), bv(bx + n, n);
-    newton_v.noalias() = newton_operator * b;
-    bv = newton_v;
-    bu += gamma * newton_v;
-    return newton_v.allFinite() ? 0 : 1;
+    if (newton.Prepare(gamma)) *refactored = true;
+    return newton.Solve(bx) ? 0 : 1;
   };
 
   CvodesOptions cv;
@@ -116,29 +92,10 @@ std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<doubl
   if (!created.ok()) return absl::StrCat("integrator setup: ", created.status().message());
   CvodesIntegrator& integrator = **created;
 
-  std::string failure;
-  auto check = [&](const absl::Status& status) {
-    if (!status.ok() && failure.empty()) failure = std::string(status.message());
-    return status.ok();
-  };
   const double t_last = instants_s.empty() ? 0.0 : instants_s.back();
-  const std::vector<double> kinks = m.KinkTimes(0.0, t_last);
-  size_t next_kink = 0;
-  if (next_kink < kinks.size()) check(integrator.SetStopTime(kinks[next_kink]));
-  Eigen::VectorXd q(n), v(n);
-  for (size_t i = 0; failure.empty() && i < instants_s.size(); ++i) {
-    const double t = instants_s[i];
-    // Cross every kink up to t with a stop and a fresh start.
-    while (failure.empty() && next_kink < kinks.size() && kinks[next_kink] <= t) {
-      const double kink = kinks[next_kink++];
-      if (!check(integrator.IntegrateTo(kink, &y)) || !check(integrator.Restart(kink, y))) break;
-      if (next_kink < kinks.size()) check(integrator.SetStopTime(kinks[next_kink]));
-    }
-    if (!failure.empty() || !check(integrator.IntegrateTo(t, &y))) break;
-    q = y.head(n);
-    v = y.tail(n);
-    failure = at_instant(t, q, v);
-  }
+  const std::string failure = IntegrateAcrossKinks(
+      integrator, m.KinkTimes(0.0, t_last), instants_s, &y,
+      [&](double t, const Eigen::VectorXd& state) { return at_instant(t, state.head(n), state.tail(n)); });
   const CvodesCounters c = integrator.counters();
   counters->time_steps = c.steps;
   counters->rhs_evaluations = c.rhs_evaluations;

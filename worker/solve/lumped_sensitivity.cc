@@ -11,11 +11,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <variant>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "worker/model/lumped_model.h"
+#include "worker/solve/cvodes_integrator.h"
+#include "worker/solve/integrate_across_kinks.h"
+#include "worker/solve/lumped_newton_operator.h"
 
 namespace mbopt::solve {
 namespace {
@@ -39,38 +43,56 @@ struct SensitivityProblem {
   Eigen::MatrixXd minv_k, minv_c;
   std::vector<ParameterDerivative> derivatives;
   Eigen::VectorXd force, rhs;  // scratch
-  Eigen::VectorXd s, sv, a;    // scratch of the sensitivity right-hand side
   Eigen::VectorXd zero;        // q = 0, for the ground-input part of a deflection
+  // Ground-input part of each element's deflection and its rate at
+  // `inputs_time`: every parameter's df/dp is built from these, so one
+  // sensitivity right-hand side evaluates the inputs once, not once per
+  // parameter.
+  std::vector<double> input_deflection, input_rate;
+  double inputs_time = std::numeric_limits<double>::quiet_NaN();
   std::string sundials_message;
   // IntegratorSettings::max_wall_seconds (<= 0: none), checked in Rhs.
   double max_wall_seconds = 0;
   std::chrono::steady_clock::time_point start;
   bool wall_time_exceeded = false;
 
-  // d f / dp_k at t.
-  void ForcingDerivative(int k, double t, Eigen::VectorXd* out) const {
+  void EvaluateInputs(double t) {
+    if (t == inputs_time) return;
+    for (size_t e = 0; e < model->elements().size(); ++e) {
+      input_deflection[e] = model->Deflection(static_cast<int>(e), zero, t);
+      input_rate[e] = model->DeflectionRate(static_cast<int>(e), zero, t);
+    }
+    inputs_time = t;
+  }
+  // d f / dp_k at the time of the last EvaluateInputs.
+  void ForcingDerivative(int k, Eigen::VectorXd* out) const {
     out->setZero(n);
     const ParameterDerivative& d = derivatives[static_cast<size_t>(k)];
     for (int e : d.stiffness_elements) {
-      *out -= model->elements()[static_cast<size_t>(e)].gradient * model->Deflection(e, zero, t);
+      *out -= model->elements()[static_cast<size_t>(e)].gradient *
+              input_deflection[static_cast<size_t>(e)];
     }
     for (int e : d.damping_elements) {
       *out -= model->elements()[static_cast<size_t>(e)].gradient *
-              model->DeflectionRate(e, zero, t);
+              input_rate[static_cast<size_t>(e)];
     }
   }
   // d q'' / dp_k from the differentiated equations of motion.
-  void AccelerationDerivative(int k, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
-                              const Eigen::VectorXd& qddot, const Eigen::VectorXd& s,
-                              const Eigen::VectorXd& sv, Eigen::VectorXd* out) {
+  template <typename Out>
+  void AccelerationDerivative(int k, double t, const Eigen::Ref<const Eigen::VectorXd>& q,
+                              const Eigen::Ref<const Eigen::VectorXd>& v,
+                              const Eigen::Ref<const Eigen::VectorXd>& qddot,
+                              const Eigen::Ref<const Eigen::VectorXd>& s,
+                              const Eigen::Ref<const Eigen::VectorXd>& sv, Out&& out) {
     const ParameterDerivative& d = derivatives[static_cast<size_t>(k)];
-    ForcingDerivative(k, t, &rhs);
+    EvaluateInputs(t);
+    ForcingDerivative(k, &rhs);
     rhs -= d.mass_diagonal.cwiseProduct(qddot);
     rhs.noalias() -= d.damping * v;
     rhs.noalias() -= d.stiffness * q;
-    *out = inverse_mass.cwiseProduct(rhs);
-    out->noalias() -= minv_k * s;
-    out->noalias() -= minv_c * sv;
+    out = inverse_mass.cwiseProduct(rhs);
+    out.noalias() -= minv_k * s;
+    out.noalias() -= minv_c * sv;
   }
 };
 
@@ -100,19 +122,32 @@ int SensitivityRhs(int num_sensitivities, realtype t, N_Vector y, N_Vector ydot,
   const int n = p->n;
   const Eigen::Map<const Eigen::VectorXd> q(N_VGetArrayPointer(y), n),
       v(N_VGetArrayPointer(y) + n, n), qddot(N_VGetArrayPointer(ydot) + n, n);
-  Eigen::VectorXd& s = p->s;
-  Eigen::VectorXd& sv = p->sv;
-  Eigen::VectorXd& a = p->a;
   for (int k = 0; k < num_sensitivities; ++k) {
-    s = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(ys[k]), n);
-    sv = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(ys[k]) + n, n);
-    p->AccelerationDerivative(k, t, q, v, qddot, s, sv, &a);
+    const double* in = N_VGetArrayPointer(ys[k]);
     double* out = N_VGetArrayPointer(ysdot[k]);
+    const Eigen::Map<const Eigen::VectorXd> s(in, n), sv(in + n, n);
+    Eigen::Map<Eigen::VectorXd> a(out + n, n);
+    p->AccelerationDerivative(k, t, q, v, qddot, s, sv, a);
     Eigen::Map<Eigen::VectorXd>(out, n) = sv;
-    Eigen::Map<Eigen::VectorXd>(out + n, n) = a;
     if (!a.allFinite()) return -1;
   }
   return 0;
+}
+
+// CV_STAGGERED1's form: one sensitivity per call.
+int SensitivityRhs1(int, realtype t, N_Vector y, N_Vector ydot, int k, N_Vector ys,
+                    N_Vector ysdot, void* user_data, N_Vector, N_Vector) {
+  auto* p = static_cast<SensitivityProblem*>(user_data);
+  const int n = p->n;
+  const Eigen::Map<const Eigen::VectorXd> q(N_VGetArrayPointer(y), n),
+      v(N_VGetArrayPointer(y) + n, n), qddot(N_VGetArrayPointer(ydot) + n, n);
+  const double* in = N_VGetArrayPointer(ys);
+  double* out = N_VGetArrayPointer(ysdot);
+  const Eigen::Map<const Eigen::VectorXd> s(in, n), sv(in + n, n);
+  Eigen::Map<Eigen::VectorXd> a(out + n, n);
+  p->AccelerationDerivative(k, t, q, v, qddot, s, sv, a);
+  Eigen::Map<Eigen::VectorXd>(out, n) = sv;
+  return a.allFinite() ? 0 : -1;
 }
 
 int Jacobian(realtype, N_Vector, N_Vector, SUNMatrix jac, void* user_data, N_Vector, N_Vector,
@@ -167,6 +202,128 @@ engine::AnalysisReport Failed(engine::AnalysisReport report, std::string reason)
   return report;
 }
 
+// The states and all sensitivities as one ODE of size 2n (1 + ns),
+// Y = (y, s_1, ..., s_ns), integrated by CVODES without its sensitivity
+// module. Its Newton matrix is block lower triangular,
+//
+//     [ I - gJ                 ]
+//     [ -g B_k        I - gJ   ],   B_k = d(sensitivity RHS k)/dy,
+//
+// so one n x n factorization of M + gC + g^2 K (as IntegrateLumped) solves
+// every block: x_0 from b_0, then x_k from b_k + g B_k x_0. The error test
+// weighs every component with the tolerances CVodeSensEEtolerances would
+// give the sensitivities (rtol, atol_i / pbar_k), i.e. the sensitivities are
+// error-controlled as with CVodeSetSensErrCon(SUNTRUE). What this saves over
+// the sensitivity module is per-vector overhead: CVODES does each of its
+// vector operations once on a 2n (1 + ns) array instead of 1 + ns times on
+// 2n-element vectors, which dominates for small n.
+template <typename Record>
+std::string IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSettings& settings,
+                               const LumpedSensitivityOptions& options, double omega_max,
+                               const std::vector<double>& pbar,
+                               const std::vector<double>& instants, const Record& record,
+                               engine::AnalysisCounters* counters,
+                               LumpedSensitivityCounters* sensitivity_counters) {
+  const model::LumpedModel& m = *p->model;
+  const int n = p->n;
+  const int ns = static_cast<int>(p->derivatives.size());
+  const int block = 2 * n;
+  const int size = block * (1 + ns);
+  // B_k's only nonzero rows (the rate rows): M^-1 (dM M^-1 [K C] - [dK dC]).
+  std::vector<Eigen::MatrixXd> coupling(static_cast<size_t>(ns));
+  Eigen::MatrixXd minv_kc(n, 2 * n);
+  minv_kc << p->minv_k, p->minv_c;
+  for (int k = 0; k < ns; ++k) {
+    const ParameterDerivative& d = p->derivatives[static_cast<size_t>(k)];
+    Eigen::MatrixXd b = d.mass_diagonal.asDiagonal() * minv_kc;
+    b.leftCols(n) -= d.stiffness;
+    b.rightCols(n) -= d.damping;
+    coupling[static_cast<size_t>(k)] = p->inverse_mass.asDiagonal() * b;
+  }
+  auto rhs = [p, n, ns, block](double t, const double* y, double* ydot) -> int {
+    const Eigen::Map<const Eigen::VectorXd> q(y, n), v(y + n, n);
+    Eigen::Map<Eigen::VectorXd> qdot(ydot, n), vdot(ydot + n, n);
+    qdot = v;
+    p->model->Forcing(t, &p->force);
+    vdot = p->inverse_mass.cwiseProduct(p->force);
+    vdot.noalias() -= p->minv_k * q;
+    vdot.noalias() -= p->minv_c * v;
+    if (!vdot.allFinite()) return -1;
+    for (int k = 0; k < ns; ++k) {
+      const double* in = y + block * (1 + k);
+      double* out = ydot + block * (1 + k);
+      const Eigen::Map<const Eigen::VectorXd> s(in, n), sv(in + n, n);
+      Eigen::Map<Eigen::VectorXd> a(out + n, n);
+      p->AccelerationDerivative(k, t, q, v, vdot, s, sv, a);
+      Eigen::Map<Eigen::VectorXd>(out, n) = sv;
+      if (!a.allFinite()) return -1;
+    }
+    return 0;
+  };
+  // Each block through the plain integration's operator; a sensitivity
+  // block's right-hand side first takes the coupling to the state block
+  // already solved (the Newton matrix is block lower triangular).
+  LumpedNewtonOperator newton(m);
+  Eigen::VectorXd state_x(block);
+  auto newton_solve = [&](double, double gamma, double* bx, bool* refactored) -> int {
+    if (newton.Prepare(gamma)) *refactored = true;
+    for (int k = 0; k <= ns; ++k) {
+      double* x = bx + block * k;
+      Eigen::Map<Eigen::VectorXd> b(x, block), bv(x + n, n);
+      if (k > 0) bv.noalias() += gamma * (coupling[static_cast<size_t>(k - 1)] * state_x);
+      if (!newton.Solve(x)) return 1;
+      if (k == 0) state_x = b;
+    }
+    return 0;
+  };
+
+  // CVODES' sensitivity module requires each of the 1 + ns blocks to pass
+  // the error test on its own (the largest of the block norms); the
+  // augmented system has one WRMS norm over all blocks, which averages a
+  // large error in one block with small ones elsewhere. Dividing every
+  // tolerance by sqrt(1 + ns) makes that norm the root-sum-square of the
+  // block norms, never less than the largest: the test is at least as
+  // strict as the module's.
+  const double norm_bound = options.augmented_block_norm_bound ? std::sqrt(1.0 + ns) : 1.0;
+  CvodesOptions cv;
+  cv.relative_tolerance = settings.relative_tolerance / norm_bound;
+  cv.max_steps = settings.max_steps;
+  cv.max_wall_seconds = settings.max_wall_seconds;
+  cv.absolute_tolerances.resize(size);
+  for (int k = 0; k <= ns; ++k) {
+    const double scale = (k == 0 ? 1.0 : 1.0 / pbar[static_cast<size_t>(k - 1)]) / norm_bound;
+    cv.absolute_tolerances.segment(block * k, n).setConstant(settings.absolute_tolerance * scale);
+    cv.absolute_tolerances.segment(block * k + n, n)
+        .setConstant(settings.absolute_tolerance * std::max(1.0, omega_max) * scale);
+  }
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(size);
+  absl::StatusOr<std::unique_ptr<CvodesIntegrator>> created =
+      CvodesIntegrator::CreateWithNewtonSolver(size, rhs, newton_solve,
+                                               CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv,
+                                               0.0, y);
+  if (!created.ok()) return absl::StrCat("integrator setup: ", created.status().message());
+  CvodesIntegrator& integrator = **created;
+
+  const double t_last = instants.empty() ? 0.0 : instants.back();
+  const std::string failure = IntegrateAcrossKinks(
+      integrator, m.KinkTimes(0.0, t_last), instants, &y, [&](double t, const Eigen::VectorXd& state) {
+        record(t, state.head(block), [&](int k) { return state.data() + block * (1 + k); });
+        return std::string();
+      });
+  const CvodesCounters c = integrator.counters();
+  counters->time_steps = c.steps;
+  counters->rhs_evaluations = c.rhs_evaluations;
+  counters->jacobian_evaluations = c.jacobian_evaluations;
+  counters->newton_iterations = c.nonlinear_iterations;
+  // One right-hand side evaluates every sensitivity; one Newton iteration
+  // corrects them all.
+  sensitivity_counters->sensitivity_rhs_evaluations = c.rhs_evaluations;
+  sensitivity_counters->sensitivity_newton_iterations = c.nonlinear_iterations;
+  sensitivity_counters->linear_setups = c.jacobian_evaluations;
+  sensitivity_counters->error_test_failures = c.error_test_failures;
+  return failure;
+}
+
 }  // namespace
 
 std::string LumpedSensitivityUnavailable(const spec::Scene& scene,
@@ -209,7 +366,7 @@ std::string LumpedSensitivityUnavailable(const spec::Scene& scene,
 
 LumpedSensitivityResult SimulateLumpedWithSensitivities(
     const spec::Scene& scene, const std::vector<double>& parameter_values_si,
-    const std::vector<int>& parameters) {
+    const std::vector<int>& parameters, const LumpedSensitivityOptions& options) {
   LumpedSensitivityResult result;
   engine::AnalysisReport& report = result.report;
   report.formulation = engine::Formulation::kDynamic;
@@ -247,6 +404,10 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   problem.minv_k = problem.inverse_mass.asDiagonal() * m.stiffness();
   problem.minv_c = problem.inverse_mass.asDiagonal() * m.damping();
   problem.zero = Eigen::VectorXd::Zero(n);
+  problem.force = Eigen::VectorXd::Zero(n);
+  problem.rhs = Eigen::VectorXd::Zero(n);
+  problem.input_deflection.assign(m.elements().size(), 0.0);
+  problem.input_rate.assign(m.elements().size(), 0.0);
   problem.max_wall_seconds = scene.integrator.max_wall_seconds;
   problem.start = std::chrono::steady_clock::now();
   for (int p : parameters) {
@@ -315,7 +476,8 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   result.output_derivatives.assign(static_cast<size_t>(ns),
                                    std::vector<std::vector<double>>(plans.size()));
 
-  // SUNDIALS setup: BDF, dense Newton, tolerances as IntegrateLumped.
+  // Tolerances as IntegrateLumped for either method; the module below uses
+  // BDF with CVODES' dense Newton solver.
   Sundials s;
   std::string failure;
   auto check = [&](int flag, const char* call) {
@@ -330,6 +492,59 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
       inverse_root_mass.asDiagonal() * m.stiffness() * inverse_root_mass.asDiagonal(),
       Eigen::EigenvaluesOnly);
   const double omega_max = std::sqrt(std::max(0.0, modes.eigenvalues().maxCoeff()));
+  std::vector<double> pbar(static_cast<size_t>(ns));
+  for (int k = 0; k < ns; ++k) {
+    const double value = std::abs(parameter_values_si[static_cast<size_t>(parameters[k])]);
+    pbar[static_cast<size_t>(k)] = value > 0.0 ? value : 1.0;
+  }
+
+  // Appends the outputs and their derivatives at instant t from the state
+  // (q, q') and sensitivity(k) -> (s, s') of parameter k.
+  bool need_acceleration = false;
+  for (const Plan& plan : plans) need_acceleration = need_acceleration || !plan.deflection;
+  Eigen::VectorXd q(n), v(n), qddot(n), dqddot(n);
+  auto record = [&](double t, const Eigen::Ref<const Eigen::VectorXd>& state,
+                    const auto& sensitivity) {
+    q = state.head(n);
+    v = state.tail(n);
+    m.Acceleration(t, q, v, &qddot);
+    for (size_t o = 0; o < plans.size(); ++o) {
+      const Plan& plan = plans[o];
+      const double value = plan.deflection
+                               ? m.Deflection(plan.index, q, t)
+                               : m.PointAcceleration(plan.index, plan.ox, plan.oy, plan.axis, qddot);
+      report.outputs[o].series[0].push_back(value);
+    }
+    for (int k = 0; k < ns; ++k) {
+      const double* sk = sensitivity(k);
+      const Eigen::Map<const Eigen::VectorXd> sq(sk, n), sv(sk + n, n);
+      if (need_acceleration) problem.AccelerationDerivative(k, t, q, v, qddot, sq, sv, dqddot);
+      for (size_t o = 0; o < plans.size(); ++o) {
+        const Plan& plan = plans[o];
+        const double derivative =
+            plan.deflection
+                ? m.elements()[static_cast<size_t>(plan.index)].gradient.dot(sq)
+                : m.PointAcceleration(plan.index, plan.ox, plan.oy, plan.axis, dqddot);
+        result.output_derivatives[static_cast<size_t>(k)][o].push_back(derivative);
+      }
+    }
+  };
+
+  if (options.method == LumpedSensitivityOptions::Method::kAugmentedSystem) {
+    const std::string failure =
+        IntegrateAugmented(&problem, settings, options, omega_max, pbar, report.times_s, record,
+                           &report.counters, &result.counters);
+    if (!failure.empty()) {
+      report = Failed(report, failure);
+      result.output_derivatives.clear();
+    }
+    return result;
+  }
+  if (!(options.tolerance_factor > 0.0) || !std::isfinite(options.tolerance_factor)) {
+    report = Failed(report, absl::StrCat("sensitivity tolerance factor must be positive, got ",
+                                         options.tolerance_factor));
+    return result;
+  }
   if (SUNContext_Create(nullptr, &s.context) != 0) {
     report = Failed(report, "SUNContext_Create failed");
     return result;
@@ -339,6 +554,10 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   s.cvode = CVodeCreate(CV_BDF, s.context);
   if (s.y == nullptr || s.abstol == nullptr || s.cvode == nullptr) {
     report = Failed(report, "SUNDIALS allocation failed");
+    return result;
+  }
+  if (options.fused_vector_operations && N_VEnableFusedOps_Serial(s.y, SUNTRUE) != 0) {
+    report = Failed(report, "N_VEnableFusedOps_Serial failed");
     return result;
   }
   Eigen::Map<Eigen::VectorXd> y(N_VGetArrayPointer(s.y), 2 * n);
@@ -355,11 +574,34 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
     return result;
   }
   for (int k = 0; k < ns; ++k) N_VConst(0.0, s.ys[k]);
-  std::vector<realtype> pbar(static_cast<size_t>(ns));
-  for (int k = 0; k < ns; ++k) {
-    const double value = std::abs(parameter_values_si[static_cast<size_t>(parameters[k])]);
-    pbar[static_cast<size_t>(k)] = value > 0.0 ? value : 1.0;
+  int corrector = CV_STAGGERED;
+  switch (options.corrector) {
+    case LumpedSensitivityOptions::Corrector::kSimultaneous: corrector = CV_SIMULTANEOUS; break;
+    case LumpedSensitivityOptions::Corrector::kStaggered: corrector = CV_STAGGERED; break;
+    case LumpedSensitivityOptions::Corrector::kStaggered1: corrector = CV_STAGGERED1; break;
   }
+  // Sensitivity tolerances: EE's own choice (rtol, atol_i / pbar_k), or the
+  // same scaled by options.tolerance_factor.
+  const bool estimated_tolerances = options.tolerance_factor == 1.0;
+  N_Vector* sensitivity_abstol = nullptr;
+  if (!estimated_tolerances) {
+    sensitivity_abstol = N_VCloneVectorArray(ns, s.y);
+    if (sensitivity_abstol == nullptr) {
+      report = Failed(report, "SUNDIALS allocation failed");
+      return result;
+    }
+    for (int k = 0; k < ns; ++k) {
+      N_VScale(options.tolerance_factor / pbar[static_cast<size_t>(k)], s.abstol,
+               sensitivity_abstol[k]);
+    }
+  }
+  struct AbstolArray {
+    N_Vector* v;
+    int count;
+    ~AbstolArray() {
+      if (v != nullptr) N_VDestroyVectorArray(v, count);
+    }
+  } abstol_owner{sensitivity_abstol, ns};
   bool ok = check(CVodeSetErrHandlerFn(s.cvode, &CaptureMessage, &problem), "CVodeSetErrHandlerFn") &&
             check(CVodeInit(s.cvode, &Rhs, 0.0, s.y), "CVodeInit") &&
             check(CVodeSetUserData(s.cvode, &problem), "CVodeSetUserData") &&
@@ -369,12 +611,27 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
                   "CVodeSetLinearSolver") &&
             check(CVodeSetJacFn(s.cvode, &Jacobian), "CVodeSetJacFn") &&
             check(CVodeSetMaxNumSteps(s.cvode, settings.max_steps), "CVodeSetMaxNumSteps") &&
-            check(CVodeSensInit(s.cvode, ns, CV_STAGGERED, &SensitivityRhs, s.ys),
-                  "CVodeSensInit") &&
+            (options.jacobian_eval_frequency <= 0 ||
+             check(CVodeSetJacEvalFrequency(s.cvode, options.jacobian_eval_frequency),
+                   "CVodeSetJacEvalFrequency")) &&
+            (options.linear_setup_frequency <= 0 ||
+             check(CVodeSetLSetupFrequency(s.cvode, options.linear_setup_frequency),
+                   "CVodeSetLSetupFrequency")) &&
+            (corrector == CV_STAGGERED1
+                 ? check(CVodeSensInit1(s.cvode, ns, corrector, &SensitivityRhs1, s.ys),
+                         "CVodeSensInit1")
+                 : check(CVodeSensInit(s.cvode, ns, corrector, &SensitivityRhs, s.ys),
+                         "CVodeSensInit")) &&
             check(CVodeSetSensParams(s.cvode, nullptr, pbar.data(), nullptr),
                   "CVodeSetSensParams") &&
-            check(CVodeSensEEtolerances(s.cvode), "CVodeSensEEtolerances") &&
-            check(CVodeSetSensErrCon(s.cvode, SUNTRUE), "CVodeSetSensErrCon");
+            (estimated_tolerances
+                 ? check(CVodeSensEEtolerances(s.cvode), "CVodeSensEEtolerances")
+                 : check(CVodeSensSVtolerances(
+                             s.cvode, settings.relative_tolerance * options.tolerance_factor,
+                             sensitivity_abstol),
+                         "CVodeSensSVtolerances")) &&
+            check(CVodeSetSensErrCon(s.cvode, options.error_control ? SUNTRUE : SUNFALSE),
+                  "CVodeSetSensErrCon");
 
   const std::vector<double>& instants = report.times_s;
   const double t_last = instants.empty() ? 0.0 : instants.back();
@@ -403,53 +660,47 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
     return check(CVodeGetSens(s.cvode, &t_sens, s.ys), "CVodeGetSens");
   };
   ok = ok && set_stop();
-  Eigen::VectorXd q(n), v(n), qddot(n), sq(n), sv(n), dqddot(n);
+  // CVodeReInit (at every kink) zeroes CVODES' counters: they are summed
+  // over the histories.
+  bool history_counted = false;  // until the next CVodeReInit
+  auto accumulate_counters = [&]() {
+    long value = 0;
+    auto add = [&](int (*get)(void*, long*), auto* total) {
+      value = 0;
+      if (get(s.cvode, &value) == CV_SUCCESS) *total += value;
+    };
+    add(&CVodeGetNumSteps, &report.counters.time_steps);
+    add(&CVodeGetNumRhsEvals, &report.counters.rhs_evaluations);
+    add(&CVodeGetNumJacEvals, &report.counters.jacobian_evaluations);
+    add(&CVodeGetNumNonlinSolvIters, &report.counters.newton_iterations);
+    LumpedSensitivityCounters& c = result.counters;
+    add(&CVodeGetSensNumRhsEvals, &c.sensitivity_rhs_evaluations);
+    add(&CVodeGetSensNumNonlinSolvIters, &c.sensitivity_newton_iterations);
+    add(&CVodeGetNumLinSolvSetups, &c.linear_setups);
+    add(&CVodeGetNumErrTestFails, &c.error_test_failures);
+    add(&CVodeGetSensNumErrTestFails, &c.sensitivity_error_test_failures);
+  };
   for (size_t i = 0; ok && i < instants.size(); ++i) {
     const double t = instants[i];
     while (ok && next_kink < kinks.size() && kinks[next_kink] <= t) {
       const double kink = kinks[next_kink++];
-      ok = advance(kink) && check(CVodeReInit(s.cvode, kink, s.y), "CVodeReInit") &&
-           check(CVodeSensReInit(s.cvode, CV_STAGGERED, s.ys), "CVodeSensReInit") && set_stop();
+      if (!advance(kink)) {
+        ok = false;
+        break;
+      }
+      accumulate_counters();
+      history_counted = true;
+      ok = check(CVodeReInit(s.cvode, kink, s.y), "CVodeReInit");
+      if (ok) history_counted = false;
+      ok = ok && check(CVodeSensReInit(s.cvode, corrector, s.ys), "CVodeSensReInit") && set_stop();
     }
     if (!ok || !advance(t)) {
       ok = false;
       break;
     }
-    q = y.head(n);
-    v = y.tail(n);
-    m.Acceleration(t, q, v, &qddot);
-    for (size_t o = 0; o < plans.size(); ++o) {
-      const Plan& plan = plans[o];
-      const double value = plan.deflection
-                               ? m.Deflection(plan.index, q, t)
-                               : m.PointAcceleration(plan.index, plan.ox, plan.oy, plan.axis, qddot);
-      report.outputs[o].series[0].push_back(value);
-    }
-    for (int k = 0; k < ns; ++k) {
-      sq = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.ys[k]), n);
-      sv = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.ys[k]) + n, n);
-      bool need_acceleration = false;
-      for (const Plan& plan : plans) need_acceleration = need_acceleration || !plan.deflection;
-      if (need_acceleration) problem.AccelerationDerivative(k, t, q, v, qddot, sq, sv, &dqddot);
-      for (size_t o = 0; o < plans.size(); ++o) {
-        const Plan& plan = plans[o];
-        const double derivative =
-            plan.deflection
-                ? m.elements()[static_cast<size_t>(plan.index)].gradient.dot(sq)
-                : m.PointAcceleration(plan.index, plan.ox, plan.oy, plan.axis, dqddot);
-        result.output_derivatives[static_cast<size_t>(k)][o].push_back(derivative);
-      }
-    }
+    record(t, y, [&](int k) { return N_VGetArrayPointer(s.ys[k]); });
   }
-  long steps = 0, rhs = 0, jacobians = 0, newton = 0;
-  CVodeGetNumSteps(s.cvode, &steps);
-  CVodeGetNumRhsEvals(s.cvode, &rhs);
-  CVodeGetNumJacEvals(s.cvode, &jacobians);
-  CVodeGetNumNonlinSolvIters(s.cvode, &newton);
-  report.counters.time_steps = steps;
-  report.counters.rhs_evaluations = rhs;
-  report.counters.jacobian_evaluations = jacobians;
-  report.counters.newton_iterations = newton;
+  if (!history_counted) accumulate_counters();
   if (!ok) {
     report = Failed(report, failure.empty() ? "sensitivity integration failed" : failure);
     result.output_derivatives.clear();
