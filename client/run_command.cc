@@ -114,6 +114,9 @@ int RunCommandMain(const Args& args) {
     SetUnaryDeadline(&context);
     get_status = stub->Get(&context, ref, &job);
   }
+  // Close our connection first: a server that is stopping waits out its
+  // grace period (server/service/server.cc) for clients still connected.
+  stub.reset();
   (*cluster)->Stop();
 
   if (outcome.interrupted) {
