@@ -33,13 +33,13 @@ absl::StatusOr<ParsedArgs> Parse(const Args& args, const ArgSpec& spec, size_t p
 
 struct Connection {
   std::string address;
-  std::unique_ptr<v1::JobService::Stub> stub;
+  std::unique_ptr<v1::JobService::Stub> job_service;  // the gRPC client of the server's JobService
 };
 
 Connection Connect(const ParsedArgs& parsed) {
   Connection c;
   c.address = ResolveServerAddress(parsed.Value("--server"));
-  c.stub = ConnectJobService(c.address);
+  c.job_service = ConnectJobService(c.address);
   return c;
 }
 
@@ -54,7 +54,7 @@ grpc::Status GetJob(Connection& c, const std::string& job_id, v1::GetJobResponse
   ref.set_job_id(job_id);
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
-  return c.stub->Get(&context, ref, response);
+  return c.job_service->Get(&context, ref, response);
 }
 
 // Follows a job to its end, printing the table; returns the exit code of its
@@ -63,7 +63,7 @@ grpc::Status GetJob(Connection& c, const std::string& job_id, v1::GetJobResponse
 int Follow(Connection& c, const std::string& job_id) {
   WatchOptions options;
   options.progress_line = isatty(STDOUT_FILENO) != 0;
-  WatchOutcome outcome = WatchJob(*c.stub, c.address, job_id, options);
+  WatchOutcome outcome = WatchJob(*c.job_service, c.address, job_id, options);
   if (outcome.interrupted) {
     std::fprintf(stderr, "mbopt: stopped watching; job %s goes on on the server\n",
                  job_id.c_str());
@@ -101,7 +101,7 @@ int SubmitCommand(const Args& args) {
   v1::SubmitJobResponse response;
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
-  grpc::Status status = c.stub->Submit(&context, request, &response);
+  grpc::Status status = c.job_service->Submit(&context, request, &response);
   if (!status.ok()) return FailRpc(status, c.address);
   std::printf("%s\n", response.job_id().c_str());
   std::fflush(stdout);
@@ -135,7 +135,7 @@ int ListCommand(const Args& args) {
   v1::ListJobsResponse response;
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
-  grpc::Status status = c.stub->List(&context, v1::ListJobsRequest(), &response);
+  grpc::Status status = c.job_service->List(&context, v1::ListJobsRequest(), &response);
   if (!status.ok()) return FailRpc(status, c.address);
   std::printf("%s\n", ListHeader().c_str());
   for (const auto& job : response.jobs()) std::printf("%s\n", ListRow(job).c_str());
@@ -155,8 +155,8 @@ int CancelOrResume(const Args& args, bool cancel) {
   v1::JobSummary summary;
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
-  grpc::Status status = cancel ? c.stub->Cancel(&context, ref, &summary)
-                               : c.stub->Resume(&context, ref, &summary);
+  grpc::Status status = cancel ? c.job_service->Cancel(&context, ref, &summary)
+                               : c.job_service->Resume(&context, ref, &summary);
   if (!status.ok()) return FailRpc(status, c.address);
   std::printf("%s: %s\n", summary.job_id().c_str(), StateName(summary.state()).c_str());
   return kExitOk;

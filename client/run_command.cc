@@ -83,7 +83,7 @@ int RunCommandMain(const Args& args) {
     std::printf("mbopt run: server at %s, %d workers\n", address.c_str(), num_workers);
   }
 
-  auto stub = ConnectJobService(address);
+  auto job_service = ConnectJobService(address);
   v1::SubmitJobRequest request;
   *request.mutable_study() = *std::move(study);
   request.set_source_name(path);
@@ -91,7 +91,7 @@ int RunCommandMain(const Args& args) {
   {
     grpc::ClientContext context;
     SetUnaryDeadline(&context);
-    grpc::Status status = stub->Submit(&context, request, &submitted);
+    grpc::Status status = job_service->Submit(&context, request, &submitted);
     if (!status.ok()) {
       RpcFailure f = DescribeRpcFailure(status, address);
       return Fail(f.message, f.exit_code);
@@ -103,7 +103,7 @@ int RunCommandMain(const Args& args) {
   WatchOptions watch_options;
   watch_options.table_out = (quiet || json) ? nullptr : stdout;
   watch_options.progress_line = watch_options.table_out != nullptr && isatty(STDOUT_FILENO);
-  WatchOutcome outcome = WatchJob(*stub, address, job_id, watch_options);
+  WatchOutcome outcome = WatchJob(*job_service, address, job_id, watch_options);
 
   v1::GetJobResponse job;
   grpc::Status get_status;
@@ -112,11 +112,11 @@ int RunCommandMain(const Args& args) {
     ref.set_job_id(job_id);
     grpc::ClientContext context;
     SetUnaryDeadline(&context);
-    get_status = stub->Get(&context, ref, &job);
+    get_status = job_service->Get(&context, ref, &job);
   }
   // Close our connection first: a server that is stopping waits out its
   // grace period (server/service/server.cc) for clients still connected.
-  stub.reset();
+  job_service.reset();
   (*cluster)->Stop();
 
   if (outcome.interrupted) {

@@ -22,14 +22,14 @@ void DrawProgress(const WatchOptions& options, const v1::JobSummary& s) {
 
 }  // namespace
 
-WatchOutcome WatchJob(v1::JobService::Stub& stub, const std::string& address,
+WatchOutcome WatchJob(v1::JobService::Stub& job_service, const std::string& address,
                       const std::string& job_id, const WatchOptions& options) {
   WatchOutcome outcome;
   grpc::ClientContext context;
   Interrupts::SetCancelTarget(&context);
   v1::JobRef ref;
   ref.set_job_id(job_id);
-  auto reader = stub.Watch(&context, ref);
+  auto reader = job_service.Watch(&context, ref);
   bool header_printed = false;
   v1::JobEvent event;
   while (reader->Read(&event)) {

@@ -23,7 +23,7 @@ struct WatchOutcome {
   RpcFailure failure;           // when !ok && !interrupted
 };
 
-WatchOutcome WatchJob(v1::JobService::Stub& stub, const std::string& address,
+WatchOutcome WatchJob(v1::JobService::Stub& job_service, const std::string& address,
                       const std::string& job_id, const WatchOptions& options);
 
 }  // namespace mbopt::client

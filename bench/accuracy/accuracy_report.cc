@@ -94,7 +94,12 @@ bool Acceptable(const ProblemSweep& s, const SettingResult& r, const Acceptance&
     return std::abs(r.objective - def->objective) / Scale(s) <= a.objective_error &&
            r.true_max_violation <= SolverViolationLimit(*def, a);
   }
-  return ObjectiveError(s, r.objective) <= a.objective_error && r.true_max_violation <= a.true_violation;
+  return WithinReferenceTolerances(s, r, a);
+}
+
+bool WithinReferenceTolerances(const ProblemSweep& s, const SettingResult& r, const Acceptance& a) {
+  return r.recheck_ok && ObjectiveError(s, r.objective) <= a.objective_error &&
+         r.true_max_violation <= a.true_violation;
 }
 
 Setting RecommendedSetting(const ProblemSweep& s, const Acceptance& full, std::vector<std::string>* why,
@@ -266,8 +271,7 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
   for (const std::string& w : recommendation_why) absl::StrAppend(&out, "- ", w, "\n");
   if (s.recommended.has_value()) {
     const SettingResult& r = *s.recommended;
-    const bool pass = r.recheck_ok && ObjectiveError(s, r.objective) <= a.objective_error &&
-                      r.true_max_violation <= a.true_violation;
+    const bool pass = WithinReferenceTolerances(s, r, a);
     absl::StrAppendFormat(
         &out,
         "\nThe combination (%s) was run to check it (table row \"recommended\"): error %.2g %% against F_ref, "
@@ -279,8 +283,7 @@ std::string ProblemMarkdown(const ProblemSweep& s, const Acceptance& a, const st
   }
   if (s.fallback.has_value()) {
     const SettingResult& r = *s.fallback;
-    const bool pass = r.recheck_ok && ObjectiveError(s, r.objective) <= a.objective_error &&
-                      r.true_max_violation <= a.true_violation;
+    const bool pass = WithinReferenceTolerances(s, r, a);
     absl::StrAppendFormat(
         &out,
         "The model knobs alone (%s; solver knobs at the study's own) were run as well: error %.2g %%, "

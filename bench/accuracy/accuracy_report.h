@@ -37,6 +37,11 @@ struct ProblemSweep {
 // tolerance and the true violation not more than the tolerance above the
 // default's.
 bool Acceptable(const ProblemSweep& sweep, const SettingResult& r, const Acceptance& acceptance);
+// Against the reference only, whatever the knob: the re-check succeeded, the
+// objective is within the tolerance of F_ref and the true violation within
+// its own. How a recommended combination is judged.
+bool WithinReferenceTolerances(const ProblemSweep& sweep, const SettingResult& r,
+                               const Acceptance& acceptance);
 
 // The combination to verify: per model knob the fastest acceptable value
 // (the reference's value when none is acceptable), per solver knob the

@@ -123,8 +123,7 @@ absl::StatusOr<ProblemSweep> RunProblem(const SweepPlan& plan, const Acceptance&
   const Setting recommended = RecommendedSetting(sweep, acceptance, why, &model_only);
   MBOPT_ASSIGN_OR_RETURN(sweep.recommended, TimedRun(base, plan.study_file, recommended, recheck));
   const SettingResult& r = *sweep.recommended;
-  const bool pass = r.recheck_ok && ObjectiveError(sweep, r.objective) <= acceptance.objective_error &&
-                    r.true_max_violation <= acceptance.true_violation;
+  const bool pass = WithinReferenceTolerances(sweep, r, acceptance);
   if (!pass && recommended.value != model_only.value) {
     MBOPT_ASSIGN_OR_RETURN(sweep.fallback, TimedRun(base, plan.study_file, model_only, recheck));
   }

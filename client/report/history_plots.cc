@@ -102,6 +102,15 @@ PlotSpec BasePlot(const std::string& title, const std::string& y_label) {
   return spec;
 }
 
+// Design variable i's line: its name, and a colour and dash of its own.
+PlotSeries VariableSeries(const ReportData& data, int i) {
+  PlotSeries s;
+  s.name = VariableName(data, i);
+  s.color = SeriesColor(i);
+  s.dash = SeriesDash(i);
+  return s;
+}
+
 }  // namespace
 
 std::string SeriesColor(int k) {
@@ -190,10 +199,7 @@ PlotSpec MoveLimitPlot(const ReportData& data) {
   const int n = VariableCount(data);
   const std::vector<CycleGroup> groups = GroupByCycle(data);
   for (int i = 0; i < n; ++i) {
-    PlotSeries s;
-    s.name = VariableName(data, i);
-    s.color = SeriesColor(i);
-    s.dash = SeriesDash(i);
+    PlotSeries s = VariableSeries(data, i);
     PlotSeries rejected = s;
     rejected.draw_line = false;
     rejected.marker = MarkerShape::kHollowCircle;
@@ -228,10 +234,7 @@ PlotSpec DesignVariablePlot(const ReportData& data) {
   const int n = VariableCount(data);
   const std::vector<CycleGroup> groups = GroupByCycle(data);
   for (int i = 0; i < n; ++i) {
-    PlotSeries s;
-    s.name = VariableName(data, i);
-    s.color = SeriesColor(i);
-    s.dash = SeriesDash(i);
+    PlotSeries s = VariableSeries(data, i);
     if (!data.records.empty()) {
       s.x.push_back(0);
       s.y.push_back(At(data.records.front().x0_scaled, i));

@@ -152,17 +152,23 @@ TEST(CvodesIntegrator, StopsExactlyAtStopTimeAndRestartsThere) {
   EXPECT_EQ(i.counters().restarts, 1);
 }
 
+// y' = rhs from y(0) = 0 to t = 1 with the default options: how the
+// integration ended.
+absl::Status IntegrateScalarToOne(const CvodesIntegrator::RhsFunction& rhs) {
+  auto integrator =
+      CvodesIntegrator::Create(1, rhs, nullptr, CvodesOptions(), 0.0, Eigen::VectorXd::Zero(1));
+  if (!integrator.ok()) return integrator.status();
+  Eigen::VectorXd y;
+  return (*integrator)->IntegrateTo(1.0, &y);
+}
+
 TEST(CvodesIntegrator, ThrowingRhsIsAFailedIntegrationWithReason) {
   auto rhs = [](double t, const double*, double* ydot) -> int {
     if (t > 0.1) throw std::runtime_error("model exploded");
     ydot[0] = 1.0;
     return 0;
   };
-  auto integrator =
-      CvodesIntegrator::Create(1, rhs, nullptr, CvodesOptions(), 0.0, Eigen::VectorXd::Zero(1));
-  ASSERT_TRUE(integrator.ok());
-  Eigen::VectorXd y;
-  const absl::Status s = (*integrator)->IntegrateTo(1.0, &y);
+  const absl::Status s = IntegrateScalarToOne(rhs);
   EXPECT_EQ(s.code(), absl::StatusCode::kAborted);
   EXPECT_THAT(std::string(s.message()), HasSubstr("model exploded"));
 }
@@ -172,11 +178,7 @@ TEST(CvodesIntegrator, NonFiniteRhsIsAFailedIntegration) {
     ydot[0] = t > 0.2 ? std::numeric_limits<double>::quiet_NaN() : 1.0;
     return 0;
   };
-  auto integrator =
-      CvodesIntegrator::Create(1, rhs, nullptr, CvodesOptions(), 0.0, Eigen::VectorXd::Zero(1));
-  ASSERT_TRUE(integrator.ok());
-  Eigen::VectorXd y;
-  const absl::Status s = (*integrator)->IntegrateTo(1.0, &y);
+  const absl::Status s = IntegrateScalarToOne(rhs);
   EXPECT_EQ(s.code(), absl::StatusCode::kAborted);
   EXPECT_THAT(std::string(s.message()), HasSubstr("not finite"));
 }

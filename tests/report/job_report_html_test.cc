@@ -21,9 +21,7 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 int Count(const std::string& haystack, const std::string& needle) {
-  int n = 0;
-  for (std::size_t p = haystack.find(needle); p != std::string::npos; p = haystack.find(needle, p + 1)) ++n;
-  return n;
+  return testing::CountOccurrences(haystack, needle);
 }
 
 // The table row of a design variable, from its name cell to the row end.

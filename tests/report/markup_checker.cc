@@ -181,4 +181,10 @@ std::vector<std::string> NumericAttributeValues(std::string_view svg) {
   return out;
 }
 
+int CountOccurrences(std::string_view haystack, std::string_view needle) {
+  int n = 0;
+  for (std::size_t p = haystack.find(needle); p != std::string_view::npos; p = haystack.find(needle, p + 1)) ++n;
+  return n;
+}
+
 }  // namespace mbopt::report::testing

@@ -21,4 +21,7 @@ std::vector<std::string> SvgFragments(std::string_view html);
 // r, width, height, points, viewBox) of every tag in `svg`.
 std::vector<std::string> NumericAttributeValues(std::string_view svg);
 
+// How often `needle` occurs in `haystack`, overlapping occurrences included.
+int CountOccurrences(std::string_view haystack, std::string_view needle);
+
 }  // namespace mbopt::report::testing

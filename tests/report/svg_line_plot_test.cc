@@ -16,9 +16,7 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 int Count(const std::string& haystack, const std::string& needle) {
-  int n = 0;
-  for (std::size_t p = haystack.find(needle); p != std::string::npos; p = haystack.find(needle, p + 1)) ++n;
-  return n;
+  return testing::CountOccurrences(haystack, needle);
 }
 
 void ExpectCoordinatesAreNumbers(const std::string& svg) {
