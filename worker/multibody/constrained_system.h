@@ -1,0 +1,57 @@
+// The equations of motion of a planar constrained mechanical system, as the
+// forward-dynamics integrator (forward_dynamics.h) sees them. The mechanism
+// kernel (mechanism.h) implements this for a scene's bodies, joints, drivers
+// and forces in absolute coordinates (x, y, phi per body); tests implement it
+// by hand for textbook systems.
+//
+//   M(q) a + Phi_q(t, q)^T lambda = Q(t, q, v)      (n equations)
+//   Phi(t, q) = 0                                    (m constraints, drivers included)
+//   Phi_q v + Phi_t = 0                              (velocity level)
+//   Phi_q a = gamma(t, q, v)                         (acceleration level)
+//
+// q: n coordinates; v = dq/dt; a = dv/dt; lambda: m Lagrange multipliers
+// (constraint reactions in generalized form). SI units throughout.
+//
+// Every evaluation returns the SUNDIALS callback contract: 0 ok, > 0 a
+// recoverable failure (the integrator retries with a smaller step, e.g. a
+// tabulated curve evaluated outside its range), < 0 unrecoverable. Outputs
+// are sized by the callee. Implementations are immutable during an
+// integration except for the parameter array (parameters()), which
+// sensitivity analysis perturbs in place; every evaluation must read the
+// current values from it.
+#pragma once
+
+#include <Eigen/Dense>
+
+namespace mbopt::multibody {
+
+class ConstrainedSystem {
+ public:
+  virtual ~ConstrainedSystem() = default;
+
+  virtual int num_coordinates() const = 0;  // n
+  virtual int num_constraints() const = 0;  // m, driver equations included
+
+  // M(q): n x n, symmetric positive definite.
+  virtual int MassMatrix(const Eigen::VectorXd& q, Eigen::MatrixXd* mass) const = 0;
+  // Q(t, q, v): applied generalized forces (gravity, springs, dampers, point
+  // forces and torques) plus velocity-dependent inertia terms, if any.
+  virtual int AppliedForces(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                            Eigen::VectorXd* forces) const = 0;
+  // Phi(t, q): m values.
+  virtual int Constraints(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi) const = 0;
+  // Phi_q(t, q): m x n.
+  virtual int ConstraintJacobian(double t, const Eigen::VectorXd& q, Eigen::MatrixXd* phi_q) const = 0;
+  // Phi_t(t, q): m values (non-zero only for rheonomic, i.e. driver, rows).
+  virtual int ConstraintTimeDerivative(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi_t) const = 0;
+  // gamma = -(Phi_q v)_q v - 2 Phi_qt v - Phi_tt: m values.
+  virtual int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                    Eigen::VectorXd* gamma) const = 0;
+
+  // Parameters the equations depend on (stiffnesses, masses, ...), for
+  // forward sensitivity analysis by difference quotients. Empty by default.
+  virtual int num_parameters() const { return 0; }
+  virtual double* parameters() { return nullptr; }
+};
+
+}  // namespace mbopt::multibody
