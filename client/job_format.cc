@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,19 @@ std::string CycleTableRow(const v1::CycleRecord& r) {
   return buf;
 }
 
+// "3 analyses (integrator 2, assembly 1)", kinds in name order.
+std::string FailedAnalysesText(const v1::JobSummary& s) {
+  const std::map<std::string, std::int64_t> failed(s.failed_analyses_by_kind().begin(),
+                                                   s.failed_analyses_by_kind().end());
+  std::int64_t total = 0;
+  std::string kinds;
+  for (const auto& [kind, count] : failed) {
+    total += count;
+    kinds += (kinds.empty() ? "" : ", ") + kind + " " + std::to_string(count);
+  }
+  return std::to_string(total) + (total == 1 ? " analysis (" : " analyses (") + kinds + ")";
+}
+
 std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   std::string out;
   out += "job:           " + s.job_id() + "\n";
@@ -123,6 +137,7 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   out += "max violation: " + Format("%.4g", s.max_violation()) + "\n";
   out += "wall time:     " + Format("%.2f", s.wall_seconds()) + " s\n";
   if (!s.message().empty()) out += "message:       " + s.message() + "\n";
+  if (!s.failed_analyses_by_kind().empty()) out += "failed:        " + FailedAnalysesText(s) + "\n";
   if (s.design_size() > 0) out += "design:\n" + DesignLines(s, study);
   return out;
 }
@@ -223,6 +238,13 @@ std::string ResultsJson(const v1::GetJobResponse& job) {
   w.EndObject();
   w.Field("wall_seconds", s.wall_seconds());
   w.Field("message", s.message());
+  // Sorted by kind name: the map's order on the wire is unspecified.
+  const std::map<std::string, std::int64_t> failed(s.failed_analyses_by_kind().begin(),
+                                                   s.failed_analyses_by_kind().end());
+  w.Key("failed_analyses");
+  w.BeginObject();
+  for (const auto& [kind, count] : failed) w.Field(kind, static_cast<long long>(count));
+  w.EndObject();
   w.Key("history");
   w.BeginArray();
   for (const auto& r : job.cycles()) {

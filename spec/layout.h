@@ -103,7 +103,7 @@ struct StudyValues {
 };
 
 // `outputs_si[o]` points at output o's series, [series][instant], SI (as
-// engine::OutputValues::series). InvalidArgument if a shape differs from the
+// spec::OutputValues::series). InvalidArgument if a shape differs from the
 // layout's; a non-finite value is passed through (the optimizer rejects it).
 absl::StatusOr<StudyValues> ComputeStudyValues(
     const Study& study, const StudyLayout& layout,

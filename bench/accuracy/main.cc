@@ -18,7 +18,7 @@
 #include "bench/accuracy/sweep_plan.h"
 #include "bench/accuracy/sweep_run.h"
 #include "common/status_macros.h"
-#include "server/local_run/evaluate_design.h"
+#include "worker/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::accuracy {
@@ -110,9 +110,9 @@ absl::StatusOr<ProblemSweep> RunProblem(const SweepPlan& plan, const Acceptance&
   MBOPT_ASSIGN_OR_RETURN(RecheckModel recheck, MakeRecheckModel(base, plan.study_file, plan.recheck));
   Eigen::VectorXd x0(recheck.study.variables.size());
   for (size_t i = 0; i < recheck.study.variables.size(); ++i) x0[i] = recheck.study.variables[i].initial;
-  MBOPT_ASSIGN_OR_RETURN(local_run::DesignEvaluation e0,
+  MBOPT_ASSIGN_OR_RETURN(engine::StudyEvaluation e0,
                          local_run::EvaluateDesign(recheck.study, recheck.layout, x0));
-  if (!e0.ok()) return absl::FailedPreconditionError(absl::StrCat("initial design fails: ", e0.failure_reason));
+  if (!e0.ok()) return absl::FailedPreconditionError(absl::StrCat("initial design fails: ", e0.failure.reason));
   sweep.initial_objective = e0.values->objective;
   MBOPT_ASSIGN_OR_RETURN(sweep.reference, TimedRun(base, plan.study_file, plan.reference, recheck));
   for (const Setting& s : plan.settings) {

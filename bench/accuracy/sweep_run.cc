@@ -3,8 +3,7 @@
 #include <utility>
 
 #include "common/status_macros.h"
-#include "server/local_run/evaluate_design.h"
-#include "server/local_run/local_run.h"
+#include "worker/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::accuracy {
@@ -40,14 +39,14 @@ absl::StatusOr<SettingResult> RunSetting(const v1::Study& base, const std::strin
   r.analyses = run.outcome.analyses;
   r.wall_seconds = run.wall_seconds;
   r.design_scaled = run.design_scaled;
-  MBOPT_ASSIGN_OR_RETURN(local_run::DesignEvaluation check,
+  MBOPT_ASSIGN_OR_RETURN(engine::StudyEvaluation check,
                          local_run::EvaluateDesign(recheck.study, recheck.layout, run.outcome.design));
   r.recheck_ok = check.ok();
   if (check.ok()) {
     r.true_objective = check.values->objective;
     r.true_max_violation = check.values->max_violation;
   } else {
-    r.recheck_failure = check.failure_reason;
+    r.recheck_failure = check.failure.reason;
   }
   return r;
 }

@@ -3,8 +3,8 @@
 #include <utility>
 
 #include "common/status_macros.h"
-#include "server/local_run/evaluate_design.h"
 #include "server/slp/finite_difference.h"
+#include "worker/local_run/local_run.h"
 
 namespace mbopt::compare {
 
@@ -31,12 +31,12 @@ Eigen::VectorXd CountedStudy::initial() const {
 }
 
 absl::StatusOr<CountedStudy::Point> CountedStudy::Evaluate(const Eigen::VectorXd& x) {
-  MBOPT_ASSIGN_OR_RETURN(local_run::DesignEvaluation e, local_run::EvaluateDesign(study_, layout_, x));
+  MBOPT_ASSIGN_OR_RETURN(engine::StudyEvaluation e, local_run::EvaluateDesign(study_, layout_, x));
   ++analyses_;
   Point p;
   if (!e.ok()) {
     ++failed_;
-    p.failure_reason = e.failure_reason;
+    p.failure_reason = e.failure.reason;
     return p;
   }
   const spec::StudyValues& v = *e.values;

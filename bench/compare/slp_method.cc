@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "common/status_macros.h"
-#include "server/local_run/local_run.h"
+#include "worker/local_run/local_run.h"
 
 namespace mbopt::compare {
 

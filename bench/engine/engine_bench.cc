@@ -41,9 +41,9 @@ void BM_VehicleAnalysis_Rtol1e6(benchmark::State& state) {
   const mbopt::spec::Study study = LoadVehicle(1e-6);
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   for (auto _ : state) {
-    mbopt::engine::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
-    if (report.status != mbopt::engine::AnalysisStatus::kOk) {
-      state.SkipWithError(report.failure_reason.c_str());
+    mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
+    if (!report.ok()) {
+      state.SkipWithError(report.failure.reason.c_str());
       break;
     }
     benchmark::DoNotOptimize(report);
@@ -58,7 +58,7 @@ void BM_VehicleAnalysisAndValues_Rtol1e8(benchmark::State& state) {
   const auto layout = mbopt::spec::MakeStudyLayout(study);
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   for (auto _ : state) {
-    mbopt::engine::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
+    mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
     auto values = mbopt::engine::ComputeStudyValues(study, *layout, report);
     if (!values.ok()) {
       state.SkipWithError(std::string(values.status().message()).c_str());
@@ -78,7 +78,7 @@ void BM_VehicleLumpedMethod_Rtol1e6(benchmark::State& state) {
   options.adams = state.range(0) > 0;
   options.fixed_point = state.range(0) > 1;
   for (auto _ : state) {
-    mbopt::engine::AnalysisReport report = mbopt::solve::SimulateLumped(study.scene, p, options);
+    mbopt::spec::AnalysisReport report = mbopt::solve::SimulateLumped(study.scene, p, options);
     benchmark::DoNotOptimize(report);
     state.counters["steps"] = static_cast<double>(report.counters.time_steps);
   }
@@ -90,7 +90,7 @@ void BM_VehicleAtol_Rtol1e6(benchmark::State& state) {
   study.scene.integrator.absolute_tolerance = std::pow(10.0, -static_cast<double>(state.range(0)));
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   for (auto _ : state) {
-    mbopt::engine::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
+    mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
     benchmark::DoNotOptimize(report);
     state.counters["steps"] = static_cast<double>(report.counters.time_steps);
   }

@@ -65,8 +65,8 @@ const Derivatives& Reference() {
     const auto result = mbopt::solve::SimulateLumpedWithSensitivities(
         study.scene, study.ParameterValuesAt(InitialDesign(study)), SensitivityParameters(study),
         options);
-    if (result.report.status != mbopt::engine::AnalysisStatus::kOk) {
-      std::cerr << "reference failed: " << result.report.failure_reason << "\n";
+    if (!result.report.ok()) {
+      std::cerr << "reference failed: " << result.report.failure.reason << "\n";
       std::abort();
     }
     return result.output_derivatives;
@@ -90,7 +90,7 @@ double DerivativeError(const Derivatives& d) {
   return worst;
 }
 
-void Count(benchmark::State& state, const mbopt::engine::AnalysisCounters& c) {
+void Count(benchmark::State& state, const mbopt::spec::AnalysisCounters& c) {
   state.counters["steps"] = static_cast<double>(c.time_steps);
   state.counters["rhs"] = static_cast<double>(c.rhs_evaluations);
   state.counters["jac"] = static_cast<double>(c.jacobian_evaluations);
@@ -102,9 +102,9 @@ void BM_VehiclePlainAnalysis(benchmark::State& state) {
   const mbopt::spec::Study study = LoadVehicle();
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   for (auto _ : state) {
-    mbopt::engine::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
-    if (report.status != mbopt::engine::AnalysisStatus::kOk) {
-      state.SkipWithError(report.failure_reason.c_str());
+    mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
+    if (!report.ok()) {
+      state.SkipWithError(report.failure.reason.c_str());
       break;
     }
     benchmark::DoNotOptimize(report);
@@ -121,8 +121,8 @@ void RunSensitivities(benchmark::State& state, const LumpedSensitivityOptions& o
   mbopt::solve::LumpedSensitivityResult result;
   for (auto _ : state) {
     result = mbopt::solve::SimulateLumpedWithSensitivities(study.scene, p, parameters, options);
-    if (result.report.status != mbopt::engine::AnalysisStatus::kOk) {
-      state.SkipWithError(result.report.failure_reason.c_str());
+    if (!result.report.ok()) {
+      state.SkipWithError(result.report.failure.reason.c_str());
       return;
     }
     benchmark::DoNotOptimize(result);
@@ -208,7 +208,7 @@ void BM_VehicleStudyValues(benchmark::State& state) {
   const auto layout = mbopt::spec::MakeStudyLayout(study);
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   for (auto _ : state) {
-    mbopt::engine::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
+    mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
     auto values = mbopt::engine::ComputeStudyValues(study, *layout, report);
     if (!values.ok()) {
       state.SkipWithError(std::string(values.status().message()).c_str());

@@ -65,6 +65,13 @@ std::string SummaryTable(const ReportData& data) {
                                        (data.max_violation > 0 ? " (violated)" : ""));
   if (data.wall_seconds > 0) out += Row("wall time", EscapeHtml(FormatValue(data.wall_seconds, 4)) + " s");
   if (!data.message.empty()) out += Row("message", EscapeHtml(data.message));
+  if (!data.failed_analyses_by_kind.empty()) {
+    std::string failed;
+    for (const auto& [kind, count] : data.failed_analyses_by_kind) {
+      failed += (failed.empty() ? "" : ", ") + EscapeHtml(kind) + " " + std::to_string(count);
+    }
+    out += Row("failed analyses by kind", failed);
+  }
   out += "</tbody>\n</table>\n";
   return out;
 }

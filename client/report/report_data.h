@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,8 @@ struct ReportData {
   std::string objective_unit;
   double max_violation = 0.0;  // normalized maxg of the current best design
   double wall_seconds = 0.0;
+  // Failed analyses by failure kind name ("integrator", "assembly", ...).
+  std::map<std::string, std::int64_t> failed_analyses_by_kind;
 
   std::vector<ReportVariable> variables;
   // Current best design in physical units, one per variable; empty when

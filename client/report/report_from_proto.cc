@@ -73,6 +73,7 @@ ReportData ReportDataFromJob(const v1::GetJobResponse& job) {
   d.objective_unit = !s.objective_unit().empty() ? s.objective_unit() : job.study().objective().unit();
   d.max_violation = job.cycles_size() > 0 ? s.max_violation() : std::numeric_limits<double>::quiet_NaN();
   d.wall_seconds = s.wall_seconds();
+  d.failed_analyses_by_kind.insert(s.failed_analyses_by_kind().begin(), s.failed_analyses_by_kind().end());
 
   const auto& study_variables = job.study().variables();
   const int n = std::max(s.design_names_size(), study_variables.size());

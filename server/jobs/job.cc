@@ -1,14 +1,14 @@
 #include "server/jobs/job.h"
 
+#include <cmath>
 #include <cstring>
-#include <map>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
+#include "server/jobs/analysis_gradients.h"
 #include "server/jobs/problem_from_study.h"
 #include "server/jobs/record_codec.h"
-#include "server/lp/make_clp_lp_solver.h"
 
 namespace mbopt::jobs {
 namespace {
@@ -18,14 +18,56 @@ bool SameBits(const Eigen::VectorXd& a, const std::vector<double>& b) {
          (b.empty() || std::memcmp(a.data(), b.data(), b.size() * sizeof(double)) == 0);
 }
 
+Eigen::VectorXd ToEigen(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+// "" when every value is finite, else which one is not.
+std::string FirstNonFinite(const char* what, const std::vector<double>& values) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) return absl::StrCat(what, " ", i, " is ", values[i]);
+  }
+  return "";
+}
+
+// The optimizer's view of a record: live delivery and replay give it exactly
+// this, so a resumed job sees what the first run saw.
+slp::AnalysisResult ResultOf(const AnalysisRecord& record, const slp::ProblemSpec& problem) {
+  slp::AnalysisResult result;
+  result.request_id = record.request_id;
+  result.outcome = record.ok() ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
+  result.failure_reason = record.failure.reason;
+  if (record.ok()) {
+    result.objective_terms = ToEigen(record.objective_terms);
+    result.constraint_values = ToEigen(record.constraint_values);
+    AttachGradients(problem, record.objective_gradients, record.constraint_gradients, &result);
+  }
+  return result;
+}
+
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<Job>> Job::Create(spec::Study study) {
+absl::StatusOr<std::unique_ptr<Job>> Job::Create(spec::Study study, std::unique_ptr<lp::LpSolver> lp_solver,
+                                                 std::optional<slp::SlpOptions> options) {
   MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
   MBOPT_ASSIGN_OR_RETURN(slp::ProblemSpec problem, ProblemSpecFromStudy(study, layout));
-  MBOPT_ASSIGN_OR_RETURN(slp::SlpOptions options, SlpOptionsFromStudy(study));
-  auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, lp::MakeClpLpSolver());
-  return std::unique_ptr<Job>(new Job(std::move(study), std::move(layout), options, std::move(optimizer)));
+  slp::SlpOptions settings;
+  if (options.has_value()) {
+    settings = *options;
+    MBOPT_RETURN_IF_ERROR(settings.Validate());
+  } else {
+    MBOPT_ASSIGN_OR_RETURN(settings, SlpOptionsFromStudy(study));
+  }
+  auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), settings, std::move(lp_solver));
+  return std::unique_ptr<Job>(new Job(std::move(study), std::move(layout), settings, std::move(optimizer)));
+}
+
+absl::StatusOr<std::unique_ptr<Job>> Job::CreateForProblem(slp::ProblemSpec problem, slp::SlpOptions options,
+                                                           std::unique_ptr<lp::LpSolver> lp_solver) {
+  MBOPT_RETURN_IF_ERROR(problem.Validate());
+  MBOPT_RETURN_IF_ERROR(options.Validate());
+  auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, std::move(lp_solver));
+  return std::unique_ptr<Job>(new Job(spec::Study{}, spec::StudyLayout{}, options, std::move(optimizer)));
 }
 
 Job::Job(spec::Study study, spec::StudyLayout layout, slp::SlpOptions options,
@@ -35,18 +77,86 @@ Job::Job(spec::Study study, spec::StudyLayout layout, slp::SlpOptions options,
       options_(options),
       optimizer_(std::move(optimizer)) {}
 
-absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<LoggedAnalysis>& logged,
+absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
+  const std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
+  const slp::AnalysisRequest* request = nullptr;
+  for (const slp::AnalysisRequest& r : pending) {
+    if (r.id == candidate.request_id) request = &r;
+  }
+  if (request == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("request ", candidate.request_id, " is not pending in ", study_.name));
+  }
+  AnalysisRecord record = std::move(candidate);
+  record.x_scaled.assign(request->x.data(), request->x.data() + request->x.size());
+  const slp::ProblemSpec& problem = optimizer_->spec();
+  if (record.ok()) {
+    const size_t terms = static_cast<size_t>(problem.num_objective_terms);
+    const size_t rows = static_cast<size_t>(problem.num_constraints());
+    if (record.objective_terms.size() != terms || record.constraint_values.size() != rows) {
+      return absl::InvalidArgumentError(absl::StrCat("result of request ", record.request_id, " has ",
+                                                     record.objective_terms.size(), " objective terms and ",
+                                                     record.constraint_values.size(), " constraint values; ",
+                                                     study_.name, " needs ", terms, " and ", rows));
+    }
+    std::string non_finite = FirstNonFinite("objective term", record.objective_terms);
+    if (non_finite.empty()) non_finite = FirstNonFinite("constraint value", record.constraint_values);
+    if (!non_finite.empty()) {
+      record.failure = spec::AnalysisFailure::Of(spec::FailureKind::kNonFiniteValue,
+                                                 absl::StrCat("non-finite result: ", non_finite));
+    }
+  }
+  if (!record.ok()) {
+    if (record.failure.reason.empty()) record.failure.reason = "the analysis failed";
+    record.objective_terms.clear();
+    record.constraint_values.clear();
+    record.objective_gradients.clear();
+    record.constraint_gradients.clear();
+    record.gradients_unavailable.clear();
+    return record;
+  }
+  if (!request->want_gradients) {
+    record.objective_gradients.clear();
+    record.constraint_gradients.clear();
+    record.gradients_unavailable.clear();
+    return record;
+  }
+  // Logged as the optimizer will get them: unusable gradients are none.
+  const std::string defect = GradientDefect(problem, record.objective_gradients, record.constraint_gradients);
+  if (!defect.empty()) {
+    record.gradients_unavailable = absl::StrCat("unusable gradients: ", defect);
+    record.objective_gradients.clear();
+    record.constraint_gradients.clear();
+  } else if (record.objective_gradients.empty()) {
+    if (record.gradients_unavailable.empty()) record.gradients_unavailable = "no gradients were sent";
+    record.constraint_gradients.clear();
+  } else {
+    record.gradients_unavailable.clear();
+  }
+  return record;
+}
+
+absl::StatusOr<std::vector<slp::CycleRecord>> Job::Apply(const AnalysisRecord& record) {
+  MBOPT_RETURN_IF_ERROR(optimizer_->SubmitResult(ResultOf(record, optimizer_->spec())));
+  if (!record.ok()) {
+    ++failures_by_kind_[record.failure.kind];
+    last_failure_ = record.failure;
+  }
+  return optimizer_->TakeNewRecords();
+}
+
+absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<AnalysisRecord>& logged,
                                                           const std::vector<std::string>& logged_records) {
-  std::map<std::int64_t, const LoggedAnalysis*> by_id;
-  for (const LoggedAnalysis& a : logged) by_id[a.result.request_id] = &a;
+  std::map<std::int64_t, const AnalysisRecord*> by_id;
+  for (const AnalysisRecord& a : logged) by_id[a.request_id] = &a;
   size_t next_record = 0;
   std::vector<slp::CycleRecord> unlogged;
   size_t used = 0;
   // One result at a time, re-asking the optimizer each time: a result that
   // completes a batch changes what is pending.
   while (true) {
-    const LoggedAnalysis* next = nullptr;
-    std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
+    const AnalysisRecord* next = nullptr;
+    const std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
     const slp::AnalysisRequest* request = nullptr;
     for (const slp::AnalysisRequest& r : pending) {
       auto found = by_id.find(r.id);
@@ -63,7 +173,7 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Logg
           " asks for a different design point than the logged analysis; the optimizer is not "
           "deterministic or the database comes from another build"));
     }
-    MBOPT_ASSIGN_OR_RETURN(std::vector<slp::CycleRecord> records, Submit(next->result));
+    MBOPT_ASSIGN_OR_RETURN(std::vector<slp::CycleRecord> records, Apply(*next));
     ++used;
     for (slp::CycleRecord& record : records) {
       if (next_record < logged_records.size()) {
@@ -90,9 +200,31 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Logg
   return unlogged;
 }
 
-absl::StatusOr<std::vector<slp::CycleRecord>> Job::Submit(const slp::AnalysisResult& result) {
-  MBOPT_RETURN_IF_ERROR(optimizer_->SubmitResult(result));
-  return optimizer_->TakeNewRecords();
+absl::Status Job::Run(Evaluator& evaluator, const JobRunOptions& options) {
+  while (running()) {
+    const std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
+    if (pending.empty()) return absl::InternalError("the optimizer is running but requests no analysis");
+    if (optimizer_->analyses_used() + static_cast<std::int64_t>(pending.size()) > options.max_analyses) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat(study_.name.empty() ? "the run" : study_.name, " needs more than ", options.max_analyses,
+                       " analyses"));
+    }
+    std::vector<AnalysisRecord> batch = evaluator.Evaluate(pending);
+    if (batch.size() != pending.size()) {
+      return absl::InvalidArgumentError(absl::StrCat("the evaluator answered ", batch.size(), " of ",
+                                                     pending.size(), " requests"));
+    }
+    if (options.reorder_batch) options.reorder_batch(batch);
+    for (AnalysisRecord& candidate : batch) {
+      MBOPT_ASSIGN_OR_RETURN(AnalysisRecord record, Intake(std::move(candidate)));
+      if (options.on_analysis) options.on_analysis(record);
+      MBOPT_ASSIGN_OR_RETURN(std::vector<slp::CycleRecord> records, Apply(record));
+      if (options.on_record) {
+        for (const slp::CycleRecord& r : records) options.on_record(r);
+      }
+    }
+  }
+  return absl::OkStatus();
 }
 
 std::vector<double> Job::PhysicalDesign(const Eigen::VectorXd& x_scaled) const {

@@ -143,26 +143,7 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::Tas
     response->set_accepted(status.ok());
     return absl::IsNotFound(status) ? grpc::Status::OK : ToGrpcStatus(status);
   }
-  WorkerResult result;
-  result.worker_id = request->worker_id();
-  result.task_id = request->task_id();
-  result.job_id = request->job_id();
-  result.request_id = request->request_id();
-  result.ok = request->ok();
-  result.failure_reason = request->failure_reason();
-  result.objective_terms.assign(request->objective_terms().begin(), request->objective_terms().end());
-  result.constraint_values.assign(request->constraint_values().begin(), request->constraint_values().end());
-  result.objective_gradients.assign(request->objective_gradients().begin(), request->objective_gradients().end());
-  result.constraint_gradients.assign(request->constraint_gradients().begin(),
-                                     request->constraint_gradients().end());
-  result.gradients_unavailable = request->gradients_unavailable();
-  result.wall_seconds = request->counters().wall_seconds();
-  result.counters.time_steps = request->counters().time_steps();
-  result.counters.rhs_evaluations = request->counters().rhs_evaluations();
-  result.counters.jacobian_evaluations = request->counters().jacobian_evaluations();
-  result.counters.newton_iterations = request->counters().newton_iterations();
-  result.counters.position_solves = request->counters().position_solves();
-  absl::StatusOr<bool> accepted = manager_->ReportResult(result);
+  absl::StatusOr<bool> accepted = manager_->ReportResult(WorkerReportFromProto(*request));
   if (!accepted.ok()) return ToGrpcStatus(accepted.status());
   response->set_accepted(*accepted);
   return grpc::Status::OK;

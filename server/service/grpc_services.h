@@ -8,7 +8,7 @@
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
-#include "server/service/job_manager.h"
+#include "server/jobs/manager/job_manager.h"
 
 namespace mbopt::service {
 

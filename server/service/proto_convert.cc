@@ -1,6 +1,7 @@
 #include "server/service/proto_convert.h"
 
 #include "absl/strings/str_cat.h"
+#include "spec/io/analysis_outcome_convert.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::service {
@@ -24,7 +25,28 @@ v1::JobSummary ToProto(const JobSummaryData& s) {
   out.set_message(s.message);
   out.set_created_unix_ms(s.created_unix_ms);
   out.set_max_cycles(s.max_cycles);
+  for (const auto& [kind, count] : s.failed_analyses_by_kind) (*out.mutable_failed_analyses_by_kind())[kind] = count;
   return out;
+}
+
+WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
+  WorkerReport report;
+  report.worker_id = result.worker_id();
+  report.task_id = result.task_id();
+  report.job_id = result.job_id();
+  jobs::AnalysisRecord& record = report.record;
+  record.request_id = result.request_id();
+  if (!result.ok()) {
+    record.failure = spec::AnalysisFailure::Of(spec::io::FailureKindFromProto(result.failure_kind()),
+                                               result.failure_reason());
+  }
+  record.objective_terms.assign(result.objective_terms().begin(), result.objective_terms().end());
+  record.constraint_values.assign(result.constraint_values().begin(), result.constraint_values().end());
+  record.objective_gradients.assign(result.objective_gradients().begin(), result.objective_gradients().end());
+  record.constraint_gradients.assign(result.constraint_gradients().begin(), result.constraint_gradients().end());
+  record.gradients_unavailable = result.gradients_unavailable();
+  record.counters = spec::io::CountersFromProto(result.counters());
+  return report;
 }
 
 namespace {

@@ -8,7 +8,7 @@
 #include "absl/status/statusor.h"
 #include "mbopt/v1/service.pb.h"
 #include "mbopt/v1/study.pb.h"
-#include "server/service/job_manager.h"
+#include "server/jobs/manager/job_manager.h"
 #include "spec/study.h"
 
 namespace mbopt::service {
@@ -18,6 +18,10 @@ v1::JobSummary ToProto(const JobSummaryData& summary);
 // `row_names` and `variable_scales` as in JobView.
 v1::CycleRecord ToProto(const slp::CycleRecord& record, const std::vector<std::string>& row_names,
                         const std::vector<double>& variable_scales);
+
+// A worker's result as the job manager takes it (the job's intake then
+// validates the record).
+WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
 
 // The study decoder of the job manager: binary mbopt.v1.Study -> validated
 // study (spec/io), InvalidArgument with the loader's message.

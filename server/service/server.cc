@@ -1,11 +1,14 @@
 #include "server/service/server.h"
 
+#include "server/lp/make_clp_lp_solver.h"
+
 #include <algorithm>
 #include <chrono>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
+#include "server/lp/make_clp_lp_solver.h"
 #include "server/service/proto_convert.h"
 
 namespace mbopt::service {
@@ -35,7 +38,10 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   MBOPT_RETURN_IF_ERROR(scheduler_options.Validate());
   MBOPT_ASSIGN_OR_RETURN(s.store_, store::Store::Open(s.options_.db_path));
   s.scheduler_ = std::make_unique<scheduler::Scheduler>(s.clock_, scheduler_options);
-  s.manager_ = std::make_unique<JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, s.options_.manager);
+  JobManagerOptions manager_options = s.options_.manager;
+  if (manager_options.clock == nullptr) manager_options.clock = s.clock_;
+  if (!manager_options.make_lp_solver) manager_options.make_lp_solver = [] { return lp::MakeClpLpSolver(); };
+  s.manager_ = std::make_unique<JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, manager_options);
   MBOPT_RETURN_IF_ERROR(s.manager_->Start());
 
   s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get());

@@ -24,7 +24,7 @@
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
 #include "server/service/grpc_services.h"
-#include "server/service/job_manager.h"
+#include "server/jobs/manager/job_manager.h"
 #include "server/store/store.h"
 
 namespace mbopt::service {

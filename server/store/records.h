@@ -1,5 +1,6 @@
-// The rows of the job database as plain structs. The store does not know
-// protobuf or the SLP core: studies and cycle records arrive as opaque bytes
+// The rows of the job database as plain structs. Analyses are stored as the
+// server's one analysis record (server/jobs/analysis_record.h). The store
+// does not know protobuf or the SLP core: studies and cycle records arrive as opaque bytes
 // serialized by the layers that own their formats (the service serializes the
 // study as a binary mbopt.v1.Study; server/jobs encodes cycle records), and
 // the store keeps them bit for bit. Doubles of analyses are kept exactly
@@ -29,37 +30,6 @@ struct JobRow {
   double wall_seconds = 0;      // running time, not counting interruptions
 };
 
-struct AnalysisCounters {
-  std::int64_t time_steps = 0;
-  std::int64_t rhs_evaluations = 0;
-  std::int64_t jacobian_evaluations = 0;
-  std::int64_t newton_iterations = 0;
-  std::int64_t position_solves = 0;
-};
-
-// One analysis result as it was handed to the optimizer.
-struct AnalysisRow {
-  std::string job_id;
-  std::int64_t request_id = 0;
-  std::vector<double> x_scaled;
-  bool ok = false;
-  std::string failure_reason;
-  std::vector<double> objective_terms;
-  std::vector<double> constraint_values;
-  // Simulator sensitivities, when the analysis was asked for them and gave
-  // them: d(value)/d(x_scaled), row-major (one row per objective term, resp.
-  // constraint row; one column per design variable). Both empty: none, and
-  // gradients_unavailable may say why. Kept bit for bit like the values:
-  // a replay hands the optimizer the same gradients again.
-  std::vector<double> objective_gradients;
-  std::vector<double> constraint_gradients;
-  std::string gradients_unavailable;
-  std::string worker;           // worker id, or "" for a server-side failure
-  double wall_seconds = 0;      // the analysis' own running time
-  std::int32_t attempts = 1;    // attempts it took (leases given out)
-  AnalysisCounters counters;
-  std::int64_t committed_unix_ms = 0;
-};
 
 // One cycle record (one LP solve and its trial point) of a job.
 struct CycleRow {

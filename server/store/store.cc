@@ -3,6 +3,7 @@
 #include <sqlite3.h>
 
 #include <chrono>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -90,6 +91,13 @@ ALTER TABLE analyses ADD COLUMN objective_gradients BLOB NOT NULL DEFAULT x'';
 ALTER TABLE analyses ADD COLUMN constraint_gradients BLOB NOT NULL DEFAULT x'';
 ALTER TABLE analyses ADD COLUMN gradients_unavailable TEXT NOT NULL DEFAULT '';
 UPDATE schema_version SET version = 2;
+)sql",
+    // 2 -> 3: the failure kind of each analysis (spec/analysis_outcome.h
+    // names). Failed rows of version 2 predate kinds: "unclassified".
+    R"sql(
+ALTER TABLE analyses ADD COLUMN failure_kind TEXT NOT NULL DEFAULT 'ok';
+UPDATE analyses SET failure_kind = 'unclassified' WHERE ok = 0;
+UPDATE schema_version SET version = 3;
 )sql",
 };
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kSchemaVersion - 1,
@@ -325,7 +333,7 @@ absl::Status Store::SetJobState(const std::string& job_id, const std::string& st
   return absl::OkStatus();
 }
 
-absl::Status Store::AddAnalysis(const AnalysisRow& a) {
+absl::Status Store::AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& a) {
   std::lock_guard<std::mutex> lock(mutex_);
   MBOPT_ASSIGN_OR_RETURN(
       Statement stmt,
@@ -333,36 +341,37 @@ absl::Status Store::AddAnalysis(const AnalysisRow& a) {
                          "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
                          "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
                          "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
-                         "objective_gradients, constraint_gradients, gradients_unavailable) "
-                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
-  stmt.BindText(1, a.job_id);
+                         "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind) "
+                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
+  stmt.BindText(1, job_id);
   stmt.BindInt(2, a.request_id);
   stmt.BindBlob(3, EncodeDoubles(a.x_scaled));
-  stmt.BindInt(4, a.ok ? 1 : 0);
-  stmt.BindText(5, a.failure_reason);
+  stmt.BindInt(4, a.ok() ? 1 : 0);
+  stmt.BindText(5, a.failure.reason);
   stmt.BindBlob(6, EncodeDoubles(a.objective_terms));
   stmt.BindBlob(7, EncodeDoubles(a.constraint_values));
   stmt.BindText(8, a.worker);
-  stmt.BindDouble(9, a.wall_seconds);
+  stmt.BindDouble(9, a.counters.wall_seconds);
   stmt.BindInt(10, a.attempts);
   stmt.BindInt(11, a.counters.time_steps);
   stmt.BindInt(12, a.counters.rhs_evaluations);
   stmt.BindInt(13, a.counters.jacobian_evaluations);
   stmt.BindInt(14, a.counters.newton_iterations);
   stmt.BindInt(15, a.counters.position_solves);
-  stmt.BindInt(16, a.committed_unix_ms != 0 ? a.committed_unix_ms : NowUnixMs());
+  stmt.BindInt(16, NowUnixMs());
   stmt.BindBlob(17, EncodeDoubles(a.objective_gradients));
   stmt.BindBlob(18, EncodeDoubles(a.constraint_gradients));
   stmt.BindText(19, a.gradients_unavailable);
+  stmt.BindText(20, spec::FailureKindName(a.failure.kind));
   absl::Status status = stmt.Run();
   if (absl::IsAlreadyExists(status)) {
-    return absl::AlreadyExistsError(absl::StrCat("job '", a.job_id, "' already has a result for request ",
+    return absl::AlreadyExistsError(absl::StrCat("job '", job_id, "' already has a result for request ",
                                                  a.request_id, " (or the job does not exist)"));
   }
   return status;
 }
 
-absl::StatusOr<std::vector<AnalysisRow>> Store::LoadAnalyses(const std::string& job_id) {
+absl::StatusOr<std::vector<jobs::AnalysisRecord>> Store::LoadAnalyses(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
   MBOPT_ASSIGN_OR_RETURN(
       Statement stmt,
@@ -370,30 +379,33 @@ absl::StatusOr<std::vector<AnalysisRow>> Store::LoadAnalyses(const std::string& 
                          "SELECT request_id, x_scaled, ok, failure_reason, objective_terms, constraint_values, "
                          "worker, wall_seconds, attempts, time_steps, rhs_evaluations, jacobian_evaluations, "
                          "newton_iterations, position_solves, committed_unix_ms, objective_gradients, "
-                         "constraint_gradients, gradients_unavailable "
+                         "constraint_gradients, gradients_unavailable, failure_kind "
                          "FROM analyses WHERE job_id = ? ORDER BY request_id"));
   stmt.BindText(1, job_id);
-  std::vector<AnalysisRow> rows;
+  std::vector<jobs::AnalysisRecord> rows;
   while (true) {
     MBOPT_ASSIGN_OR_RETURN(bool more, stmt.Step());
     if (!more) break;
-    AnalysisRow a;
-    a.job_id = job_id;
+    jobs::AnalysisRecord a;
     a.request_id = stmt.ColumnInt(0);
     MBOPT_ASSIGN_OR_RETURN(a.x_scaled, DecodeDoubles(stmt.ColumnBlob(1)));
-    a.ok = stmt.ColumnInt(2) != 0;
-    a.failure_reason = stmt.ColumnText(3);
+    const bool ok = stmt.ColumnInt(2) != 0;
+    const std::optional<spec::FailureKind> kind = spec::ParseFailureKind(stmt.ColumnText(18));
+    if (!kind.has_value() || (*kind == spec::FailureKind::kNone) != ok) {
+      return absl::DataLossError(absl::StrCat("analysis ", a.request_id, " of job '", job_id, "' in ", path_,
+                                              " has failure kind '", stmt.ColumnText(18), "' with ok = ", ok));
+    }
+    a.failure = spec::AnalysisFailure::Of(*kind, stmt.ColumnText(3));
     MBOPT_ASSIGN_OR_RETURN(a.objective_terms, DecodeDoubles(stmt.ColumnBlob(4)));
     MBOPT_ASSIGN_OR_RETURN(a.constraint_values, DecodeDoubles(stmt.ColumnBlob(5)));
     a.worker = stmt.ColumnText(6);
-    a.wall_seconds = stmt.ColumnDouble(7);
+    a.counters.wall_seconds = stmt.ColumnDouble(7);
     a.attempts = static_cast<std::int32_t>(stmt.ColumnInt(8));
     a.counters.time_steps = stmt.ColumnInt(9);
     a.counters.rhs_evaluations = stmt.ColumnInt(10);
     a.counters.jacobian_evaluations = stmt.ColumnInt(11);
     a.counters.newton_iterations = stmt.ColumnInt(12);
     a.counters.position_solves = stmt.ColumnInt(13);
-    a.committed_unix_ms = stmt.ColumnInt(14);
     MBOPT_ASSIGN_OR_RETURN(a.objective_gradients, DecodeDoubles(stmt.ColumnBlob(15)));
     MBOPT_ASSIGN_OR_RETURN(a.constraint_gradients, DecodeDoubles(stmt.ColumnBlob(16)));
     a.gradients_unavailable = stmt.ColumnText(17);

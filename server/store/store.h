@@ -20,6 +20,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "server/jobs/analysis_record.h"
 #include "server/store/records.h"
 
 struct sqlite3;
@@ -29,7 +30,7 @@ namespace mbopt::store {
 // The schema version this code writes. A database with a newer version is
 // refused; older versions are migrated on open (docs/store.md lists the
 // versions and their migrations).
-inline constexpr int kSchemaVersion = 2;
+inline constexpr int kSchemaVersion = 3;
 // PRAGMA application_id of an mbopt database ("mbop").
 inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 
@@ -56,8 +57,8 @@ class Store {
 
   // Commits one analysis result (its own transaction). AlreadyExists if the
   // job already has a result for that request id.
-  absl::Status AddAnalysis(const AnalysisRow& analysis);
-  absl::StatusOr<std::vector<AnalysisRow>> LoadAnalyses(const std::string& job_id);  // by request id
+  absl::Status AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& analysis);
+  absl::StatusOr<std::vector<jobs::AnalysisRecord>> LoadAnalyses(const std::string& job_id);  // by request id
 
   // Commits `records` (appended to the job's record log, indices assigned in
   // order after the existing ones) and `progress` in ONE transaction.

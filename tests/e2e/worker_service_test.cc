@@ -69,6 +69,7 @@ TEST(TaskEvaluator, WrongDimensionIsAFailedResultNotACrash) {
   EXPECT_FALSE(result.ok());
   EXPECT_NE(result.failure_reason().find("design variables"), std::string::npos)
       << result.failure_reason();
+  EXPECT_EQ(result.failure_kind(), v1::ANALYSIS_FAILURE_SERVICE);
 }
 
 TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
@@ -88,6 +89,8 @@ TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
   EvaluateTask(**prepared, TaskAt(huge), &overflow);
   EXPECT_FALSE(overflow.ok());
   EXPECT_FALSE(overflow.failure_reason().empty());
+  // A kind the server can count: never "unspecified" for a failed result.
+  EXPECT_NE(overflow.failure_kind(), v1::ANALYSIS_FAILURE_KIND_UNSPECIFIED) << overflow.failure_reason();
 }
 
 TEST(TaskEvaluator, NoGradientsUnlessTheTaskAsks) {

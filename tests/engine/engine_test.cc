@@ -11,6 +11,11 @@
 namespace mbopt::engine {
 namespace {
 
+using spec::AnalysisReport;
+using spec::Formulation;
+using spec::FormulationName;
+using spec::OutputValues;
+
 using ::testing::HasSubstr;
 
 spec::Study Vehicle() {
@@ -29,7 +34,7 @@ TEST(Engine, FormulationNamesAreStable) {
 TEST(Engine, LumpedSceneIsADynamicAnalysisWithCountersAndWallTime) {
   const spec::Study study = Vehicle();
   const AnalysisReport r = Analyze(study.scene, study.scene.DefaultParameterValues());
-  ASSERT_EQ(r.status, AnalysisStatus::kOk) << r.failure_reason;
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
   EXPECT_EQ(r.formulation, Formulation::kDynamic);
   EXPECT_EQ(r.times_s.size(), 101u);
   EXPECT_GT(r.counters.time_steps, 0);
@@ -43,8 +48,9 @@ TEST(Engine, LumpedSceneIsADynamicAnalysisWithCountersAndWallTime) {
 TEST(Engine, WrongNumberOfParameterValuesIsAFailedAnalysis) {
   const spec::Study study = Vehicle();
   const AnalysisReport r = Analyze(study.scene, {1.0, 2.0});
-  EXPECT_EQ(r.status, AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, HasSubstr("parameter values"));
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(r.failure.reason, HasSubstr("parameter values"));
 }
 
 TEST(Engine, AnalysesAreDeterministic) {
@@ -52,7 +58,7 @@ TEST(Engine, AnalysesAreDeterministic) {
   const auto p = study.scene.DefaultParameterValues();
   const AnalysisReport a = Analyze(study.scene, p);
   const AnalysisReport b = Analyze(study.scene, p);
-  ASSERT_EQ(a.status, AnalysisStatus::kOk);
+  ASSERT_TRUE(a.ok());
   // Bit identity is the point: resumed optimizations replay analyses.
   EXPECT_EQ(a.outputs[0].series, b.outputs[0].series);
 }
@@ -62,8 +68,7 @@ TEST(StudyValuesOfReport, FailedAnalysisIsFailedPreconditionWithItsReason) {
   auto layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok());
   AnalysisReport failed;
-  failed.status = AnalysisStatus::kFailed;
-  failed.failure_reason = "integrator failed near t = 1";
+  failed.Fail(spec::FailureKind::kIntegrator, "integrator failed near t = 1");
   auto values = ComputeStudyValues(study, *layout, failed);
   EXPECT_EQ(values.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(values.status().message()), HasSubstr("integrator failed near t = 1"));

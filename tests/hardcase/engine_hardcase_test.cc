@@ -1,5 +1,5 @@
 // Hard cases where the physics is the point: studies run through the
-// analysis engine with RunStudyLocally (server/local_run). Each test says
+// analysis engine with RunStudyLocally (worker/local_run). Each test says
 // what it checks and with what tolerance. Every run must end in a named
 // state with finite numbers; a design that cannot be analysed must come back
 // as a failed analysis with a reason, never as a crash or a NaN result.
@@ -13,8 +13,8 @@
 
 #include <gtest/gtest.h>
 
-#include "server/local_run/evaluate_design.h"
-#include "server/local_run/local_run.h"
+#include "worker/engine/analysis.h"
+#include "worker/local_run/local_run.h"
 #include "spec/io/study_io.h"
 #include "tests/hardcase/analytic_problems.h"
 #include "worker/solve/lumped_dynamics.h"
@@ -92,10 +92,10 @@ TEST(HardcaseStiffVehicle, StiffTyresAnalyseAndOptimizeToAFiniteEnd) {
 
   absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok()) << layout.status();
-  absl::StatusOr<local_run::DesignEvaluation> x0 = local_run::EvaluateDesign(study, *layout, InitialDesign(study));
+  absl::StatusOr<engine::StudyEvaluation> x0 = local_run::EvaluateDesign(study, *layout, InitialDesign(study));
   ASSERT_TRUE(x0.ok()) << x0.status();
-  ASSERT_TRUE(x0->ok()) << x0->failure_reason;
-  EXPECT_EQ(x0->formulation, engine::Formulation::kDynamic);
+  ASSERT_TRUE(x0->ok()) << x0->failure.reason;
+  EXPECT_EQ(x0->formulation, spec::Formulation::kDynamic);
   EXPECT_GT(x0->counters.jacobian_evaluations, 0);
   EXPECT_TRUE(std::isfinite(x0->values->objective));
 
@@ -105,13 +105,13 @@ TEST(HardcaseStiffVehicle, StiffTyresAnalyseAndOptimizeToAFiniteEnd) {
   const Eigen::VectorXd x0_scaled = InitialDesign(study);
   const std::vector<double> x0_parameters =
       study.ParameterValuesAt(std::vector<double>(x0_scaled.data(), x0_scaled.data() + x0_scaled.size()));
-  const engine::AnalysisReport adams = solve::SimulateLumped(study.scene, x0_parameters, explicit_like);
+  const spec::AnalysisReport adams = solve::SimulateLumped(study.scene, x0_parameters, explicit_like);
   std::cout << "[hardcase] stiff vehicle x0: F " << x0->values->objective << ", BDF time steps "
             << x0->counters.time_steps << ", jacobians " << x0->counters.jacobian_evaluations << ", wall "
             << x0->counters.wall_seconds << " s; Adams/fixed-point: "
-            << (adams.status == engine::AnalysisStatus::kOk ? "ok" : adams.failure_reason) << ", time steps "
+            << (adams.ok() ? "ok" : adams.failure.reason) << ", time steps "
             << adams.counters.time_steps << "\n";
-  EXPECT_TRUE(adams.status != engine::AnalysisStatus::kOk ||
+  EXPECT_TRUE(!adams.ok() ||
               adams.counters.time_steps >= 5 * x0->counters.time_steps);
 
   const local_run::LocalRunResult run = RunLocally(study);
@@ -135,17 +135,17 @@ TEST(HardcaseLock, DesignPastTheLockFailsNamingTimeAndJoint) {
   absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok()) << layout.status();
 
-  absl::StatusOr<local_run::DesignEvaluation> before = local_run::EvaluateDesign(study, *layout, Eigen::VectorXd::Constant(1, 0.7));
+  absl::StatusOr<engine::StudyEvaluation> before = local_run::EvaluateDesign(study, *layout, Eigen::VectorXd::Constant(1, 0.7));
   ASSERT_TRUE(before.ok()) << before.status();
-  EXPECT_TRUE(before->ok()) << before->failure_reason;
+  EXPECT_TRUE(before->ok()) << before->failure.reason;
 
-  absl::StatusOr<local_run::DesignEvaluation> past = local_run::EvaluateDesign(study, *layout, Eigen::VectorXd::Constant(1, 1.0));
+  absl::StatusOr<engine::StudyEvaluation> past = local_run::EvaluateDesign(study, *layout, Eigen::VectorXd::Constant(1, 1.0));
   ASSERT_TRUE(past.ok()) << past.status();
   EXPECT_FALSE(past->ok());
   EXPECT_FALSE(past->values.has_value());
-  EXPECT_NE(past->failure_reason.find("t = "), std::string::npos) << past->failure_reason;
-  EXPECT_NE(past->failure_reason.find("J"), std::string::npos) << past->failure_reason;
-  std::cout << "[hardcase] lock: theta = 1.0 rad: " << past->failure_reason << "\n";
+  EXPECT_NE(past->failure.reason.find("t = "), std::string::npos) << past->failure.reason;
+  EXPECT_NE(past->failure.reason.find("J"), std::string::npos) << past->failure.reason;
+  std::cout << "[hardcase] lock: theta = 1.0 rad: " << past->failure.reason << "\n";
 }
 
 TEST(HardcaseLock, TrialsPastTheLockAreRejectedAndTheRunEndsOnTheBoundary) {
@@ -198,8 +198,8 @@ TEST(HardcaseLock, StartAtTheLockEdgeEndsHandled) {
   EXPECT_TRUE(run.outcome.state == slp::RunState::kConverged || run.outcome.state == slp::RunState::kStalled)
       << slp::RunStateName(run.outcome.state);
   int failed_perturbations = 0, failed_trials = 0;
-  for (const slp::AnalysisResult& result : run.outcome.results) {
-    if (result.outcome != slp::AnalysisOutcome::kFailed) continue;
+  for (const jobs::AnalysisRecord& result : run.outcome.results) {
+    if (result.ok()) continue;
     if (purpose[result.request_id] == slp::RequestPurpose::kPerturbation) ++failed_perturbations;
     if (purpose[result.request_id] == slp::RequestPurpose::kTrial) ++failed_trials;
   }
@@ -250,11 +250,11 @@ TEST(HardcaseLock, NearGrashofLimitFollowsTheBranchOrFailsNamed) {
     joints[2].position_m.x.value = j3.x();
     joints[2].position_m.y.value = j3.y();
 
-    const engine::AnalysisReport report = engine::Analyze(scene, scene.DefaultParameterValues());
-    if (report.status != engine::AnalysisStatus::kOk) {
-      std::cout << "[hardcase] near-Grashof four-bar, margin " << margin << " m: failed: " << report.failure_reason
+    const spec::AnalysisReport report = engine::Analyze(scene, scene.DefaultParameterValues());
+    if (!report.ok()) {
+      std::cout << "[hardcase] near-Grashof four-bar, margin " << margin << " m: failed: " << report.failure.reason
                 << "\n";
-      EXPECT_NE(report.failure_reason.find("t = "), std::string::npos) << report.failure_reason;
+      EXPECT_NE(report.failure.reason.find("t = "), std::string::npos) << report.failure.reason;
       continue;
     }
     ASSERT_EQ(report.outputs.size(), 4u);
@@ -328,10 +328,10 @@ TEST(HardcaseDegenerateLp, VehicleOn1001PointGridSolvesEveryLpAndConverges) {
   ASSERT_EQ(coarse_run.outcome.state, slp::RunState::kConverged);
   absl::StatusOr<spec::StudyLayout> dense_layout = spec::MakeStudyLayout(dense);
   ASSERT_TRUE(dense_layout.ok()) << dense_layout.status();
-  absl::StatusOr<local_run::DesignEvaluation> recheck =
+  absl::StatusOr<engine::StudyEvaluation> recheck =
       local_run::EvaluateDesign(dense, *dense_layout, coarse_run.outcome.design);
   ASSERT_TRUE(recheck.ok()) << recheck.status();
-  ASSERT_TRUE(recheck->ok()) << recheck->failure_reason;
+  ASSERT_TRUE(recheck->ok()) << recheck->failure.reason;
   const double coarse_optimum_on_dense_grid = recheck->values->objective;
 
   const local_run::LocalRunResult run = RunLocally(dense);

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "server/lp/make_clp_lp_solver.h"
-#include "server/slp/run_to_completion.h"
+#include "tests/slp_testing/drive_optimizer.h"
 #include "server/slp/slp_optimizer.h"
 #include "tests/hardcase/analytic_problems.h"
 

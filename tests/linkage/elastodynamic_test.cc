@@ -31,16 +31,16 @@ constexpr double kPointwiseFraction = 2e-3;
 constexpr double kPeakFraction = 1.5e-3;
 
 TEST(ElasticFourBar, StiffLinksApproachKinetostaticStresses) {
-  const engine::AnalysisReport rigid = solve::AnalyzeLinkage(FourBarScene(), kReportOptimum);
-  ASSERT_EQ(rigid.status, engine::AnalysisStatus::kOk) << rigid.failure_reason;
+  const spec::AnalysisReport rigid = solve::AnalyzeLinkage(FourBarScene(), kReportOptimum);
+  ASSERT_TRUE(rigid.ok()) << rigid.failure.reason;
   FourBarOptions stiff;
   stiff.elements = 6;
   stiff.youngs_modulus_pa *= 100;
   stiff.rotary_inertia = false;
   stiff.damping = true;
-  const engine::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(stiff), kReportOptimum);
-  ASSERT_EQ(elastic.status, engine::AnalysisStatus::kOk) << elastic.failure_reason;
-  EXPECT_EQ(elastic.formulation, engine::Formulation::kElastodynamic);
+  const spec::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(stiff), kReportOptimum);
+  ASSERT_TRUE(elastic.ok()) << elastic.failure.reason;
+  EXPECT_EQ(elastic.formulation, spec::Formulation::kElastodynamic);
   EXPECT_GT(elastic.counters.time_steps, 0);
   EXPECT_GT(elastic.counters.rhs_evaluations, 0);
   for (size_t link = 0; link < 3; ++link) {
@@ -83,8 +83,8 @@ TEST(ElasticFourBar, ReportOptimumHasEveryLinkNearTheAllowableStress) {
   report.elements = 6;
   report.rotary_inertia = true;
   report.damping = true;
-  const engine::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(report), kReportOptimum);
-  ASSERT_EQ(elastic.status, engine::AnalysisStatus::kOk) << elastic.failure_reason;
+  const spec::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(report), kReportOptimum);
+  ASSERT_TRUE(elastic.ok()) << elastic.failure.reason;
   for (size_t link = 0; link < 3; ++link) {
     double peak = 0.0;
     for (const auto& node : elastic.outputs[link].series) {
@@ -102,10 +102,10 @@ TEST(ElasticFourBar, RepeatedAnalysesAreBitIdentical) {
   o.rotary_inertia = true;
   o.damping = true;
   const spec::Scene scene = FourBarScene(o);
-  const engine::AnalysisReport first = solve::AnalyzeLinkage(scene, kReportOptimum);
-  const engine::AnalysisReport second = solve::AnalyzeLinkage(scene, kReportOptimum);
-  ASSERT_EQ(first.status, engine::AnalysisStatus::kOk) << first.failure_reason;
-  ASSERT_EQ(second.status, engine::AnalysisStatus::kOk) << second.failure_reason;
+  const spec::AnalysisReport first = solve::AnalyzeLinkage(scene, kReportOptimum);
+  const spec::AnalysisReport second = solve::AnalyzeLinkage(scene, kReportOptimum);
+  ASSERT_TRUE(first.ok()) << first.failure.reason;
+  ASSERT_TRUE(second.ok()) << second.failure.reason;
   EXPECT_EQ(first.counters.time_steps, second.counters.time_steps);
   ASSERT_EQ(first.outputs.size(), second.outputs.size());
   for (size_t k = 0; k < first.outputs.size(); ++k) {
@@ -118,9 +118,10 @@ TEST(ElasticFourBar, RigidLinkInFlexibleLinkageIsReported) {
   o.elements = 6;
   spec::Scene scene = FourBarScene(o);
   std::get<spec::LinkageModel>(scene.model).links[2].flexible_elements = 0;
-  const engine::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("link 'rocker'"));
+  const spec::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("link 'rocker'"));
 }
 
 TEST(ElasticFourBar, IntegratorGivingUpIsAFailedAnalysisNamingTheTime) {
@@ -128,9 +129,10 @@ TEST(ElasticFourBar, IntegratorGivingUpIsAFailedAnalysisNamingTheTime) {
   o.elements = 6;
   spec::Scene scene = FourBarScene(o);
   scene.integrator.max_steps = 50;  // far too few for 0.5 s
-  const engine::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("elastodynamic integration failed before t = 0.3 s"));
+  const spec::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kIntegrator);
+  EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("elastodynamic integration failed before t = 0.3 s"));
   EXPECT_TRUE(r.outputs.empty());
 }
 
@@ -143,10 +145,11 @@ TEST(ElasticFourBar, LinkBucklingIsAFailedAnalysisNamingTheLink) {
   o.elements = 6;
   o.rotary_inertia = true;
   o.damping = true;
-  const engine::AnalysisReport r = solve::AnalyzeLinkage(FourBarScene(o), {1e-4, 2e-5, 2e-5});
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("link 'coupler'"));
-  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("Euler buckling load"));
+  const spec::AnalysisReport r = solve::AnalyzeLinkage(FourBarScene(o), {1e-4, 2e-5, 2e-5});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kModelValidity);
+  EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("link 'coupler'"));
+  EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("Euler buckling load"));
   EXPECT_TRUE(r.outputs.empty());
 }
 
@@ -155,9 +158,9 @@ TEST(ElasticFourBar, KinematicOutputsOfFlexibleLinkageNeedNoIntegration) {
   o.elements = 6;
   spec::Scene scene = FourBarScene(o);
   scene.outputs = {linkage_testing::JointOutput("B_y", 2, spec::Axis::kY)};
-  const engine::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
-  EXPECT_EQ(r.formulation, engine::Formulation::kKinematic);
+  const spec::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  EXPECT_EQ(r.formulation, spec::Formulation::kKinematic);
   EXPECT_EQ(r.counters.time_steps, 0);
 }
 

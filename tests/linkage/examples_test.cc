@@ -16,21 +16,21 @@ std::string Example(const std::string& relative) {
   return std::string(MBOPT_SOURCE_DIR) + "/examples/" + relative;
 }
 
-engine::AnalysisReport AnalyzeInitial(const spec::Study& study) {
+spec::AnalysisReport AnalyzeInitial(const spec::Study& study) {
   std::vector<double> x;
   for (const spec::DesignVariable& v : study.variables) x.push_back(v.initial);
   return solve::AnalyzeLinkage(study.scene, study.ParameterValuesAt(x));
 }
 
-const engine::OutputValues& Output(const engine::AnalysisReport& r, const std::string& name) {
-  for (const engine::OutputValues& o : r.outputs) {
+const spec::OutputValues& Output(const spec::AnalysisReport& r, const std::string& name) {
+  for (const spec::OutputValues& o : r.outputs) {
     if (o.name == name) return o;
   }
   ADD_FAILURE() << "no output " << name;
   return r.outputs.front();
 }
 
-double MaxAbs(const engine::OutputValues& o) {
+double MaxAbs(const spec::OutputValues& o) {
   double m = 0.0;
   for (const auto& s : o.series)
     for (double v : s) m = std::max(m, std::abs(v));
@@ -40,8 +40,8 @@ double MaxAbs(const engine::OutputValues& o) {
 TEST(LinkageExamples, LandingGearStudyGivesInitialObjective) {
   auto study = spec::io::LoadStudyFile(Example("landing_gear/landing_gear.study.textproto"));
   ASSERT_TRUE(study.ok()) << study.status();
-  const engine::AnalysisReport r = AnalyzeInitial(*study);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
+  const spec::AnalysisReport r = AnalyzeInitial(*study);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
   const double py = Output(r, "P_y").series[0].back() * 1e3;
   const double pz = Output(r, "P_z").series[0].back() * 1e3;
   const double dphi = Output(r, "gear_rotation").series[0].back();
@@ -60,9 +60,9 @@ TEST(LinkageExamples, RigidFourBarStudyGivesInitialCheckValues) {
   // scene's grid); the study file optimizes on 1001.
   EXPECT_EQ(study->scene.time_grid.points, 1001);
   study->scene.time_grid.points = 101;
-  const engine::AnalysisReport r = AnalyzeInitial(*study);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
-  EXPECT_EQ(r.formulation, engine::Formulation::kKinetostatic);
+  const spec::AnalysisReport r = AnalyzeInitial(*study);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  EXPECT_EQ(r.formulation, spec::Formulation::kKinetostatic);
   EXPECT_NEAR(Output(r, "mass").series[0][0], 546.2168, 1e-3);
   EXPECT_NEAR(MaxAbs(Output(r, "stress_crank")) / 2.758e7, 0.2548, 6e-5);
   EXPECT_NEAR(MaxAbs(Output(r, "stress_coupler")) / 2.758e7, 0.0640, 6e-5);
@@ -76,17 +76,17 @@ TEST(LinkageExamples, RigidFourBarStudyGivesInitialCheckValues) {
 TEST(LinkageExamples, ElasticFourBarStudyAnalysesInitialDesign) {
   auto study = spec::io::LoadStudyFile(Example("fourbar/fourbar_elastic.study.textproto"));
   ASSERT_TRUE(study.ok()) << study.status();
-  const engine::AnalysisReport r = AnalyzeInitial(*study);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
-  EXPECT_EQ(r.formulation, engine::Formulation::kElastodynamic);
+  const spec::AnalysisReport r = AnalyzeInitial(*study);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  EXPECT_EQ(r.formulation, spec::Formulation::kElastodynamic);
   EXPECT_GT(r.counters.time_steps, 0);
   spec::Study rigid = *study;
   for (spec::Link& l : std::get<spec::LinkageModel>(rigid.scene.model).links) {
     l.flexible_elements = 0;
   }
-  const engine::AnalysisReport k = AnalyzeInitial(rigid);
-  ASSERT_EQ(k.status, engine::AnalysisStatus::kOk) << k.failure_reason;
-  EXPECT_EQ(k.formulation, engine::Formulation::kKinetostatic);
+  const spec::AnalysisReport k = AnalyzeInitial(rigid);
+  ASSERT_TRUE(k.ok()) << k.failure.reason;
+  EXPECT_EQ(k.formulation, spec::Formulation::kKinetostatic);
   for (const char* name : {"stress_crank", "stress_coupler", "stress_rocker"}) {
     const double rigid_peak = MaxAbs(Output(k, name));
     EXPECT_NEAR(MaxAbs(Output(r, name)), rigid_peak, 5e-3 * rigid_peak) << name;

@@ -38,7 +38,7 @@ TEST(KinematicSolver, FourBarFollowsFreudensteinClosedForm) {
                                    std::vector<double>{0.1, 0.1, 0.1});
   ASSERT_TRUE(sys.ok()) << sys.status();
   solve::KinematicSolver kin(*sys);
-  ASSERT_TRUE(kin.Start().ok);
+  ASSERT_TRUE(kin.Start().ok());
   const double a = linkage_testing::kCrankM, b = linkage_testing::kCouplerM,
                c = linkage_testing::kRockerM, d = linkage_testing::kGroundM;
   const double w2 = 10 * std::numbers::pi;
@@ -46,7 +46,7 @@ TEST(KinematicSolver, FourBarFollowsFreudensteinClosedForm) {
   int root_sign = 0;
   for (int i = 0; i <= 50; ++i) {
     const double t = 0.004 * i;  // one revolution in 0.2 s
-    ASSERT_TRUE(kin.AdvanceTo(t).ok);
+    ASSERT_TRUE(kin.AdvanceTo(t).ok());
     const solve::LinkageState& s = kin.state();
     const double th2 = -std::numbers::pi / 2 + w2 * t;
     const double th3 = s.LinkAngle(sys->links[1]);
@@ -89,11 +89,11 @@ struct GearCheck {
   double f, py, pz, dphi;
 };
 
-GearCheck EvaluateGear(const std::vector<double>& design, engine::AnalysisReport* report) {
+GearCheck EvaluateGear(const std::vector<double>& design, spec::AnalysisReport* report) {
   const spec::Scene scene = LandingGearScene();
   *report = solve::AnalyzeLinkage(scene, LandingGearDesign(design));
-  EXPECT_EQ(report->status, engine::AnalysisStatus::kOk) << report->failure_reason;
-  if (report->status != engine::AnalysisStatus::kOk) return {};
+  EXPECT_TRUE(report->ok()) << report->failure.reason;
+  if (!report->ok()) return {};
   const double py = report->outputs[0].series[0].back() * 1e3;
   const double pz = report->outputs[1].series[0].back() * 1e3;
   const double dphi = report->outputs[2].series[0].back();
@@ -103,7 +103,7 @@ GearCheck EvaluateGear(const std::vector<double>& design, engine::AnalysisReport
 }
 
 TEST(LandingGear, InitialDesignReproducesCheckValues) {
-  engine::AnalysisReport report;
+  spec::AnalysisReport report;
   const GearCheck g = EvaluateGear({100, 110, 130, 110, 160, 155, 180, 100, -2.0}, &report);
   EXPECT_NEAR(g.f, 112.43, 0.006);
   EXPECT_NEAR(g.py, 109.04, kMmTol);
@@ -112,7 +112,7 @@ TEST(LandingGear, InitialDesignReproducesCheckValues) {
 }
 
 TEST(LandingGear, ReportOptimumReproducesCheckValues) {
-  engine::AnalysisReport report;
+  spec::AnalysisReport report;
   const GearCheck g =
       EvaluateGear({99.23, 100.0, 127.2, 139.4, 173.7, 184.8, 185.4, 104.1, -1.747}, &report);
   EXPECT_NEAR(g.f, 0.884, 0.0006);
@@ -122,9 +122,9 @@ TEST(LandingGear, ReportOptimumReproducesCheckValues) {
 }
 
 TEST(KinematicAnalysis, PerformsNoTimeStepsOnlyPositionSolves) {
-  engine::AnalysisReport report;
+  spec::AnalysisReport report;
   EvaluateGear({100, 110, 130, 110, 160, 155, 180, 100, -2.0}, &report);
-  EXPECT_EQ(report.formulation, engine::Formulation::kKinematic);
+  EXPECT_EQ(report.formulation, spec::Formulation::kKinematic);
   EXPECT_EQ(report.counters.time_steps, 0);
   EXPECT_EQ(report.counters.rhs_evaluations, 0);
   // 2 rad in sub-steps of at most 2 degrees: at least 58 Newton solves.
@@ -135,12 +135,13 @@ TEST(KinematicAnalysis, BarTooShortCannotAssembleAndSaysWhere) {
   spec::Scene scene = LandingGearScene();
   auto& m = std::get<spec::LinkageModel>(scene.model);
   m.links[1].length_m = linkage_testing::Lit(0.001);  // coupler 1 mm: the loop cannot close
-  const engine::AnalysisReport report = solve::AnalyzeLinkage(
+  const spec::AnalysisReport report = solve::AnalyzeLinkage(
       scene, LandingGearDesign({100, 110, 130, 110, 160, 155, 180, 100, -2.0}));
-  ASSERT_EQ(report.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(report.failure_reason, HasSubstr("cannot assemble"));
-  EXPECT_THAT(report.failure_reason, HasSubstr("t = 0 s"));
-  EXPECT_THAT(report.failure_reason, HasSubstr("joint 'J"));
+  ASSERT_FALSE(report.ok());
+  EXPECT_EQ(report.failure.kind, spec::FailureKind::kAssembly);
+  EXPECT_THAT(report.failure.reason, HasSubstr("cannot assemble"));
+  EXPECT_THAT(report.failure.reason, HasSubstr("t = 0 s"));
+  EXPECT_THAT(report.failure.reason, HasSubstr("joint 'J"));
   EXPECT_TRUE(report.outputs.empty());
 }
 
@@ -164,10 +165,11 @@ TEST(KinematicAnalysis, MechanismDrivenIntoLockFailsNamingTimeAndJoint) {
   scene.model = m;
   scene.outputs = {linkage_testing::JointOutput("B_x", 2, spec::Axis::kX)};
   scene.time_grid = {0.0, 1.0, 11};
-  const engine::AnalysisReport report = solve::AnalyzeLinkage(scene, {});
-  ASSERT_EQ(report.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(report.failure_reason, HasSubstr("locks at t = 0.317"));
-  EXPECT_THAT(report.failure_reason, HasSubstr("joint 'B'"));
+  const spec::AnalysisReport report = solve::AnalyzeLinkage(scene, {});
+  ASSERT_FALSE(report.ok());
+  EXPECT_EQ(report.failure.kind, spec::FailureKind::kAssembly);
+  EXPECT_THAT(report.failure.reason, HasSubstr("locks at t = 0.317"));
+  EXPECT_THAT(report.failure.reason, HasSubstr("joint 'B'"));
 }
 
 TEST(KinematicAnalysis, MechanismWithFreedomLeftIsRejected) {
@@ -184,9 +186,10 @@ TEST(KinematicAnalysis, MechanismWithFreedomLeftIsRejected) {
   scene.model = m;
   scene.outputs = {linkage_testing::JointOutput("B_x", 2, spec::Axis::kX)};
   scene.time_grid = {0.0, 1.0, 2};
-  const engine::AnalysisReport report = solve::AnalyzeLinkage(scene, {});
-  ASSERT_EQ(report.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(report.failure_reason, HasSubstr("1 degree(s) of freedom"));
+  const spec::AnalysisReport report = solve::AnalyzeLinkage(scene, {});
+  ASSERT_FALSE(report.ok());
+  EXPECT_EQ(report.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(report.failure.reason, HasSubstr("1 degree(s) of freedom"));
 }
 
 }  // namespace

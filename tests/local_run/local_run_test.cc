@@ -1,6 +1,6 @@
 // RunStudyLocally and EvaluateDesign on the vehicle suspension study
 // (examples/vehicle, METHOD.md section 4.1).
-#include "server/local_run/local_run.h"
+#include "worker/local_run/local_run.h"
 
 #include <cmath>
 #include <iostream>
@@ -8,7 +8,6 @@
 
 #include <gtest/gtest.h>
 
-#include "server/local_run/evaluate_design.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::local_run {
@@ -36,26 +35,24 @@ TEST(EvaluateDesign, VehicleInitialDesignIsInfeasibleWithFiniteValues) {
   Eigen::VectorXd x0(static_cast<Eigen::Index>(study.variables.size()));
   for (size_t k = 0; k < study.variables.size(); ++k) x0[static_cast<Eigen::Index>(k)] = study.variables[k].initial;
 
-  absl::StatusOr<DesignEvaluation> evaluation = EvaluateDesign(study, *layout, x0);
+  absl::StatusOr<engine::StudyEvaluation> evaluation = EvaluateDesign(study, *layout, x0);
   ASSERT_TRUE(evaluation.ok()) << evaluation.status();
-  ASSERT_TRUE(evaluation->ok()) << evaluation->failure_reason;
+  ASSERT_TRUE(evaluation->ok()) << evaluation->failure.reason;
   ASSERT_TRUE(evaluation->values.has_value());
   EXPECT_TRUE(std::isfinite(evaluation->values->objective));
   // x0 exceeds the seat-chassis displacement limit about fourfold (METHOD.md 4.1).
   EXPECT_GT(evaluation->values->max_violation, 1.0);
   EXPECT_GT(evaluation->counters.time_steps, 0);
 
-  const slp::AnalysisResult result = ToAnalysisResult(*evaluation);
-  EXPECT_EQ(result.outcome, slp::AnalysisOutcome::kOk);
-  EXPECT_EQ(result.objective_terms.size(), layout->num_objective_terms());
-  EXPECT_EQ(result.constraint_values.size(), layout->num_constraints());
+  EXPECT_EQ(static_cast<int>(evaluation->values->objective_terms.size()), layout->num_objective_terms());
+  EXPECT_EQ(static_cast<int>(evaluation->values->constraint_values.size()), layout->num_constraints());
 }
 
 TEST(EvaluateDesign, RejectsDesignOfWrongSize) {
   const spec::Study study = LoadVehicle();
   absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok()) << layout.status();
-  const absl::StatusOr<DesignEvaluation> evaluation = EvaluateDesign(study, *layout, Eigen::VectorXd::Ones(2));
+  const absl::StatusOr<engine::StudyEvaluation> evaluation = EvaluateDesign(study, *layout, Eigen::VectorXd::Ones(2));
   EXPECT_EQ(evaluation.status().code(), absl::StatusCode::kInvalidArgument);
 }
 
@@ -67,7 +64,7 @@ TEST(RunStudyLocally, VehicleReachesReportOptimum) {
   options.on_record = [&records_seen](const slp::CycleRecord&) { ++records_seen; };
   absl::StatusOr<LocalRunResult> result = RunStudyLocally(study, options);
   ASSERT_TRUE(result.ok()) << result.status();
-  const slp::RunOutcome& run = result->outcome;
+  const RunOutcome& run = result->outcome;
   EXPECT_EQ(run.state, slp::RunState::kConverged) << slp::RunStateName(run.state) << " " << result->end_reason;
   EXPECT_LE(run.objective, kMaxSeatAccelerationAtOptimum);
   EXPECT_LT(run.max_violation, kMaxViolationAtOptimum);
@@ -96,6 +93,7 @@ TEST(RunStudyLocally, InjectedFailureOfFirstDesignEndsRunFailed) {
   EXPECT_EQ(result->outcome.state, slp::RunState::kFailed);
   EXPECT_EQ(result->analyses_run, 0);
   EXPECT_GE(result->analyses_failed, 1);
+  EXPECT_EQ(result->failures_by_kind.at(spec::FailureKind::kInjected), result->analyses_failed);
 }
 
 }  // namespace

@@ -88,8 +88,8 @@ TEST(LumpedDynamics, FreeResponseOfDampedOscillatorMatchesClosedForm) {
   LumpedDynamicsOptions options;
   const double x0 = 0.01;
   options.initial_q = Eigen::VectorXd::Constant(1, x0);
-  const engine::AnalysisReport r = SimulateLumped(scene, {p.stiffness_n_per_m}, options);
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
+  const spec::AnalysisReport r = SimulateLumped(scene, {p.stiffness_n_per_m}, options);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
   const double wn = std::sqrt(p.stiffness_n_per_m / p.mass_kg);
   const double zeta = p.damping_n_s_per_m / (2 * std::sqrt(p.stiffness_n_per_m * p.mass_kg));
   const double wd = wn * std::sqrt(1 - zeta * zeta);
@@ -139,8 +139,8 @@ TEST(LumpedDynamics, BaseExcitationByCosineBumpMatchesClosedFormWithBdfAndAdams)
   for (bool adams : {false, true}) {
     LumpedDynamicsOptions options;
     options.adams = adams;
-    const engine::AnalysisReport r = SimulateLumped(scene, {k}, options);
-    ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
+    const spec::AnalysisReport r = SimulateLumped(scene, {k}, options);
+    ASSERT_TRUE(r.ok()) << r.failure.reason;
     for (size_t i = 0; i < r.times_s.size(); ++i) {
       double s = 0, a = 0;
       exact(r.times_s[i], &s, &a);
@@ -200,16 +200,16 @@ TEST(LumpedDynamics, UndampedFreeVibrationConservesEnergy) {
   // Energy drift of a dissipative-free linear system at rtol 1e-10.
   constexpr double kEnergyTolerance = 1e-6;
   int checked = 0;
-  engine::AnalysisCounters counters;
-  const std::string failure = IntegrateLumped(
+  spec::AnalysisCounters counters;
+  const spec::AnalysisFailure failure = IntegrateLumped(
       *model, instants, settings, options,
       [&](double, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
         EXPECT_NEAR(energy(q, v) / e0, 1.0, kEnergyTolerance);
         ++checked;
-        return std::string();
+        return spec::AnalysisFailure::Ok();
       },
       &counters);
-  EXPECT_EQ(failure, "");
+  EXPECT_TRUE(failure.ok()) << failure.reason;
   EXPECT_EQ(checked, 101);
   EXPECT_GT(counters.time_steps, 0);
 }
@@ -217,9 +217,10 @@ TEST(LumpedDynamics, UndampedFreeVibrationConservesEnergy) {
 TEST(LumpedDynamics, StepLimitIsAFailedAnalysisWithReason) {
   spec::Scene scene = OneDofScene(OneDof(), true);
   scene.integrator.max_steps = 5;
-  const engine::AnalysisReport r = SimulateLumped(scene, {800.0});
-  EXPECT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, HasSubstr("step budget"));
+  const spec::AnalysisReport r = SimulateLumped(scene, {800.0});
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kIntegrator);
+  EXPECT_THAT(r.failure.reason, HasSubstr("step budget"));
   EXPECT_TRUE(r.outputs.empty());
   EXPECT_LE(r.counters.time_steps, 5);
 }
@@ -227,22 +228,24 @@ TEST(LumpedDynamics, StepLimitIsAFailedAnalysisWithReason) {
 TEST(LumpedDynamics, WallTimeLimitIsAFailedAnalysisWithReason) {
   spec::Scene scene = OneDofScene(OneDof(), true);
   scene.integrator.max_wall_seconds = 1e-12;  // over before the first step
-  const engine::AnalysisReport r = SimulateLumped(scene, {800.0});
-  EXPECT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, HasSubstr("wall-time limit"));
+  const spec::AnalysisReport r = SimulateLumped(scene, {800.0});
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kTimeLimit);
+  EXPECT_THAT(r.failure.reason, HasSubstr("wall-time limit"));
 }
 
 TEST(LumpedDynamics, UnusableParameterValueIsAFailedAnalysisNamingTheElement) {
-  const engine::AnalysisReport r = SimulateLumped(OneDofScene(OneDof(), true), {-5.0});
-  EXPECT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, HasSubstr("element \"spring\""));
+  const spec::AnalysisReport r = SimulateLumped(OneDofScene(OneDof(), true), {-5.0});
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(r.failure.reason, HasSubstr("element \"spring\""));
 }
 
 TEST(LumpedDynamics, NoRequestedOutputMeansNoIntegration) {
   spec::Scene scene = OneDofScene(OneDof(), true);
   scene.outputs.clear();
-  const engine::AnalysisReport r = SimulateLumped(scene, {800.0});
-  EXPECT_EQ(r.status, engine::AnalysisStatus::kOk);
+  const spec::AnalysisReport r = SimulateLumped(scene, {800.0});
+  EXPECT_TRUE(r.ok());
   EXPECT_TRUE(r.outputs.empty());
   EXPECT_EQ(r.counters.time_steps, 0);
   EXPECT_EQ(r.counters.rhs_evaluations, 0);
@@ -252,12 +255,12 @@ TEST(LumpedDynamics, ReportsOnlyTheRequestedOutputsInSceneOrder) {
   spec::Scene scene = OneDofScene(OneDof(), true);
   std::swap(scene.outputs[0], scene.outputs[1]);
   scene.outputs.pop_back();  // only the acceleration is left
-  const engine::AnalysisReport r = SimulateLumped(scene, {800.0});
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk);
+  const spec::AnalysisReport r = SimulateLumped(scene, {800.0});
+  ASSERT_TRUE(r.ok());
   ASSERT_EQ(r.outputs.size(), 1u);
   EXPECT_EQ(r.outputs[0].name, "a");
   EXPECT_EQ(r.outputs[0].series[0].size(), r.times_s.size());
-  EXPECT_EQ(r.formulation, engine::Formulation::kDynamic);
+  EXPECT_EQ(r.formulation, spec::Formulation::kDynamic);
 }
 
 TEST(LumpedModel, KinksAreTheBumpStartsAndEndsInsideTheInterval) {

@@ -29,7 +29,7 @@ spec::Study LoadVehicle() {
   return *std::move(study);
 }
 
-double MaxAbs(const engine::AnalysisReport& r, const std::string& output) {
+double MaxAbs(const spec::AnalysisReport& r, const std::string& output) {
   for (const auto& o : r.outputs) {
     if (o.name != output) continue;
     double m = 0;
@@ -50,10 +50,10 @@ class VehicleCheckValues : public ::testing::TestWithParam<Design> {};
 
 TEST_P(VehicleCheckValues, MaxSeatAccelerationOnTheGridMatchesTheBenchmark) {
   const spec::Study study = LoadVehicle();
-  const engine::AnalysisReport r =
+  const spec::AnalysisReport r =
       engine::Analyze(study.scene, study.ParameterValuesAt(GetParam().x));
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk) << r.failure_reason;
-  EXPECT_EQ(r.formulation, engine::Formulation::kDynamic);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  EXPECT_EQ(r.formulation, spec::Formulation::kDynamic);
   const double expected = GetParam().max_abs_a1_in_per_s2;
   EXPECT_NEAR(MaxAbs(r, "seat_acceleration") / kInch, expected,
               kCheckValueRelativeTolerance * expected);
@@ -76,11 +76,11 @@ TEST(VehicleBenchmark, DeflectionCheckValuesAtInitialDesignAndReportOptimum) {
   const spec::Study study = LoadVehicle();
   const auto at_x0 =
       engine::Analyze(study.scene, study.ParameterValuesAt({10, 15, 15, 10, 12.5, 12.5}));
-  ASSERT_EQ(at_x0.status, engine::AnalysisStatus::kOk) << at_x0.failure_reason;
+  ASSERT_TRUE(at_x0.ok()) << at_x0.failure.reason;
   EXPECT_NEAR(MaxAbs(at_x0, "s1") / kInch, 1.8332, kCheckValueRelativeTolerance * 1.8332);
   const auto at_opt =
       engine::Analyze(study.scene, study.ParameterValuesAt({5, 10, 10, 41.54, 38.53, 40}));
-  ASSERT_EQ(at_opt.status, engine::AnalysisStatus::kOk) << at_opt.failure_reason;
+  ASSERT_TRUE(at_opt.ok()) << at_opt.failure.reason;
   EXPECT_NEAR(MaxAbs(at_opt, "s1") / kInch, 0.4560, kCheckValueRelativeTolerance * 0.4560);
   EXPECT_NEAR(MaxAbs(at_opt, "s2") / kInch, 1.2107, kCheckValueRelativeTolerance * 1.2107);
   EXPECT_NEAR(MaxAbs(at_opt, "s3") / kInch, 0.6774, kCheckValueRelativeTolerance * 0.6774);
@@ -90,7 +90,7 @@ TEST(VehicleBenchmark, PeakAtInitialDesignIsAtGridPoint36) {
   const spec::Study study = LoadVehicle();
   const auto r =
       engine::Analyze(study.scene, study.ParameterValuesAt({10, 15, 15, 10, 12.5, 12.5}));
-  ASSERT_EQ(r.status, engine::AnalysisStatus::kOk);
+  ASSERT_TRUE(r.ok());
   const auto& a = r.outputs[0].series[0];
   size_t peak = 0;
   for (size_t i = 0; i < a.size(); ++i) {
@@ -116,14 +116,14 @@ TEST(VehicleBenchmark, RemovingOutputsRemovesTheirValues) {
   const auto full = engine::Analyze(study.scene, p);
   study.scene.outputs.resize(2);  // seat acceleration and s1 only
   const auto reduced = engine::Analyze(study.scene, p);
-  ASSERT_EQ(reduced.status, engine::AnalysisStatus::kOk);
+  ASSERT_TRUE(reduced.ok());
   EXPECT_EQ(full.outputs.size(), 6u);
   ASSERT_EQ(reduced.outputs.size(), 2u);
   // Same model, same integration: the values of the kept outputs agree.
   EXPECT_DOUBLE_EQ(MaxAbs(reduced, "s1"), MaxAbs(full, "s1"));
   study.scene.outputs.clear();
   const auto none = engine::Analyze(study.scene, p);
-  EXPECT_EQ(none.status, engine::AnalysisStatus::kOk);
+  EXPECT_TRUE(none.ok());
   EXPECT_EQ(none.counters.time_steps, 0);
 }
 
@@ -132,8 +132,9 @@ TEST(VehicleBenchmark, TooFewStepsIsAFailedAnalysisNotACrash) {
   study.scene.integrator.max_steps = 5;
   const auto r =
       engine::Analyze(study.scene, study.ParameterValuesAt({10, 15, 15, 10, 12.5, 12.5}));
-  EXPECT_EQ(r.status, engine::AnalysisStatus::kFailed);
-  EXPECT_THAT(r.failure_reason, ::testing::HasSubstr("step budget"));
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kIntegrator);
+  EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("step budget"));
   EXPECT_GT(r.counters.wall_seconds, 0.0);
 }
 

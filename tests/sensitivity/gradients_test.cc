@@ -10,7 +10,7 @@
 
 #include "mbopt/v1/study.pb.h"
 #include "server/jobs/problem_from_study.h"
-#include "server/local_run/evaluate_design.h"
+#include "worker/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::local_run {
@@ -48,7 +48,7 @@ Eigen::VectorXd Initial(const spec::Study& study) {
   return x;
 }
 
-Eigen::VectorXd Stacked(const DesignEvaluation& e) {
+Eigen::VectorXd Stacked(const engine::StudyEvaluation& e) {
   const auto& v = *e.values;
   Eigen::VectorXd out(static_cast<Eigen::Index>(v.objective_terms.size() + v.constraint_values.size()));
   Eigen::Index i = 0;
@@ -63,17 +63,23 @@ TEST(SimulatorSensitivities, VehicleGradientsMatchCentralDifferences) {
   absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok()) << layout.status();
   const Eigen::VectorXd x0 = Initial(study);
-  absl::StatusOr<DesignEvaluation> with = EvaluateDesignWithGradients(study, *layout, x0);
+  absl::StatusOr<engine::StudyEvaluation> with = EvaluateDesign(study, *layout, x0, true);
   ASSERT_TRUE(with.ok()) << with.status();
-  ASSERT_TRUE(with->ok()) << with->failure_reason;
+  ASSERT_TRUE(with->ok()) << with->failure.reason;
   ASSERT_TRUE(with->gradients.has_value()) << with->gradients_unavailable;
-  const slp::AnalysisResult result = ToAnalysisResult(*with);
-  const Eigen::Index k = result.objective_terms.size();
-  const Eigen::Index m = result.constraint_values.size();
-  ASSERT_EQ(result.objective_gradients.rows(), k);
-  ASSERT_EQ(result.constraint_gradients.rows(), m);
-  Eigen::MatrixXd simulator(k + m, x0.size());
-  simulator << result.objective_gradients, result.constraint_gradients;
+  const std::vector<std::vector<double>>& terms = with->gradients->objective_terms;
+  const std::vector<std::vector<double>>& rows = with->gradients->constraint_rows;
+  ASSERT_EQ(terms.size(), with->values->objective_terms.size());
+  ASSERT_EQ(rows.size(), with->values->constraint_values.size());
+  Eigen::MatrixXd simulator(static_cast<Eigen::Index>(terms.size() + rows.size()), x0.size());
+  Eigen::Index r = 0;
+  for (const auto* block : {&terms, &rows}) {
+    for (const std::vector<double>& row : *block) {
+      ASSERT_EQ(static_cast<Eigen::Index>(row.size()), x0.size());
+      for (Eigen::Index c = 0; c < x0.size(); ++c) simulator(r, c) = row[static_cast<size_t>(c)];
+      ++r;
+    }
+  }
 
   double worst = 0.0;
   for (Eigen::Index i = 0; i < x0.size(); ++i) {
@@ -81,8 +87,8 @@ TEST(SimulatorSensitivities, VehicleGradientsMatchCentralDifferences) {
     Eigen::VectorXd plus = x0, minus = x0;
     plus[i] += h;
     minus[i] -= h;
-    absl::StatusOr<DesignEvaluation> ep = EvaluateDesign(study, *layout, plus);
-    absl::StatusOr<DesignEvaluation> em = EvaluateDesign(study, *layout, minus);
+    absl::StatusOr<engine::StudyEvaluation> ep = EvaluateDesign(study, *layout, plus);
+    absl::StatusOr<engine::StudyEvaluation> em = EvaluateDesign(study, *layout, minus);
     ASSERT_TRUE(ep.ok() && em.ok());
     ASSERT_TRUE(ep->ok() && em->ok());
     const Eigen::VectorXd fd = (Stacked(*ep) - Stacked(*em)) / (2 * h);
@@ -102,8 +108,8 @@ TEST(SimulatorSensitivities, GradientsComeWithTheValuesOfAPlainAnalysis) {
   absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok()) << layout.status();
   const Eigen::VectorXd x0 = Initial(study);
-  absl::StatusOr<DesignEvaluation> with = EvaluateDesignWithGradients(study, *layout, x0);
-  absl::StatusOr<DesignEvaluation> plain = EvaluateDesign(study, *layout, x0);
+  absl::StatusOr<engine::StudyEvaluation> with = EvaluateDesign(study, *layout, x0, true);
+  absl::StatusOr<engine::StudyEvaluation> plain = EvaluateDesign(study, *layout, x0);
   ASSERT_TRUE(with.ok() && plain.ok());
   ASSERT_TRUE(with->ok() && plain->ok());
   const Eigen::VectorXd a = Stacked(*with), b = Stacked(*plain);
@@ -122,8 +128,8 @@ TEST(SimulatorSensitivities, AnalysesWithAndWithoutGradientsAreTimedAtTheSceneTo
   double plain_s = 0, with_s = 0;
   std::int64_t plain_steps = 0, with_steps = 0;
   for (int r = 0; r < kRepetitions; ++r) {
-    absl::StatusOr<DesignEvaluation> plain = EvaluateDesign(*study, *layout, x0);
-    absl::StatusOr<DesignEvaluation> with = EvaluateDesignWithGradients(*study, *layout, x0);
+    absl::StatusOr<engine::StudyEvaluation> plain = EvaluateDesign(*study, *layout, x0);
+    absl::StatusOr<engine::StudyEvaluation> with = EvaluateDesign(*study, *layout, x0, true);
     ASSERT_TRUE(plain.ok() && with.ok());
     ASSERT_TRUE(plain->ok() && with->ok() && with->gradients.has_value());
     plain_s += plain->counters.wall_seconds;

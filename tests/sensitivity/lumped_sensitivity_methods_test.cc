@@ -59,7 +59,7 @@ Vehicle LoadVehicle(double relative_tolerance, double absolute_tolerance) {
 Derivatives Derive(const Vehicle& v, const LumpedSensitivityOptions& options) {
   LumpedSensitivityResult r = SimulateLumpedWithSensitivities(
       v.study.scene, v.parameters_si, v.sensitivity_parameters, options);
-  EXPECT_EQ(r.report.status, engine::AnalysisStatus::kOk) << r.report.failure_reason;
+  EXPECT_TRUE(r.report.ok()) << r.report.failure.reason;
   return r.output_derivatives;
 }
 
@@ -129,8 +129,8 @@ TEST(LumpedSensitivityMethods, CountersCoverTheWholeIntegration) {
       scene.study.scene, scene.parameters_si, scene.sensitivity_parameters, states_only);
   const LumpedSensitivityResult augmented = SimulateLumpedWithSensitivities(
       scene.study.scene, scene.parameters_si, scene.sensitivity_parameters);
-  ASSERT_EQ(module.report.status, engine::AnalysisStatus::kOk) << module.report.failure_reason;
-  ASSERT_EQ(augmented.report.status, engine::AnalysisStatus::kOk);
+  ASSERT_TRUE(module.report.ok()) << module.report.failure.reason;
+  ASSERT_TRUE(augmented.report.ok());
   EXPECT_GT(augmented.report.counters.time_steps, module.report.counters.time_steps);
   EXPECT_GE(module.counters.sensitivity_rhs_evaluations, module.report.counters.time_steps);
   EXPECT_GE(augmented.counters.sensitivity_rhs_evaluations, augmented.report.counters.time_steps);
@@ -144,8 +144,8 @@ TEST(LumpedSensitivityMethods, StepLimitIsAFailedAnalysisWithReasonForEitherMeth
        {LumpedSensitivityOptions{}, Module(Corrector::kStaggered)}) {
     const LumpedSensitivityResult r = SimulateLumpedWithSensitivities(
         scene.study.scene, scene.parameters_si, scene.sensitivity_parameters, options);
-    EXPECT_EQ(r.report.status, engine::AnalysisStatus::kFailed);
-    EXPECT_FALSE(r.report.failure_reason.empty());
+    EXPECT_FALSE(r.report.ok());
+    EXPECT_FALSE(r.report.failure.reason.empty());
     EXPECT_TRUE(r.output_derivatives.empty());
   }
 }

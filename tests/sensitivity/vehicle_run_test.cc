@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "server/local_run/local_run.h"
+#include "worker/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::local_run {

@@ -10,6 +10,7 @@
 #include "server/jobs/analysis_gradients.h"
 #include "server/jobs/job_state.h"
 #include "server/jobs/record_codec.h"
+#include "server/lp/make_clp_lp_solver.h"
 #include "spec/io/study_io.h"
 #include "tests/server/test_study.h"
 
@@ -75,18 +76,37 @@ TEST(JobState, NamesRoundTrip) {
 
 // A run driven to its end in process, with everything a server would log.
 struct LoggedRun {
-  std::vector<LoggedAnalysis> analyses;
+  std::vector<AnalysisRecord> analyses;
   std::vector<std::string> records;
   slp::RunState state = slp::RunState::kRunning;
   Eigen::VectorXd design;
 };
 
-std::unique_ptr<Job> NewJob(const v1::Study& proto) {
+std::unique_ptr<Job> NewJob(const v1::Study& proto, std::unique_ptr<lp::LpSolver> lp = lp::MakeClpLpSolver()) {
   absl::StatusOr<spec::Study> study = spec::io::StudyFromProto(proto, "test");
   EXPECT_TRUE(study.ok()) << study.status();
-  absl::StatusOr<std::unique_ptr<Job>> job = Job::Create(*study);
+  absl::StatusOr<std::unique_ptr<Job>> job = Job::Create(*study, std::move(lp));
   EXPECT_TRUE(job.ok()) << job.status();
   return job.ok() ? *std::move(job) : nullptr;
+}
+
+// The analytic values (and gradients, when asked) of a request, as a
+// worker would send them.
+AnalysisRecord AnalyticRecord(const v1::Study& proto, const slp::AnalysisRequest& request) {
+  const std::vector<double> x(request.x.data(), request.x.data() + request.x.size());
+  AnalysisRecord record;
+  record.request_id = request.id;
+  absl::StatusOr<testing::FakeValues> values = testing::EvaluateAnalytically(proto, x);
+  EXPECT_TRUE(values.ok());
+  record.objective_terms = values->objective_terms;
+  record.constraint_values = values->constraint_values;
+  if (request.want_gradients) {
+    absl::StatusOr<testing::FakeGradients> gradients = testing::GradientsAnalytically(proto, x);
+    EXPECT_TRUE(gradients.ok()) << gradients.status();
+    record.objective_gradients = gradients->objective_gradients;
+    record.constraint_gradients = gradients->constraint_gradients;
+  }
+  return record;
 }
 
 LoggedRun RunAndLog(const v1::Study& proto) {
@@ -97,32 +117,117 @@ LoggedRun RunAndLog(const v1::Study& proto) {
     if (pending.empty()) break;
     // Answer the batch last-first, to differ from the replay's order.
     for (auto it = pending.rbegin(); it != pending.rend(); ++it) {
-      const std::vector<double> x(it->x.data(), it->x.data() + it->x.size());
-      absl::StatusOr<testing::FakeValues> values = testing::EvaluateAnalytically(proto, x);
-      EXPECT_TRUE(values.ok());
-      LoggedAnalysis a;
-      a.x_scaled = x;
-      a.result.request_id = it->id;
-      a.result.objective_terms = Eigen::Map<const Eigen::VectorXd>(values->objective_terms.data(),
-                                                                    static_cast<Eigen::Index>(values->objective_terms.size()));
-      a.result.constraint_values = Eigen::Map<const Eigen::VectorXd>(
-          values->constraint_values.data(), static_cast<Eigen::Index>(values->constraint_values.size()));
+      absl::StatusOr<AnalysisRecord> record = job->Intake(AnalyticRecord(proto, *it));
+      EXPECT_TRUE(record.ok()) << record.status();
       if (it->want_gradients) {
-        absl::StatusOr<testing::FakeGradients> gradients = testing::GradientsAnalytically(proto, x);
-        EXPECT_TRUE(gradients.ok()) << gradients.status();
-        AttachGradients(job->problem(), gradients->objective_gradients, gradients->constraint_gradients,
-                        &a.result);
-        EXPECT_TRUE(a.result.has_gradients());
+        EXPECT_FALSE(record->objective_gradients.empty()) << record->gradients_unavailable;
       }
-      absl::StatusOr<std::vector<slp::CycleRecord>> records = job->Submit(a.result);
+      absl::StatusOr<std::vector<slp::CycleRecord>> records = job->Apply(*record);
       EXPECT_TRUE(records.ok()) << records.status();
       for (const slp::CycleRecord& r : *records) run.records.push_back(EncodeCycleRecord(r));
-      run.analyses.push_back(std::move(a));
+      run.analyses.push_back(*std::move(record));
     }
   }
   run.state = job->optimizer().state();
   run.design = job->optimizer().current_design();
   return run;
+}
+
+TEST(JobIntake, FillsTheRequestsDesignPointAndDropsUnaskedGradients) {
+  const v1::Study proto = testing::OscillatorStudy();
+  std::unique_ptr<Job> job = NewJob(proto);
+  const std::vector<slp::AnalysisRequest> pending = job->PendingRequests();
+  ASSERT_FALSE(pending.empty());
+  ASSERT_FALSE(pending[0].want_gradients);
+  AnalysisRecord candidate = AnalyticRecord(proto, pending[0]);
+  candidate.objective_gradients.assign(static_cast<size_t>(pending[0].x.size()), 1.0);
+  absl::StatusOr<AnalysisRecord> record = job->Intake(candidate);
+  ASSERT_TRUE(record.ok()) << record.status();
+  ASSERT_EQ(record->x_scaled.size(), static_cast<size_t>(pending[0].x.size()));
+  EXPECT_EQ(std::memcmp(record->x_scaled.data(), pending[0].x.data(), sizeof(double) * record->x_scaled.size()), 0);
+  EXPECT_TRUE(record->objective_gradients.empty());
+}
+
+TEST(JobIntake, NonFiniteValueBecomesAFailureOfThatKind) {
+  const v1::Study proto = testing::OscillatorStudy();
+  std::unique_ptr<Job> job = NewJob(proto);
+  AnalysisRecord candidate = AnalyticRecord(proto, job->PendingRequests()[0]);
+  ASSERT_FALSE(candidate.constraint_values.empty());
+  candidate.constraint_values[0] = std::numeric_limits<double>::infinity();
+  absl::StatusOr<AnalysisRecord> record = job->Intake(candidate);
+  ASSERT_TRUE(record.ok()) << record.status();
+  EXPECT_EQ(record->failure.kind, spec::FailureKind::kNonFiniteValue);
+  EXPECT_NE(record->failure.reason.find("constraint value 0"), std::string::npos) << record->failure.reason;
+  EXPECT_TRUE(record->constraint_values.empty());
+}
+
+TEST(JobIntake, WrongSizeOrUnknownRequestIsRefused) {
+  const v1::Study proto = testing::OscillatorStudy();
+  std::unique_ptr<Job> job = NewJob(proto);
+  AnalysisRecord candidate = AnalyticRecord(proto, job->PendingRequests()[0]);
+  candidate.constraint_values.push_back(1.0);
+  EXPECT_EQ(job->Intake(candidate).status().code(), absl::StatusCode::kInvalidArgument);
+  AnalysisRecord unknown = AnalyticRecord(proto, job->PendingRequests()[0]);
+  unknown.request_id = 999'999;
+  EXPECT_EQ(job->Intake(unknown).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(JobIntake, FailedAnalysesAreCountedByKind) {
+  const v1::Study proto = testing::OscillatorStudy();
+  std::unique_ptr<Job> job = NewJob(proto);
+  AnalysisRecord failed;
+  failed.request_id = job->PendingRequests()[0].id;
+  failed.failure = spec::AnalysisFailure::Of(spec::FailureKind::kAssembly, "joint B cannot close at t = 0 s");
+  absl::StatusOr<AnalysisRecord> record = job->Intake(failed);
+  ASSERT_TRUE(record.ok()) << record.status();
+  ASSERT_TRUE(job->Apply(*record).ok());
+  EXPECT_EQ(job->failures_by_kind().at(spec::FailureKind::kAssembly), 1);
+  EXPECT_EQ(job->last_failure().reason, "joint B cannot close at t = 0 s");
+}
+
+// An LP solver that fails every solve: a job built with it shows that the
+// solver is the injected one (CLP would solve these LPs).
+class FailingLpSolver : public lp::LpSolver {
+ public:
+  lp::LpSolution Solve(const lp::LinearProgram&) override {
+    ++solves_;
+    lp::LpSolution solution;
+    solution.status = lp::LpStatus::kNumericalFailure;
+    solution.message = "injected LP failure";
+    return solution;
+  }
+  void ResetWarmStart() override {}
+  int solves() const { return solves_; }
+
+ private:
+  int solves_ = 0;
+};
+
+TEST(JobRun, UsesTheInjectedLpSolver) {
+  const v1::Study proto = testing::OscillatorStudy();
+  auto lp = std::make_unique<FailingLpSolver>();
+  const FailingLpSolver* solver = lp.get();
+  std::unique_ptr<Job> job = NewJob(proto, std::move(lp));
+  FunctionEvaluator evaluator([&proto](const slp::AnalysisRequest& request) { return AnalyticRecord(proto, request); });
+  JobRunOptions options;
+  options.max_analyses = 1'000;
+  ASSERT_TRUE(job->Run(evaluator, options).ok());
+  EXPECT_GT(solver->solves(), 0);
+  EXPECT_NE(job->optimizer().state(), slp::RunState::kConverged);
+}
+
+TEST(JobRun, EndsAsTheStepByStepDriveDoes) {
+  const v1::Study proto = testing::OscillatorStudy();
+  const LoggedRun stepwise = RunAndLog(proto);
+  std::unique_ptr<Job> job = NewJob(proto);
+  FunctionEvaluator evaluator([&proto](const slp::AnalysisRequest& request) { return AnalyticRecord(proto, request); });
+  std::vector<std::string> records;
+  JobRunOptions options;
+  options.on_record = [&records](const slp::CycleRecord& r) { records.push_back(EncodeCycleRecord(r)); };
+  ASSERT_TRUE(job->Run(evaluator, options).ok());
+  ASSERT_FALSE(records.empty());
+  EXPECT_EQ(records, stepwise.records);
+  EXPECT_EQ(job->optimizer().state(), stepwise.state);
 }
 
 TEST(JobReplay, ReplayOfAWholeRunRebuildsTheFinalState) {
@@ -234,12 +339,12 @@ TEST(JobReplay, PartialLogLeavesOnlyTheMissingAnalysesPending) {
   LoggedRun run = RunAndLog(proto);
   std::unique_ptr<Job> reference = NewJob(proto);
   const size_t kept = run.analyses.size() / 2;
-  std::vector<LoggedAnalysis> half(run.analyses.begin(), run.analyses.begin() + static_cast<std::ptrdiff_t>(kept));
+  std::vector<AnalysisRecord> half(run.analyses.begin(), run.analyses.begin() + static_cast<std::ptrdiff_t>(kept));
   std::unique_ptr<Job> job = NewJob(proto);
   absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = job->Replay(half, {});
   ASSERT_TRUE(unlogged.ok()) << unlogged.status();
   for (const slp::AnalysisRequest& request : job->PendingRequests()) {
-    for (const LoggedAnalysis& a : half) EXPECT_NE(a.result.request_id, request.id);
+    for (const AnalysisRecord& a : half) EXPECT_NE(a.request_id, request.id);
   }
   EXPECT_FALSE(job->PendingRequests().empty());
 }

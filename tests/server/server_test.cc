@@ -242,13 +242,13 @@ TEST_F(ServerTest, RestartRightAfterACycleCommitResumesBitIdentically) {
 // ---------------------------------------------------- simulator gradients --
 
 // The analysis log of a job (the server must be gone: it holds the lock).
-std::vector<store::AnalysisRow> LoggedAnalyses(const std::filesystem::path& db, const std::string& id) {
+std::vector<jobs::AnalysisRecord> LoggedAnalyses(const std::filesystem::path& db, const std::string& id) {
   auto store = store::Store::Open(db.string());
   EXPECT_TRUE(store.ok()) << store.status();
   if (!store.ok()) return {};
   auto rows = (*store)->LoadAnalyses(id);
   EXPECT_TRUE(rows.ok()) << rows.status();
-  return rows.ok() ? *rows : std::vector<store::AnalysisRow>{};
+  return rows.ok() ? *rows : std::vector<jobs::AnalysisRecord>{};
 }
 
 TEST_F(ServerTest, SimulatorSensitivityJobTakesGradientsFromItsAnalyses) {
@@ -273,10 +273,10 @@ TEST_F(ServerTest, SimulatorSensitivityJobTakesGradientsFromItsAnalyses) {
   const v1::GetJobResponse finite_differences = RunToEnd("fd.db", 1);
   EXPECT_LT(job.summary().analyses(), finite_differences.summary().analyses());
 
-  const std::vector<store::AnalysisRow> logged = LoggedAnalyses(dir_ / "sens.db", id);
+  const std::vector<jobs::AnalysisRecord> logged = LoggedAnalyses(dir_ / "sens.db", id);
   ASSERT_EQ(static_cast<std::int64_t>(logged.size()), job.summary().analyses());
-  for (const store::AnalysisRow& row : logged) {
-    ASSERT_TRUE(row.ok) << row.failure_reason;
+  for (const jobs::AnalysisRecord& row : logged) {
+    ASSERT_TRUE(row.ok()) << row.failure.reason;
     // 1 objective term x 2 variables; 1 constraint row x 2 variables.
     EXPECT_EQ(row.objective_gradients.size(), 2u) << "request " << row.request_id;
     EXPECT_EQ(row.constraint_gradients.size(), 2u) << "request " << row.request_id;
@@ -295,8 +295,8 @@ TEST_F(ServerTest, MissingOrUnusableGradientsFallBackToFiniteDifferences) {
     const char* reason;
   };
   for (const Case& c : {Case{FakeWorker::GradientMode::kNone, "this fake worker has no gradients"},
-                        Case{FakeWorker::GradientMode::kWrongSize, "unusable gradients from the worker"},
-                        Case{FakeWorker::GradientMode::kNonFinite, "unusable gradients from the worker"}}) {
+                        Case{FakeWorker::GradientMode::kWrongSize, "unusable gradients"},
+                        Case{FakeWorker::GradientMode::kNonFinite, "unusable gradients"}}) {
     const std::string db = absl::StrCat("mode", static_cast<int>(c.mode), ".db");
     std::string id;
     v1::GetJobResponse job;
@@ -312,7 +312,7 @@ TEST_F(ServerTest, MissingOrUnusableGradientsFallBackToFiniteDifferences) {
     EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
     ExpectSameCycles(reference, job);
     int without = 0;
-    for (const store::AnalysisRow& row : LoggedAnalyses(dir_ / db, id)) {
+    for (const jobs::AnalysisRecord& row : LoggedAnalyses(dir_ / db, id)) {
       EXPECT_TRUE(row.objective_gradients.empty());
       EXPECT_TRUE(row.constraint_gradients.empty());
       if (!row.gradients_unavailable.empty()) {

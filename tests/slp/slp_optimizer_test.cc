@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "server/lp/make_clp_lp_solver.h"
-#include "server/slp/run_to_completion.h"
+#include "tests/slp_testing/drive_optimizer.h"
 #include "tests/slp/test_problems.h"
 
 namespace mbopt::slp::testing {

@@ -15,7 +15,7 @@
 #include <Eigen/Dense>
 
 #include "server/slp/problem.h"
-#include "server/slp/run_to_completion.h"
+#include "tests/slp_testing/drive_optimizer.h"
 #include "server/slp/slp_optimizer.h"
 
 namespace mbopt::slp::testing {

@@ -80,11 +80,10 @@ TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
   ASSERT_TRUE(store.ok()) << store.status();
   auto job = (*store)->CreateJob(SampleJob());
   ASSERT_TRUE(job.ok()) << job.status();
-  AnalysisRow a;
-  a.job_id = job->id;
+  jobs::AnalysisRecord a;
+  const std::string a_job = job->id;
   a.request_id = 7;
   a.x_scaled = {1.0 / 7.0, 2.0 / 3.0};
-  a.ok = true;
   a.objective_terms = AwkwardDoubles();
   a.constraint_values = {std::sqrt(2.0), -1e-300};
   // Gradients: 8 terms x 2 variables and 2 rows x 2 variables, row-major.
@@ -98,7 +97,7 @@ TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
   a.constraint_gradients = {nan, -0.0, std::nextafter(0.0, 1.0), 1.0 / 49.0};
   a.worker = "w-1";
   a.counters.time_steps = 1234;
-  ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+  ASSERT_TRUE((*store)->AddAnalysis(a_job, a).ok());
   auto rows = (*store)->LoadAnalyses(job->id);
   ASSERT_TRUE(rows.ok()) << rows.status();
   ASSERT_EQ(rows->size(), 1u);
@@ -117,13 +116,12 @@ TEST_F(StoreTest, AnalysisWithoutGradientsKeepsTheReason) {
   ASSERT_TRUE(store.ok()) << store.status();
   auto job = (*store)->CreateJob(SampleJob());
   ASSERT_TRUE(job.ok()) << job.status();
-  AnalysisRow a;
-  a.job_id = job->id;
+  jobs::AnalysisRecord a;
+  const std::string a_job = job->id;
   a.request_id = 3;
-  a.ok = true;
   a.objective_terms = {1.5};
   a.gradients_unavailable = "design variable x3 sets an offset";
-  ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+  ASSERT_TRUE((*store)->AddAnalysis(a_job, a).ok());
   auto rows = (*store)->LoadAnalyses(job->id);
   ASSERT_TRUE(rows.ok()) << rows.status();
   ASSERT_EQ(rows->size(), 1u);
@@ -137,11 +135,11 @@ TEST_F(StoreTest, SecondResultForTheSameRequestIsRefused) {
   ASSERT_TRUE(store.ok());
   auto job = (*store)->CreateJob(SampleJob());
   ASSERT_TRUE(job.ok());
-  AnalysisRow a;
-  a.job_id = job->id;
+  jobs::AnalysisRecord a;
+  const std::string a_job = job->id;
   a.request_id = 0;
-  ASSERT_TRUE((*store)->AddAnalysis(a).ok());
-  EXPECT_EQ((*store)->AddAnalysis(a).code(), absl::StatusCode::kAlreadyExists);
+  ASSERT_TRUE((*store)->AddAnalysis(a_job, a).ok());
+  EXPECT_EQ((*store)->AddAnalysis(a_job, a).code(), absl::StatusCode::kAlreadyExists);
 }
 
 TEST_F(StoreTest, EverythingSurvivesCloseAndReopen) {
@@ -152,12 +150,11 @@ TEST_F(StoreTest, EverythingSurvivesCloseAndReopen) {
     auto job = (*store)->CreateJob(SampleJob());
     ASSERT_TRUE(job.ok());
     job_id = job->id;
-    AnalysisRow a;
-    a.job_id = job_id;
+    jobs::AnalysisRecord a;
+    const std::string a_job = job_id;
     a.request_id = 0;
-    a.ok = false;
-    a.failure_reason = "integrator failed";
-    ASSERT_TRUE((*store)->AddAnalysis(a).ok());
+    a.failure = spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "integrator failed");
+    ASSERT_TRUE((*store)->AddAnalysis(a_job, a).ok());
     JobProgress progress{"CONVERGED", "", 3, 12, 1.5};
     ASSERT_TRUE((*store)->CommitCycle(job_id, {{0, 1, 0, "r1"}, {0, 1, 1, std::string("r\0 2", 4)}}, progress).ok());
     ASSERT_TRUE((*store)->AddEvent(job_id, "converged", "after 3 cycles").ok());
@@ -180,7 +177,8 @@ TEST_F(StoreTest, EverythingSurvivesCloseAndReopen) {
   auto analyses = (*store)->LoadAnalyses(job_id);
   ASSERT_TRUE(analyses.ok());
   ASSERT_EQ(analyses->size(), 1u);
-  EXPECT_EQ((*analyses)[0].failure_reason, "integrator failed");
+  EXPECT_EQ((*analyses)[0].failure.reason, "integrator failed");
+  EXPECT_EQ((*analyses)[0].failure.kind, spec::FailureKind::kIntegrator);
   auto events = (*store)->LoadEvents(job_id);
   ASSERT_TRUE(events.ok());
   ASSERT_EQ(events->size(), 1u);
@@ -236,20 +234,20 @@ std::int64_t SchemaVersionOf(const std::string& path) {
 // its analyses bit for bit (without gradients) and takes new ones with them.
 TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
   std::string job_id;
-  AnalysisRow old_row;
+  jobs::AnalysisRecord old_row;
+  std::string old_row_job;
   {
     auto store = Store::Open(path_);
     ASSERT_TRUE(store.ok()) << store.status();
     auto job = (*store)->CreateJob(SampleJob());
     ASSERT_TRUE(job.ok());
     job_id = job->id;
-    old_row.job_id = job_id;
+    old_row_job = job_id;
     old_row.request_id = 0;
-    old_row.ok = true;
     old_row.x_scaled = {1.0 / 3.0};
     old_row.objective_terms = AwkwardDoubles();
     old_row.constraint_values = {-0.0};
-    ASSERT_TRUE((*store)->AddAnalysis(old_row).ok());
+    ASSERT_TRUE((*store)->AddAnalysis(old_row_job, old_row).ok());
   }
   // Exactly the version 1 layout: the columns version 2 added are the last
   // three of `analyses`.
@@ -257,6 +255,7 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
          "ALTER TABLE analyses DROP COLUMN objective_gradients;"
          "ALTER TABLE analyses DROP COLUMN constraint_gradients;"
          "ALTER TABLE analyses DROP COLUMN gradients_unavailable;"
+         "ALTER TABLE analyses DROP COLUMN failure_kind;"
          "UPDATE schema_version SET version = 1;");
   ASSERT_EQ(SchemaVersionOf(path_), 1);
 
@@ -271,10 +270,10 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
     EXPECT_TRUE((*rows)[0].objective_gradients.empty());
     EXPECT_TRUE((*rows)[0].constraint_gradients.empty());
     EXPECT_EQ((*rows)[0].gradients_unavailable, "");
-    AnalysisRow with_gradients = old_row;
+    jobs::AnalysisRecord with_gradients = old_row;
     with_gradients.request_id = 1;
     with_gradients.objective_gradients = {0.1, 0.2};
-    ASSERT_TRUE((*store)->AddAnalysis(with_gradients).ok());
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, with_gradients).ok());
   }
   EXPECT_EQ(SchemaVersionOf(path_), kSchemaVersion);
   auto store = Store::Open(path_);
@@ -283,6 +282,54 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
   ASSERT_TRUE(rows.ok()) << rows.status();
   ASSERT_EQ(rows->size(), 2u);
   EXPECT_TRUE(BitIdentical((*rows)[1].objective_gradients, {0.1, 0.2}));
+}
+
+// A version 2 database (analyses without a failure kind) is migrated: its
+// failed analyses become "unclassified", its successful ones stay ok.
+TEST_F(StoreTest, VersionTwoFailuresBecomeUnclassified) {
+  std::string job_id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto job = (*store)->CreateJob(SampleJob());
+    ASSERT_TRUE(job.ok());
+    job_id = job->id;
+    jobs::AnalysisRecord ok;
+    ok.request_id = 0;
+    ok.objective_terms = {1.0};
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, ok).ok());
+    jobs::AnalysisRecord failed;
+    failed.request_id = 1;
+    failed.failure = spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "integrator failed near t = 1");
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, failed).ok());
+  }
+  RunSql(path_,
+         "ALTER TABLE analyses DROP COLUMN failure_kind;"
+         "UPDATE schema_version SET version = 2;");
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto rows = (*store)->LoadAnalyses(job_id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 2u);
+  EXPECT_TRUE((*rows)[0].ok());
+  EXPECT_EQ((*rows)[1].failure.kind, spec::FailureKind::kUnclassified);
+  EXPECT_EQ((*rows)[1].failure.reason, "integrator failed near t = 1");
+}
+
+TEST_F(StoreTest, FailureKindRoundTrips) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto job = (*store)->CreateJob(SampleJob());
+  ASSERT_TRUE(job.ok());
+  jobs::AnalysisRecord a;
+  a.request_id = 4;
+  a.failure = spec::AnalysisFailure::Of(spec::FailureKind::kAssembly, "joint B cannot close at t = 0.4 s");
+  ASSERT_TRUE((*store)->AddAnalysis(job->id, a).ok());
+  auto rows = (*store)->LoadAnalyses(job->id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 1u);
+  EXPECT_EQ((*rows)[0].failure.kind, spec::FailureKind::kAssembly);
+  EXPECT_EQ((*rows)[0].failure.reason, a.failure.reason);
 }
 
 TEST_F(StoreTest, NewDatabaseHasTheCurrentSchemaVersion) {

@@ -10,32 +10,17 @@
 
 namespace mbopt::engine {
 
-const char* FormulationName(Formulation f) {
-  switch (f) {
-    case Formulation::kKinematic:
-      return "kinematic";
-    case Formulation::kKinetostatic:
-      return "kinetostatic";
-    case Formulation::kDynamic:
-      return "dynamic";
-    case Formulation::kElastodynamic:
-      return "elastodynamic";
-  }
-  return "unknown";
-}
-
-AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si) {
+spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si) {
   const auto start = std::chrono::steady_clock::now();
-  AnalysisReport report;
+  spec::AnalysisReport report;
   if (std::holds_alternative<spec::LumpedModel>(scene.model)) {
     report = solve::SimulateLumped(scene, parameter_values_si);
   } else {
 #ifdef MBOPT_HAVE_LINKAGE
     report = solve::AnalyzeLinkage(scene, parameter_values_si);
 #else
-    report.status = AnalysisStatus::kFailed;
-    report.failure_reason = "linkage scenes are not available in this build";
     report.times_s = scene.time_grid.Instants();
+    report.Fail(spec::FailureKind::kInvalidModel, "linkage scenes are not available in this build");
 #endif
   }
   report.counters.wall_seconds =

@@ -24,7 +24,7 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
   out.report = std::move(result.report);
   out.report.counters.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (out.report.status != AnalysisStatus::kOk) {
+  if (!out.report.ok()) {
     out.gradients_unavailable = "the analysis failed";
     return out;
   }

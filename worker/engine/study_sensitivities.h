@@ -22,7 +22,7 @@
 namespace mbopt::engine {
 
 struct StudyAnalysisWithGradients {
-  AnalysisReport report;  // wall time included
+  spec::AnalysisReport report;  // wall time included
   std::optional<spec::StudyGradients> gradients;  // only when report is kOk
   std::string gradients_unavailable;              // why gradients is empty
 };

@@ -6,9 +6,9 @@ namespace mbopt::engine {
 
 absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
-                                                     const AnalysisReport& report) {
-  if (report.status != AnalysisStatus::kOk) {
-    return absl::FailedPreconditionError(absl::StrCat("analysis failed: ", report.failure_reason));
+                                                     const spec::AnalysisReport& report) {
+  if (!report.ok()) {
+    return absl::FailedPreconditionError(absl::StrCat("analysis failed: ", report.failure.reason));
   }
   if (report.outputs.size() != layout.outputs.size()) {
     return absl::InvalidArgumentError(absl::StrCat("analysis has ", report.outputs.size(),
@@ -18,7 +18,7 @@ absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
   std::vector<const std::vector<std::vector<double>>*> series(report.outputs.size());
   std::vector<std::vector<std::vector<double>>> selected(report.outputs.size());
   for (size_t o = 0; o < report.outputs.size(); ++o) {
-    const OutputValues& output = report.outputs[o];
+    const spec::OutputValues& output = report.outputs[o];
     const spec::OutputShape& shape = layout.outputs[o];
     if (static_cast<int>(output.series.size()) == shape.series) {
       series[o] = &output.series;

@@ -6,7 +6,7 @@
 #include "absl/status/statusor.h"
 #include "spec/layout.h"
 #include "spec/study.h"
-#include "worker/engine/analysis.h"
+#include "spec/analysis_report.h"
 
 namespace mbopt::engine {
 
@@ -17,6 +17,6 @@ namespace mbopt::engine {
 // labels (spec::OutputShapeOf).
 absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
-                                                     const AnalysisReport& report);
+                                                     const spec::AnalysisReport& report);
 
 }  // namespace mbopt::engine

@@ -193,11 +193,11 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
   }
 
-  const engine::AnalysisReport report = engine::Analyze(study.scene, parameters);
-  const bool ok = report.status == engine::AnalysisStatus::kOk;
+  const spec::AnalysisReport report = engine::Analyze(study.scene, parameters);
+  const bool ok = report.ok();
   absl::StatusOr<spec::StudyValues> values =
       ok ? engine::ComputeStudyValues(study, *layout, report)
-         : absl::StatusOr<spec::StudyValues>(absl::FailedPreconditionError(report.failure_reason));
+         : absl::StatusOr<spec::StudyValues>(absl::FailedPreconditionError(report.failure.reason));
   if (ok && !values.ok()) {
     err << "mbopt-worker eval: " << values.status().message() << "\n";
     return kExitAnalysisFailed;
@@ -223,8 +223,8 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     out << "{";
     out << "\"study\": " << JsonString(study.name);
     out << ", \"status\": " << JsonString(ok ? "ok" : "failed");
-    if (!ok) out << ", \"failure_reason\": " << JsonString(report.failure_reason);
-    out << ", \"formulation\": " << JsonString(engine::FormulationName(report.formulation));
+    if (!ok) out << ", \"failure_reason\": " << JsonString(report.failure.reason);
+    out << ", \"formulation\": " << JsonString(spec::FormulationName(report.formulation));
     out << ", \"design\": {";
     for (size_t k = 0; k < x.size(); ++k) {
       out << (k ? ", " : "") << JsonString(study.variables[k].name) << ": " << JsonNumber(x[k]);
@@ -285,9 +285,9 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   }
   out << "design       " << absl::StrJoin(design, " ") << "\n";
   for (const std::string& w : outside) out << "warning      " << w << "\n";
-  out << "formulation  " << engine::FormulationName(report.formulation) << "\n";
+  out << "formulation  " << spec::FormulationName(report.formulation) << "\n";
   if (!ok) {
-    out << "status       FAILED: " << report.failure_reason << "\n";
+    out << "status       FAILED: " << report.failure.reason << "\n";
   } else {
     out << "status       ok\n";
     out << absl::StrFormat("objective    %.6g %s (%d term%s)\n", values->objective, objective_unit,

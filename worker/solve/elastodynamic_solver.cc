@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "worker/model/beam_element.h"
+#include "worker/solve/integrator_failure.h"
 
 namespace mbopt::solve {
 
@@ -152,7 +153,7 @@ class ElasticLinkage {
   // Why the integration could not go on, if the model knows: a failed
   // rigid motion, a singular mass matrix, or an elastic response that blew
   // up (a link in compression beyond its buckling load).
-  std::string failure() const { return failure_.empty() ? divergence_ : failure_; }
+  spec::AnalysisFailure failure() const { return failure_.ok() ? divergence_ : failure_; }
 
   // Rigid motion and the assembled M, K, C, load at t (cached per t).
   bool Prepare(double t) {
@@ -167,8 +168,8 @@ class ElasticLinkage {
     } else {
       near = (t - std::prev(it)->time_s < it->time_s - t) ? &*std::prev(it) : &*it;
     }
-    if (KinematicOutcome o = kinematics_->SolveFrom(*near, t, &state_); !o.ok) {
-      failure_ = o.reason;
+    if (KinematicOutcome o = kinematics_->SolveFrom(*near, t, &state_); !o.ok()) {
+      failure_ = o;
       prepared_ = false;
       return false;
     }
@@ -201,7 +202,8 @@ class ElasticLinkage {
     }
     lu_.compute(m_);
     if (lu_.info() != Eigen::Success) {
-      failure_ = absl::StrFormat("mass matrix not positive definite at t = %.6g s", t);
+      failure_ = spec::AnalysisFailure::Of(
+          spec::FailureKind::kInvalidModel, absl::StrFormat("mass matrix not positive definite at t = %.6g s", t));
       prepared_ = false;
       return false;
     }
@@ -219,7 +221,7 @@ class ElasticLinkage {
     AddGeometricForces(u, &geometric_force_);
     dv = lu_.solve(f_ - k_ * u - c_ * v - geometric_force_);
     if (dv.allFinite()) {
-      divergence_.clear();
+      divergence_ = spec::AnalysisFailure::Ok();
       if (buckled_link_ < 0 && largest_compression_ratio_ > 1.0) {
         buckled_link_ = most_compressed_link_;
         buckled_t_ = t;
@@ -316,13 +318,16 @@ class ElasticLinkage {
 
   // Names the first link whose compression passed its Euler load (ends
   // pinned): past that load the linear elastic response grows without bound.
-  std::string DivergenceReason(double t) const {
-    if (buckled_link_ < 0) return absl::StrFormat("elastic response diverged at t = %.6g s", t);
-    return absl::StrFormat(
+  spec::AnalysisFailure DivergenceReason(double t) const {
+    if (buckled_link_ < 0) {
+      return spec::AnalysisFailure::Of(spec::FailureKind::kNonFiniteValue,
+                                       absl::StrFormat("elastic response diverged at t = %.6g s", t));
+    }
+    return spec::AnalysisFailure::Of(spec::FailureKind::kModelValidity, absl::StrFormat(
         "elastic response diverged at t = %.6g s after %s passed its Euler buckling load (ends "
         "pinned) in compression at t = %.6g s: the link is too slender for the mechanism's inertia "
         "loads",
-        t, sys_.LinkLabel(buckled_link_), buckled_t_);
+        t, sys_.LinkLabel(buckled_link_), buckled_t_));
   }
 
   // Internal forces of the axial force acting on the bending deflection (the
@@ -446,8 +451,8 @@ class ElasticLinkage {
   LinkageState state_;
   bool prepared_ = false;
   double prepared_t_ = 0.0;
-  std::string failure_;
-  std::string divergence_;           // set while the right-hand side is not finite
+  spec::AnalysisFailure failure_;
+  spec::AnalysisFailure divergence_;  // set while the right-hand side is not finite
   int most_compressed_link_ = -1;    // of the last right-hand side, -1: none in compression
   double largest_compression_ratio_ = 0.0;  // its compression / Euler load
   int buckled_link_ = -1;  // the first link compressed beyond its Euler load, -1: none
@@ -462,10 +467,12 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
                                   ElastodynamicResult* result) {
   std::vector<LinkageState> trail{kinematics->state()};
   const double t_end = times_s.empty() ? 0.0 : times_s.back();
-  if (KinematicOutcome o = kinematics->AdvanceTo(t_end, &trail); !o.ok) return o;
+  if (KinematicOutcome o = kinematics->AdvanceTo(t_end, &trail); !o.ok()) return o;
 
   ElasticLinkage elastic(system, kinematics, trail);
-  if (std::string why = elastic.Build(); !why.empty()) return KinematicOutcome::Failed(why);
+  if (std::string why = elastic.Build(); !why.empty()) {
+    return KinematicOutcome::Of(spec::FailureKind::kInvalidModel, why);
+  }
   result->lowest_link_frequency_rad_per_s = elastic.lowest_frequency();
   const int n = elastic.num_dofs();
 
@@ -484,13 +491,13 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
       },
       CvodesIntegrator::NewtonRefresh::kEveryIteration, options, 0.0, y0);
   if (!created.ok()) {
-    return KinematicOutcome::Failed(
+    return KinematicOutcome::Of(spec::FailureKind::kIntegrator,
         absl::StrFormat("elastodynamic integrator setup failed: %s", created.status().message()));
   }
   CvodesIntegrator& cvodes = **created;
   if (t_end > 0.0) {
     if (absl::Status s = cvodes.SetStopTime(t_end); !s.ok()) {
-      return KinematicOutcome::Failed(std::string(s.message()));
+      return KinematicOutcome::Of(spec::FailureKind::kIntegrator, std::string(s.message()));
     }
   }
   Eigen::VectorXd y = y0;
@@ -501,16 +508,20 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
     if (t > cvodes.current_time()) {
       if (absl::Status s = cvodes.IntegrateTo(t, &y); !s.ok()) {
         result->counters = cvodes.counters();
-        std::string why = elastic.failure().empty() ? std::string(s.message()) : elastic.failure();
-        return KinematicOutcome::Failed(absl::StrFormat(
-            "elastodynamic integration failed before t = %.6g s: %s", t, why));
+        const std::string context = absl::StrFormat("elastodynamic integration failed before t = %.6g s: ", t);
+        const spec::AnalysisFailure model_failure = elastic.failure();
+        if (!model_failure.ok()) return KinematicOutcome::Of(model_failure.kind, context + model_failure.reason);
+        return IntegratorFailure(s, context + std::string(s.message()));
       }
     }
     std::vector<std::vector<double>> moments;
     double torque = 0.0;
     if (!elastic.Moments(t, y, &moments, &torque)) {
       result->counters = cvodes.counters();
-      return KinematicOutcome::Failed(elastic.failure());
+      const spec::AnalysisFailure model_failure = elastic.failure();
+      return model_failure.ok() ? KinematicOutcome::Of(spec::FailureKind::kNonFiniteValue,
+                                                       absl::StrFormat("elastic moments not finite at t = %.6g s", t))
+                                : model_failure;
     }
     result->rigid_states.push_back(elastic.rigid_state());
     result->node_moment_n_m.push_back(std::move(moments));

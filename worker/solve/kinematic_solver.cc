@@ -260,7 +260,7 @@ KinematicOutcome KinematicSolver::Start() {
   const int num_equations = static_cast<int>(constrained_links_.size()) + 2;
   if (num_equations != num_unknowns_) {
     const int dof = num_unknowns_ - num_equations;
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kInvalidModel, absl::StrFormat(
         "the driven linkage has %d degree(s) of freedom (%d joint coordinates, %d constraints); "
         "a driven mechanism needs exactly 0",
         dof, num_unknowns_, num_equations));
@@ -298,12 +298,12 @@ KinematicOutcome KinematicSolver::Start() {
     converged = r_.lpNorm<Eigen::Infinity>() <= tol;
   }
   if (!converged) {
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
         "the mechanism cannot assemble at t = 0 s (driver angle %.6g rad): %s", angle,
         WorstConstraint(q, angle)));
   }
   if (!Complete(q, 0.0, &state_)) {
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
         "the mechanism is locked at t = 0 s (singular constraint Jacobian, a dead-centre "
         "position) at %s",
         NullMotionJoint()));
@@ -314,7 +314,7 @@ KinematicOutcome KinematicSolver::Start() {
 }
 
 KinematicOutcome KinematicSolver::AdvanceTo(double t_s, std::vector<LinkageState>* trail) {
-  if (!started_) return KinematicOutcome::Failed("kinematic solver not started");
+  if (!started_) return KinematicOutcome::Of(spec::FailureKind::kInvalidModel, "kinematic solver not started");
   const double omega = sys_.driver.angular_velocity_rad_per_s;
   if (omega == 0.0 || t_s <= state_.time_s) {
     state_.time_s = std::max(state_.time_s, t_s);
@@ -358,18 +358,18 @@ KinematicOutcome KinematicSolver::AdvanceTo(double t_s, std::vector<LinkageState
     Jacobian(q, &jac_);
     const std::string joint = NullMotionJoint();
     if (why == Rejection::kBranch) {
-      return KinematicOutcome::Failed(absl::StrFormat(
+      return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
           "the mechanism changes assembly branch at t = %.6g s (driver angle %.6g rad): it "
           "passes a locking position at %s",
           state_.time_s, state_.driver_angle_rad, joint));
     }
     if (why == Rejection::kSingular) {
-      return KinematicOutcome::Failed(absl::StrFormat(
+      return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
           "the mechanism locks at t = %.6g s (driver angle %.6g rad): singular constraint "
           "Jacobian (dead-centre position) at %s",
           state_.time_s, state_.driver_angle_rad, joint));
     }
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
         "the mechanism locks at t = %.6g s (driver angle %.6g rad): no closed position beyond "
         "it; the loop cannot close at %s (%s)",
         state_.time_s, state_.driver_angle_rad, joint, WorstConstraint(predicted_, DriverAngle(t_next))));
@@ -385,7 +385,7 @@ KinematicOutcome KinematicSolver::SolveFrom(const LinkageState& near, double t_s
   const NewtonResult result = Newton(&q, DriverAngle(t_s), kStepNewtonIterations);
   if (result != NewtonResult::kConverged || !Complete(q, t_s, out) ||
       out->branch_sign != near.branch_sign) {
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
         "no closed position of the linkage at t = %.6g s on the start branch", t_s));
   }
   return {};

@@ -18,6 +18,8 @@
 // Owns its work buffers; borrows the LinkageSystem, which must outlive it.
 #pragma once
 
+#include "spec/analysis_outcome.h"
+
 #include <cstdint>
 #include <numbers>
 #include <string>
@@ -43,11 +45,10 @@ struct LinkageState {
   double LinkAngularAcceleration(const model::LinkageLink& link) const;  // rad/s^2
 };
 
-struct KinematicOutcome {
-  bool ok = true;
-  std::string reason;  // when !ok: says when and where
-  static KinematicOutcome Failed(std::string why) { return {false, std::move(why)}; }
-};
+// Outcomes of the kinematic, kinetostatic and elastodynamic solvers: the
+// project's one failure vocabulary (spec/analysis_outcome.h), so a solver's
+// failure reaches the user with its kind.
+using KinematicOutcome = spec::AnalysisFailure;
 
 class KinematicSolver {
  public:

@@ -33,7 +33,7 @@ KinematicOutcome KinetostaticSolver::Solve(const LinkageState& s, KinetostaticLo
   for (const model::LinkageJoint& j : sys_.joints) n_free_joints += j.ground ? 0 : 1;
   const int n_rows = 3 * num_moving_ + 2 * n_free_joints;
   if (n_rows != n_unknowns) {
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kInvalidModel, absl::StrFormat(
         "pin forces are not statically determinate (%d equations, %d unknowns)", n_rows,
         n_unknowns));
   }
@@ -87,7 +87,7 @@ KinematicOutcome KinetostaticSolver::Solve(const LinkageState& s, KinetostaticLo
   }
   Eigen::PartialPivLU<Eigen::MatrixXd> lu(a_);
   if (!(lu.rcond() > kSingularRcond)) {
-    return KinematicOutcome::Failed(absl::StrFormat(
+    return KinematicOutcome::Of(spec::FailureKind::kAssembly, absl::StrFormat(
         "pin forces are indeterminate at t = %.6g s (singular equilibrium equations)", s.time_s));
   }
   const Eigen::VectorXd x = lu.solve(b_);

@@ -16,10 +16,10 @@ namespace mbopt::solve {
 
 namespace {
 
-using engine::AnalysisReport;
-using engine::AnalysisStatus;
-using engine::Formulation;
-using engine::OutputValues;
+using spec::AnalysisReport;
+using spec::FailureKind;
+using spec::Formulation;
+using spec::OutputValues;
 
 // Wraps to (-pi, pi].
 double WrapAngle(double a) {
@@ -42,11 +42,10 @@ bool NeedsLoads(const spec::Output& o) {
          std::holds_alternative<spec::DriveTorqueOutput>(o.kind);
 }
 
-void Fail(AnalysisReport* report, std::string why) {
-  report->status = AnalysisStatus::kFailed;
-  report->failure_reason = std::move(why);
-  report->outputs.clear();
+void Fail(AnalysisReport* report, const spec::AnalysisFailure& failure) {
+  report->Fail(failure.kind, failure.reason);
 }
+void Fail(AnalysisReport* report, std::string why) { report->Fail(FailureKind::kInvalidModel, std::move(why)); }
 
 // Checks that every output fits a linkage and refers to existing items.
 std::string CheckOutputs(const spec::Scene& scene, const model::LinkageSystem& sys) {
@@ -178,9 +177,9 @@ AnalysisReport AnalyzeLinkage(const spec::Scene& scene,
     report.counters.position_solves += kinematics.position_solves();
     report.counters.newton_iterations += kinematics.newton_iterations();
   };
-  if (KinematicOutcome o = kinematics.Start(); !o.ok) {
+  if (KinematicOutcome o = kinematics.Start(); !o.ok()) {
     count();
-    Fail(&report, o.reason);
+    Fail(&report, o);
     return finish();
   }
   const LinkageState start = kinematics.state();
@@ -194,8 +193,8 @@ AnalysisReport AnalyzeLinkage(const spec::Scene& scene,
     report.counters.rhs_evaluations = elastic.counters.rhs_evaluations;
     report.counters.jacobian_evaluations = elastic.counters.jacobian_evaluations;
     report.counters.newton_iterations += elastic.counters.nonlinear_iterations;
-    if (!o.ok) {
-      Fail(&report, o.reason);
+    if (!o.ok()) {
+      Fail(&report, o);
       return finish();
     }
     for (size_t i = 0; i < nt; ++i) {
@@ -219,17 +218,17 @@ AnalysisReport AnalyzeLinkage(const spec::Scene& scene,
   KinetostaticSolver statics(sys);
   KinetostaticLoads loads;
   for (size_t i = 0; i < nt; ++i) {
-    if (KinematicOutcome o = kinematics.AdvanceTo(report.times_s[i]); !o.ok) {
+    if (KinematicOutcome o = kinematics.AdvanceTo(report.times_s[i]); !o.ok()) {
       count();
-      Fail(&report, o.reason);
+      Fail(&report, o);
       return finish();
     }
     const LinkageState& s = kinematics.state();
     RecordMotion(scene, sys, start, s, i, &report.outputs);
     if (!needs_loads) continue;
-    if (KinematicOutcome o = statics.Solve(s, &loads); !o.ok) {
+    if (KinematicOutcome o = statics.Solve(s, &loads); !o.ok()) {
       count();
-      Fail(&report, o.reason);
+      Fail(&report, o);
       return finish();
     }
     for (size_t k = 0; k < scene.outputs.size(); ++k) {

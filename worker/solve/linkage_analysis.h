@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "spec/scene.h"
-#include "worker/engine/analysis.h"
+#include "spec/analysis_report.h"
 
 namespace mbopt::solve {
 
 // `scene.model` must hold a LinkageModel; `parameter_values_si` has one SI
 // value per scene parameter.
-engine::AnalysisReport AnalyzeLinkage(const spec::Scene& scene,
+spec::AnalysisReport AnalyzeLinkage(const spec::Scene& scene,
                                       const std::vector<double>& parameter_values_si);
 
 }  // namespace mbopt::solve

@@ -16,11 +16,12 @@
 namespace mbopt::solve {
 namespace {
 
-engine::AnalysisReport Failed(engine::AnalysisReport report, std::string reason) {
-  report.status = engine::AnalysisStatus::kFailed;
-  report.failure_reason = std::move(reason);
-  report.outputs.clear();  // partial series must not pass for results
+spec::AnalysisReport Failed(spec::AnalysisReport report, spec::FailureKind kind, std::string reason) {
+  report.Fail(kind, std::move(reason));  // partial series must not pass for results
   return report;
+}
+spec::AnalysisReport Failed(spec::AnalysisReport report, const spec::AnalysisFailure& failure) {
+  return Failed(std::move(report), failure.kind, failure.reason);
 }
 
 // What to evaluate for one requested output at each instant.
@@ -34,11 +35,11 @@ struct OutputPlan {
 
 }  // namespace
 
-std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<double>& instants_s,
+spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& m, const std::vector<double>& instants_s,
                             const spec::IntegratorSettings& settings,
                             const LumpedDynamicsOptions& options,
                             const LumpedInstantCallback& at_instant,
-                            engine::AnalysisCounters* counters) {
+                            spec::AnalysisCounters* counters) {
   const int n = m.num_coordinates();
   // y' = A y + (0, M^-1 f(t)) with A = [0 I; -M^-1 K  -M^-1 C].
   const Eigen::VectorXd inverse_mass = m.mass_diagonal().cwiseInverse();
@@ -89,11 +90,14 @@ std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<doubl
           ? CvodesIntegrator::CreateWithNewtonSolver(
                 2 * n, rhs, newton_solve, CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv, 0.0, y)
           : CvodesIntegrator::Create(2 * n, rhs, nullptr, cv, 0.0, y);
-  if (!created.ok()) return absl::StrCat("integrator setup: ", created.status().message());
+  if (!created.ok()) {
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator,
+                                     absl::StrCat("integrator setup: ", created.status().message()));
+  }
   CvodesIntegrator& integrator = **created;
 
   const double t_last = instants_s.empty() ? 0.0 : instants_s.back();
-  const std::string failure = IntegrateAcrossKinks(
+  const spec::AnalysisFailure failure = IntegrateAcrossKinks(
       integrator, m.KinkTimes(0.0, t_last), instants_s, &y,
       [&](double t, const Eigen::VectorXd& state) { return at_instant(t, state.head(n), state.tail(n)); });
   const CvodesCounters c = integrator.counters();
@@ -104,21 +108,23 @@ std::string IntegrateLumped(const model::LumpedModel& m, const std::vector<doubl
   return failure;
 }
 
-engine::AnalysisReport SimulateLumped(const spec::Scene& scene,
+spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
                                       const std::vector<double>& parameter_values_si,
                                       const LumpedDynamicsOptions& options) {
-  engine::AnalysisReport report;
-  report.formulation = engine::Formulation::kDynamic;
+  spec::AnalysisReport report;
+  report.formulation = spec::Formulation::kDynamic;
   report.times_s = scene.time_grid.Instants();
   const auto* spec_model = std::get_if<spec::LumpedModel>(&scene.model);
-  if (spec_model == nullptr) return Failed(report, "scene has no lumped model");
+  if (spec_model == nullptr) return Failed(report, spec::FailureKind::kInvalidModel, "scene has no lumped model");
   if (parameter_values_si.size() != scene.parameters.size()) {
-    return Failed(report, absl::StrCat("got ", parameter_values_si.size(), " parameter values for ",
+    return Failed(report, spec::FailureKind::kInvalidModel, absl::StrCat("got ", parameter_values_si.size(), " parameter values for ",
                                        scene.parameters.size(), " scene parameters"));
   }
   absl::StatusOr<model::LumpedModel> assembled =
       model::LumpedModel::Assemble(*spec_model, parameter_values_si);
-  if (!assembled.ok()) return Failed(report, std::string(assembled.status().message()));
+  if (!assembled.ok()) {
+    return Failed(report, spec::FailureKind::kInvalidModel, std::string(assembled.status().message()));
+  }
   const model::LumpedModel& m = *assembled;
 
   std::vector<OutputPlan> plans;
@@ -136,12 +142,12 @@ engine::AnalysisReport SimulateLumped(const spec::Scene& scene,
       plan.axis = a->axis;
       needs_acceleration = true;
     } else {
-      return Failed(report, absl::StrCat("output \"", out.name,
+      return Failed(report, spec::FailureKind::kInvalidModel, absl::StrCat("output \"", out.name,
                                          "\" is not available for a lumped scene (only "
                                          "element_deflection and body_acceleration are)"));
     }
     plans.push_back(plan);
-    engine::OutputValues values;
+    spec::OutputValues values;
     values.name = out.name;
     values.series_labels = {out.name};
     values.series.assign(1, std::vector<double>());
@@ -160,16 +166,17 @@ engine::AnalysisReport SimulateLumped(const spec::Scene& scene,
               ? m.Deflection(plan.element, q, t)
               : m.PointAcceleration(plan.body, plan.offset_x_m, plan.offset_y_m, plan.axis, a);
       if (!std::isfinite(value)) {
-        return absl::StrFormat("output \"%s\" is not finite at t = %.9g s", scene.outputs[o].name,
-                               t);
+        return spec::AnalysisFailure::Of(
+            spec::FailureKind::kNonFiniteValue,
+            absl::StrFormat("output \"%s\" is not finite at t = %.9g s", scene.outputs[o].name, t));
       }
       report.outputs[o].series[0].push_back(value);
     }
-    return std::string();
+    return spec::AnalysisFailure::Ok();
   };
-  std::string failure =
+  const spec::AnalysisFailure failure =
       IntegrateLumped(m, report.times_s, scene.integrator, options, at_instant, &report.counters);
-  if (!failure.empty()) return Failed(report, std::move(failure));
+  if (!failure.ok()) return Failed(report, failure);
   return report;
 }
 

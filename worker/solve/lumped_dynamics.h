@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "spec/scene.h"
-#include "worker/engine/analysis.h"
+#include "spec/analysis_report.h"
 #include "worker/model/lumped_model.h"
 
 namespace mbopt::solve {
@@ -40,22 +40,21 @@ struct LumpedDynamicsOptions {
 };
 
 // The integration itself: calls `at_instant(t, q, q')` at every instant of
-// `instants_s` (ascending, >= 0), starting from t = 0; a non-empty string
-// returned by the callback stops the integration as a failure. Returns the
-// failure reason (empty on success); `counters` receives the integrator's
-// counters either way.
+// `instants_s` (ascending, >= 0), starting from t = 0; a failure returned by
+// the callback stops the integration. Returns how the integration ended;
+// `counters` receives the integrator's counters either way.
 using LumpedInstantCallback =
-    std::function<std::string(double t_s, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot)>;
-std::string IntegrateLumped(const model::LumpedModel& model, const std::vector<double>& instants_s,
+    std::function<spec::AnalysisFailure(double t_s, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot)>;
+spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& model, const std::vector<double>& instants_s,
                             const spec::IntegratorSettings& settings,
                             const LumpedDynamicsOptions& options,
                             const LumpedInstantCallback& at_instant,
-                            engine::AnalysisCounters* counters);
+                            spec::AnalysisCounters* counters);
 
 // `scene.model` must hold a LumpedModel; `parameter_values_si` has one value
 // per scene parameter. Fills formulation kDynamic, the grid, the outputs in
 // scene order and the integrator counters (not the wall time).
-engine::AnalysisReport SimulateLumped(const spec::Scene& scene,
+spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
                                       const std::vector<double>& parameter_values_si,
                                       const LumpedDynamicsOptions& options = {});
 

@@ -21,11 +21,12 @@ using sensitivity_internal::SensitivityRecorder;
 
 bool Uses(const spec::Number& number, int parameter) { return number.param == parameter; }
 
-engine::AnalysisReport Failed(engine::AnalysisReport report, std::string reason) {
-  report.status = engine::AnalysisStatus::kFailed;
-  report.failure_reason = std::move(reason);
-  report.outputs.clear();
+spec::AnalysisReport Failed(spec::AnalysisReport report, spec::FailureKind kind, std::string reason) {
+  report.Fail(kind, std::move(reason));
   return report;
+}
+spec::AnalysisReport Failed(spec::AnalysisReport report, std::string reason) {
+  return Failed(std::move(report), spec::FailureKind::kInvalidModel, std::move(reason));
 }
 
 }  // namespace
@@ -72,8 +73,8 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
     const spec::Scene& scene, const std::vector<double>& parameter_values_si,
     const std::vector<int>& parameters, const LumpedSensitivityOptions& options) {
   LumpedSensitivityResult result;
-  engine::AnalysisReport& report = result.report;
-  report.formulation = engine::Formulation::kDynamic;
+  spec::AnalysisReport& report = result.report;
+  report.formulation = spec::Formulation::kDynamic;
   report.times_s = scene.time_grid.Instants();
   const auto* spec_model = std::get_if<spec::LumpedModel>(&scene.model);
   if (spec_model == nullptr) {
@@ -171,7 +172,7 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
       return result;
     }
     plans.push_back(plan);
-    engine::OutputValues values;
+    spec::OutputValues values;
     values.name = out.name;
     values.series_labels = {out.name};
     values.series.assign(1, std::vector<double>());
@@ -226,20 +227,20 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   };
 
   if (options.method == LumpedSensitivityOptions::Method::kAugmentedSystem) {
-    const std::string failure =
+    const spec::AnalysisFailure failure =
         sensitivity_internal::IntegrateAugmented(&problem, settings, options, omega_max, pbar, report.times_s, record,
                            &report.counters, &result.counters);
-    if (!failure.empty()) {
-      report = Failed(report, failure);
+    if (!failure.ok()) {
+      report = Failed(report, failure.kind, failure.reason);
       result.output_derivatives.clear();
     }
     return result;
   }
-  const std::string failure =
+  const spec::AnalysisFailure failure =
       sensitivity_internal::IntegrateWithSensitivityModule(&problem, settings, options, omega_max, pbar, report.times_s,
                                      record, &report.counters, &result.counters);
-  if (!failure.empty()) {
-    report = Failed(report, failure);
+  if (!failure.ok()) {
+    report = Failed(report, failure.kind, failure.reason);
     result.output_derivatives.clear();
   }
   return result;

@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "spec/scene.h"
-#include "worker/engine/analysis.h"
+#include "spec/analysis_report.h"
 
 namespace mbopt::solve {
 
@@ -90,7 +90,7 @@ struct LumpedSensitivityCounters {
 struct LumpedSensitivityResult {
   // Values as SimulateLumped reports them (kDynamic, grid, one series per
   // output), from the integration that also carried the sensitivities.
-  engine::AnalysisReport report;
+  spec::AnalysisReport report;
   // [k][output][instant]: d output / d parameter_values_si[parameters[k]],
   // SI per SI. Filled when report.status is kOk.
   std::vector<std::vector<std::vector<double>>> output_derivatives;

@@ -13,11 +13,11 @@
 
 namespace mbopt::solve::sensitivity_internal {
 
-std::string IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSettings& settings,
+spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSettings& settings,
                                const LumpedSensitivityOptions& options, double omega_max,
                                const std::vector<double>& pbar,
                                const std::vector<double>& instants, const SensitivityRecorder& record,
-                               engine::AnalysisCounters* counters,
+                               spec::AnalysisCounters* counters,
                                LumpedSensitivityCounters* sensitivity_counters) {
   const model::LumpedModel& m = *p->model;
   const int n = p->n;
@@ -96,14 +96,17 @@ std::string IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSett
       CvodesIntegrator::CreateWithNewtonSolver(size, rhs, newton_solve,
                                                CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv,
                                                0.0, y);
-  if (!created.ok()) return absl::StrCat("integrator setup: ", created.status().message());
+  if (!created.ok()) {
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator,
+                                     absl::StrCat("integrator setup: ", created.status().message()));
+  }
   CvodesIntegrator& integrator = **created;
 
   const double t_last = instants.empty() ? 0.0 : instants.back();
-  const std::string failure = IntegrateAcrossKinks(
+  const spec::AnalysisFailure failure = IntegrateAcrossKinks(
       integrator, m.KinkTimes(0.0, t_last), instants, &y, [&](double t, const Eigen::VectorXd& state) {
         record(t, state.head(block), [&](int k) { return state.data() + block * (1 + k); });
-        return std::string();
+        return spec::AnalysisFailure::Ok();
       });
   const CvodesCounters c = integrator.counters();
   counters->time_steps = c.steps;

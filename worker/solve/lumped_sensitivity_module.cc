@@ -14,6 +14,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "worker/solve/integrator_failure.h"
 #include "worker/solve/lumped_sensitivity_problem.h"
 
 namespace mbopt::solve::sensitivity_internal {
@@ -120,13 +121,13 @@ struct Sundials {
 
 }  // namespace
 
-std::string IntegrateWithSensitivityModule(SensitivityProblem* p,
+spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
                                            const spec::IntegratorSettings& settings,
                                            const LumpedSensitivityOptions& options, double omega_max,
                                            const std::vector<double>& pbar,
                                            const std::vector<double>& instants,
                                            const SensitivityRecorder& record,
-                                           engine::AnalysisCounters* counters,
+                                           spec::AnalysisCounters* counters,
                                            LumpedSensitivityCounters* sensitivity_counters) {
   const model::LumpedModel& m = *p->model;
   const int n = p->n;
@@ -142,20 +143,21 @@ std::string IntegrateWithSensitivityModule(SensitivityProblem* p,
     return false;
   };
   if (!(options.tolerance_factor > 0.0) || !std::isfinite(options.tolerance_factor)) {
-    return absl::StrCat("sensitivity tolerance factor must be positive, got ",
-                        options.tolerance_factor);
+    return spec::AnalysisFailure::Of(spec::FailureKind::kInvalidModel,
+                                     absl::StrCat("sensitivity tolerance factor must be positive, got ",
+                                                  options.tolerance_factor));
   }
   if (SUNContext_Create(nullptr, &s.context) != 0) {
-    return "SUNContext_Create failed";
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNContext_Create failed");
   }
   s.y = N_VNew_Serial(2 * n, s.context);
   s.abstol = N_VNew_Serial(2 * n, s.context);
   s.cvode = CVodeCreate(CV_BDF, s.context);
   if (s.y == nullptr || s.abstol == nullptr || s.cvode == nullptr) {
-    return "SUNDIALS allocation failed";
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   }
   if (options.fused_vector_operations && N_VEnableFusedOps_Serial(s.y, SUNTRUE) != 0) {
-    return "N_VEnableFusedOps_Serial failed";
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "N_VEnableFusedOps_Serial failed");
   }
   Eigen::Map<Eigen::VectorXd> y(N_VGetArrayPointer(s.y), 2 * n);
   y.setZero();
@@ -167,7 +169,7 @@ std::string IntegrateWithSensitivityModule(SensitivityProblem* p,
   s.ys = N_VCloneVectorArray(ns, s.y);
   s.num_sensitivities = ns;
   if (s.matrix == nullptr || s.linear_solver == nullptr || s.ys == nullptr) {
-    return "SUNDIALS allocation failed";
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   }
   for (int k = 0; k < ns; ++k) N_VConst(0.0, s.ys[k]);
   int corrector = CV_STAGGERED;
@@ -183,7 +185,7 @@ std::string IntegrateWithSensitivityModule(SensitivityProblem* p,
   if (!estimated_tolerances) {
     sensitivity_abstol = N_VCloneVectorArray(ns, s.y);
     if (sensitivity_abstol == nullptr) {
-      return "SUNDIALS allocation failed";
+      return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
     }
     for (int k = 0; k < ns; ++k) {
       N_VScale(options.tolerance_factor / pbar[static_cast<size_t>(k)], s.abstol,
@@ -295,8 +297,11 @@ std::string IntegrateWithSensitivityModule(SensitivityProblem* p,
     record(t, y, [&](int k) { return N_VGetArrayPointer(s.ys[k]); });
   }
   if (!history_counted) accumulate_counters();
-  if (!ok) return failure.empty() ? "sensitivity integration failed" : failure;
-  return "";
+  if (!ok) {
+    return IntegratorFailure(p->wall_time_exceeded ? absl::DeadlineExceededError("") : absl::AbortedError(""),
+                             failure.empty() ? "sensitivity integration failed" : failure);
+  }
+  return spec::AnalysisFailure::Ok();
 }
 
 }  // namespace mbopt::solve::sensitivity_internal

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "spec/scene.h"
-#include "worker/engine/analysis.h"
+#include "spec/analysis_report.h"
 #include "worker/model/lumped_model.h"
 #include "worker/solve/lumped_sensitivity.h"
 
@@ -94,7 +94,7 @@ using SensitivityRecorder =
     std::function<void(double t, const Eigen::Ref<const Eigen::VectorXd>& state,
                        const std::function<const double*(int)>& sensitivity)>;
 
-// Both return "" or why the integration failed, and fill the counters.
+// Both return how the integration ended (ok, or the failure) and fill the counters.
 
 // lumped_sensitivity_augmented.cc (the default): the states and all sensitivities as one ODE of size 2n (1 + ns),
 // Y = (y, s_1, ..., s_ns), integrated by CVODES without its sensitivity
@@ -111,23 +111,23 @@ using SensitivityRecorder =
 // the sensitivity module is per-vector overhead: CVODES does each of its
 // vector operations once on a 2n (1 + ns) array instead of 1 + ns times on
 // 2n-element vectors, which dominates for small n.
-std::string IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSettings& settings,
+spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSettings& settings,
                                const LumpedSensitivityOptions& options, double omega_max,
                                const std::vector<double>& pbar,
                                const std::vector<double>& instants,
                                const SensitivityRecorder& record,
-                               engine::AnalysisCounters* counters,
+                               spec::AnalysisCounters* counters,
                                LumpedSensitivityCounters* sensitivity_counters);
 
 // lumped_sensitivity_module.cc: CVODES' forward sensitivity module
 // (CVodeSensInit), BDF with its dense Newton solver, configured by `options`.
-std::string IntegrateWithSensitivityModule(SensitivityProblem* p,
+spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
                                            const spec::IntegratorSettings& settings,
                                            const LumpedSensitivityOptions& options,
                                            double omega_max, const std::vector<double>& pbar,
                                            const std::vector<double>& instants,
                                            const SensitivityRecorder& record,
-                                           engine::AnalysisCounters* counters,
+                                           spec::AnalysisCounters* counters,
                                            LumpedSensitivityCounters* sensitivity_counters);
 
 }  // namespace mbopt::solve::sensitivity_internal

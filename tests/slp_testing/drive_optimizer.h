@@ -1,6 +1,6 @@
-// Runs an SlpOptimizer to its end in memory against an evaluator function:
-// for tests, examples and tools that have F and g at hand. The service does
-// not use it (it hands requests to workers); it shows the calling protocol.
+// Runs an SlpOptimizer to its end in memory against an evaluator function,
+// for the core's own tests on analytic problems: they test the core alone.
+// Studies are driven by jobs::Job only (server/jobs/job.h).
 #pragma once
 
 #include <cstdint>

@@ -10,6 +10,12 @@
 // the optimizer's new requests are queued. So a record is durable before
 // anyone sees it, and a crash at any point is repaired by replay (job.h).
 //
+// Every change of a job's state goes through one function (EnterStateLocked),
+// which persists it, logs the event and wakes watchers; a store error on the
+// way is logged, never dropped. Results are validated once, by the job's
+// intake (jobs::Job::Intake), into the record that is logged and replayed.
+// The LP solver of each job and the clock are injected.
+//
 // Thread-safe. Optimizer work is short (LP solves) and done on the calling
 // thread under the job's mutex; the store's commits are the only I/O.
 #pragma once
@@ -24,8 +30,11 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "server/jobs/analysis_record.h"
 #include "server/jobs/job.h"
 #include "server/jobs/job_state.h"
+#include "server/lp/linear_program.h"
+#include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
 #include "server/store/store.h"
 #include "spec/layout.h"
@@ -42,6 +51,10 @@ struct JobManagerOptions {
   // Called after each cycle record is committed, with the number committed
   // by this manager so far (all jobs). For fault-injection tests.
   std::function<void(std::int64_t records_committed)> after_record_commit;
+  // Makes each job's LP solver (one per job and per resume). Required.
+  std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver;
+  // Measures the jobs' running time; not owned. nullptr: a steady clock.
+  const scheduler::Clock* clock = nullptr;
 };
 
 struct JobSummaryData {
@@ -60,6 +73,8 @@ struct JobSummaryData {
   std::string message;
   std::int64_t created_unix_ms = 0;
   int max_cycles = 0;
+  // Failed analyses so far by failure kind name (spec::FailureKindName).
+  std::map<std::string, std::int64_t> failed_analyses_by_kind;
 };
 
 // What a client needs to show a job's records with names and units.
@@ -74,23 +89,14 @@ struct JobView {
   std::string study_bytes;
 };
 
-// One result from a worker, in domain terms.
-struct WorkerResult {
+// One result from a worker: where it goes, and the candidate record the
+// job's intake validates (request_id set; x_scaled and attempts are the
+// scheduler's).
+struct WorkerReport {
   std::string worker_id;
   std::string task_id;
   std::string job_id;
-  std::int64_t request_id = 0;
-  bool ok = false;
-  std::string failure_reason;
-  std::vector<double> objective_terms;
-  std::vector<double> constraint_values;
-  // When the task wanted gradients: row-major d(value)/d(x_scaled)
-  // (server/jobs/analysis_gradients.h), or both empty and the reason.
-  std::vector<double> objective_gradients;
-  std::vector<double> constraint_gradients;
-  std::string gradients_unavailable;
-  double wall_seconds = 0;
-  store::AnalysisCounters counters;
+  jobs::AnalysisRecord record;
 };
 
 class JobManager {
@@ -130,7 +136,7 @@ class JobManager {
   // not an error: the values are taken without them (the reason is logged
   // with the analysis) and the optimizer uses finite differences for that
   // cycle. NotFound for an unknown job. Unavailable after Shutdown.
-  absl::StatusOr<bool> ReportResult(const WorkerResult& result);
+  absl::StatusOr<bool> ReportResult(WorkerReport report);
 
   // A worker could not run a task (not a failure of the analysis).
   absl::Status ReportWorkerError(const std::string& worker_id, const std::string& task_id,
@@ -152,22 +158,35 @@ class JobManager {
 
   absl::StatusOr<std::shared_ptr<Entry>> Find(const std::string& job_id);
   // The following run under the entry's mutex.
+  // How EnterStateLocked records a state: SetJobState, or already stored
+  // by the caller in the same transaction as other rows.
+  enum class Persist { kSetState, kAlreadyStored };
+  // The one place where a job's state changes. Starts or stops the running
+  // time, drops the job's tasks when it stops running, persists the state
+  // (unless already stored), logs the event (if `event` is not empty) and
+  // wakes watchers. Returns the first store error; it is also logged.
+  absl::Status EnterStateLocked(Entry& entry, jobs::JobState to, std::string message, const std::string& event,
+                                const std::string& event_detail, Persist persist = Persist::kSetState);
   absl::Status ResumeLocked(Entry& entry, const std::string& why);
-  absl::Status DeliverLocked(Entry& entry, const store::AnalysisRow& row);
+  absl::Status DeliverLocked(Entry& entry, const jobs::AnalysisRecord& record);
   absl::Status CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records);
   void ScheduleLocked(Entry& entry);
-  void FinishIfDoneLocked(Entry& entry);
   void FailJobLocked(Entry& entry, const std::string& message);
   JobSummaryData SummaryLocked(const Entry& entry) const;
   JobView ViewLocked(const Entry& entry, std::size_t first_record) const;
   double WallSecondsLocked(const Entry& entry) const;
   void Changed(Entry& entry);
+  // The record of a task the scheduler gave up on (attempts used up, or a
+  // result that did not fit), delivered as a failed analysis.
+  void DeliverGivenUpLocked(Entry& entry, const scheduler::FinishedTask& task);
   void GiveUp(const scheduler::FinishedTask& task);
 
   store::Store* store_;
   scheduler::Scheduler* scheduler_;
   StudyDecoder decoder_;
   JobManagerOptions options_;
+  scheduler::SteadyClock steady_clock_;
+  const scheduler::Clock* clock_;
 
   std::mutex mutex_;  // guards jobs_, shutdown_, records_committed_
   std::map<std::string, std::shared_ptr<Entry>> jobs_;

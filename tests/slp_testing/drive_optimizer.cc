@@ -1,4 +1,4 @@
-#include "server/slp/run_to_completion.h"
+#include "tests/slp_testing/drive_optimizer.h"
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"

@@ -1,20 +1,17 @@
-#include "server/service/job_manager.h"
+#include "server/jobs/manager/job_manager.h"
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <iostream>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
-#include "server/jobs/analysis_gradients.h"
 #include "server/jobs/record_codec.h"
 
 namespace mbopt::service {
 
 using jobs::JobState;
-using Clock = std::chrono::steady_clock;
 
 struct JobManager::Entry {
   std::mutex mutex;
@@ -31,47 +28,29 @@ struct JobManager::Entry {
 
   std::vector<slp::CycleRecord> records;
   std::int64_t version = 0;
-  std::string last_failure;  // of the latest failed analysis
 
   double wall_before_s = 0;  // running time of earlier runs
   bool timing = false;
-  Clock::time_point run_started;
+  std::int64_t run_started_ms = 0;
 };
 
 namespace {
-
-std::vector<double> ToVector(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
-
-Eigen::VectorXd ToEigen(const std::vector<double>& v) {
-  Eigen::VectorXd e(static_cast<Eigen::Index>(v.size()));
-  for (size_t i = 0; i < v.size(); ++i) e[static_cast<Eigen::Index>(i)] = v[i];
-  return e;
-}
-
-// The optimizer's view of a logged analysis: live delivery and replay give
-// it exactly this, so a resumed job sees what the first run saw.
-slp::AnalysisResult ResultOf(const store::AnalysisRow& row, const slp::ProblemSpec& problem) {
-  slp::AnalysisResult result;
-  result.request_id = row.request_id;
-  result.outcome = row.ok ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
-  result.failure_reason = row.failure_reason;
-  if (row.ok) {
-    result.objective_terms = ToEigen(row.objective_terms);
-    result.constraint_values = ToEigen(row.constraint_values);
-    jobs::AttachGradients(problem, row.objective_gradients, row.constraint_gradients, &result);
-  }
-  return result;
-}
 
 void LogError(const std::string& job_id, const absl::Status& status) {
   std::cerr << "mbopt-server: job " << job_id << ": " << status << std::endl;
 }
 
+bool Running(JobState state) { return state == JobState::kRunning || state == JobState::kQueued; }
+
 }  // namespace
 
 JobManager::JobManager(store::Store* store, scheduler::Scheduler* scheduler, StudyDecoder decoder,
                        JobManagerOptions options)
-    : store_(store), scheduler_(scheduler), decoder_(std::move(decoder)), options_(std::move(options)) {}
+    : store_(store),
+      scheduler_(scheduler),
+      decoder_(std::move(decoder)),
+      options_(std::move(options)),
+      clock_(options_.clock != nullptr ? options_.clock : &steady_clock_) {}
 
 JobManager::~JobManager() = default;
 
@@ -89,14 +68,42 @@ void JobManager::Changed(Entry& entry) {
 
 double JobManager::WallSecondsLocked(const Entry& entry) const {
   double wall = entry.wall_before_s;
-  if (entry.timing) wall += std::chrono::duration<double>(Clock::now() - entry.run_started).count();
+  if (entry.timing) wall += static_cast<double>(clock_->NowMs() - entry.run_started_ms) / 1000.0;
   return wall;
 }
 
-static void StopTiming(double& wall_before_s, bool& timing, Clock::time_point started) {
-  if (!timing) return;
-  wall_before_s += std::chrono::duration<double>(Clock::now() - started).count();
-  timing = false;
+absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string message, const std::string& event,
+                                          const std::string& event_detail, Persist persist) {
+  const std::string& id = entry.row.id;
+  if (to == JobState::kRunning) {
+    if (!entry.timing) {
+      entry.timing = true;
+      entry.run_started_ms = clock_->NowMs();
+    }
+  } else {
+    if (entry.timing) entry.wall_before_s = WallSecondsLocked(entry);
+    entry.timing = false;
+    scheduler_->DropJob(id);
+  }
+  entry.state = to;
+  entry.message = std::move(message);
+  absl::Status first_error;
+  if (persist == Persist::kSetState) {
+    absl::Status status = store_->SetJobState(id, jobs::JobStateName(to), entry.message);
+    if (!status.ok()) {
+      LogError(id, status);
+      first_error = status;
+    }
+  }
+  if (!event.empty()) {
+    absl::Status status = store_->AddEvent(id, event, event_detail);
+    if (!status.ok()) {
+      LogError(id, status);
+      if (first_error.ok()) first_error = status;
+    }
+  }
+  Changed(entry);
+  return first_error;
 }
 
 absl::Status JobManager::Start() {
@@ -142,8 +149,7 @@ absl::Status JobManager::Start() {
       FailJobLocked(*entry, absl::StrCat("cannot read the cycle log: ", cycles.status().message()));
       continue;
     }
-    if (entry->state == JobState::kRunning || entry->state == JobState::kQueued ||
-        entry->state == JobState::kInterrupted) {
+    if (Running(entry->state) || entry->state == JobState::kInterrupted) {
       const std::string why = entry->state == JobState::kInterrupted ? "the server was stopped"
                                                                      : "the server ended without stopping the job";
       absl::Status resumed = ResumeLocked(*entry, absl::StrCat("resumed on start (", why, ")"));
@@ -159,8 +165,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
   MBOPT_ASSIGN_OR_RETURN(spec::Study study, decoder_(study_bytes, source_name));
-  MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study));
-  MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
+  MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study, options_.make_lp_solver()));
   store::JobRow row;
   row.study_name = study.name;
   row.source_name = source_name;
@@ -170,22 +175,18 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   auto entry = std::make_shared<Entry>();
   std::lock_guard<std::mutex> entry_lock(entry->mutex);
   entry->row = std::move(stored);
-  entry->state = JobState::kRunning;
+  entry->layout = job->layout();
   entry->study = std::move(study);
-  entry->layout = std::move(layout);
   entry->study_ok = true;
   entry->job = std::move(job);
-  entry->timing = true;
-  entry->run_started = Clock::now();
   const std::string id = entry->row.id;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_[id] = entry;
   }
-  (void)store_->AddEvent(id, "submitted", source_name);
-  FinishIfDoneLocked(*entry);
-  if (entry->state == JobState::kRunning) ScheduleLocked(*entry);
-  Changed(*entry);
+  // CreateJob stored the state; a failing event log does not undo the job.
+  (void)EnterStateLocked(*entry, JobState::kRunning, "", "submitted", source_name, Persist::kAlreadyStored);
+  ScheduleLocked(*entry);
   return id;
 }
 
@@ -196,28 +197,19 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
     FailJobLocked(entry, message);
     return absl::FailedPreconditionError(message);
   }
-  absl::StatusOr<std::unique_ptr<jobs::Job>> job = jobs::Job::Create(entry.study);
+  absl::StatusOr<std::unique_ptr<jobs::Job>> job = jobs::Job::Create(entry.study, options_.make_lp_solver());
   if (!job.ok()) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", job.status().message()));
     return job.status();
   }
-  absl::StatusOr<std::vector<store::AnalysisRow>> analyses = store_->LoadAnalyses(id);
+  absl::StatusOr<std::vector<jobs::AnalysisRecord>> analyses = store_->LoadAnalyses(id);
   absl::StatusOr<std::vector<store::CycleRow>> cycles =
       analyses.ok() ? store_->LoadCycles(id) : absl::StatusOr<std::vector<store::CycleRow>>(analyses.status());
   if (!cycles.ok()) {
     // The database is not readable now; the job stays resumable.
-    entry.state = JobState::kInterrupted;
-    entry.message = absl::StrCat("cannot resume: ", cycles.status().message());
-    Changed(entry);
+    (void)EnterStateLocked(entry, JobState::kInterrupted, absl::StrCat("cannot resume: ", cycles.status().message()),
+                           "", "", Persist::kAlreadyStored);
     return cycles.status();
-  }
-  std::vector<jobs::LoggedAnalysis> logged;
-  logged.reserve(analyses->size());
-  for (const store::AnalysisRow& a : *analyses) {
-    jobs::LoggedAnalysis l;
-    l.result = ResultOf(a, (*job)->problem());
-    l.x_scaled = a.x_scaled;
-    logged.push_back(std::move(l));
   }
   std::vector<std::string> logged_records;
   std::vector<slp::CycleRecord> decoded;
@@ -230,59 +222,51 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
     }
     decoded.push_back(*std::move(r));
   }
-  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = (*job)->Replay(logged, logged_records);
+  absl::StatusOr<std::vector<slp::CycleRecord>> unlogged = (*job)->Replay(*analyses, logged_records);
   if (!unlogged.ok()) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", unlogged.status().message()));
     return unlogged.status();
   }
   entry.job = *std::move(job);
   entry.records = std::move(decoded);
-  entry.state = JobState::kRunning;
-  entry.message.clear();
-  entry.timing = true;
-  entry.run_started = Clock::now();
-  absl::Status status = store_->SetJobState(id, jobs::JobStateName(JobState::kRunning), "");
+  absl::Status status = EnterStateLocked(
+      entry, JobState::kRunning, "", "resumed",
+      absl::StrCat(why, "; replayed ", analyses->size(), " analyses and ", logged_records.size(), " cycle records"));
   if (!status.ok()) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", status.message()));
     return status;
   }
-  (void)store_->AddEvent(id, "resumed",
-                         absl::StrCat(why, "; replayed ", logged.size(), " analyses and ", logged_records.size(),
-                                      " cycle records"));
-  if (!unlogged->empty() || entry.job->optimizer().state() != slp::RunState::kRunning) {
+  if (!unlogged->empty() || !entry.job->running()) {
     MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, *std::move(unlogged)));
   }
-  FinishIfDoneLocked(entry);
-  if (entry.state == JobState::kRunning) ScheduleLocked(entry);
-  Changed(entry);
+  ScheduleLocked(entry);
   return absl::OkStatus();
 }
 
 void JobManager::ScheduleLocked(Entry& entry) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
   for (const slp::AnalysisRequest& request : entry.job->PendingRequests()) {
-    scheduler_->Enqueue(entry.row.id, request.id, ToVector(request.x), request.want_gradients);
+    scheduler_->Enqueue(entry.row.id, request.id, std::vector<double>(request.x.data(), request.x.data() + request.x.size()),
+                        request.want_gradients);
   }
 }
 
 void JobManager::FailJobLocked(Entry& entry, const std::string& message) {
   LogError(entry.row.id, absl::InternalError(message));
-  entry.state = JobState::kFailed;
-  entry.message = message;
-  StopTiming(entry.wall_before_s, entry.timing, entry.run_started);
-  scheduler_->DropJob(entry.row.id);
-  absl::Status status = store_->SetJobState(entry.row.id, jobs::JobStateName(JobState::kFailed), message);
-  if (!status.ok()) LogError(entry.row.id, status);
-  (void)store_->AddEvent(entry.row.id, "failed", message);
-  Changed(entry);
+  (void)EnterStateLocked(entry, JobState::kFailed, message, "failed", message);
 }
 
+// Commits the records the optimizer emitted, with the job's progress, in one
+// transaction; when the optimizer has ended, that transaction also stores
+// the final state, and the job then enters it.
 absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records) {
   const slp::SlpOptimizer& optimizer = entry.job->optimizer();
-  JobState state = jobs::JobStateOf(optimizer.state());
+  const JobState state = jobs::JobStateOf(optimizer.state());
   std::string message;
   if (state == JobState::kFailed) {
-    message = absl::StrCat("the initial design could not be analysed: ", entry.last_failure);
+    const spec::AnalysisFailure& last = entry.job->last_failure();
+    message = absl::StrCat("the initial design could not be analysed (", spec::FailureKindName(last.kind),
+                           "): ", last.reason);
   } else if (state == JobState::kStalled) {
     message = "the move limits collapsed or every trial point failed";
     if (!records.empty() && !records.back().rejection_reason.empty()) {
@@ -305,7 +289,6 @@ absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::Cycl
     FailJobLocked(entry, absl::StrCat("cannot log cycle records: ", status.message()));
     return status;
   }
-  entry.message = message;
   for (slp::CycleRecord& r : records) entry.records.push_back(std::move(r));
   std::int64_t committed = 0;
   {
@@ -318,114 +301,86 @@ absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::Cycl
       options_.after_record_commit(n);
     }
   }
+  if (state != JobState::kRunning) {
+    (void)EnterStateLocked(entry, state, message, "ended",
+                           absl::StrCat(jobs::JobStateName(state), " after ", optimizer.cycles_completed(), " cycles"),
+                           Persist::kAlreadyStored);
+  } else {
+    entry.message = message;
+  }
   return absl::OkStatus();
 }
 
-void JobManager::FinishIfDoneLocked(Entry& entry) {
-  if (entry.job == nullptr || entry.state != JobState::kRunning) return;
-  const slp::RunState run = entry.job->optimizer().state();
-  if (run == slp::RunState::kRunning) return;
-  entry.state = jobs::JobStateOf(run);
-  StopTiming(entry.wall_before_s, entry.timing, entry.run_started);
-  scheduler_->DropJob(entry.row.id);
-  (void)store_->AddEvent(entry.row.id, "ended",
-                         absl::StrCat(jobs::JobStateName(entry.state), " after ",
-                                      entry.job->optimizer().cycles_completed(), " cycles"));
-}
-
-absl::Status JobManager::DeliverLocked(Entry& entry, const store::AnalysisRow& row) {
+absl::Status JobManager::DeliverLocked(Entry& entry, const jobs::AnalysisRecord& record) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return absl::OkStatus();
-  absl::Status status = store_->AddAnalysis(row);
+  absl::Status status = store_->AddAnalysis(entry.row.id, record);
   if (!status.ok()) {
-    FailJobLocked(entry, absl::StrCat("cannot log analysis ", row.request_id, ": ", status.message()));
+    FailJobLocked(entry, absl::StrCat("cannot log analysis ", record.request_id, ": ", status.message()));
     return status;
   }
-  if (!row.ok) entry.last_failure = row.failure_reason;
-  absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Submit(ResultOf(row, entry.job->problem()));
+  absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Apply(record);
   if (!records.ok()) {
-    FailJobLocked(entry, absl::StrCat("the optimizer refused analysis ", row.request_id, ": ",
+    FailJobLocked(entry, absl::StrCat("the optimizer refused analysis ", record.request_id, ": ",
                                       records.status().message()));
     return records.status();
   }
-  if (!records->empty() || entry.job->optimizer().state() != slp::RunState::kRunning) {
+  if (!records->empty() || !entry.job->running()) {
     MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, *std::move(records)));
   }
-  FinishIfDoneLocked(entry);
   ScheduleLocked(entry);
   Changed(entry);
   return absl::OkStatus();
 }
 
-absl::StatusOr<bool> JobManager::ReportResult(const WorkerResult& r) {
+void JobManager::DeliverGivenUpLocked(Entry& entry, const scheduler::FinishedTask& task) {
+  if (entry.job == nullptr || entry.state != JobState::kRunning) return;
+  jobs::AnalysisRecord candidate;
+  candidate.request_id = task.request_id;
+  candidate.failure = spec::AnalysisFailure::Of(spec::FailureKind::kService, task.failure_reason);
+  candidate.attempts = task.attempts;
+  absl::StatusOr<jobs::AnalysisRecord> record = entry.job->Intake(std::move(candidate));
+  if (!record.ok()) {
+    LogError(entry.row.id, record.status());
+    return;
+  }
+  absl::Status delivered = DeliverLocked(entry, *record);
+  if (!delivered.ok()) LogError(entry.row.id, delivered);
+}
+
+absl::StatusOr<bool> JobManager::ReportResult(WorkerReport report) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(r.job_id));
+  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(report.job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
-  const std::string expected_prefix = absl::StrCat(r.job_id, "/", r.request_id, "/");
-  if (r.task_id.rfind(expected_prefix, 0) != 0) {
-    return absl::InvalidArgumentError(absl::StrCat("task id '", r.task_id, "' does not belong to job '", r.job_id,
-                                                   "' request ", r.request_id));
+  const std::int64_t request_id = report.record.request_id;
+  const std::string expected_prefix = absl::StrCat(report.job_id, "/", request_id, "/");
+  if (report.task_id.rfind(expected_prefix, 0) != 0) {
+    return absl::InvalidArgumentError(absl::StrCat("task id '", report.task_id, "' does not belong to job '",
+                                                   report.job_id, "' request ", request_id));
   }
   if (entry->job == nullptr || entry->state != JobState::kRunning) return false;
-  if (r.ok) {
-    const size_t terms = static_cast<size_t>(entry->job->problem().num_objective_terms);
-    const size_t rows = static_cast<size_t>(entry->job->problem().num_constraints());
-    if (r.objective_terms.size() != terms || r.constraint_values.size() != rows) {
-      const std::string reason =
-          absl::StrCat("result of task ", r.task_id, " has ", r.objective_terms.size(), " objective terms and ",
-                       r.constraint_values.size(), " constraint values; job ", r.job_id, " needs ", terms,
-                       " and ", rows);
-      absl::StatusOr<std::optional<scheduler::FinishedTask>> failed = scheduler_->Fail(r.worker_id, r.task_id, reason);
-      if (failed.ok() && failed->has_value()) {
-        store::AnalysisRow row;
-        row.job_id = r.job_id;
-        row.request_id = (*failed)->request_id;
-        row.x_scaled = (*failed)->x_scaled;
-        row.ok = false;
-        row.failure_reason = (*failed)->failure_reason;
-        row.attempts = (*failed)->attempts;
-        (void)DeliverLocked(*entry, row);
-      }
-      return absl::InvalidArgumentError(reason);
-    }
+  const std::vector<slp::AnalysisRequest> pending = entry->job->PendingRequests();
+  if (std::none_of(pending.begin(), pending.end(),
+                   [request_id](const slp::AnalysisRequest& r) { return r.id == request_id; })) {
+    return false;  // answered already (another attempt won): dropped
   }
-  bool wanted_gradients = false;
-  for (const slp::AnalysisRequest& request : entry->job->PendingRequests()) {
-    if (request.id == r.request_id) wanted_gradients = request.want_gradients;
+  report.record.worker = report.worker_id;
+  absl::StatusOr<jobs::AnalysisRecord> record = entry->job->Intake(std::move(report.record));
+  if (!record.ok()) {
+    // A result that does not fit its task counts as a failed attempt; the
+    // worker is told why, and the task goes to another worker.
+    const std::string reason = absl::StrCat("result of task ", report.task_id, ": ", record.status().message());
+    absl::StatusOr<std::optional<scheduler::FinishedTask>> failed =
+        scheduler_->Fail(report.worker_id, report.task_id, reason);
+    if (failed.ok() && failed->has_value()) DeliverGivenUpLocked(*entry, **failed);
+    return absl::InvalidArgumentError(reason);
   }
-  absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(r.worker_id, r.task_id);
+  absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(report.worker_id, report.task_id);
   if (!finished.ok()) return false;
-  store::AnalysisRow row;
-  row.job_id = r.job_id;
-  row.request_id = finished->request_id;
-  row.x_scaled = finished->x_scaled;
-  row.ok = r.ok;
-  row.failure_reason = r.ok ? "" : (r.failure_reason.empty() ? "the analysis failed" : r.failure_reason);
-  if (r.ok) {
-    row.objective_terms = r.objective_terms;
-    row.constraint_values = r.constraint_values;
-  }
-  if (r.ok && wanted_gradients) {
-    // Logged as the optimizer will get them: unusable gradients are none.
-    const std::string defect = jobs::GradientDefect(entry->job->problem(), r.objective_gradients,
-                                                    r.constraint_gradients);
-    if (!defect.empty()) {
-      row.gradients_unavailable = absl::StrCat("unusable gradients from the worker: ", defect);
-    } else if (r.objective_gradients.empty()) {
-      row.gradients_unavailable =
-          r.gradients_unavailable.empty() ? "the worker sent no gradients" : r.gradients_unavailable;
-    } else {
-      row.objective_gradients = r.objective_gradients;
-      row.constraint_gradients = r.constraint_gradients;
-    }
-  }
-  row.worker = r.worker_id;
-  row.wall_seconds = r.wall_seconds;
-  row.attempts = finished->attempts;
-  row.counters = r.counters;
-  MBOPT_RETURN_IF_ERROR(DeliverLocked(*entry, row));
+  record->attempts = finished->attempts;
+  MBOPT_RETURN_IF_ERROR(DeliverLocked(*entry, *record));
   return true;
 }
 
@@ -433,14 +388,7 @@ void JobManager::GiveUp(const scheduler::FinishedTask& task) {
   absl::StatusOr<std::shared_ptr<Entry>> entry = Find(task.job_id);
   if (!entry.ok()) return;
   std::lock_guard<std::mutex> lock((*entry)->mutex);
-  store::AnalysisRow row;
-  row.job_id = task.job_id;
-  row.request_id = task.request_id;
-  row.x_scaled = task.x_scaled;
-  row.ok = false;
-  row.failure_reason = task.failure_reason;
-  row.attempts = task.attempts;
-  (void)DeliverLocked(**entry, row);
+  DeliverGivenUpLocked(**entry, task);
 }
 
 absl::Status JobManager::ReportWorkerError(const std::string& worker_id, const std::string& task_id,
@@ -483,6 +431,9 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
     const slp::SlpOptimizer& optimizer = entry.job->optimizer();
     s.cycles = optimizer.cycles_completed();
     s.analyses = optimizer.analyses_used();
+    for (const auto& [kind, count] : entry.job->failures_by_kind()) {
+      s.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
+    }
     if (!entry.records.empty()) {
       design = optimizer.current_design();
       s.objective = optimizer.current_objective();
@@ -519,7 +470,7 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
   view.first_record = std::min(first_record, entry.records.size());
   view.records.assign(entry.records.begin() + static_cast<std::ptrdiff_t>(view.first_record), entry.records.end());
   view.version = entry.version;
-  view.ended = entry.state != JobState::kRunning && entry.state != JobState::kQueued;
+  view.ended = !Running(entry.state);
   if (entry.study_ok) {
     for (const spec::ConstraintRow& row : entry.layout.rows) view.row_names.push_back(row.name);
     for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
@@ -546,8 +497,7 @@ absl::StatusOr<std::vector<JobSummaryData>> JobManager::List() {
     std::lock_guard<std::mutex> lock(entry->mutex);
     ordered.emplace_back(entry->row.seq, SummaryLocked(*entry));
   }
-  std::sort(ordered.begin(), ordered.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<JobSummaryData> summaries;
   for (auto& [seq, summary] : ordered) summaries.push_back(std::move(summary));
   return summaries;
@@ -556,18 +506,12 @@ absl::StatusOr<std::vector<JobSummaryData>> JobManager::List() {
 absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
-  if (entry->state != JobState::kRunning && entry->state != JobState::kQueued &&
-      entry->state != JobState::kInterrupted) {
+  if (!Running(entry->state) && entry->state != JobState::kInterrupted) {
     return absl::FailedPreconditionError(absl::StrCat("job '", job_id, "' has already ended (",
                                                       jobs::JobStateName(entry->state), ")"));
   }
-  entry->state = JobState::kCancelled;
-  entry->message = "cancelled on request; `resume` continues it";
-  StopTiming(entry->wall_before_s, entry->timing, entry->run_started);
-  scheduler_->DropJob(job_id);
-  MBOPT_RETURN_IF_ERROR(store_->SetJobState(job_id, jobs::JobStateName(JobState::kCancelled), entry->message));
-  (void)store_->AddEvent(job_id, "cancelled", "");
-  Changed(*entry);
+  MBOPT_RETURN_IF_ERROR(EnterStateLocked(*entry, JobState::kCancelled, "cancelled on request; `resume` continues it",
+                                         "cancelled", ""));
   return SummaryLocked(*entry);
 }
 
@@ -581,8 +525,7 @@ absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id) {
   if (entry->state == JobState::kRunning) return SummaryLocked(*entry);
   if (!jobs::IsResumable(entry->state)) {
     return absl::FailedPreconditionError(absl::StrCat("job '", job_id, "' has ended (",
-                                                      jobs::JobStateName(entry->state),
-                                                      ") and cannot be resumed"));
+                                                      jobs::JobStateName(entry->state), ") and cannot be resumed"));
   }
   MBOPT_RETURN_IF_ERROR(ResumeLocked(*entry, "resumed on request"));
   return SummaryLocked(*entry);
@@ -592,6 +535,7 @@ absl::StatusOr<JobView> JobManager::WaitForChange(const std::string& job_id, std
                                                   std::int64_t version_seen, std::int64_t max_wait_ms) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::unique_lock<std::mutex> lock(entry->mutex);
+  // A real-time wait: watchers are people, not the job's clock.
   entry->changed.wait_for(lock, std::chrono::milliseconds(std::max<std::int64_t>(0, max_wait_ms)),
                           [&] { return entry->version != version_seen; });
   return ViewLocked(*entry, first_record);
@@ -614,15 +558,9 @@ void JobManager::Shutdown() {
   scheduler_->Shutdown();
   for (const auto& entry : entries) {
     std::lock_guard<std::mutex> lock(entry->mutex);
-    if (entry->state != JobState::kRunning && entry->state != JobState::kQueued) continue;
-    entry->state = JobState::kInterrupted;
-    entry->message = "the server was stopped; the job resumes when it starts again";
-    StopTiming(entry->wall_before_s, entry->timing, entry->run_started);
-    absl::Status status =
-        store_->SetJobState(entry->row.id, jobs::JobStateName(JobState::kInterrupted), entry->message);
-    if (!status.ok()) LogError(entry->row.id, status);
-    (void)store_->AddEvent(entry->row.id, "interrupted", "server stopped");
-    Changed(*entry);
+    if (!Running(entry->state)) continue;
+    (void)EnterStateLocked(*entry, JobState::kInterrupted, "the server was stopped; the job resumes when it starts again",
+                           "interrupted", "server stopped");
   }
 }
 
