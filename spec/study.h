@@ -2,6 +2,7 @@
 // meanings are documented in proto/mbopt/v1/study.proto.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,14 +47,16 @@ struct Constraint {
   double si_per_unit = 1.0;
 };
 
+// What the study file sets of the optimizer. An unset value is the method's
+// default, which is written once, in slp::SlpOptions (server/slp/options.h).
 struct OptimizerSettings {
-  double initial_move_limit = 0.2;
-  int max_cycles = 50;
-  double convergence_objective_tolerance = 0.005;
-  double convergence_violation_tolerance = 0.005;
-  double screening_threshold = -0.3;
+  std::optional<double> initial_move_limit;
+  std::optional<int> max_cycles;
+  std::optional<double> convergence_objective_tolerance;
+  std::optional<double> convergence_violation_tolerance;
+  std::optional<double> screening_threshold;
   bool central_differences = false;
-  double finite_difference_relative_step = 1e-4;
+  std::optional<double> finite_difference_relative_step;
   // Gradients from the simulator's forward sensitivity analysis instead of
   // finite differences (lumped scenes only).
   bool simulator_sensitivities = false;

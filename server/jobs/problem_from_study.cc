@@ -46,14 +46,17 @@ absl::StatusOr<slp::ProblemSpec> ProblemSpecFromStudy(const spec::Study& study, 
 absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study) {
   slp::SlpOptions options;
   const spec::OptimizerSettings& s = study.optimizer;
-  options.initial_move_limit = s.initial_move_limit;
-  options.max_cycles = s.max_cycles;
-  options.convergence_objective_tolerance = s.convergence_objective_tolerance;
-  options.convergence_violation_tolerance = s.convergence_violation_tolerance;
-  options.screening_threshold = s.screening_threshold;
+  options.initial_move_limit = s.initial_move_limit.value_or(options.initial_move_limit);
+  options.max_cycles = s.max_cycles.value_or(options.max_cycles);
+  options.convergence_objective_tolerance =
+      s.convergence_objective_tolerance.value_or(options.convergence_objective_tolerance);
+  options.convergence_violation_tolerance =
+      s.convergence_violation_tolerance.value_or(options.convergence_violation_tolerance);
+  options.screening_threshold = s.screening_threshold.value_or(options.screening_threshold);
   options.finite_difference =
       s.central_differences ? slp::FiniteDifferenceScheme::kCentral : slp::FiniteDifferenceScheme::kForward;
-  options.finite_difference_relative_step = s.finite_difference_relative_step;
+  options.finite_difference_relative_step =
+      s.finite_difference_relative_step.value_or(options.finite_difference_relative_step);
   options.analyses_provide_gradients = s.simulator_sensitivities;
   absl::Status valid = InStudy(study, options.Validate());
   if (!valid.ok()) return valid;

@@ -256,7 +256,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     const Where w = where.Child("optimizer");
     const v1::OptimizerOptions& p = m.optimizer();
     OptimizerSettings& s = study.optimizer;
-    auto positive = [&](const char* field, double value, double* target) {
+    auto positive = [&](const char* field, double value, std::optional<double>* target) {
       if (value < 0.0 || !std::isfinite(value)) {
         errors->Add(w, field,
                     absl::StrFormat("must be positive (0 for the default), got %g", value));

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
+#include "server/jobs/problem_from_study.h"
 #include "server/jobs/record_codec.h"
 
 namespace mbopt::service {
@@ -416,7 +417,11 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   Eigen::VectorXd design;
   if (entry.study_ok) {
     s.objective_unit = entry.study.objective.unit;
-    s.max_cycles = entry.study.optimizer.max_cycles;
+    if (entry.job != nullptr) {
+      s.max_cycles = entry.job->options().max_cycles;
+    } else if (absl::StatusOr<slp::SlpOptions> options = jobs::SlpOptionsFromStudy(entry.study); options.ok()) {
+      s.max_cycles = options->max_cycles;
+    }
     design.resize(static_cast<Eigen::Index>(entry.study.variables.size()));
     for (size_t i = 0; i < entry.study.variables.size(); ++i) {
       const spec::DesignVariable& v = entry.study.variables[i];
