@@ -15,6 +15,10 @@ function(mbopt_library name)
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   mbopt_warnings(${name})
+  # An edited include is checked before anything compiles (ModuleEdges.cmake).
+  if(TARGET mbopt_module_edges)
+    add_dependencies(${name} mbopt_module_edges)
+  endif()
 endfunction()
 
 # mbopt_test(NAME SOURCES ... DEPS ... LABELS ...): a GoogleTest binary whose

@@ -121,6 +121,7 @@ absl::StatusOr<std::vector<Task>> Scheduler::AcquireWait(const std::string& work
     worker->second.last_seen_ms = clock_->NowMs();
     std::vector<Task> tasks = AcquireLocked(worker_id, std::max(1, max_tasks));
     if (!tasks.empty() || shutdown_) return tasks;
+    if (options_.on_long_poll_blocks) options_.on_long_poll_blocks();
     if (task_available_.wait_until(lock, deadline) == std::cv_status::timeout) {
       return AcquireLocked(worker_id, std::max(1, max_tasks));
     }

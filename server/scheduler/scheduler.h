@@ -24,6 +24,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -45,6 +46,12 @@ struct SchedulerOptions {
   // A worker not heard from for this long is not counted as a live
   // alternative when choosing who retries a task. 0: 3 * lease_ms.
   std::int64_t worker_silence_ms = 0;
+  // Called each time an AcquireWait is about to block (no task on offer, no
+  // shutdown), with the scheduler's lock held: the wait begins as soon as it
+  // returns, so whatever happens next (Enqueue, Shutdown) meets a blocked
+  // long poll. It must not call the scheduler. For tests that need the poll
+  // to be waiting, not merely started; empty: nothing is called.
+  std::function<void()> on_long_poll_blocks;
   absl::Status Validate() const;
 };
 

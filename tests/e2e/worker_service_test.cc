@@ -4,6 +4,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -321,13 +322,38 @@ TEST(WorkerService, RejectsBadOptions) {
   EXPECT_FALSE(RunWorker(options, stop).ok()) << "zero slots";
 }
 
+// A worker that cannot reach its server waits before trying again (the
+// backoff); a stop request must end that wait. The stop comes once the
+// worker is in that wait (the stop signal reports each wait and its length;
+// the heartbeat thread's waits are shorter), and the backoff is far longer
+// than the guard, so only the stop can end it in time.
 TEST(WorkerService, StopsWhileTheServerIsUnreachable) {
+  constexpr auto kBackoff = std::chrono::milliseconds(60'000);
+  constexpr auto kFailureGuard = std::chrono::seconds(20);  // a working stop takes milliseconds
   WorkerOptions options;
   options.server_address = "127.0.0.1:1";  // nothing listens there
+  options.backoff.initial = kBackoff;
+  options.backoff.max = kBackoff;
+  options.backoff.jitter = 0.0;
   StopSignal stop;
-  std::thread worker([&] { EXPECT_TRUE(RunWorker(options, stop).ok()); });
+  std::promise<void> in_backoff;
+  std::once_flag in_backoff_once;
+  stop.OnWaitBlocks([&](std::chrono::milliseconds timeout) {
+    if (timeout == kBackoff) std::call_once(in_backoff_once, [&] { in_backoff.set_value(); });
+  });
+  std::promise<absl::Status> ran;
+  std::future<absl::Status> run_status = ran.get_future();
+  std::thread worker([&] { ran.set_value(RunWorker(options, stop)); });
+
+  const bool worker_waits = in_backoff.get_future().wait_for(kFailureGuard) == std::future_status::ready;
   stop.Stop();
-  worker.join();  // returns: the backoff wait ends at the stop request
+  const bool worker_returned = run_status.wait_for(kFailureGuard) == std::future_status::ready;
+  worker.join();  // at the latest when the backoff ends
+
+  ASSERT_TRUE(worker_waits) << "the worker never began its reconnection backoff";
+  ASSERT_TRUE(worker_returned) << "the worker still waited out its backoff 20 s after the stop request";
+  const absl::Status status = run_status.get();
+  EXPECT_TRUE(status.ok()) << status;
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 // and the retry limit, on a fake clock (no test waits for real time).
 #include "server/scheduler/scheduler.h"
 
+#include <chrono>
+#include <future>
 #include <map>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -254,14 +257,43 @@ TEST(Scheduler, LongPollWakesWhenATaskIsQueued) {
   EXPECT_EQ(got[0].job_id, "job-1");
 }
 
+// Shutdown() must wake a long poll that is already blocked in its wait (the
+// scheduler's hook says when it is), not only refuse later ones: the poll
+// returns, empty, long before its own wait would end.
 TEST(Scheduler, ShutdownEndsLongPolls) {
   FakeClock clock;
-  Scheduler scheduler(&clock, Options());
+  SchedulerOptions options = Options();
+  std::promise<void> blocked;
+  std::once_flag blocked_once;
+  options.on_long_poll_blocks = [&] { std::call_once(blocked_once, [&] { blocked.set_value(); }); };
+  Scheduler scheduler(&clock, options);
   const std::string worker = scheduler.RegisterWorker("w", 1);
-  constexpr std::int64_t kFailureGuardMs = 60'000;
-  std::thread poller([&] { EXPECT_TRUE(scheduler.AcquireWait(worker, 1, kFailureGuardMs)->empty()); });
+  // Only a wake-up can end this poll within the test: its own wait is far
+  // longer than the guard. The guard bounds how long a broken wake-up is
+  // waited for; a working one takes microseconds.
+  constexpr std::int64_t kPollMs = 600'000;
+  constexpr auto kFailureGuard = std::chrono::seconds(20);
+  std::promise<absl::StatusOr<std::vector<Task>>> polled;
+  std::future<absl::StatusOr<std::vector<Task>>> poll_result = polled.get_future();
+  std::thread poller([&] { polled.set_value(scheduler.AcquireWait(worker, 1, kPollMs)); });
+
+  const bool poll_blocked = blocked.get_future().wait_for(kFailureGuard) == std::future_status::ready;
   scheduler.Shutdown();
+  const bool poll_returned = poll_result.wait_for(kFailureGuard) == std::future_status::ready;
+  // A poll that Shutdown() did not wake is woken by a task instead, so that
+  // the test can end and report it.
+  if (!poll_returned) scheduler.Enqueue("job-1", 0, {});
   poller.join();
+
+  EXPECT_TRUE(poll_blocked) << "AcquireWait never blocked: Shutdown() was not tested on a waiting poll";
+  ASSERT_TRUE(poll_returned) << "a blocked long poll was still waiting 20 s after Shutdown()";
+  const absl::StatusOr<std::vector<Task>> tasks = poll_result.get();
+  ASSERT_TRUE(tasks.ok()) << tasks.status();
+  EXPECT_TRUE(tasks->empty());
+  // And a poll after Shutdown() does not wait at all.
+  auto late = scheduler.AcquireWait(worker, 1, kPollMs);
+  ASSERT_TRUE(late.ok()) << late.status();
+  EXPECT_TRUE(late->empty());
 }
 
 TEST(SchedulerOptions, HeartbeatMustBeShorterThanLease) {

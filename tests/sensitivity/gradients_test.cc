@@ -1,7 +1,6 @@
 // Simulator sensitivities of the vehicle study (examples/vehicle) against
 // central finite differences of the same study values.
 #include <algorithm>
-#include <cstdint>
 #include <cmath>
 #include <iostream>
 #include <string>
@@ -115,37 +114,6 @@ TEST(SimulatorSensitivities, GradientsComeWithTheValuesOfAPlainAnalysis) {
   const Eigen::VectorXd a = Stacked(*with), b = Stacked(*plain);
   constexpr double kValueAgreement = 1e-6;  // relative to max |value|; tolerances are 1e-11
   EXPECT_LT((a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff(), kValueAgreement);
-}
-
-TEST(SimulatorSensitivities, AnalysesWithAndWithoutGradientsAreTimedAtTheSceneTolerances) {
-  // At the scene's own tolerances; wall time of repeated analyses at x0.
-  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kVehicleStudy);
-  ASSERT_TRUE(study.ok()) << study.status();
-  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
-  ASSERT_TRUE(layout.ok()) << layout.status();
-  const Eigen::VectorXd x0 = Initial(*study);
-  constexpr int kRepetitions = 20;
-  double plain_s = 0, with_s = 0;
-  std::int64_t plain_steps = 0, with_steps = 0;
-  for (int r = 0; r < kRepetitions; ++r) {
-    absl::StatusOr<engine::StudyEvaluation> plain = EvaluateDesign(*study, *layout, x0);
-    absl::StatusOr<engine::StudyEvaluation> with = EvaluateDesign(*study, *layout, x0, true);
-    ASSERT_TRUE(plain.ok() && with.ok());
-    ASSERT_TRUE(plain->ok() && with->ok() && with->gradients.has_value());
-    plain_s += plain->counters.wall_seconds;
-    with_s += with->counters.wall_seconds;
-    plain_steps = plain->counters.time_steps;
-    with_steps = with->counters.time_steps;
-  }
-  const double n = static_cast<double>(study->variables.size());
-  std::cout << "wall per analysis: plain " << plain_s / kRepetitions * 1e3 << " ms ("
-            << plain_steps << " steps), with sensitivities " << with_s / kRepetitions * 1e3
-            << " ms (" << with_steps << " steps), ratio " << with_s / plain_s
-            << "; forward differences need n + 1 = " << n + 1 << " analyses\n";
-  // The figures are reported in docs/method.md; wall times on shared
-  // machines are too noisy for a bound here.
-  EXPECT_GT(with_steps, 0);
-  EXPECT_GT(plain_steps, 0);
 }
 
 TEST(SimulatorSensitivities, LinkageStudyIsRejectedAtLoad) {

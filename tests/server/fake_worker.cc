@@ -69,6 +69,7 @@ grpc::Status FakeWorker::Answer(const v1::AnalysisTask& task, bool* accepted) {
     for (double v : values->constraint_values) result.add_constraint_values(v);
   }
   (task.want_gradients() ? tasks_wanting_gradients_ : tasks_without_gradients_) += 1;
+  answered_request_ids_.push_back(task.request_id());
   if (values.ok() && task.want_gradients()) {
     if (gradient_mode_ == GradientMode::kNone) {
       result.set_gradients_unavailable("this fake worker has no gradients");

@@ -13,6 +13,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <grpcpp/grpcpp.h>
 
@@ -48,6 +49,8 @@ class FakeWorker {
   // Tasks answered so far that asked for gradients, and that did not.
   int tasks_wanting_gradients() const { return tasks_wanting_gradients_; }
   int tasks_without_gradients() const { return tasks_without_gradients_; }
+  // The request ids of the tasks answered so far, in the order answered.
+  const std::vector<std::int64_t>& answered_request_ids() const { return answered_request_ids_; }
 
   // Instead of failing the test, an RPC error ends Run() and sets failed():
   // for tests that kill the server under the worker.
@@ -70,6 +73,7 @@ class FakeWorker {
   GradientMode gradient_mode_ = GradientMode::kExact;
   int tasks_wanting_gradients_ = 0;
   int tasks_without_gradients_ = 0;
+  std::vector<std::int64_t> answered_request_ids_;
   bool tolerate_errors_ = false;
   bool failed_ = false;  // taken, not answered yet
 };

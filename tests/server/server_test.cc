@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -86,12 +87,15 @@ class ServerTest : public ::testing::Test {
   }
 
   // Runs the study to its end on a fresh database; returns the final Get.
+  // `answer_order`: the request ids in the order the worker answered them.
   v1::GetJobResponse RunToEnd(const std::string& db_name, std::uint32_t seed,
-                              const v1::Study& study = OscillatorStudy()) {
+                              const v1::Study& study = OscillatorStudy(),
+                              std::vector<std::int64_t>* answer_order = nullptr) {
     auto server = StartServer(db_name);
     const std::string id = Submit(*server, study);
     FakeWorker worker(server->InProcessChannel(), seed);
     worker.Run();
+    if (answer_order != nullptr) *answer_order = worker.answered_request_ids();
     return Get(*server, id);
   }
 
@@ -129,9 +133,21 @@ TEST_F(ServerTest, SubmittedStudyConvergesToTheAnalyticOptimum) {
   EXPECT_EQ(last.x_trial_physical(0), testing::kStiffnessScale * last.x_trial_scaled(0));
 }
 
+// The same study, answered in two different orders (the fake worker
+// shuffles with its seed), gives the same records bit for bit. Both runs
+// must have run to convergence and answered in different orders, or the
+// comparison would prove nothing.
 TEST_F(ServerTest, ResultsDoNotDependOnTheOrderOfAnswers) {
-  v1::GetJobResponse first = RunToEnd("a.db", 1);
-  v1::GetJobResponse second = RunToEnd("b.db", 12345);
+  std::vector<std::int64_t> first_order, second_order;
+  v1::GetJobResponse first = RunToEnd("a.db", 1, OscillatorStudy(), &first_order);
+  v1::GetJobResponse second = RunToEnd("b.db", 12345, OscillatorStudy(), &second_order);
+  for (const v1::GetJobResponse* job : {&first, &second}) {
+    ASSERT_EQ(job->summary().state(), v1::JOB_STATE_CONVERGED) << job->summary().message();
+    ASSERT_GT(job->cycles_size(), 1) << "a run of one cycle does not depend on any order";
+    EXPECT_TRUE(job->cycles(job->cycles_size() - 1).converged());
+  }
+  ASSERT_FALSE(first_order.empty());
+  ASSERT_NE(first_order, second_order) << "both runs answered in the same order";
   ExpectSameCycles(first, second);
 }
 

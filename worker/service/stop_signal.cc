@@ -26,7 +26,14 @@ bool StopSignal::stopped() const {
 
 bool StopSignal::WaitFor(std::chrono::milliseconds timeout) const {
   std::unique_lock<std::mutex> lock(mutex_);
+  if (stopped_) return true;
+  if (wait_observer_) wait_observer_(timeout);
   return cv_.wait_for(lock, timeout, [this] { return stopped_; });
+}
+
+void StopSignal::OnWaitBlocks(std::function<void(std::chrono::milliseconds)> observer) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  wait_observer_ = std::move(observer);
 }
 
 void StopSignal::OnStop(std::function<void()> callback) {

@@ -19,12 +19,19 @@ class StopSignal {
   // Runs `callback` when Stop() is called (at once if already stopped), on
   // the stopping thread; used to cancel blocking RPCs.
   void OnStop(std::function<void()> callback);
+  // Runs `observer` with the timeout each time a WaitFor is about to block
+  // (stop not requested yet), with the signal's lock held: a Stop() that
+  // follows meets a waiting thread. It must not call the StopSignal. For
+  // tests that must stop a worker while it waits (its reconnection backoff),
+  // not before it gets there.
+  void OnWaitBlocks(std::function<void(std::chrono::milliseconds)> observer);
 
  private:
   mutable std::mutex mutex_;
   mutable std::condition_variable cv_;
   bool stopped_ = false;
   std::vector<std::function<void()>> callbacks_;
+  std::function<void(std::chrono::milliseconds)> wait_observer_;
 };
 
 // Blocks SIGTERM and SIGINT in the calling thread (and so in every thread it
