@@ -22,16 +22,19 @@ include_guard(GLOBAL)
 cmake_policy(VERSION 3.25)
 
 # mbopt_module(<name> [DIRS dir...] [FILES file...] [USES module...|*]
-#              [PURE] [PURE_EXCEPT file...] [LIBS target...] [SUMMARY text])
+#              [PURE] [BRIDGE] [PURE_EXCEPT file...] [LIBS target...] [SUMMARY text])
 # Paths are relative to the tree's root. USES * (tests, benchmarks) means
 # every module that does not itself use *: such a module is a leaf, since
 # anything using it would close a cycle. PURE_EXCEPT names the files of a
 # pure module allowed a third-party include a pure module may not have (the
-# one CLP adapter); their in-repo edges are still checked. LIBS (the CMake
+# one CLP adapter); their in-repo edges are still checked. BRIDGE: the module
+# may use modules on both sides of a separation (MBOPT_SEPARATED_TREES), and
+# in exchange only leaves (tests, benchmarks) may use it: the in-process run,
+# a job whose evaluator is this process's engine. LIBS (the CMake
 # targets built from the module) and SUMMARY only document: they are columns
 # of the table in docs/architecture.md.
 function(mbopt_module name)
-  cmake_parse_arguments(ARG "PURE" "SUMMARY" "DIRS;FILES;USES;PURE_EXCEPT;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "PURE;BRIDGE" "SUMMARY" "DIRS;FILES;USES;PURE_EXCEPT;LIBS" ${ARGN})
   if(ARG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "mbopt_module(${name}): unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
   endif()
@@ -44,6 +47,7 @@ function(mbopt_module name)
   set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_FILES "${ARG_FILES}")
   set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_USES "${ARG_USES}")
   set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_PURE ${ARG_PURE})
+  set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_BRIDGE ${ARG_BRIDGE})
   set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_PURE_EXCEPT "${ARG_PURE_EXCEPT}")
   set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_SUMMARY "${ARG_SUMMARY}")
   set_property(GLOBAL PROPERTY MBOPT_MODULE_${name}_LIBS "${ARG_LIBS}")
@@ -89,10 +93,7 @@ function(mbopt_declare_modules)
     SUMMARY "the SLP optimizer core (the LP solver is injected)")
   mbopt_module(jobs DIRS server/jobs USES slp lp spec common PURE
     LIBS mbopt_jobs
-    SUMMARY "a job: study, layout, SLP optimizer, replay, record codec")
-  mbopt_module(local_run DIRS server/local_run USES jobs slp lp spec common PURE
-    LIBS mbopt_local_run
-    SUMMARY "a study run to its end in one process")
+    SUMMARY "a job: the one driver of the SLP core, with intake, replay, record codec and the analysis record")
 
   # The analysis engine's numerical core, bottom up.
   mbopt_module(model DIRS worker/model USES spec common PURE
@@ -104,19 +105,25 @@ function(mbopt_declare_modules)
   mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
     SUMMARY "planar constrained multibody systems and their forward dynamics")
   mbopt_module(engine DIRS worker/engine USES multibody solve model spec common PURE
-    LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities
-    SUMMARY "one analysis of a scene (formulation dispatch), its study values and gradients")
+    LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
+    SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")
+  mbopt_module(local_run DIRS worker/local_run USES jobs slp lp engine spec common PURE BRIDGE
+    LIBS mbopt_local_run
+    SUMMARY "a study optimized in this process: a job with an in-process evaluator (tests, tools)")
 
   # Plumbing and boundaries.
-  mbopt_module(store DIRS server/store USES common
+  mbopt_module(store DIRS server/store USES jobs spec common
     LIBS mbopt_store
     SUMMARY "the SQLite job database")
   mbopt_module(scheduler DIRS server/scheduler USES common
     LIBS mbopt_scheduler
     SUMMARY "task queue, worker registry, leases (threads, an injected clock)")
-  mbopt_module(service DIRS server/service USES jobs scheduler store spec spec_io proto common
-    LIBS mbopt_job_manager mbopt_service
-    SUMMARY "boundary: job manager and the gRPC services")
+  mbopt_module(job_manager DIRS server/jobs/manager USES jobs lp scheduler store spec common
+    LIBS mbopt_job_manager
+    SUMMARY "the server's jobs: jobs, scheduler and store meet (threads, an injected clock)")
+  mbopt_module(service DIRS server/service USES job_manager jobs lp scheduler store spec spec_io proto common
+    LIBS mbopt_service
+    SUMMARY "boundary: the gRPC services and the server object")
   mbopt_module(server_main DIRS server/main USES service common
     LIBS mbopt-server
     SUMMARY "the `mbopt-server` program")
@@ -185,6 +192,7 @@ function(_mbopt_me_check_declaration root errors_var)
     _mbopt_me_get(uses ${name} USES)
     _mbopt_me_get(pure ${name} PURE)
     _mbopt_me_get(pure_except ${name} PURE_EXCEPT)
+    _mbopt_me_get(bridge ${name} BRIDGE)
     if(NOT dirs AND NOT files)
       string(APPEND errors "module ${name} owns no directory and no file\n")
     endif()
@@ -215,6 +223,13 @@ function(_mbopt_me_check_declaration root errors_var)
       _mbopt_me_get(used_pure ${used} PURE)
       if(pure AND NOT used_pure)
         string(APPEND errors "pure module ${name} uses ${used}, which is not pure\n")
+      endif()
+      _mbopt_me_get(used_bridge ${used} BRIDGE)
+      if(used_bridge AND NOT "*" IN_LIST uses)
+        string(APPEND errors "module ${name} uses ${used}, a bridge between the server and the worker: only tests and benchmarks may\n")
+      endif()
+      if(bridge)
+        continue()
       endif()
       _mbopt_me_get(used_dirs ${used} DIRS)
       _mbopt_me_get(used_files ${used} FILES)

@@ -211,7 +211,7 @@ void BM_VehicleStudyValues(benchmark::State& state) {
   const mbopt::spec::Study study = LoadVehicle();
   const auto layout = mbopt::spec::MakeStudyLayout(study);
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
-  mbopt::engine::AnalysisCounters counters;
+  mbopt::spec::AnalysisCounters counters;
   for (auto _ : state) {
     mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
     auto values = mbopt::engine::ComputeStudyValues(study, *layout, report);
