@@ -590,6 +590,7 @@ TEST_F(ServerTest, FailedAnalysisGoesToTheOptimizerWithoutRetry) {
     failure.set_request_id(task.request_id());
     failure.set_ok(false);
     failure.set_failure_reason("integrator failed at t = 0.3 s");
+    failure.set_failure_kind(v1::ANALYSIS_FAILURE_INTEGRATOR);
     grpc::ClientContext context;
     v1::ReportResultResponse response;
     ASSERT_TRUE(worker.stub().ReportResult(&context, failure, &response).ok());
@@ -601,6 +602,54 @@ TEST_F(ServerTest, FailedAnalysisGoesToTheOptimizerWithoutRetry) {
   // The initial design cannot be analysed: the run fails, with the reason.
   EXPECT_EQ(job.summary().state(), v1::JOB_STATE_FAILED);
   EXPECT_THAT(job.summary().message(), HasSubstr("integrator failed"));
+  // The failure's kind reaches the job's summary and its message.
+  EXPECT_THAT(job.summary().message(), HasSubstr("(integrator)"));
+  ASSERT_EQ(job.summary().failed_analyses_by_kind().count("integrator"), 1u);
+  EXPECT_EQ(job.summary().failed_analyses_by_kind().at("integrator"), 1);
+}
+
+// A job's running time is read from the server's injected clock.
+TEST_F(ServerTest, JobWallTimeFollowsTheInjectedClock) {
+  auto server = StartServer("clock.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  const double before = Get(*server, id).summary().wall_seconds();
+  clock_.Advance(1500);
+  EXPECT_DOUBLE_EQ(Get(*server, id).summary().wall_seconds() - before, 1.5);
+}
+
+// A resumed job counts the failures of its replayed analyses too.
+TEST_F(ServerTest, FailureKindsSurviveAResume) {
+  std::string id;
+  {
+    auto server = StartServer("kinds.db");
+    id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 12);
+    std::vector<v1::AnalysisTask> tasks = worker.Acquire(100);
+    ASSERT_GT(tasks.size(), 1u);
+    // A perturbation fails as an assembly failure; it is retried on the other
+    // side, so the job goes on.
+    for (const v1::AnalysisTask& task : tasks) {
+      if (task.request_id() == 0) continue;
+      v1::TaskResult failure;
+      failure.set_worker_id(worker.worker_id());
+      failure.set_task_id(task.task_id());
+      failure.set_job_id(id);
+      failure.set_request_id(task.request_id());
+      failure.set_ok(false);
+      failure.set_failure_reason("joint B cannot close at t = 0 s");
+      failure.set_failure_kind(v1::ANALYSIS_FAILURE_ASSEMBLY);
+      grpc::ClientContext context;
+      v1::ReportResultResponse response;
+      ASSERT_TRUE(worker.stub().ReportResult(&context, failure, &response).ok());
+      break;
+    }
+    EXPECT_EQ(Get(*server, id).summary().failed_analyses_by_kind().at("assembly"), 1);
+  }
+  // The server is gone; a new one replays the log.
+  auto server = StartServer("kinds.db");
+  v1::GetJobResponse job = Get(*server, id);
+  ASSERT_EQ(job.summary().failed_analyses_by_kind().count("assembly"), 1u);
+  EXPECT_EQ(job.summary().failed_analyses_by_kind().at("assembly"), 1);
 }
 
 std::set<std::int64_t> RequestIds(const std::vector<v1::AnalysisTask>& tasks) {
