@@ -571,6 +571,24 @@ TEST_F(ServerTest, GarbageResultIsRejectedWhileAnotherJobContinues) {
   }
 }
 
+// Reports `task` as a failed analysis of `kind`; true when the server took it.
+bool ReportFailure(FakeWorker& worker, const std::string& job_id, const v1::AnalysisTask& task,
+                   v1::AnalysisFailureKind kind, const std::string& reason) {
+  v1::TaskResult failure;
+  failure.set_worker_id(worker.worker_id());
+  failure.set_task_id(task.task_id());
+  failure.set_job_id(job_id);
+  failure.set_request_id(task.request_id());
+  failure.set_ok(false);
+  failure.set_failure_reason(reason);
+  failure.set_failure_kind(kind);
+  grpc::ClientContext context;
+  v1::ReportResultResponse response;
+  const grpc::Status status = worker.stub().ReportResult(&context, failure, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  return status.ok() && response.accepted();
+}
+
 TEST_F(ServerTest, FailedAnalysisGoesToTheOptimizerWithoutRetry) {
   auto server = StartServer("a.db");
   const std::string id = Submit(*server, OscillatorStudy());
@@ -583,18 +601,7 @@ TEST_F(ServerTest, FailedAnalysisGoesToTheOptimizerWithoutRetry) {
       ASSERT_TRUE(worker.Answer(task).ok());
       continue;
     }
-    v1::TaskResult failure;
-    failure.set_worker_id(worker.worker_id());
-    failure.set_task_id(task.task_id());
-    failure.set_job_id(id);
-    failure.set_request_id(task.request_id());
-    failure.set_ok(false);
-    failure.set_failure_reason("integrator failed at t = 0.3 s");
-    failure.set_failure_kind(v1::ANALYSIS_FAILURE_INTEGRATOR);
-    grpc::ClientContext context;
-    v1::ReportResultResponse response;
-    ASSERT_TRUE(worker.stub().ReportResult(&context, failure, &response).ok());
-    EXPECT_TRUE(response.accepted());
+    EXPECT_TRUE(ReportFailure(worker, id, task, v1::ANALYSIS_FAILURE_INTEGRATOR, "integrator failed at t = 0.3 s"));
   }
   // Not retried: nothing more is offered.
   EXPECT_TRUE(worker.Acquire(100).empty());
@@ -630,17 +637,7 @@ TEST_F(ServerTest, FailureKindsSurviveAResume) {
     // side, so the job goes on.
     for (const v1::AnalysisTask& task : tasks) {
       if (task.request_id() == 0) continue;
-      v1::TaskResult failure;
-      failure.set_worker_id(worker.worker_id());
-      failure.set_task_id(task.task_id());
-      failure.set_job_id(id);
-      failure.set_request_id(task.request_id());
-      failure.set_ok(false);
-      failure.set_failure_reason("joint B cannot close at t = 0 s");
-      failure.set_failure_kind(v1::ANALYSIS_FAILURE_ASSEMBLY);
-      grpc::ClientContext context;
-      v1::ReportResultResponse response;
-      ASSERT_TRUE(worker.stub().ReportResult(&context, failure, &response).ok());
+      EXPECT_TRUE(ReportFailure(worker, id, task, v1::ANALYSIS_FAILURE_ASSEMBLY, "joint B cannot close at t = 0 s"));
       break;
     }
     EXPECT_EQ(Get(*server, id).summary().failed_analyses_by_kind().at("assembly"), 1);
