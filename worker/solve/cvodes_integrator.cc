@@ -17,28 +17,20 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "common/status_macros.h"
+#include "worker/solve/sundials_handles.h"
 
 namespace mbopt::solve {
 
+// Declared in the order of creation, so destroyed CVODE memory first (it may
+// still reference the solvers) and context last (sundials_handles.h).
 struct CvodesIntegrator::Sundials {
-  SUNContext context = nullptr;
-  void* cvode = nullptr;
-  N_Vector y = nullptr;
-  N_Vector abstol = nullptr;
-  SUNMatrix matrix = nullptr;
-  SUNLinearSolver linear_solver = nullptr;
-  SUNNonlinearSolver nonlinear_solver = nullptr;
-
-  ~Sundials() {
-    // CVodeFree first: it may still reference the solvers.
-    if (cvode != nullptr) CVodeFree(&cvode);
-    if (nonlinear_solver != nullptr) SUNNonlinSolFree(nonlinear_solver);
-    if (linear_solver != nullptr) SUNLinSolFree(linear_solver);
-    if (matrix != nullptr) SUNMatDestroy(matrix);
-    if (abstol != nullptr) N_VDestroy(abstol);
-    if (y != nullptr) N_VDestroy(y);
-    if (context != nullptr) SUNContext_Free(&context);
-  }
+  sundials::Context context;
+  sundials::Vector y;
+  sundials::Vector abstol;
+  sundials::Matrix matrix;
+  sundials::LinearSolver linear_solver;
+  sundials::NonlinearSolver nonlinear_solver;
+  sundials::Memory<&CVodeFree> cvode;
 };
 
 // The C side of the callbacks: each turns an exception or a non-finite value
@@ -126,8 +118,8 @@ struct CvodesCallbacks {
     auto* self = static_cast<CvodesIntegrator*>(ls->content);
     double t = self->setup_t_, gamma = self->setup_gamma_;
     if (self->newton_refresh_ == CvodesIntegrator::NewtonRefresh::kEveryIteration &&
-        (CVodeGetCurrentTime(self->sundials_->cvode, &t) != CV_SUCCESS ||
-         CVodeGetCurrentGamma(self->sundials_->cvode, &gamma) != CV_SUCCESS)) {
+        (CVodeGetCurrentTime(self->sundials_->cvode.get(), &t) != CV_SUCCESS ||
+         CVodeGetCurrentGamma(self->sundials_->cvode.get(), &gamma) != CV_SUCCESS)) {
       self->callback_failure_ = "Newton solver could not read the step's time and gamma";
       return SUNLS_PACKAGE_FAIL_UNREC;
     }
@@ -154,14 +146,6 @@ struct CvodesCallbacks {
     ls->content = nullptr;
     SUNLinSolFreeEmpty(ls);
     return SUNLS_SUCCESS;
-  }
-
-  static void Error(int code, const char* module, const char* function, char* message,
-                    void* user_data) {
-    auto* self = static_cast<CvodesIntegrator*>(user_data);
-    self->last_sundials_message_ = absl::StrFormat(
-        "%s %s (code %d): %s", module != nullptr ? module : "CVODES",
-        function != nullptr ? function : "", code, message != nullptr ? message : "");
   }
 };
 
@@ -268,51 +252,52 @@ absl::Status CvodesIntegrator::Check(int flag, const char* call) {
 
 absl::Status CvodesIntegrator::Init(double t0, const Eigen::VectorXd& y0) {
   Sundials& s = *sundials_;
-  if (SUNContext_Create(nullptr, &s.context) != 0 || s.context == nullptr) {
+  s.context = sundials::MakeContext();
+  if (!s.context) {
     return absl::InternalError("SUNContext_Create failed");
   }
-  s.y = N_VNew_Serial(num_states_, s.context);
-  if (s.y == nullptr) return absl::InternalError("N_VNew_Serial failed");
-  std::copy(y0.data(), y0.data() + num_states_, N_VGetArrayPointer(s.y));
+  s.y.reset(N_VNew_Serial(num_states_, s.context.get()));
+  if (!s.y) return absl::InternalError("N_VNew_Serial failed");
+  std::copy(y0.data(), y0.data() + num_states_, N_VGetArrayPointer(s.y.get()));
   // Fused vector operations: fewer passes over the (small) state vectors per
   // step; CVODES' internal vectors are cloned from this one and inherit it.
-  if (N_VEnableFusedOps_Serial(s.y, SUNTRUE) != 0) {
+  if (N_VEnableFusedOps_Serial(s.y.get(), SUNTRUE) != 0) {
     return absl::InternalError("N_VEnableFusedOps_Serial failed");
   }
-  s.cvode =
-      CVodeCreate(options_.method == CvodesOptions::Method::kBdf ? CV_BDF : CV_ADAMS, s.context);
-  if (s.cvode == nullptr) return absl::InternalError("CVodeCreate failed");
+  s.cvode.reset(CVodeCreate(options_.method == CvodesOptions::Method::kBdf ? CV_BDF : CV_ADAMS, s.context.get()));
+  if (!s.cvode) return absl::InternalError("CVodeCreate failed");
   MBOPT_RETURN_IF_ERROR(
-      Check(CVodeSetErrHandlerFn(s.cvode, &CvodesCallbacks::Error, this), "CVodeSetErrHandlerFn"));
-  MBOPT_RETURN_IF_ERROR(Check(CVodeInit(s.cvode, &CvodesCallbacks::Rhs, t0, s.y), "CVodeInit"));
-  MBOPT_RETURN_IF_ERROR(Check(CVodeSetUserData(s.cvode, this), "CVodeSetUserData"));
+      Check(CVodeSetErrHandlerFn(s.cvode.get(), &sundials::CaptureMessage, &last_sundials_message_),
+            "CVodeSetErrHandlerFn"));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeInit(s.cvode.get(), &CvodesCallbacks::Rhs, t0, s.y.get()), "CVodeInit"));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeSetUserData(s.cvode.get(), this), "CVodeSetUserData"));
   if (options_.absolute_tolerances.size() == 0) {
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSStolerances(s.cvode, options_.relative_tolerance, options_.absolute_tolerance),
+        Check(CVodeSStolerances(s.cvode.get(), options_.relative_tolerance, options_.absolute_tolerance),
               "CVodeSStolerances"));
   } else {
-    s.abstol = N_VNew_Serial(num_states_, s.context);
-    if (s.abstol == nullptr) return absl::InternalError("N_VNew_Serial failed");
+    s.abstol.reset(N_VNew_Serial(num_states_, s.context.get()));
+    if (!s.abstol) return absl::InternalError("N_VNew_Serial failed");
     std::copy(options_.absolute_tolerances.data(),
-              options_.absolute_tolerances.data() + num_states_, N_VGetArrayPointer(s.abstol));
-    MBOPT_RETURN_IF_ERROR(Check(CVodeSVtolerances(s.cvode, options_.relative_tolerance, s.abstol),
+              options_.absolute_tolerances.data() + num_states_, N_VGetArrayPointer(s.abstol.get()));
+    MBOPT_RETURN_IF_ERROR(Check(CVodeSVtolerances(s.cvode.get(), options_.relative_tolerance, s.abstol.get()),
                                 "CVodeSVtolerances"));
   }
   if (options_.iteration == CvodesOptions::Iteration::kFixedPoint) {
-    s.nonlinear_solver = SUNNonlinSol_FixedPoint(s.y, 0, s.context);
-    if (s.nonlinear_solver == nullptr) return absl::InternalError("SUNNonlinSol_FixedPoint failed");
+    s.nonlinear_solver.reset(SUNNonlinSol_FixedPoint(s.y.get(), 0, s.context.get()));
+    if (!s.nonlinear_solver) return absl::InternalError("SUNNonlinSol_FixedPoint failed");
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSetNonlinearSolver(s.cvode, s.nonlinear_solver), "CVodeSetNonlinearSolver"));
+        Check(CVodeSetNonlinearSolver(s.cvode.get(), s.nonlinear_solver.get()), "CVodeSetNonlinearSolver"));
   } else {
     MBOPT_RETURN_IF_ERROR(InitLinearSolver());
   }
   if (options_.max_step_size > 0.0) {
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSetMaxStep(s.cvode, options_.max_step_size), "CVodeSetMaxStep"));
+        Check(CVodeSetMaxStep(s.cvode.get(), options_.max_step_size), "CVodeSetMaxStep"));
   }
   if (options_.initial_step_size > 0.0) {
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSetInitStep(s.cvode, options_.initial_step_size), "CVodeSetInitStep"));
+        Check(CVodeSetInitStep(s.cvode.get(), options_.initial_step_size), "CVodeSetInitStep"));
   }
   t_ = t0;
   return absl::OkStatus();
@@ -321,34 +306,34 @@ absl::Status CvodesIntegrator::Init(double t0, const Eigen::VectorXd& y0) {
 absl::Status CvodesIntegrator::InitLinearSolver() {
   Sundials& s = *sundials_;
   if (newton_solve_) {
-    s.linear_solver = SUNLinSolNewEmpty(s.context);
-    if (s.linear_solver == nullptr) return absl::InternalError("SUNLinSolNewEmpty failed");
-    s.linear_solver->content = this;
-    s.linear_solver->ops->gettype = &CvodesCallbacks::NewtonType;
-    s.linear_solver->ops->getid = &CvodesCallbacks::NewtonId;
-    s.linear_solver->ops->solve = &CvodesCallbacks::NewtonSolve;
-    s.linear_solver->ops->free = &CvodesCallbacks::NewtonFree;
+    s.linear_solver.reset(SUNLinSolNewEmpty(s.context.get()));
+    if (!s.linear_solver) return absl::InternalError("SUNLinSolNewEmpty failed");
+    s.linear_solver.get()->content = this;
+    s.linear_solver.get()->ops->gettype = &CvodesCallbacks::NewtonType;
+    s.linear_solver.get()->ops->getid = &CvodesCallbacks::NewtonId;
+    s.linear_solver.get()->ops->solve = &CvodesCallbacks::NewtonSolve;
+    s.linear_solver.get()->ops->free = &CvodesCallbacks::NewtonFree;
     if (newton_refresh_ == NewtonRefresh::kEveryIteration) {
-      return Check(CVodeSetLinearSolver(s.cvode, s.linear_solver, nullptr),
+      return Check(CVodeSetLinearSolver(s.cvode.get(), s.linear_solver.get(), nullptr),
                    "CVodeSetLinearSolver");
     }
     // CVODES' direct-solver interface wants a matrix; the caller owns the
     // real one, so a 1 x 1 placeholder stands in and is never read.
-    s.matrix = SUNDenseMatrix(1, 1, s.context);
-    if (s.matrix == nullptr) return absl::InternalError("SUNDenseMatrix failed");
+    s.matrix.reset(SUNDenseMatrix(1, 1, s.context.get()));
+    if (!s.matrix) return absl::InternalError("SUNDenseMatrix failed");
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSetLinearSolver(s.cvode, s.linear_solver, s.matrix), "CVodeSetLinearSolver"));
-    return Check(CVodeSetLinSysFn(s.cvode, &CvodesCallbacks::LinSys), "CVodeSetLinSysFn");
+        Check(CVodeSetLinearSolver(s.cvode.get(), s.linear_solver.get(), s.matrix.get()), "CVodeSetLinearSolver"));
+    return Check(CVodeSetLinSysFn(s.cvode.get(), &CvodesCallbacks::LinSys), "CVodeSetLinSysFn");
   }
-  s.matrix = SUNDenseMatrix(num_states_, num_states_, s.context);
-  if (s.matrix == nullptr) return absl::InternalError("SUNDenseMatrix failed");
-  s.linear_solver = SUNLinSol_Dense(s.y, s.matrix, s.context);
-  if (s.linear_solver == nullptr) return absl::InternalError("SUNLinSol_Dense failed");
+  s.matrix.reset(SUNDenseMatrix(num_states_, num_states_, s.context.get()));
+  if (!s.matrix) return absl::InternalError("SUNDenseMatrix failed");
+  s.linear_solver.reset(SUNLinSol_Dense(s.y.get(), s.matrix.get(), s.context.get()));
+  if (!s.linear_solver) return absl::InternalError("SUNLinSol_Dense failed");
   MBOPT_RETURN_IF_ERROR(
-      Check(CVodeSetLinearSolver(s.cvode, s.linear_solver, s.matrix), "CVodeSetLinearSolver"));
+      Check(CVodeSetLinearSolver(s.cvode.get(), s.linear_solver.get(), s.matrix.get()), "CVodeSetLinearSolver"));
   if (jacobian_) {
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSetJacFn(s.cvode, &CvodesCallbacks::Jacobian), "CVodeSetJacFn"));
+        Check(CVodeSetJacFn(s.cvode.get(), &CvodesCallbacks::Jacobian), "CVodeSetJacFn"));
   }
   return absl::OkStatus();
 }
@@ -358,7 +343,7 @@ absl::Status CvodesIntegrator::SetStopTime(double t_stop) {
     return absl::InvalidArgumentError(
         absl::StrFormat("stop time %.9g is not ahead of the current time %.9g", t_stop, t_));
   }
-  MBOPT_RETURN_IF_ERROR(Check(CVodeSetStopTime(sundials_->cvode, t_stop), "CVodeSetStopTime"));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeSetStopTime(sundials_->cvode.get(), t_stop), "CVodeSetStopTime"));
   stop_time_ = t_stop;
   stop_time_set_ = true;
   return absl::OkStatus();
@@ -369,14 +354,14 @@ absl::Status CvodesIntegrator::Restart(double t, const Eigen::VectorXd& y) {
     return absl::InvalidArgumentError("restart state has the wrong size or is not finite");
   }
   AccumulateCounters();
-  std::copy(y.data(), y.data() + num_states_, N_VGetArrayPointer(sundials_->y));
-  MBOPT_RETURN_IF_ERROR(Check(CVodeReInit(sundials_->cvode, t, sundials_->y), "CVodeReInit"));
+  std::copy(y.data(), y.data() + num_states_, N_VGetArrayPointer(sundials_->y.get()));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeReInit(sundials_->cvode.get(), t, sundials_->y.get()), "CVodeReInit"));
   if (stop_time_set_ && stop_time_ <= t) {
     // CVODES 6.4 keeps a stop time across CVodeReInit and has no call to
     // clear it; one at or behind the restart time would fail the next step,
     // so it is moved out of reach.
     MBOPT_RETURN_IF_ERROR(
-        Check(CVodeSetStopTime(sundials_->cvode, std::numeric_limits<double>::max()),
+        Check(CVodeSetStopTime(sundials_->cvode.get(), std::numeric_limits<double>::max()),
               "CVodeSetStopTime"));
     stop_time_set_ = false;
   }
@@ -397,7 +382,7 @@ void CvodesIntegrator::AccumulateCounters() {
 CvodesCounters CvodesIntegrator::counters() const {
   CvodesCounters c = carried_;
   c.jacobian_evaluations += newton_refactorizations_;
-  void* mem = sundials_->cvode;
+  void* mem = sundials_->cvode.get();
   if (mem == nullptr) return c;
   long value = 0;
   if (CVodeGetNumSteps(mem, &value) == CV_SUCCESS) c.steps += value;
@@ -429,7 +414,7 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
     // CVODES refuses a zero or rounding-size request ("tout too close to
     // t0"), e.g. a grid instant one ulp after a restart; the state there is
     // the current one to within rounding.
-    const double* data = N_VGetArrayPointer(s.y);
+    const double* data = N_VGetArrayPointer(s.y.get());
     std::copy(data, data + num_states_, y->data());
     t_ = t_out;
     return absl::OkStatus();
@@ -439,10 +424,10 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
   // step. Asking CVode instead would fail when that step ended exactly on a
   // stop time ("tstop is behind current t").
   double t_internal = t_;
-  MBOPT_RETURN_IF_ERROR(Check(CVodeGetCurrentTime(s.cvode, &t_internal), "CVodeGetCurrentTime"));
+  MBOPT_RETURN_IF_ERROR(Check(CVodeGetCurrentTime(s.cvode.get(), &t_internal), "CVodeGetCurrentTime"));
   if (t_out <= t_internal) {
-    MBOPT_RETURN_IF_ERROR(Check(CVodeGetDky(s.cvode, t_out, 0, s.y), "CVodeGetDky"));
-    const double* data = N_VGetArrayPointer(s.y);
+    MBOPT_RETURN_IF_ERROR(Check(CVodeGetDky(s.cvode.get(), t_out, 0, s.y.get()), "CVodeGetDky"));
+    const double* data = N_VGetArrayPointer(s.y.get());
     std::copy(data, data + num_states_, y->data());
     t_ = t_out;
     if (!y->allFinite()) {
@@ -457,11 +442,11 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
         absl::StrFormat("step budget of %d exhausted at t = %.9g", options_.max_steps, t_));
   }
   MBOPT_RETURN_IF_ERROR(
-      Check(CVodeSetMaxNumSteps(s.cvode, static_cast<long>(remaining)), "CVodeSetMaxNumSteps"));
+      Check(CVodeSetMaxNumSteps(s.cvode.get(), static_cast<long>(remaining)), "CVodeSetMaxNumSteps"));
   last_sundials_message_.clear();
   callback_failure_.clear();
   double t_reached = t_;
-  const int flag = CVode(s.cvode, t_out, s.y, &t_reached, CV_NORMAL);
+  const int flag = CVode(s.cvode.get(), t_out, s.y.get(), &t_reached, CV_NORMAL);
   if (flag < 0) {
     if (wall_time_exceeded_) {
       return absl::DeadlineExceededError(
@@ -500,7 +485,7 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
     return absl::AbortedError(message);
   }
   t_ = t_reached;
-  const double* data = N_VGetArrayPointer(s.y);
+  const double* data = N_VGetArrayPointer(s.y.get());
   std::copy(data, data + num_states_, y->data());
   if (!y->allFinite()) {
     return absl::AbortedError(absl::StrFormat("state is not finite at t = %.9g", t_));

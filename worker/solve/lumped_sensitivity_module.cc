@@ -16,6 +16,7 @@
 #include "absl/strings/str_format.h"
 #include "worker/solve/integrator_failure.h"
 #include "worker/solve/lumped_sensitivity_problem.h"
+#include "worker/solve/sundials_handles.h"
 
 namespace mbopt::solve::sensitivity_internal {
 namespace {
@@ -86,37 +87,16 @@ int Jacobian(realtype, N_Vector, N_Vector, SUNMatrix jac, void* user_data, N_Vec
   return 0;
 }
 
-void CaptureMessage(int code, const char* module, const char* function, char* message,
-                    void* user_data) {
-  auto* p = static_cast<SensitivityProblem*>(user_data);
-  p->sundials_message = absl::StrFormat("%s/%s (%d): %s", module != nullptr ? module : "",
-                                        function != nullptr ? function : "", code,
-                                        message != nullptr ? message : "");
-}
-
-// Owns every SUNDIALS object of one integration.
+// Owns every SUNDIALS object of one integration, in the order of creation
+// (sundials_handles.h).
 struct Sundials {
-  SUNContext context = nullptr;
-  void* cvode = nullptr;
-  N_Vector y = nullptr;
-  N_Vector abstol = nullptr;
-  N_Vector* ys = nullptr;
-  int num_sensitivities = 0;
-  SUNMatrix matrix = nullptr;
-  SUNLinearSolver linear_solver = nullptr;
-
-  Sundials() = default;
-  Sundials(const Sundials&) = delete;
-  Sundials& operator=(const Sundials&) = delete;
-  ~Sundials() {
-    if (cvode != nullptr) CVodeFree(&cvode);
-    if (linear_solver != nullptr) SUNLinSolFree(linear_solver);
-    if (matrix != nullptr) SUNMatDestroy(matrix);
-    if (ys != nullptr) N_VDestroyVectorArray(ys, num_sensitivities);
-    if (abstol != nullptr) N_VDestroy(abstol);
-    if (y != nullptr) N_VDestroy(y);
-    if (context != nullptr) SUNContext_Free(&context);
-  }
+  sundials::Context context;
+  sundials::Vector y;
+  sundials::Vector abstol;
+  sundials::Matrix matrix;
+  sundials::LinearSolver linear_solver;
+  sundials::VectorArray ys;
+  sundials::Memory<&CVodeFree> cvode;
 };
 
 }  // namespace
@@ -147,28 +127,28 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
                                      absl::StrCat("sensitivity tolerance factor must be positive, got ",
                                                   options.tolerance_factor));
   }
-  if (SUNContext_Create(nullptr, &s.context) != 0) {
+  s.context = sundials::MakeContext();
+  if (!s.context) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNContext_Create failed");
   }
-  s.y = N_VNew_Serial(2 * n, s.context);
-  s.abstol = N_VNew_Serial(2 * n, s.context);
-  s.cvode = CVodeCreate(CV_BDF, s.context);
-  if (s.y == nullptr || s.abstol == nullptr || s.cvode == nullptr) {
+  s.y.reset(N_VNew_Serial(2 * n, s.context.get()));
+  s.abstol.reset(N_VNew_Serial(2 * n, s.context.get()));
+  s.cvode.reset(CVodeCreate(CV_BDF, s.context.get()));
+  if (!s.y || !s.abstol || !s.cvode) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   }
-  if (options.fused_vector_operations && N_VEnableFusedOps_Serial(s.y, SUNTRUE) != 0) {
+  if (options.fused_vector_operations && N_VEnableFusedOps_Serial(s.y.get(), SUNTRUE) != 0) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "N_VEnableFusedOps_Serial failed");
   }
-  Eigen::Map<Eigen::VectorXd> y(N_VGetArrayPointer(s.y), 2 * n);
+  Eigen::Map<Eigen::VectorXd> y(N_VGetArrayPointer(s.y.get()), 2 * n);
   y.setZero();
-  Eigen::Map<Eigen::VectorXd> abstol(N_VGetArrayPointer(s.abstol), 2 * n);
+  Eigen::Map<Eigen::VectorXd> abstol(N_VGetArrayPointer(s.abstol.get()), 2 * n);
   abstol.head(n).setConstant(settings.absolute_tolerance);
   abstol.tail(n).setConstant(settings.absolute_tolerance * std::max(1.0, omega_max));
-  s.matrix = SUNDenseMatrix(2 * n, 2 * n, s.context);
-  s.linear_solver = SUNLinSol_Dense(s.y, s.matrix, s.context);
-  s.ys = N_VCloneVectorArray(ns, s.y);
-  s.num_sensitivities = ns;
-  if (s.matrix == nullptr || s.linear_solver == nullptr || s.ys == nullptr) {
+  s.matrix.reset(SUNDenseMatrix(2 * n, 2 * n, s.context.get()));
+  s.linear_solver.reset(SUNLinSol_Dense(s.y.get(), s.matrix.get(), s.context.get()));
+  s.ys = sundials::VectorArray(N_VCloneVectorArray(ns, s.y.get()), ns);
+  if (!s.matrix || !s.linear_solver || !s.ys) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   }
   for (int k = 0; k < ns; ++k) N_VConst(0.0, s.ys[k]);
@@ -181,53 +161,46 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
   // Sensitivity tolerances: EE's own choice (rtol, atol_i / pbar_k), or the
   // same scaled by options.tolerance_factor.
   const bool estimated_tolerances = options.tolerance_factor == 1.0;
-  N_Vector* sensitivity_abstol = nullptr;
+  sundials::VectorArray sensitivity_abstol;
   if (!estimated_tolerances) {
-    sensitivity_abstol = N_VCloneVectorArray(ns, s.y);
-    if (sensitivity_abstol == nullptr) {
+    sensitivity_abstol = sundials::VectorArray(N_VCloneVectorArray(ns, s.y.get()), ns);
+    if (!sensitivity_abstol) {
       return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
     }
     for (int k = 0; k < ns; ++k) {
-      N_VScale(options.tolerance_factor / pbar[static_cast<size_t>(k)], s.abstol,
-               sensitivity_abstol[k]);
+      N_VScale(options.tolerance_factor / pbar[static_cast<size_t>(k)], s.abstol.get(), sensitivity_abstol[k]);
     }
   }
-  struct AbstolArray {
-    N_Vector* v;
-    int count;
-    ~AbstolArray() {
-      if (v != nullptr) N_VDestroyVectorArray(v, count);
-    }
-  } abstol_owner{sensitivity_abstol, ns};
-  bool ok = check(CVodeSetErrHandlerFn(s.cvode, &CaptureMessage, p), "CVodeSetErrHandlerFn") &&
-            check(CVodeInit(s.cvode, &Rhs, 0.0, s.y), "CVodeInit") &&
-            check(CVodeSetUserData(s.cvode, p), "CVodeSetUserData") &&
-            check(CVodeSVtolerances(s.cvode, settings.relative_tolerance, s.abstol),
+  bool ok = check(CVodeSetErrHandlerFn(s.cvode.get(), &sundials::CaptureMessage, &p->sundials_message),
+                  "CVodeSetErrHandlerFn") &&
+            check(CVodeInit(s.cvode.get(), &Rhs, 0.0, s.y.get()), "CVodeInit") &&
+            check(CVodeSetUserData(s.cvode.get(), p), "CVodeSetUserData") &&
+            check(CVodeSVtolerances(s.cvode.get(), settings.relative_tolerance, s.abstol.get()),
                   "CVodeSVtolerances") &&
-            check(CVodeSetLinearSolver(s.cvode, s.linear_solver, s.matrix),
+            check(CVodeSetLinearSolver(s.cvode.get(), s.linear_solver.get(), s.matrix.get()),
                   "CVodeSetLinearSolver") &&
-            check(CVodeSetJacFn(s.cvode, &Jacobian), "CVodeSetJacFn") &&
-            check(CVodeSetMaxNumSteps(s.cvode, settings.max_steps), "CVodeSetMaxNumSteps") &&
+            check(CVodeSetJacFn(s.cvode.get(), &Jacobian), "CVodeSetJacFn") &&
+            check(CVodeSetMaxNumSteps(s.cvode.get(), settings.max_steps), "CVodeSetMaxNumSteps") &&
             (options.jacobian_eval_frequency <= 0 ||
-             check(CVodeSetJacEvalFrequency(s.cvode, options.jacobian_eval_frequency),
+             check(CVodeSetJacEvalFrequency(s.cvode.get(), options.jacobian_eval_frequency),
                    "CVodeSetJacEvalFrequency")) &&
             (options.linear_setup_frequency <= 0 ||
-             check(CVodeSetLSetupFrequency(s.cvode, options.linear_setup_frequency),
+             check(CVodeSetLSetupFrequency(s.cvode.get(), options.linear_setup_frequency),
                    "CVodeSetLSetupFrequency")) &&
             (corrector == CV_STAGGERED1
-                 ? check(CVodeSensInit1(s.cvode, ns, corrector, &SensitivityRhs1, s.ys),
+                 ? check(CVodeSensInit1(s.cvode.get(), ns, corrector, &SensitivityRhs1, s.ys.get()),
                          "CVodeSensInit1")
-                 : check(CVodeSensInit(s.cvode, ns, corrector, &SensitivityRhs, s.ys),
+                 : check(CVodeSensInit(s.cvode.get(), ns, corrector, &SensitivityRhs, s.ys.get()),
                          "CVodeSensInit")) &&
-            check(CVodeSetSensParams(s.cvode, nullptr, parameter_scales.data(), nullptr),
+            check(CVodeSetSensParams(s.cvode.get(), nullptr, parameter_scales.data(), nullptr),
                   "CVodeSetSensParams") &&
             (estimated_tolerances
-                 ? check(CVodeSensEEtolerances(s.cvode), "CVodeSensEEtolerances")
+                 ? check(CVodeSensEEtolerances(s.cvode.get()), "CVodeSensEEtolerances")
                  : check(CVodeSensSVtolerances(
-                             s.cvode, settings.relative_tolerance * options.tolerance_factor,
-                             sensitivity_abstol),
+                             s.cvode.get(), settings.relative_tolerance * options.tolerance_factor,
+                             sensitivity_abstol.get()),
                          "CVodeSensSVtolerances")) &&
-            check(CVodeSetSensErrCon(s.cvode, options.error_control ? SUNTRUE : SUNFALSE),
+            check(CVodeSetSensErrCon(s.cvode.get(), options.error_control ? SUNTRUE : SUNFALSE),
                   "CVodeSetSensErrCon");
 
   const double t_last = instants.empty() ? 0.0 : instants.back();
@@ -236,12 +209,12 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
   double t_now = 0.0;
   auto set_stop = [&]() {
     const double stop = next_kink < kinks.size() ? kinks[next_kink] : t_last;
-    return stop <= t_now || check(CVodeSetStopTime(s.cvode, stop), "CVodeSetStopTime");
+    return stop <= t_now || check(CVodeSetStopTime(s.cvode.get(), stop), "CVodeSetStopTime");
   };
   auto advance = [&](double t) {
     if (t <= t_now) return true;
     realtype reached = t_now;
-    const int flag = CVode(s.cvode, t, s.y, &reached, CV_NORMAL);
+    const int flag = CVode(s.cvode.get(), t, s.y.get(), &reached, CV_NORMAL);
     if (flag < 0) {
       failure = absl::StrFormat("integrator failed near t = %.9g (target %.9g): flag %d", reached,
                                 t, flag);
@@ -253,7 +226,7 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
     }
     t_now = t;
     realtype t_sens = t;
-    return check(CVodeGetSens(s.cvode, &t_sens, s.ys), "CVodeGetSens");
+    return check(CVodeGetSens(s.cvode.get(), &t_sens, s.ys.get()), "CVodeGetSens");
   };
   ok = ok && set_stop();
   // CVodeReInit (at every kink) zeroes CVODES' counters: they are summed
@@ -263,7 +236,7 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
     long value = 0;
     auto add = [&](int (*get)(void*, long*), auto* total) {
       value = 0;
-      if (get(s.cvode, &value) == CV_SUCCESS) *total += value;
+      if (get(s.cvode.get(), &value) == CV_SUCCESS) *total += value;
     };
     add(&CVodeGetNumSteps, &counters->time_steps);
     add(&CVodeGetNumRhsEvals, &counters->rhs_evaluations);
@@ -286,9 +259,9 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
       }
       accumulate_counters();
       history_counted = true;
-      ok = check(CVodeReInit(s.cvode, kink, s.y), "CVodeReInit");
+      ok = check(CVodeReInit(s.cvode.get(), kink, s.y.get()), "CVodeReInit");
       if (ok) history_counted = false;
-      ok = ok && check(CVodeSensReInit(s.cvode, corrector, s.ys), "CVodeSensReInit") && set_stop();
+      ok = ok && check(CVodeSensReInit(s.cvode.get(), corrector, s.ys.get()), "CVodeSensReInit") && set_stop();
     }
     if (!ok || !advance(t)) {
       ok = false;
