@@ -1,0 +1,61 @@
+// Forward dynamics of a constrained system (DOF > 0) with SUNDIALS IDAS, in
+// the stabilized index-2 form of Gear, Gupta and Leimkuhler (GGL), as in
+// SUNDIALS' own slider-crank example: unknowns y = (q, v, lambda, mu) and
+//
+//   q' - v + Phi_q^T mu = 0        (mu keeps the positions on Phi = 0)
+//   M v' + Phi_q^T lambda - Q = 0
+//   Phi(t, q) = 0
+//   Phi_q v + Phi_t = 0
+//
+// so both position and velocity constraints hold along the solution, without
+// a stabilization parameter to tune. q and v are differential, lambda and mu
+// algebraic and left out of the error test (IDASetSuppressAlg): their
+// accuracy follows from q and v. Consistent initial values come from the
+// caller's assembled (q0, v0): a0 and lambda0 from the augmented system
+// [M Phi_q^T; Phi_q 0] [a; lambda] = [Q; gamma], mu0 = 0.
+//
+// Failures are data: IDAS giving up (error-test or convergence failures, the
+// step budget), a singular augmented matrix at the start (a lock-up), and the
+// wall-time limit end the analysis with their kind and the time.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "spec/analysis_outcome.h"
+#include "worker/multibody/constrained_system.h"
+#include "worker/multibody/motion.h"
+
+namespace mbopt::multibody {
+
+struct ForwardDynamicsOptions {
+  double relative_tolerance = 1e-6;
+  double absolute_tolerance = 1e-9;  // on q (m, rad) and v (m/s, rad/s)
+  long max_steps = 100000;           // over the whole integration
+  double max_wall_seconds = 0.0;     // 0: no limit
+  double max_step_size = 0.0;        // 0: no limit
+};
+
+struct ForwardDynamicsCounters {
+  std::int64_t steps = 0;
+  std::int64_t residual_evaluations = 0;
+  std::int64_t jacobian_evaluations = 0;
+  std::int64_t nonlinear_iterations = 0;
+  std::int64_t error_test_failures = 0;
+  std::int64_t convergence_failures = 0;
+  // Largest |Phi| and |Phi_q v + Phi_t| at the output instants: the drift
+  // the GGL form keeps at the integration tolerance.
+  double max_position_drift = 0.0;
+  double max_velocity_drift = 0.0;
+};
+
+// From (t0, q0, v0), consistent with the constraints, to every instant of
+// `times_s` (ascending, >= t0); `at_instant` sees (t, q, v, a, lambda).
+spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t0_s, const Eigen::VectorXd& q0,
+                                       const Eigen::VectorXd& v0, const std::vector<double>& times_s,
+                                       const ForwardDynamicsOptions& options, const MotionCallback& at_instant,
+                                       ForwardDynamicsCounters* counters);
+
+}  // namespace mbopt::multibody

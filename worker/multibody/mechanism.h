@@ -1,0 +1,91 @@
+// The equations of a planar multibody Model in absolute coordinates (Haug;
+// Nikravesh): q = (x_i, y_i, phi_i) per body, a constant diagonal mass matrix,
+// and one block of constraint rows per joint and per driver (docs/physics.md
+// lists them with their Jacobians and right-hand sides gamma). Implements
+// ConstrainedSystem for the forward-dynamics integrator and evaluates the
+// outputs (point positions, joint coordinates, spring forces, energies) of a
+// state. Counters prove what was computed: gravity is evaluated only when the
+// model declares it.
+//
+// Row layout: the joints in order (revolute: 2 rows, x and y of marker a minus
+// marker b; prismatic: 2, the offset normal to the axis and the relative
+// angle; fixed: 3; point on line: 1, the offset normal to the axis), then one
+// row per driver.
+//
+// Not thread-safe (the counters); one Mechanism per analysis. The model must
+// be valid (Model::Validate) and must outlive the mechanism.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "worker/multibody/constrained_system.h"
+#include "worker/multibody/model.h"
+
+namespace mbopt::multibody {
+
+struct MechanismCounters {
+  std::int64_t constraint_evaluations = 0;  // Phi, Phi_t or gamma
+  std::int64_t jacobian_evaluations = 0;    // Phi_q
+  std::int64_t force_evaluations = 0;       // Q
+  std::int64_t gravity_evaluations = 0;     // Q evaluations that included gravity
+  std::int64_t mass_matrix_evaluations = 0;
+};
+
+class Mechanism : public ConstrainedSystem {
+ public:
+  explicit Mechanism(const Model& model);
+
+  const Model& model() const { return model_; }
+  int num_coordinates() const override { return 3 * static_cast<int>(model_.bodies.size()); }
+  int num_constraints() const override { return num_rows_; }
+  int first_row_of_joint(int joint) const { return joint_row_[static_cast<size_t>(joint)]; }
+  int row_of_driver(int driver) const { return driver_row_[static_cast<size_t>(driver)]; }
+  // The joint (or, for a driver row, the driven joint) a constraint row belongs to.
+  int joint_of_row(int row) const { return row_joint_[static_cast<size_t>(row)]; }
+  bool is_driver_row(int row) const { return row >= joint_rows_; }
+
+  int MassMatrix(const Eigen::VectorXd& q, Eigen::MatrixXd* mass) const override;
+  int AppliedForces(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                    Eigen::VectorXd* forces) const override;
+  int Constraints(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi) const override;
+  int ConstraintJacobian(double t, const Eigen::VectorXd& q, Eigen::MatrixXd* phi_q) const override;
+  int ConstraintTimeDerivative(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi_t) const override;
+  int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                            Eigen::VectorXd* gamma) const override;
+
+  // The initial guess of the coordinates: the bodies' initial poses.
+  Eigen::VectorXd InitialGuess() const;
+
+  // Outputs of a state (SI).
+  Eigen::Vector2d PointPosition(const Point& p, const Eigen::VectorXd& q) const;
+  Eigen::Vector2d PointVelocity(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  Eigen::Vector2d PointAcceleration(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                    const Eigen::VectorXd& a) const;
+  double JointCoordinate(int joint, const Eigen::VectorXd& q) const;
+  double JointRate(int joint, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  double SpringLength(int spring, const Eigen::VectorXd& q) const;
+  double SpringTension(int spring, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  double KineticEnergy(const Eigen::VectorXd& v) const;
+  // Gravity (zero at y = 0 for g along -y) and the springs' strain energy.
+  double PotentialEnergy(const Eigen::VectorXd& q) const;
+
+  const MechanismCounters& counters() const { return counters_; }
+
+ private:
+  // One evaluation of every row: whichever outputs are not null.
+  void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
+                    Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
+  double ReferenceAngle(int joint) const { return reference_angle_[static_cast<size_t>(joint)]; }
+
+  const Model& model_;
+  int joint_rows_ = 0;
+  int num_rows_ = 0;
+  std::vector<int> joint_row_, driver_row_, row_joint_;
+  std::vector<double> reference_angle_;  // phi_b - phi_a of the initial poses
+  mutable MechanismCounters counters_;
+};
+
+}  // namespace mbopt::multibody
