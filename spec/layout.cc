@@ -83,6 +83,23 @@ Dimension OutputDimension(const Output& output) {
                         [](const BendingStressOutput&) { return Dimension::kPressure; },
                         [](const DriveTorqueOutput&) { return Dimension::kTorque; },
                         [](const MassOutput&) { return Dimension::kMass; },
+                        [](const MultibodyOutput& m) {
+                          using Q = MultibodyOutput::Quantity;
+                          switch (m.quantity) {
+                            case Q::kMarkerPosition: return Dimension::kLength;
+                            case Q::kMarkerVelocity: return Dimension::kVelocity;
+                            case Q::kMarkerAcceleration: return Dimension::kAcceleration;
+                            case Q::kJointCoordinate: return m.linear ? Dimension::kLength : Dimension::kAngle;
+                            case Q::kJointRate: return m.linear ? Dimension::kVelocity : Dimension::kAngularVelocity;
+                            case Q::kJointReaction: return Dimension::kForce;
+                            case Q::kDriverEffort: return m.linear ? Dimension::kForce : Dimension::kTorque;
+                            case Q::kSpringLength: return Dimension::kLength;
+                            case Q::kSpringForce: return Dimension::kForce;
+                            case Q::kKineticEnergy:
+                            case Q::kPotentialEnergy: return Dimension::kAny;
+                          }
+                          return Dimension::kAny;
+                        },
                     },
                     output.kind);
 }

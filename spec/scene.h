@@ -105,6 +105,64 @@ struct LumpedModel {
   std::vector<GroundInput> inputs;
 };
 
+// ---- multibody (any planar mechanism; worker/multibody)
+// A marker of a body (body >= 0) or of ground (body = -1).
+struct MarkerRef {
+  int body = -1;
+  int marker = -1;
+};
+struct RigidBody {
+  std::string name;
+  Number mass_kg, inertia_kg_m2;
+  Vec2 position_m;
+  Number angle_rad;
+  std::vector<LinkPoint> markers;  // in body axes, from the centre of mass
+};
+enum class JointKind { kRevolute, kPrismatic, kFixed, kPointOnLine };
+struct MultibodyJoint {
+  std::string name;
+  JointKind kind = JointKind::kRevolute;
+  MarkerRef a, b;
+  Number axis_angle_rad;
+  std::optional<Number> initial_value, initial_rate;
+  bool linear() const { return kind == JointKind::kPrismatic || kind == JointKind::kPointOnLine; }
+};
+struct MultibodyDriver {
+  int joint = -1;
+  enum class Profile { kConstantRate, kPolynomial, kHarmonic } profile = Profile::kConstantRate;
+  Number start, rate;                 // kConstantRate; start is the mean for kHarmonic
+  std::vector<Number> coefficients;   // kPolynomial
+  Number amplitude, angular_frequency_rad_per_s, phase_rad;  // kHarmonic
+};
+struct MultibodySpring {
+  std::string name;
+  MarkerRef a, b;
+  Number free_length_m, stiffness_n_per_m, damping_n_s_per_m, actuator_force_n;
+};
+struct RotationalSpring {
+  std::string name;
+  int joint = -1;
+  Number stiffness_n_m_per_rad, damping_n_m_s_per_rad, free_angle_rad;
+};
+struct MultibodyPointForce {
+  MarkerRef at;
+  Vec2 force_n;
+};
+struct MultibodyTorque {
+  int body = -1;
+  Number torque_n_m;
+};
+struct MultibodyModel {
+  std::vector<LinkPoint> ground_markers;
+  std::vector<RigidBody> bodies;
+  std::vector<MultibodyJoint> joints;
+  std::vector<MultibodyDriver> drivers;
+  std::vector<MultibodySpring> springs;
+  std::vector<RotationalSpring> rotational_springs;
+  std::vector<MultibodyPointForce> point_forces;
+  std::vector<MultibodyTorque> torques;
+};
+
 // ---- outputs
 enum class Axis { kX, kY };
 struct PointPositionOutput { int link = -1; int point = -1; int joint = -1; Axis axis = Axis::kX; };  // link point, or joint if joint >= 0
@@ -114,11 +172,26 @@ struct BodyAccelerationOutput { int body = -1; Vec2 offset_m; Axis axis = Axis::
 struct BendingStressOutput { int link = -1; };
 struct DriveTorqueOutput {};
 struct MassOutput {};
+// An output of a multibody scene. Reactions are the force body a's side of
+// the joint exerts on body b; a driver's effort is the torque (revolute) or
+// force (prismatic) it applies to body b.
+struct MultibodyOutput {
+  enum class Quantity {
+    kMarkerPosition, kMarkerVelocity, kMarkerAcceleration,
+    kJointCoordinate, kJointRate, kJointReaction, kDriverEffort,
+    kSpringLength, kSpringForce, kKineticEnergy, kPotentialEnergy,
+  } quantity = Quantity::kMarkerPosition;
+  MarkerRef marker;
+  int joint = -1;
+  int spring = -1;
+  Axis axis = Axis::kX;
+  bool linear = false;  // joint outputs of a prismatic or point-on-line joint (m, N)
+};
 
 struct Output {
   std::string name;
   std::variant<PointPositionOutput, LinkRotationOutput, ElementDeflectionOutput,
-               BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput>
+               BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput>
       kind;
 };
 
@@ -142,7 +215,7 @@ struct Scene {
   std::string source_file;  // for messages
   std::vector<Parameter> parameters;
   Effects effects;
-  std::variant<LinkageModel, LumpedModel> model;
+  std::variant<LinkageModel, LumpedModel, MultibodyModel> model;
   std::vector<Output> outputs;
   TimeGrid time_grid;
   IntegratorSettings integrator;

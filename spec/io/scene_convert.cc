@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "spec/layout.h"
 #include "spec/units.h"
 
@@ -32,10 +33,13 @@ class SceneConverter {
       case v1::Scene::kLumped:
         scene_.model = ConvertLumped(msg_.lumped(), where_.Child("lumped"));
         break;
+      case v1::Scene::kMultibody:
+        scene_.model = ConvertMultibody(msg_.multibody(), where_.Child("multibody"));
+        break;
       case v1::Scene::MODEL_NOT_SET:
         errors_.Add(where_, "",
-                    "the scene has no model: expected `linkage { ... }` or "
-                    "`lumped { ... }`");
+                    "the scene has no model: expected `linkage { ... }`, `lumped { ... }` or "
+                    "`multibody { ... }`");
         return scene_;
     }
     if (msg_.model_case() == v1::Scene::kLumped && msg_.has_effects()) {
@@ -481,10 +485,284 @@ class SceneConverter {
     return out;
   }
 
+  // ---------------------------------------------------------- multibody --
+  // "body.marker" or "ground.marker" to a marker reference.
+  MarkerRef Marker(const Where& w, const std::string& field, const std::string& ref) {
+    MarkerRef out;
+    const size_t dot = ref.find('.');
+    if (dot == std::string::npos) {
+      errors_.Add(w, field, absl::StrCat("\"", ref, "\": expected \"body.marker\" or \"ground.marker\""));
+      return out;
+    }
+    const std::string body = ref.substr(0, dot), marker = ref.substr(dot + 1);
+    const std::vector<LinkPoint>* markers = &multibody_.ground_markers;
+    if (body != "ground") {
+      auto it = multibody_bodies_.find(body);
+      if (it == multibody_bodies_.end()) {
+        errors_.Add(w, field, absl::StrCat("unknown body \"", body, "\" in \"", ref, "\" (bodies: ",
+                                           absl::StrJoin(Names(multibody_bodies_), ", "), ")"));
+        return out;
+      }
+      out.body = it->second;
+      markers = &multibody_.bodies[static_cast<size_t>(out.body)].markers;
+    }
+    for (size_t k = 0; k < markers->size(); ++k) {
+      if ((*markers)[k].name == marker) out.marker = static_cast<int>(k);
+    }
+    if (out.marker < 0) {
+      std::vector<std::string> names;
+      for (const LinkPoint& p : *markers) names.push_back(p.name);
+      errors_.Add(w, field, absl::StrCat("\"", body, "\" has no marker \"", marker, "\" (markers: ",
+                                         names.empty() ? "none" : absl::StrJoin(names, ", "), ")"));
+    }
+    return out;
+  }
+
+  static std::vector<std::string> Names(const std::map<std::string, int>& table) {
+    std::vector<std::pair<int, std::string>> ordered;
+    for (const auto& [name, index] : table) ordered.emplace_back(index, name);
+    std::sort(ordered.begin(), ordered.end());
+    std::vector<std::string> names;
+    for (const auto& [index, name] : ordered) names.push_back(name);
+    return names;
+  }
+
+  std::vector<LinkPoint> Markers(const Where& w, const std::string& field,
+                                 const google::protobuf::RepeatedPtrField<v1::Marker>& markers) {
+    std::vector<LinkPoint> out;
+    std::set<std::string> names;
+    for (int k = 0; k < markers.size(); ++k) {
+      const Where mw = w.Child(field, k);
+      LinkPoint p;
+      p.name = markers[k].name();
+      if (p.name.empty()) errors_.Add(mw, "name", "a marker needs a name");
+      if (!names.insert(p.name).second) errors_.Add(mw, "name", absl::StrCat("duplicate marker \"", p.name, "\""));
+      p.position_m = Vec(mw, "position_m", markers[k].has_position_m(), markers[k].position_m(), Dimension::kLength);
+      out.push_back(std::move(p));
+    }
+    return out;
+  }
+
+  int MultibodyJointIndex(const Where& w, const std::string& field, const std::string& name) {
+    auto it = multibody_joints_.find(name);
+    if (it == multibody_joints_.end()) {
+      errors_.Add(w, field, absl::StrCat("unknown joint \"", name, "\" (joints: ",
+                                         absl::StrJoin(Names(multibody_joints_), ", "), ")"));
+      return -1;
+    }
+    return it->second;
+  }
+
+  MultibodyModel ConvertMultibody(const v1::MultibodyModel& m, const Where& w) {
+    multibody_ = MultibodyModel{};
+    multibody_.ground_markers = Markers(w, "ground_markers", m.ground_markers());
+    for (int i = 0; i < m.bodies_size(); ++i) {
+      const v1::RigidBody& b = m.bodies(i);
+      const Where bw = w.Child("bodies", i);
+      RigidBody body;
+      body.name = b.name();
+      if (b.name().empty() || b.name() == "ground") {
+        errors_.Add(bw, "name", "a body needs a name other than \"ground\"");
+      }
+      if (!multibody_bodies_.emplace(b.name(), i).second) {
+        errors_.Add(bw, "name", absl::StrCat("duplicate body name \"", b.name(), "\""));
+      }
+      body.mass_kg = Num(bw, "mass_kg", b.has_mass_kg(), b.mass_kg(), Dimension::kMass);
+      RequirePositive(bw, "mass_kg", body.mass_kg);
+      body.inertia_kg_m2 = Num(bw, "inertia_kg_m2", b.has_inertia_kg_m2(), b.inertia_kg_m2(), Dimension::kInertia);
+      RequirePositive(bw, "inertia_kg_m2", body.inertia_kg_m2);
+      body.position_m = Vec(bw, "position_m", b.has_position_m(), b.position_m(), Dimension::kLength);
+      body.angle_rad = Num(bw, "angle_rad", b.has_angle_rad(), b.angle_rad(), Dimension::kAngle, 0.0);
+      body.markers = Markers(bw, "markers", b.markers());
+      multibody_.bodies.push_back(std::move(body));
+    }
+    if (m.bodies_size() == 0) errors_.Add(w, "bodies", "a multibody model needs at least one body");
+    for (int i = 0; i < m.joints_size(); ++i) {
+      const v1::MultibodyJoint& j = m.joints(i);
+      const Where jw = w.Child("joints", i);
+      MultibodyJoint joint;
+      joint.name = j.name();
+      if (j.name().empty()) errors_.Add(jw, "name", "a joint needs a name");
+      if (!multibody_joints_.emplace(j.name(), i).second) {
+        errors_.Add(jw, "name", absl::StrCat("duplicate joint name \"", j.name(), "\""));
+      }
+      switch (j.kind()) {
+        case v1::JOINT_REVOLUTE: joint.kind = JointKind::kRevolute; break;
+        case v1::JOINT_PRISMATIC: joint.kind = JointKind::kPrismatic; break;
+        case v1::JOINT_FIXED: joint.kind = JointKind::kFixed; break;
+        case v1::JOINT_POINT_ON_LINE: joint.kind = JointKind::kPointOnLine; break;
+        default:
+          errors_.Add(jw, "kind", "expected JOINT_REVOLUTE, JOINT_PRISMATIC, JOINT_FIXED or JOINT_POINT_ON_LINE");
+      }
+      joint.a = Marker(jw, "a", j.a());
+      joint.b = Marker(jw, "b", j.b());
+      if (joint.a.marker >= 0 && joint.b.marker >= 0 && joint.a.body == joint.b.body) {
+        errors_.Add(jw, "b", "a joint joins two different bodies (or a body and ground)");
+      }
+      joint.axis_angle_rad = Num(jw, "axis_angle_rad", j.has_axis_angle_rad(), j.axis_angle_rad(), Dimension::kAngle, 0.0);
+      const Dimension coordinate = joint.linear() ? Dimension::kLength : Dimension::kAngle;
+      if (j.has_initial_value()) joint.initial_value = Num(jw, "initial_value", true, j.initial_value(), coordinate);
+      if (j.has_initial_rate()) joint.initial_rate = Num(jw, "initial_rate", true, j.initial_rate(), Dimension::kAny);
+      multibody_.joints.push_back(std::move(joint));
+    }
+    std::set<int> driven;
+    for (int i = 0; i < m.drivers_size(); ++i) {
+      const v1::MultibodyDriver& d = m.drivers(i);
+      const Where dw = w.Child("drivers", i);
+      MultibodyDriver driver;
+      driver.joint = MultibodyJointIndex(dw, "joint", d.joint());
+      if (driver.joint >= 0) {
+        if (multibody_.joints[static_cast<size_t>(driver.joint)].kind == JointKind::kFixed) {
+          errors_.Add(dw, "joint", "a fixed joint cannot be driven");
+        }
+        if (!driven.insert(driver.joint).second) errors_.Add(dw, "joint", "this joint already has a driver");
+      }
+      switch (d.profile_case()) {
+        case v1::MultibodyDriver::kConstantRate: {
+          const Where pw = dw.Child("constant_rate");
+          driver.profile = MultibodyDriver::Profile::kConstantRate;
+          driver.start = Num(pw, "start", d.constant_rate().has_start(), d.constant_rate().start(), Dimension::kAny, 0.0);
+          driver.rate = Num(pw, "rate", d.constant_rate().has_rate(), d.constant_rate().rate(), Dimension::kAny);
+          break;
+        }
+        case v1::MultibodyDriver::kPolynomial: {
+          const Where pw = dw.Child("polynomial");
+          driver.profile = MultibodyDriver::Profile::kPolynomial;
+          for (int k = 0; k < d.polynomial().coefficients_size(); ++k) {
+            driver.coefficients.push_back(Num(pw, absl::StrCat("coefficients[", k, "]"), true, d.polynomial().coefficients(k), Dimension::kAny));
+          }
+          if (driver.coefficients.empty()) errors_.Add(pw, "coefficients", "a polynomial needs at least one coefficient");
+          break;
+        }
+        case v1::MultibodyDriver::kHarmonic: {
+          const Where pw = dw.Child("harmonic");
+          const v1::HarmonicProfile& h = d.harmonic();
+          driver.profile = MultibodyDriver::Profile::kHarmonic;
+          driver.start = Num(pw, "mean", h.has_mean(), h.mean(), Dimension::kAny, 0.0);
+          driver.amplitude = Num(pw, "amplitude", h.has_amplitude(), h.amplitude(), Dimension::kAny);
+          driver.angular_frequency_rad_per_s = Num(pw, "angular_frequency_rad_per_s", h.has_angular_frequency_rad_per_s(),
+                                                   h.angular_frequency_rad_per_s(), Dimension::kAngularVelocity);
+          driver.phase_rad = Num(pw, "phase_rad", h.has_phase_rad(), h.phase_rad(), Dimension::kAngle, 0.0);
+          break;
+        }
+        case v1::MultibodyDriver::PROFILE_NOT_SET:
+          errors_.Add(dw, "", "a driver needs a profile: `constant_rate`, `polynomial` or `harmonic`");
+          break;
+      }
+      multibody_.drivers.push_back(std::move(driver));
+    }
+    for (int i = 0; i < m.springs_size(); ++i) {
+      const v1::MultibodySpring& sp = m.springs(i);
+      const Where sw = w.Child("springs", i);
+      MultibodySpring spring;
+      spring.name = sp.name();
+      if (sp.name().empty()) errors_.Add(sw, "name", "a spring needs a name");
+      if (!multibody_springs_.emplace(sp.name(), i).second) {
+        errors_.Add(sw, "name", absl::StrCat("duplicate spring name \"", sp.name(), "\""));
+      }
+      spring.a = Marker(sw, "a", sp.a());
+      spring.b = Marker(sw, "b", sp.b());
+      spring.free_length_m = Num(sw, "free_length_m", sp.has_free_length_m(), sp.free_length_m(), Dimension::kLength, 0.0);
+      RequireNotNegative(sw, "free_length_m", spring.free_length_m);
+      spring.stiffness_n_per_m = Num(sw, "stiffness_n_per_m", sp.has_stiffness_n_per_m(), sp.stiffness_n_per_m(), Dimension::kStiffness, 0.0);
+      spring.damping_n_s_per_m = Num(sw, "damping_n_s_per_m", sp.has_damping_n_s_per_m(), sp.damping_n_s_per_m(), Dimension::kDamping, 0.0);
+      spring.actuator_force_n = Num(sw, "actuator_force_n", sp.has_actuator_force_n(), sp.actuator_force_n(), Dimension::kForce, 0.0);
+      multibody_.springs.push_back(std::move(spring));
+    }
+    for (int i = 0; i < m.rotational_springs_size(); ++i) {
+      const v1::RotationalSpring& r = m.rotational_springs(i);
+      const Where rw = w.Child("rotational_springs", i);
+      RotationalSpring spring;
+      spring.name = r.name();
+      spring.joint = MultibodyJointIndex(rw, "joint", r.joint());
+      if (spring.joint >= 0 && multibody_.joints[static_cast<size_t>(spring.joint)].kind != JointKind::kRevolute) {
+        errors_.Add(rw, "joint", "a rotational spring acts at a revolute joint");
+      }
+      spring.stiffness_n_m_per_rad = Num(rw, "stiffness_n_m_per_rad", r.has_stiffness_n_m_per_rad(), r.stiffness_n_m_per_rad(), Dimension::kAny, 0.0);
+      spring.damping_n_m_s_per_rad = Num(rw, "damping_n_m_s_per_rad", r.has_damping_n_m_s_per_rad(), r.damping_n_m_s_per_rad(), Dimension::kAny, 0.0);
+      spring.free_angle_rad = Num(rw, "free_angle_rad", r.has_free_angle_rad(), r.free_angle_rad(), Dimension::kAngle, 0.0);
+      multibody_.rotational_springs.push_back(std::move(spring));
+    }
+    for (int i = 0; i < m.point_forces_size(); ++i) {
+      const Where fw = w.Child("point_forces", i);
+      MultibodyPointForce force;
+      force.at = Marker(fw, "at", m.point_forces(i).at());
+      force.force_n = Vec(fw, "force_n", m.point_forces(i).has_force_n(), m.point_forces(i).force_n(), Dimension::kForce);
+      multibody_.point_forces.push_back(std::move(force));
+    }
+    for (int i = 0; i < m.torques_size(); ++i) {
+      const Where tw = w.Child("torques", i);
+      MultibodyTorque torque;
+      auto it = multibody_bodies_.find(m.torques(i).body());
+      if (it == multibody_bodies_.end()) {
+        errors_.Add(tw, "body", absl::StrCat("unknown body \"", m.torques(i).body(), "\""));
+      } else {
+        torque.body = it->second;
+      }
+      torque.torque_n_m = Num(tw, "torque_n_m", m.torques(i).has_torque_n_m(), m.torques(i).torque_n_m(), Dimension::kTorque);
+      multibody_.torques.push_back(std::move(torque));
+    }
+    return multibody_;
+  }
+
+  MultibodyOutput MultibodyOutputOf(const v1::Output& o, const Where& ow) {
+    using Q = MultibodyOutput::Quantity;
+    MultibodyOutput out;
+    auto marker = [&](const char* field, const v1::MarkerOutput& m, Q quantity) {
+      const Where kw = ow.Child(field);
+      out.quantity = quantity;
+      out.marker = Marker(kw, "marker", m.marker());
+      out.axis = m.axis() == v1::AXIS_Y ? Axis::kY : Axis::kX;
+      if (m.axis() != v1::AXIS_X && m.axis() != v1::AXIS_Y) errors_.Add(kw, "axis", "expected AXIS_X or AXIS_Y");
+    };
+    auto joint = [&](const char* field, const v1::JointOutput& j, Q quantity, bool needs_axis) {
+      const Where kw = ow.Child(field);
+      out.quantity = quantity;
+      out.joint = MultibodyJointIndex(kw, "joint", j.joint());
+      if (out.joint >= 0) out.linear = multibody_.joints[static_cast<size_t>(out.joint)].linear();
+      if (needs_axis) {
+        out.axis = j.axis() == v1::AXIS_Y ? Axis::kY : Axis::kX;
+        if (j.axis() != v1::AXIS_X && j.axis() != v1::AXIS_Y) errors_.Add(kw, "axis", "expected AXIS_X or AXIS_Y");
+      }
+      if (quantity == Q::kDriverEffort && out.joint >= 0) {
+        bool driven = false;
+        for (const MultibodyDriver& d : multibody_.drivers) driven = driven || d.joint == out.joint;
+        if (!driven) errors_.Add(kw, "joint", absl::StrCat("joint \"", j.joint(), "\" has no driver"));
+      }
+    };
+    auto spring = [&](const char* field, const v1::SpringOutput& sp, Q quantity) {
+      const Where kw = ow.Child(field);
+      out.quantity = quantity;
+      auto it = multibody_springs_.find(sp.spring());
+      if (it == multibody_springs_.end()) {
+        errors_.Add(kw, "spring", absl::StrCat("unknown spring \"", sp.spring(), "\""));
+      } else {
+        out.spring = it->second;
+      }
+    };
+    switch (o.kind_case()) {
+      case v1::Output::kMarkerPosition: marker("marker_position", o.marker_position(), Q::kMarkerPosition); break;
+      case v1::Output::kMarkerVelocity: marker("marker_velocity", o.marker_velocity(), Q::kMarkerVelocity); break;
+      case v1::Output::kMarkerAcceleration: marker("marker_acceleration", o.marker_acceleration(), Q::kMarkerAcceleration); break;
+      case v1::Output::kJointCoordinate: joint("joint_coordinate", o.joint_coordinate(), Q::kJointCoordinate, false); break;
+      case v1::Output::kJointRate: joint("joint_rate", o.joint_rate(), Q::kJointRate, false); break;
+      case v1::Output::kJointReaction: joint("joint_reaction", o.joint_reaction(), Q::kJointReaction, true); break;
+      case v1::Output::kDriverEffort: joint("driver_effort", o.driver_effort(), Q::kDriverEffort, false); break;
+      case v1::Output::kSpringLength: spring("spring_length", o.spring_length(), Q::kSpringLength); break;
+      case v1::Output::kSpringForce: spring("spring_force", o.spring_force(), Q::kSpringForce); break;
+      case v1::Output::kKineticEnergy: out.quantity = Q::kKineticEnergy; break;
+      case v1::Output::kPotentialEnergy: out.quantity = Q::kPotentialEnergy; break;
+      default: break;
+    }
+    return out;
+  }
+
   // ------------------------------------------------------------ outputs --
   void ConvertOutputs() {
     std::set<std::string> names;
     const bool lumped = std::holds_alternative<LumpedModel>(scene_.model);
+    const bool linkage = std::holds_alternative<LinkageModel>(scene_.model);
+    const bool multibody = std::holds_alternative<MultibodyModel>(scene_.model);
     auto lookup = [&](const std::map<std::string, int>& table, const Where& w,
                       const std::string& field, const std::string& name, const char* what) {
       auto it = table.find(name);
@@ -536,14 +814,14 @@ class SceneConverter {
           const Where kw = ow.Child("point_position");
           PointPositionOutput k;
           k.axis = axis(kw, o.point_position().axis());
-          if (!lumped) ResolvePoint(kw, o.point_position().point(), &k);
+          if (linkage) ResolvePoint(kw, o.point_position().point(), &k);
           out.kind = k;
           break;
         }
         case v1::Output::kLinkRotation: {
           needs = "linkage";
           LinkRotationOutput k;
-          if (!lumped) {
+          if (linkage) {
             k.link = lookup(linkage_links_, ow.Child("link_rotation"), "link",
                             o.link_rotation().link(), "link");
           }
@@ -554,7 +832,7 @@ class SceneConverter {
           needs = "linkage";
           BendingStressOutput k;
           const Where kw = ow.Child("bending_stress");
-          if (!lumped) {
+          if (linkage) {
             k.link = lookup(linkage_links_, kw, "link", o.bending_stress().link(), "link");
             const auto& linkage = std::get<LinkageModel>(scene_.model);
             if (k.link >= 0 && !linkage.links[static_cast<size_t>(k.link)].section) {
@@ -574,14 +852,29 @@ class SceneConverter {
           needs = "linkage";
           out.kind = MassOutput{};
           break;
+        case v1::Output::kMarkerPosition:
+        case v1::Output::kMarkerVelocity:
+        case v1::Output::kMarkerAcceleration:
+        case v1::Output::kJointCoordinate:
+        case v1::Output::kJointRate:
+        case v1::Output::kJointReaction:
+        case v1::Output::kDriverEffort:
+        case v1::Output::kSpringLength:
+        case v1::Output::kSpringForce:
+        case v1::Output::kKineticEnergy:
+        case v1::Output::kPotentialEnergy:
+          needs = "multibody";
+          out.kind = multibody ? MultibodyOutputOf(o, ow) : MultibodyOutput{};
+          break;
         case v1::Output::KIND_NOT_SET:
           errors_.Add(ow, "", "the output has no kind (e.g. `element_deflection { ... }`)");
           break;
       }
-      if (needs != nullptr && (std::string(needs) == "lumped") != lumped) {
+      const char* model_kind = lumped ? "lumped" : linkage ? "linkage" : "multibody";
+      if (needs != nullptr && std::string(needs) != model_kind) {
         errors_.Add(ow, "",
-                    absl::StrCat("output \"", o.name(), "\" needs a ", needs,
-                                 " model; this scene is ", lumped ? "lumped" : "a linkage"));
+                    absl::StrCat("output \"", o.name(), "\" needs a ", needs, " model; this scene's model is ",
+                                 model_kind));
       }
       scene_.outputs.push_back(std::move(out));
     }
@@ -677,6 +970,8 @@ class SceneConverter {
 
   const v1::Scene& msg_;
   const Where& where_;
+  MultibodyModel multibody_;
+  std::map<std::string, int> multibody_bodies_, multibody_joints_, multibody_springs_;
   Errors& errors_;
   Scene scene_;
   std::vector<Dimension> units_;  // per parameter

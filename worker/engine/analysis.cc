@@ -3,6 +3,7 @@
 #include <chrono>
 #include <variant>
 
+#include "worker/multibody/scene_analysis.h"
 #include "worker/solve/lumped_dynamics.h"
 #ifdef MBOPT_HAVE_LINKAGE
 #include "worker/solve/linkage_analysis.h"
@@ -15,6 +16,8 @@ spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>
   spec::AnalysisReport report;
   if (std::holds_alternative<spec::LumpedModel>(scene.model)) {
     report = solve::SimulateLumped(scene, parameter_values_si);
+  } else if (std::holds_alternative<spec::MultibodyModel>(scene.model)) {
+    report = multibody::AnalyzeMultibodyScene(scene, parameter_values_si);
   } else {
 #ifdef MBOPT_HAVE_LINKAGE
     report = solve::AnalyzeLinkage(scene, parameter_values_si);

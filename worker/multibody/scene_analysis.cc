@@ -1,0 +1,243 @@
+#include "worker/multibody/scene_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "worker/multibody/assembly.h"
+#include "worker/multibody/forward_dynamics.h"
+#include "worker/multibody/kinematic_analysis.h"
+#include "worker/multibody/mechanism.h"
+
+namespace mbopt::multibody {
+namespace {
+
+using Quantity = spec::MultibodyOutput::Quantity;
+
+Eigen::Vector2d Resolve(const spec::Vec2& v, const std::vector<double>& p) {
+  return Eigen::Vector2d(v.x.Resolve(p), v.y.Resolve(p));
+}
+
+Point PointOf(const spec::MultibodyModel& m, const spec::MarkerRef& ref, const std::vector<double>& p) {
+  const std::vector<spec::LinkPoint>& markers =
+      ref.body < 0 ? m.ground_markers : m.bodies[static_cast<size_t>(ref.body)].markers;
+  const spec::LinkPoint& marker = markers[static_cast<size_t>(ref.marker)];
+  return Point{ref.body < 0 ? kGround : ref.body, Resolve(marker.position_m, p), marker.name};
+}
+
+bool NeedsMultipliers(const spec::Scene& scene) {
+  for (const spec::Output& o : scene.outputs) {
+    const auto* m = std::get_if<spec::MultibodyOutput>(&o.kind);
+    if (m != nullptr && (m->quantity == Quantity::kJointReaction || m->quantity == Quantity::kDriverEffort)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The value of output `o` in the state `s`.
+double OutputValue(const Mechanism& mech, const spec::MultibodyModel& sm, const spec::MultibodyOutput& o,
+                   const std::vector<double>& p, const MotionSample& s, Eigen::MatrixXd* phi_q) {
+  const int axis = o.axis == spec::Axis::kX ? 0 : 1;
+  switch (o.quantity) {
+    case Quantity::kMarkerPosition: return mech.PointPosition(PointOf(sm, o.marker, p), s.q)[axis];
+    case Quantity::kMarkerVelocity: return mech.PointVelocity(PointOf(sm, o.marker, p), s.q, s.v)[axis];
+    case Quantity::kMarkerAcceleration:
+      return mech.PointAcceleration(PointOf(sm, o.marker, p), s.q, s.v, s.a)[axis];
+    case Quantity::kJointCoordinate: return mech.JointCoordinate(o.joint, s.q);
+    case Quantity::kJointRate: return mech.JointRate(o.joint, s.q, s.v);
+    case Quantity::kJointReaction: {
+      // Force on body b (or, with b ground, minus the force on body a): the
+      // generalized constraint force -Phi_q^T lambda of the joint's rows on
+      // that body's x and y.
+      const Joint& joint = mech.model().joints[static_cast<size_t>(o.joint)];
+      const int body = joint.b.body != kGround ? joint.b.body : joint.a.body;
+      const double sign = joint.b.body != kGround ? 1.0 : -1.0;
+      mech.ConstraintJacobian(s.t_s, s.q, phi_q);
+      const int first = mech.first_row_of_joint(o.joint);
+      int rows = 0;
+      while (first + rows < mech.num_constraints() && !mech.is_driver_row(first + rows) &&
+             mech.joint_of_row(first + rows) == o.joint) {
+        ++rows;
+      }
+      const Eigen::VectorXd force =
+          -phi_q->block(first, 3 * body, rows, 2).transpose() * s.lambda.segment(first, rows);
+      return sign * force[axis];
+    }
+    case Quantity::kDriverEffort: {
+      for (size_t d = 0; d < mech.model().drivers.size(); ++d) {
+        if (mech.model().drivers[d].joint == o.joint) return -s.lambda[mech.row_of_driver(static_cast<int>(d))];
+      }
+      return NAN;
+    }
+    case Quantity::kSpringLength: return mech.SpringLength(o.spring, s.q);
+    case Quantity::kSpringForce: return mech.SpringTension(o.spring, s.q, s.v);
+    case Quantity::kKineticEnergy: return mech.KineticEnergy(s.v);
+    case Quantity::kPotentialEnergy: return mech.PotentialEnergy(s.q);
+  }
+  return NAN;
+}
+
+}  // namespace
+
+absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<double>& p) {
+  const auto& sm = std::get<spec::MultibodyModel>(scene.model);
+  Model m;
+  for (const spec::RigidBody& b : sm.bodies) {
+    m.bodies.push_back(Body{b.name, b.mass_kg.Resolve(p), b.inertia_kg_m2.Resolve(p), Resolve(b.position_m, p),
+                            b.angle_rad.Resolve(p)});
+  }
+  for (const spec::MultibodyJoint& j : sm.joints) {
+    Joint joint;
+    joint.name = j.name;
+    switch (j.kind) {
+      case spec::JointKind::kRevolute: joint.kind = JointKind::kRevolute; break;
+      case spec::JointKind::kPrismatic: joint.kind = JointKind::kPrismatic; break;
+      case spec::JointKind::kFixed: joint.kind = JointKind::kFixed; break;
+      case spec::JointKind::kPointOnLine: joint.kind = JointKind::kPointOnLine; break;
+    }
+    joint.a = PointOf(sm, j.a, p);
+    joint.b = PointOf(sm, j.b, p);
+    joint.axis_angle_rad = j.axis_angle_rad.Resolve(p);
+    if (j.initial_value) joint.initial_value = j.initial_value->Resolve(p);
+    if (j.initial_rate) joint.initial_rate = j.initial_rate->Resolve(p);
+    m.joints.push_back(std::move(joint));
+  }
+  for (const spec::MultibodyDriver& d : sm.drivers) {
+    Driver driver;
+    driver.joint = d.joint;
+    switch (d.profile) {
+      case spec::MultibodyDriver::Profile::kConstantRate:
+        driver.profile.kind = Profile::Kind::kConstantRate;
+        driver.profile.start = d.start.Resolve(p);
+        driver.profile.rate = d.rate.Resolve(p);
+        break;
+      case spec::MultibodyDriver::Profile::kPolynomial:
+        driver.profile.kind = Profile::Kind::kPolynomial;
+        for (const spec::Number& c : d.coefficients) driver.profile.coefficients.push_back(c.Resolve(p));
+        break;
+      case spec::MultibodyDriver::Profile::kHarmonic:
+        driver.profile.kind = Profile::Kind::kHarmonic;
+        driver.profile.start = d.start.Resolve(p);
+        driver.profile.amplitude = d.amplitude.Resolve(p);
+        driver.profile.angular_frequency_rad_per_s = d.angular_frequency_rad_per_s.Resolve(p);
+        driver.profile.phase_rad = d.phase_rad.Resolve(p);
+        break;
+    }
+    m.drivers.push_back(std::move(driver));
+  }
+  for (const spec::MultibodySpring& s : sm.springs) {
+    m.springs.push_back(SpringDamper{s.name, PointOf(sm, s.a, p), PointOf(sm, s.b, p), s.free_length_m.Resolve(p),
+                                     s.stiffness_n_per_m.Resolve(p), s.damping_n_s_per_m.Resolve(p),
+                                     s.actuator_force_n.Resolve(p)});
+  }
+  for (const spec::RotationalSpring& r : sm.rotational_springs) {
+    m.rotational_springs.push_back(RotationalSpringDamper{r.name, r.joint, r.stiffness_n_m_per_rad.Resolve(p),
+                                                          r.damping_n_m_s_per_rad.Resolve(p),
+                                                          r.free_angle_rad.Resolve(p)});
+  }
+  for (const spec::MultibodyPointForce& f : sm.point_forces) {
+    m.point_forces.push_back(PointForce{PointOf(sm, f.at, p), Resolve(f.force_n, p)});
+  }
+  for (const spec::MultibodyTorque& t : sm.torques) m.torques.push_back(BodyTorque{t.body, t.torque_n_m.Resolve(p)});
+  if (scene.effects.gravity_m_per_s2.has_value()) m.gravity_m_per_s2 = Resolve(*scene.effects.gravity_m_per_s2, p);
+  if (absl::Status valid = m.Validate(); !valid.ok()) return valid;
+  return m;
+}
+
+spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& p) {
+  spec::AnalysisReport report;
+  report.times_s = scene.time_grid.Instants();
+  report.formulation = spec::Formulation::kKinematic;
+  if (!std::holds_alternative<spec::MultibodyModel>(scene.model) || p.size() != scene.parameters.size()) {
+    report.Fail(spec::FailureKind::kInvalidModel,
+                absl::StrFormat("expected a multibody scene and %d parameter values", scene.parameters.size()));
+    return report;
+  }
+  const auto& sm = std::get<spec::MultibodyModel>(scene.model);
+  absl::StatusOr<Model> model = CompileModel(scene, p);
+  if (!model.ok()) {
+    report.Fail(spec::FailureKind::kInvalidModel, std::string(model.status().message()));
+    return report;
+  }
+  for (const spec::Output& o : scene.outputs) {
+    if (!std::holds_alternative<spec::MultibodyOutput>(o.kind)) {
+      report.Fail(spec::FailureKind::kInvalidModel, absl::StrFormat("output '%s' is not a multibody output", o.name));
+      return report;
+    }
+    spec::OutputValues values;
+    values.name = o.name;
+    values.series_labels = {o.name};
+    values.series.assign(1, std::vector<double>());
+    values.series[0].reserve(report.times_s.size());
+    report.outputs.push_back(std::move(values));
+  }
+  if (report.outputs.empty()) return report;  // nothing requested: nothing computed
+
+  const Mechanism mechanism(*model);
+  const Assembly assembled = Assemble(mechanism, 0.0);
+  report.counters.newton_iterations += assembled.newton_iterations;
+  if (!assembled.failure.ok()) {
+    report.Fail(assembled.failure.kind, assembled.failure.reason);
+    return report;
+  }
+  if (!assembled.redundant.empty()) {
+    report.Fail(spec::FailureKind::kInvalidModel,
+                absl::StrFormat("redundant constraints at joint(s) %s: a planar loop closes with one revolute "
+                                "joint fewer, or with a point-on-line joint",
+                                absl::StrJoin(assembled.redundant, ", ")));
+    return report;
+  }
+  // The motion starts at t = 0; the grid may start later.
+  std::vector<double> times;
+  if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
+  times.insert(times.end(), report.times_s.begin(), report.times_s.end());
+  size_t next_instant = 0;
+  Eigen::MatrixXd phi_q;
+  const MotionCallback record = [&](const MotionSample& s) {
+    if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
+      return spec::AnalysisFailure::Ok();
+    }
+    ++next_instant;
+    for (size_t k = 0; k < scene.outputs.size(); ++k) {
+      const auto& o = std::get<spec::MultibodyOutput>(scene.outputs[k].kind);
+      const double value = OutputValue(mechanism, sm, o, p, s, &phi_q);
+      if (!std::isfinite(value)) {
+        return spec::AnalysisFailure::Of(
+            spec::FailureKind::kNonFiniteValue,
+            absl::StrFormat("output '%s' is not finite at t = %.6g s", scene.outputs[k].name, s.t_s));
+      }
+      report.outputs[k].series[0].push_back(value);
+    }
+    return spec::AnalysisFailure::Ok();
+  };
+  spec::AnalysisFailure outcome;
+  if (assembled.degrees_of_freedom == 0) {
+    KinematicOptions options;
+    options.inverse_dynamics = NeedsMultipliers(scene);
+    report.formulation = options.inverse_dynamics ? spec::Formulation::kKinetostatic : spec::Formulation::kKinematic;
+    KinematicCounters counters;
+    outcome = RunKinematics(mechanism, assembled.q, times, options, record, &counters);
+    report.counters.position_solves += counters.position_solves;
+    report.counters.newton_iterations += counters.newton_iterations;
+  } else {
+    report.formulation = spec::Formulation::kDynamic;
+    ForwardDynamicsOptions options;
+    options.relative_tolerance = scene.integrator.relative_tolerance;
+    options.absolute_tolerance = scene.integrator.absolute_tolerance;
+    options.max_steps = scene.integrator.max_steps;
+    options.max_wall_seconds = scene.integrator.max_wall_seconds;
+    ForwardDynamicsCounters counters;
+    outcome = IntegrateForward(mechanism, 0.0, assembled.q, assembled.v, times, options, record, &counters);
+    report.counters.time_steps = counters.steps;
+    report.counters.rhs_evaluations = counters.residual_evaluations;
+    report.counters.jacobian_evaluations = counters.jacobian_evaluations;
+    report.counters.newton_iterations += counters.nonlinear_iterations;
+  }
+  if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
+  return report;
+}
+
+}  // namespace mbopt::multibody
