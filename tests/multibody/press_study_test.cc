@@ -1,0 +1,84 @@
+// The crank-press example (examples/press) through the study loader, the
+// engine's multibody analysis and a job: it loads, its analysis is the
+// driven (kinetostatic) one, and the optimizer reaches the optimum the
+// geometry predicts. Also the loader's errors for multibody scenes.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "spec/io/study_io.h"
+#include "worker/local_run/local_run.h"
+
+namespace mbopt {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr char kPressStudy[] = "examples/press/press.study.textproto";
+
+TEST(PressStudy, LoadsAndIsAnalysedKinetostatically) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kPressStudy);
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  Eigen::VectorXd x0(2);
+  x0 << 1.5, 8.0;
+  absl::StatusOr<engine::StudyEvaluation> e = local_run::EvaluateDesign(*study, *layout, x0);
+  ASSERT_TRUE(e.ok()) << e.status();
+  ASSERT_TRUE(e->ok()) << e->failure.reason;
+  EXPECT_EQ(e->formulation, spec::Formulation::kKinetostatic);
+  EXPECT_EQ(e->counters.time_steps, 0);       // driven: no time integration
+  EXPECT_EQ(e->counters.position_solves, 101);
+  // The slider ends at bottom dead centre, l - r = 0.65 m: the reach row is
+  // (0.65 - 0.45) / 0.45 over its limit.
+  constexpr double kRoundOff = 1e-9;
+  EXPECT_NEAR(e->values->max_violation, 0.2 / 0.45, kRoundOff);
+}
+
+// Peak torque grows with the crank radius and falls with the rod length;
+// the reach limit l - r <= 0.45 m ties them, so the optimum is the smallest
+// crank (the stroke's bound, r = 0.1 m) with l = 0.55 m, the obliquity
+// (0.1 / 0.55 rad at most) well inside its limit.
+TEST(PressStudy, OptimumIsTheStrokeBoundWithTheReachLimitActive) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kPressStudy);
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<local_run::LocalRunResult> run = local_run::RunStudyLocally(*study);
+  ASSERT_TRUE(run.ok()) << run.status();
+  EXPECT_EQ(run->outcome.state, slp::RunState::kConverged) << run->end_reason;
+  ASSERT_EQ(run->design_si.size(), 2u);
+  // The SLP's convergence tolerance (0.5 % on F, 0.5 % on maxg) bounds how
+  // close it stops to the vertex.
+  constexpr double kDesignTolerance = 1e-3;  // m
+  EXPECT_NEAR(run->design_si[0], 0.10, kDesignTolerance);
+  EXPECT_NEAR(run->design_si[1], 0.55, kDesignTolerance);
+  EXPECT_LT(run->outcome.max_violation, 0.005);
+  std::cout << "press: peak torque " << run->outcome.objective << " N m after " << run->outcome.cycles
+            << " cycles, " << run->outcome.analyses << " analyses\n";
+}
+
+TEST(MultibodySceneLoading, UnknownMarkerIsNamedWithFileLineAndTheMarkersThatExist) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mbopt_multibody_scene_test";
+  std::filesystem::create_directories(dir);
+  std::ifstream in("examples/press/press.scene.textproto");
+  std::string scene((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "b: \"crank.pivot\"";
+  ASSERT_NE(scene.find(from), std::string::npos);
+  scene.replace(scene.find(from), from.size(), "b: \"crank.hub\"");
+  std::ofstream(dir / "press.scene.textproto") << scene;
+  std::ifstream study_in(kPressStudy);
+  std::ofstream(dir / "press.study.textproto") << study_in.rdbuf();
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile((dir / "press.study.textproto").string());
+  ASSERT_FALSE(study.ok());
+  const std::string message(study.status().message());
+  EXPECT_THAT(message, HasSubstr("press.scene.textproto:"));
+  EXPECT_THAT(message, HasSubstr("multibody.joints[0]"));
+  EXPECT_THAT(message, HasSubstr("no marker \"hub\""));
+  EXPECT_THAT(message, HasSubstr("pivot, pin"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace mbopt
