@@ -1,7 +1,7 @@
-// The crank-press example (examples/press) through the study loader, the
-// engine's multibody analysis and a job: it loads, its analysis is the
-// driven (kinetostatic) one, and the optimizer reaches the optimum the
-// geometry predicts. Also the loader's errors for multibody scenes.
+// The multibody examples (examples/press, examples/isolator) through the
+// study loader, the engine and a job: they load, each gets the analysis its
+// degrees of freedom call for, and the optimizer reaches the optimum the
+// problem predicts. Also the loader's errors for multibody scenes.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -57,6 +57,34 @@ TEST(PressStudy, OptimumIsTheStrokeBoundWithTheReachLimitActive) {
   EXPECT_LT(run->outcome.max_violation, 0.005);
   std::cout << "press: peak torque " << run->outcome.objective << " N m after " << run->outcome.cycles
             << " cycles, " << run->outcome.analyses << " analyses\n";
+}
+
+// A mechanism that moves freely (examples/isolator): forward dynamics with
+// IDAS at every analysis, and an optimum where the swing limit is active.
+TEST(IsolatorStudy, ConvergesWithTheSwingLimitActive) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/isolator/isolator.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  Eigen::VectorXd x0(2);
+  x0 << 20.0, 2.0;
+  absl::StatusOr<engine::StudyEvaluation> start = local_run::EvaluateDesign(*study, *layout, x0);
+  ASSERT_TRUE(start.ok() && start->ok());
+  EXPECT_EQ(start->formulation, spec::Formulation::kDynamic);
+  EXPECT_GT(start->counters.time_steps, 0);
+  EXPECT_GT(start->values->max_violation, 0.0);  // the start swings too much
+  absl::StatusOr<local_run::LocalRunResult> run = local_run::RunStudyLocally(*study);
+  ASSERT_TRUE(run.ok()) << run.status();
+  EXPECT_EQ(run->outcome.state, slp::RunState::kConverged) << run->end_reason;
+  // Active: within the study's convergence tolerance (1e-4) of its limit.
+  constexpr double kActive = 1e-4;
+  EXPECT_NEAR(run->outcome.max_violation, 0.0, kActive);
+  // A feasible design that transmits less than the (infeasible) start's
+  // 69.7 N; the preload alone is 36.8 N.
+  EXPECT_LT(run->outcome.objective, 65.0);
+  EXPECT_GT(run->outcome.objective, 36.8);
+  std::cout << "isolator: peak force " << run->outcome.objective << " N at k = " << run->design_si[0]
+            << " N/m, c = " << run->design_si[1] << " N s/m after " << run->outcome.cycles << " cycles\n";
 }
 
 TEST(MultibodySceneLoading, UnknownMarkerIsNamedWithFileLineAndTheMarkersThatExist) {
