@@ -15,6 +15,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   libnlopt-cxx-dev
+  libsimbody-dev
   chromium zlib1g-dev
 )
 
