@@ -5,19 +5,34 @@
 // Field meanings are documented in proto/mbopt/v1/scene.proto.
 #pragma once
 
+#include <algorithm>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "spec/expression.h"
+
 namespace mbopt::spec {
 
-// A value in SI units: literal, or the value of parameter `param`.
+// A value in SI units: literal, the value of parameter `param`, or an
+// arithmetic expression of parameters (spec/expression.h).
 struct Number {
-  double value = 0.0;  // used when param < 0
+  double value = 0.0;  // used when param < 0 and there is no expression
   int param = -1;      // index into Scene::parameters
+  std::shared_ptr<const Expression> expression;
   double Resolve(const std::vector<double>& parameter_values_si) const {
+    if (expression != nullptr) return expression->Evaluate(parameter_values_si);
     return param >= 0 ? parameter_values_si[static_cast<size_t>(param)] : value;
+  }
+  // Whether the value changes with parameter `p`.
+  bool DependsOn(int p) const {
+    if (expression != nullptr) {
+      const std::vector<int>& read = expression->parameters();
+      return std::binary_search(read.begin(), read.end(), p);
+    }
+    return param == p;
   }
 };
 

@@ -125,16 +125,37 @@ class SceneConverter {
         }
         break;
       }
+      case v1::Number::kExpr: {
+        Expression::Names names;
+        names.find = [this](const std::string& name) -> std::optional<int> {
+          const int index = scene_.FindParameter(name);
+          return index >= 0 ? std::optional<int>(index) : std::nullopt;
+        };
+        for (const Parameter& parameter : scene_.parameters) names.all.push_back(parameter.name);
+        absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(n.expr(), names);
+        if (!parsed.ok()) {
+          errors_.Add(w, field, std::string(parsed.status().message()));
+          break;
+        }
+        out.expression = *std::move(parsed);
+        // Caught here, not in every analysis: an expression that cannot be
+        // evaluated at the parameters' defaults (a division by zero, the
+        // root of a negative number).
+        const double at_defaults = out.expression->Evaluate(scene_.DefaultParameterValues());
+        if (!std::isfinite(at_defaults)) {
+          errors_.Add(w, field,
+                      absl::StrCat("\"", n.expr(), "\" is ", at_defaults, " at the parameters' default values"));
+        }
+        break;
+      }
       case v1::Number::SOURCE_NOT_SET:
-        errors_.Add(w, field, "empty number: expected `value: ...` or `param: \"name\"`");
+        errors_.Add(w, field, "empty number: expected `value: ...`, `param: \"name\"` or `expr: \"...\"`");
         break;
     }
     return out;
   }
 
-  double Default(const Number& n) const {
-    return n.param >= 0 ? scene_.parameters[static_cast<size_t>(n.param)].value_si : n.value;
-  }
+  double Default(const Number& n) const { return n.Resolve(scene_.DefaultParameterValues()); }
 
   void RequirePositive(const Where& w, const std::string& field, const Number& n) {
     const double v = Default(n);

@@ -12,8 +12,8 @@
 
 namespace mbopt::linkage_testing {
 
-inline spec::Number Lit(double v) { return spec::Number{v, -1}; }
-inline spec::Number Par(int i) { return spec::Number{0.0, i}; }
+inline spec::Number Lit(double v) { return spec::Number{v, -1, nullptr}; }
+inline spec::Number Par(int i) { return spec::Number{0.0, i, nullptr}; }
 inline spec::Vec2 At(double x, double y) { return {Lit(x), Lit(y)}; }
 
 inline spec::Output PointOutput(std::string name, int link, int point, spec::Axis axis) {

@@ -19,7 +19,13 @@ using sensitivity_internal::ParameterDerivative;
 using sensitivity_internal::SensitivityProblem;
 using sensitivity_internal::SensitivityRecorder;
 
-bool Uses(const spec::Number& number, int parameter) { return number.param == parameter; }
+// The analytic derivatives below take a mass, inertia, stiffness or damping
+// bound directly to a parameter (derivative 1); one computed from it by an
+// expression has no simulator sensitivity (yet).
+bool Uses(const spec::Number& number, int parameter) { return number.DependsOn(parameter); }
+bool ThroughExpression(const spec::Number& number, int parameter) {
+  return number.expression != nullptr && number.DependsOn(parameter);
+}
 
 spec::AnalysisReport Failed(spec::AnalysisReport report, spec::FailureKind kind, std::string reason) {
   report.Fail(kind, std::move(reason));
@@ -44,7 +50,15 @@ std::string LumpedSensitivityUnavailable(const spec::Scene& scene,
                           ", which has no simulator sensitivity (only masses, inertias, "
                           "stiffnesses and dampings have)");
     };
+    for (const spec::Body& b : m->bodies) {
+      if (ThroughExpression(b.mass_kg, p) || ThroughExpression(b.inertia_kg_m2, p)) {
+        return where(absl::StrCat("the mass or inertia of body ", b.name, " through an expression"));
+      }
+    }
     for (const spec::SpringDamper& e : m->elements) {
+      if (ThroughExpression(e.stiffness_n_per_m, p) || ThroughExpression(e.damping_n_s_per_m, p)) {
+        return where(absl::StrCat("the stiffness or damping of element ", e.name, " through an expression"));
+      }
       for (const spec::Attachment* at : {&e.a, &e.b}) {
         if (Uses(at->offset_m.x, p) || Uses(at->offset_m.y, p)) {
           return where(absl::StrCat("an attachment offset of element ", e.name));

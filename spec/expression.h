@@ -1,0 +1,56 @@
+// Arithmetic expressions for numbers in scene files, e.g.
+// `expr: "wheelbase / speed"` or `expr: "-rod_length / 2"`: parsed once when
+// the scene is loaded (names resolved to parameter indices), evaluated per
+// analysis from the SI parameter values. Expressions work in SI: a parameter
+// contributes its SI value whatever unit the file gives it.
+//
+// Grammar: + - * / ^ (power, right-associative, binds tighter than unary
+// minus: -a^2 = -(a^2)), parentheses, numbers (1e-3), parameter names, the
+// constant pi, and the functions sqrt, sin, cos, tan, asin, acos, atan, exp,
+// log, abs (one argument) and atan2, min, max, pow (two). Pure.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+
+namespace mbopt::spec {
+
+class Expression {
+ public:
+  // Finds a parameter's index by name (nullopt: no such parameter) and lists
+  // the names, for "did you mean" messages.
+  struct Names {
+    std::function<std::optional<int>(const std::string&)> find;
+    std::vector<std::string> all;
+  };
+  // InvalidArgument "column N: <what was expected>" (1-based), or naming the
+  // unknown parameter with the nearest known names.
+  static absl::StatusOr<std::shared_ptr<const Expression>> Parse(const std::string& text, const Names& names);
+
+  double Evaluate(const std::vector<double>& parameter_values_si) const;
+  // Indices of the parameters it reads (sorted, unique).
+  const std::vector<int>& parameters() const { return parameters_; }
+  const std::string& text() const { return text_; }
+
+  // Reverse Polish code: the evaluator runs it on a small stack.
+  enum class Op { kConstant, kParameter, kNegate, kAdd, kSubtract, kMultiply, kDivide, kPower, kFunction1, kFunction2 };
+  struct Instruction {
+    Op op;
+    double value = 0.0;  // kConstant
+    int index = 0;       // kParameter: parameter; kFunction*: function
+  };
+
+ private:
+  std::string text_;
+  std::vector<Instruction> code_;
+  std::vector<int> parameters_;
+  int max_stack_ = 0;
+  friend class ExpressionParser;
+};
+
+}  // namespace mbopt::spec
