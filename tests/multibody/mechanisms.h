@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "worker/multibody/model.h"
 
@@ -136,6 +137,35 @@ inline Model SundialsSliderCrank(double k, double c) {
   s.damping_n_s_per_m = c;
   m.springs.push_back(s);
   m.point_forces.push_back(PointForce{At(1, 1.0), Eigen::Vector2d(1.0, 0.0)});
+  return m;
+}
+
+// The ten-body chain of tests/oracle/simbody_oracle.h (TenBodyChain): five
+// rockers hanging from ground pivots at x = 0..4 at angle theta, four
+// couplers joining their lower ends (parallelograms), and a free pendulum on
+// the last rocker's lower end at pendulum_angle; at rest, under gravity.
+inline Model TenBodyChain(double theta = -1.2, double pendulum_angle = -2.0) {
+  Model m;
+  const Eigen::Vector2d down(std::cos(theta), std::sin(theta));
+  for (int i = 0; i < 5; ++i) {
+    m.bodies.push_back(Bar("rocker" + std::to_string(i), 1.0, 1.0, Eigen::Vector2d(i, 0.0) + 0.5 * down, theta));
+    Joint pivot = Revolute("pivot" + std::to_string(i), Point{kGround, Eigen::Vector2d(i, 0.0), ""}, At(i, -0.5));
+    if (i == 0) pivot.initial_value = theta;
+    m.joints.push_back(pivot);
+  }
+  for (int j = 0; j < 4; ++j) {
+    const int body = static_cast<int>(m.bodies.size());
+    m.bodies.push_back(Bar("coupler" + std::to_string(j), 1.0, 1.0, Eigen::Vector2d(j + 0.5, 0.0) + down, 0.0));
+    m.joints.push_back(Revolute("left" + std::to_string(j), At(j, 0.5), At(body, -0.5)));
+    m.joints.push_back(Revolute("right" + std::to_string(j), At(body, 0.5), At(j + 1, 0.5)));
+  }
+  const int pendulum = static_cast<int>(m.bodies.size());
+  const Eigen::Vector2d hang(std::cos(pendulum_angle), std::sin(pendulum_angle));
+  m.bodies.push_back(Bar("pendulum", 0.5, 0.6, Eigen::Vector2d(4.0, 0.0) + down + 0.3 * hang, pendulum_angle));
+  Joint hinge = Revolute("hinge", At(4, 0.5), At(pendulum, -0.3));
+  hinge.initial_value = pendulum_angle - theta;
+  m.joints.push_back(hinge);
+  m.gravity_m_per_s2 = Eigen::Vector2d(0.0, -9.81);
   return m;
 }
 

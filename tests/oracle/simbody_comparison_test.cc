@@ -184,5 +184,16 @@ TEST(SimbodyComparison, SliderCrankWithAFlywheel) {
   std::cout << "slider-crank: largest difference to Simbody " << worst << " (rad, m)\n";
 }
 
+// The speed benchmark's model (bench/multibody) is the same in both codes.
+TEST(SimbodyComparison, TenBodyChainOfTheSpeedBenchmark) {
+  const oracle::OracleRun simbody = RunSimbody("ten_body_chain");
+  const auto ours = RunMbopt(testing::TenBodyChain(), [](const Mechanism&, const MotionSample& s) {
+    return std::vector<double>{s.q[2], s.q[29]};
+  });
+  const double worst = Compare(simbody, ours);
+  EXPECT_LT(worst, kAgreement);
+  std::cout << "ten-body chain: largest angle difference to Simbody " << worst << " rad\n";
+}
+
 }  // namespace
 }  // namespace mbopt::multibody

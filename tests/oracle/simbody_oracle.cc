@@ -1,6 +1,7 @@
 // C++17, Simbody types only here (see simbody_oracle.h).
 #include "tests/oracle/simbody_oracle.h"
 
+#include <chrono>
 #include <cmath>
 #include <exception>
 
@@ -117,6 +118,45 @@ OracleRun SimulateSliderCrank(const SliderCrank& p, const std::vector<double>& t
     return Record(system, state, accuracy, times, [&](const State& st) {
       return std::vector<double>{crank.getAngle(st), slider.getLength(st)};
     });
+  } catch (const std::exception& e) {
+    return OracleRun{false, e.what(), {}};
+  }
+}
+
+OracleRun SimulateTenBodyChain(const TenBodyChain& p, const std::vector<double>& times, double accuracy,
+                               double* wall_seconds) {
+  try {
+    MultibodySystem system;
+    SimbodyMatterSubsystem matter(system);
+    GeneralForceSubsystem forces(system);
+    Force::UniformGravity gravity(forces, matter, Vec3(0, -p.g, 0));
+    std::vector<MobilizedBody::Pin> rockers;
+    for (int i = 0; i < 5; ++i) {
+      rockers.emplace_back(matter.Ground(), Transform(Vec3(i, 0, 0)), Bar(1.0, 1.0), Transform(Vec3(-0.5, 0, 0)));
+    }
+    std::vector<MobilizedBody::Pin> couplers;
+    std::vector<Constraint::PointInPlane> closures;
+    for (int j = 0; j < 4; ++j) {
+      couplers.emplace_back(rockers[static_cast<size_t>(j)], Transform(Vec3(0.5, 0, 0)), Bar(1.0, 1.0),
+                            Transform(Vec3(-0.5, 0, 0)));
+      MobilizedBody& next = rockers[static_cast<size_t>(j + 1)];
+      closures.emplace_back(next, UnitVec3(1, 0, 0), 0.5, couplers.back(), Vec3(0.5, 0, 0));
+      closures.emplace_back(next, UnitVec3(0, 1, 0), 0.0, couplers.back(), Vec3(0.5, 0, 0));
+    }
+    MobilizedBody::Pin pendulum(rockers.back(), Transform(Vec3(0.5, 0, 0)), Bar(0.5, 0.6), Transform(Vec3(-0.3, 0, 0)));
+    State state = system.realizeTopology();
+    for (auto& r : rockers) r.setAngle(state, p.theta);
+    for (auto& c : couplers) c.setAngle(state, -p.theta);  // horizontal
+    pendulum.setAngle(state, p.pendulum_angle - p.theta);
+    system.realize(state, Stage::Position);
+    const auto start = std::chrono::steady_clock::now();
+    OracleRun run = Record(system, state, accuracy, times, [&](const State& s) {
+      return std::vector<double>{rockers.front().getAngle(s), rockers.back().getAngle(s) + pendulum.getAngle(s)};
+    });
+    if (wall_seconds != nullptr) {
+      *wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    return run;
   } catch (const std::exception& e) {
     return OracleRun{false, e.what(), {}};
   }

@@ -57,4 +57,20 @@ struct SliderCrank {
 };
 OracleRun SimulateSliderCrank(const SliderCrank& p, const std::vector<double>& times_s, double accuracy);
 
+// Ten bodies with closed loops, for the speed benchmark: five rockers
+// (uniform bars, 1 kg, length 1 m) hang from ground pivots at x = 0, 1, ..., 4
+// and swing at the same angle; four couplers (uniform bars, 1 kg, 1 m) join
+// the rockers' lower ends (a chain of four parallelograms: one degree of
+// freedom); a free pendulum (uniform bar, 0.5 kg, 0.6 m) hangs from the last
+// rocker's lower end. Released at rest with the rockers at angle theta
+// (from +x; -pi/2 hangs down) and the pendulum at angle pendulum_angle, under
+// gravity. Values: the first rocker's and the pendulum's angles. Also
+// returns, in wall_seconds, the time of the integration alone (no model
+// building), which is what the benchmark compares.
+struct TenBodyChain {
+  double theta = -1.2, pendulum_angle = -2.0, g = 9.81;
+};
+OracleRun SimulateTenBodyChain(const TenBodyChain& p, const std::vector<double>& times_s, double accuracy,
+                               double* wall_seconds);
+
 }  // namespace mbopt::oracle
