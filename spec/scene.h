@@ -144,7 +144,8 @@ struct MultibodyJoint {
 };
 struct MultibodyDriver {
   int joint = -1;
-  enum class Profile { kConstantRate, kPolynomial, kHarmonic } profile = Profile::kConstantRate;
+  enum class Profile { kConstantRate, kPolynomial, kHarmonic, kTabulated } profile = Profile::kConstantRate;
+  std::vector<double> times_s, values;  // kTabulated (literal table)
   Number start, rate;                 // kConstantRate; start is the mean for kHarmonic
   std::vector<Number> coefficients;   // kPolynomial
   Number amplitude, angular_frequency_rad_per_s, phase_rad;  // kHarmonic
@@ -153,6 +154,8 @@ struct MultibodySpring {
   std::string name;
   MarkerRef a, b;
   Number free_length_m, stiffness_n_per_m, damping_n_s_per_m, actuator_force_n;
+  // Force curves (literal tables; empty: the linear coefficient).
+  std::vector<double> deflection_m, deflection_force_n, velocity_m_per_s, velocity_force_n;
 };
 struct RotationalSpring {
   std::string name;

@@ -666,6 +666,20 @@ class SceneConverter {
           driver.phase_rad = Num(pw, "phase_rad", h.has_phase_rad(), h.phase_rad(), Dimension::kAngle, 0.0);
           break;
         }
+        case v1::MultibodyDriver::kTabulated: {
+          const Where pw = dw.Child("tabulated");
+          driver.profile = MultibodyDriver::Profile::kTabulated;
+          driver.times_s.assign(d.tabulated().times_s().begin(), d.tabulated().times_s().end());
+          driver.values.assign(d.tabulated().values().begin(), d.tabulated().values().end());
+          if (CheckTable(pw, "times_s", "values", driver.times_s, driver.values) && msg_.has_time_grid() &&
+              (driver.times_s.front() > 0.0 || driver.times_s.back() < msg_.time_grid().end_s())) {
+            errors_.Add(pw, "times_s",
+                        absl::StrFormat("the table covers %g..%g s; it must cover the motion from 0 to the time "
+                                        "grid's end, %g s",
+                                        driver.times_s.front(), driver.times_s.back(), msg_.time_grid().end_s()));
+          }
+          break;
+        }
         case v1::MultibodyDriver::PROFILE_NOT_SET:
           errors_.Add(dw, "", "a driver needs a profile: `constant_rate`, `polynomial` or `harmonic`");
           break;
@@ -688,6 +702,16 @@ class SceneConverter {
       spring.stiffness_n_per_m = Num(sw, "stiffness_n_per_m", sp.has_stiffness_n_per_m(), sp.stiffness_n_per_m(), Dimension::kStiffness, 0.0);
       spring.damping_n_s_per_m = Num(sw, "damping_n_s_per_m", sp.has_damping_n_s_per_m(), sp.damping_n_s_per_m(), Dimension::kDamping, 0.0);
       spring.actuator_force_n = Num(sw, "actuator_force_n", sp.has_actuator_force_n(), sp.actuator_force_n(), Dimension::kForce, 0.0);
+      if (sp.has_deflection_curve()) {
+        spring.deflection_m.assign(sp.deflection_curve().x().begin(), sp.deflection_curve().x().end());
+        spring.deflection_force_n.assign(sp.deflection_curve().force_n().begin(), sp.deflection_curve().force_n().end());
+        CheckTable(sw.Child("deflection_curve"), "x", "force_n", spring.deflection_m, spring.deflection_force_n);
+      }
+      if (sp.has_velocity_curve()) {
+        spring.velocity_m_per_s.assign(sp.velocity_curve().x().begin(), sp.velocity_curve().x().end());
+        spring.velocity_force_n.assign(sp.velocity_curve().force_n().begin(), sp.velocity_curve().force_n().end());
+        CheckTable(sw.Child("velocity_curve"), "x", "force_n", spring.velocity_m_per_s, spring.velocity_force_n);
+      }
       multibody_.springs.push_back(std::move(spring));
     }
     for (int i = 0; i < m.rotational_springs_size(); ++i) {
@@ -724,6 +748,27 @@ class SceneConverter {
       multibody_.torques.push_back(std::move(torque));
     }
     return multibody_;
+  }
+
+  // A table of at least two finite points, abscissae strictly increasing.
+  bool CheckTable(const Where& w, const std::string& x_field, const std::string& y_field, const std::vector<double>& x,
+                  const std::vector<double>& y) {
+    if (x.size() < 2 || x.size() != y.size()) {
+      errors_.Add(w, x_field, absl::StrFormat("a table needs at least 2 points and as many %s as %s (got %d and %d)",
+                                              x_field, y_field, x.size(), y.size()));
+      return false;
+    }
+    for (size_t k = 0; k < x.size(); ++k) {
+      if (!std::isfinite(x[k]) || !std::isfinite(y[k])) {
+        errors_.Add(w, x_field, absl::StrFormat("point %d is not finite", k));
+        return false;
+      }
+      if (k > 0 && !(x[k] > x[k - 1])) {
+        errors_.Add(w, x_field, absl::StrFormat("must increase strictly: %g after %g (point %d)", x[k], x[k - 1], k));
+        return false;
+      }
+    }
+    return true;
   }
 
   MultibodyOutput MultibodyOutputOf(const v1::Output& o, const Where& ow) {

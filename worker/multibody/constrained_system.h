@@ -21,6 +21,8 @@
 // current values from it.
 #pragma once
 
+#include <string>
+
 #include <Eigen/Dense>
 
 namespace mbopt::multibody {
@@ -51,6 +53,10 @@ class ConstrainedSystem {
   // Parameters the equations depend on (stiffnesses, masses, ...), for
   // forward sensitivity analysis by difference quotients. Empty by default.
   virtual int num_parameters() const { return 0; }
+  // Why the latest evaluation that returned non-zero failed, when the system
+  // knows better than "not finite" (a force curve left its table): says
+  // which element and where. Empty otherwise.
+  virtual std::string FailureReason() const { return ""; }
   virtual double* parameters() { return nullptr; }
 };
 

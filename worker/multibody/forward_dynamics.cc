@@ -111,6 +111,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   if (system.MassMatrix(q0, &mass) != 0 || system.AppliedForces(t0, q0, v0, &forces) != 0 ||
       (m > 0 && (system.ConstraintJacobian(t0, q0, &phi_q) != 0 ||
                  system.AccelerationRightSide(t0, q0, v0, &gamma) != 0))) {
+    if (!system.FailureReason().empty()) return Failed(spec::FailureKind::kModelValidity, system.FailureReason());
     return Failed(spec::FailureKind::kNonFiniteValue, absl::StrFormat("the equations are not finite at t = %.6g s", t0));
   }
   Eigen::MatrixXd augmented = Eigen::MatrixXd::Zero(n + m, n + m);
@@ -203,6 +204,10 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
       const int flag = IDASolve(ida, t, &t_reached, h.yy.get(), h.yp.get(), IDA_NORMAL);
       Accumulate(ida, counters);
       if (flag < 0) {
+        if (!system.FailureReason().empty()) {
+          return Failed(spec::FailureKind::kModelValidity,
+                        absl::StrFormat("%s; the integrator gave up near t = %.6g s", system.FailureReason(), t_reached));
+        }
         if (p.wall_time_exceeded) {
           return Failed(spec::FailureKind::kTimeLimit,
                         absl::StrFormat("the wall-time limit of %g s was reached near t = %.6g s", p.max_wall_seconds,

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "absl/strings/str_format.h"
+
 namespace mbopt::multibody {
 namespace {
 
@@ -221,7 +223,7 @@ int Mechanism::AccelerationRightSide(double t, const VectorXd& q, const VectorXd
   return gamma->allFinite() ? 0 : 1;
 }
 
-int Mechanism::AppliedForces(double, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
+int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
   ++counters_.force_evaluations;
   forces->setZero(num_coordinates());
   // A force f (world axes) at point s of a body: f on (x, y), (B s) . f on phi.
@@ -244,6 +246,14 @@ int Mechanism::AppliedForces(double, const VectorXd& q, const VectorXd& v, Vecto
     if (!(length > 0.0)) return 1;  // coincident ends: no direction (the step is retried)
     const Vector2d u = d / length;
     const double tension = SpringTension(static_cast<int>(k), q, v);
+    if (!std::isfinite(tension)) {
+      // Recoverable: a trial step may overshoot the table where the motion
+      // itself stays inside; if the motion leaves it, the reason stays.
+      failure_ = absl::StrFormat(
+          "spring '%s' left the range of its force table at t = %.6g s (length %.6g m, free length %.6g m)", s.name,
+          t, length, s.free_length_m);
+      return 1;
+    }
     apply(s.a, tension * u);
     apply(s.b, -tension * u);
   }
@@ -303,7 +313,13 @@ double Mechanism::SpringTension(int spring, const VectorXd& q, const VectorXd& v
   const double length = d.norm();
   const double length_rate =
       length > 0.0 ? d.dot(PointVelocity(s.b, q, v) - PointVelocity(s.a, q, v)) / length : 0.0;
-  return s.stiffness_n_per_m * (length - s.free_length_m) + s.damping_n_s_per_m * length_rate + s.actuator_force_n;
+  const double deflection = length - s.free_length_m;
+  double elastic = s.stiffness_n_per_m * deflection, viscous = s.damping_n_s_per_m * length_rate;
+  // A curve evaluated outside its table: NaN, so that the analysis fails
+  // naming the spring (scene_analysis.cc) instead of extrapolating.
+  if (!s.deflection_curve.empty() && !s.deflection_curve.Evaluate(deflection, &elastic)) return NAN;
+  if (!s.velocity_curve.empty() && !s.velocity_curve.Evaluate(length_rate, &viscous)) return NAN;
+  return elastic + viscous + s.actuator_force_n;
 }
 
 double Mechanism::KineticEnergy(const VectorXd& v) const {

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -73,6 +74,7 @@ class Mechanism : public ConstrainedSystem {
   double PotentialEnergy(const Eigen::VectorXd& q) const;
 
   const MechanismCounters& counters() const { return counters_; }
+  std::string FailureReason() const override { return failure_; }
 
  private:
   // One evaluation of every row: whichever outputs are not null.
@@ -86,6 +88,7 @@ class Mechanism : public ConstrainedSystem {
   std::vector<int> joint_row_, driver_row_, row_joint_;
   std::vector<double> reference_angle_;  // phi_b - phi_a of the initial poses
   mutable MechanismCounters counters_;
+  mutable std::string failure_;
 };
 
 }  // namespace mbopt::multibody

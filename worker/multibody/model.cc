@@ -1,5 +1,6 @@
 #include "worker/multibody/model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -22,6 +23,11 @@ Profile::Value Profile::At(double t) const {
       }
       break;
     }
+    case Kind::kTabulated:
+      // Outside the table (excluded when the scene is loaded): NaN, which the
+      // engine reports as a failed analysis.
+      if (!table.Evaluate(t, &v.q, &v.q_dot, &v.q_ddot)) v.q = v.q_dot = v.q_ddot = NAN;
+      break;
     case Kind::kHarmonic: {
       const double w = angular_frequency_rad_per_s;
       const double s = std::sin(w * t + phase_rad), c = std::cos(w * t + phase_rad);
@@ -32,6 +38,51 @@ Profile::Value Profile::At(double t) const {
     }
   }
   return v;
+}
+
+CubicSpline::CubicSpline(std::vector<double> x, std::vector<double> y) : x_(std::move(x)), y_(std::move(y)) {
+  const size_t n = x_.size();
+  second_.assign(n, 0.0);
+  if (n < 3) return;
+  // Natural spline: second derivatives zero at the ends; the tridiagonal
+  // system by the Thomas algorithm.
+  std::vector<double> c(n, 0.0), d(n, 0.0);
+  for (size_t i = 1; i + 1 < n; ++i) {
+    const double h0 = x_[i] - x_[i - 1], h1 = x_[i + 1] - x_[i];
+    const double a = h0, b = 2.0 * (h0 + h1), cc = h1;
+    const double r = 6.0 * ((y_[i + 1] - y_[i]) / h1 - (y_[i] - y_[i - 1]) / h0);
+    const double m = b - a * c[i - 1];
+    c[i] = cc / m;
+    d[i] = (r - a * d[i - 1]) / m;
+  }
+  for (size_t i = n - 2; i >= 1; --i) {
+    second_[i] = d[i] - c[i] * second_[i + 1];
+    if (i == 1) break;
+  }
+}
+
+bool CubicSpline::Evaluate(double x, double* y, double* dy, double* d2y) const {
+  if (x_.size() < 2 || !(x >= x_.front() && x <= x_.back())) return false;
+  const size_t k = std::min<size_t>(
+      static_cast<size_t>(std::upper_bound(x_.begin(), x_.end(), x) - x_.begin()), x_.size() - 1);
+  const size_t i = k == 0 ? 0 : k - 1;
+  const double h = x_[i + 1] - x_[i];
+  const double a = (x_[i + 1] - x) / h, b = (x - x_[i]) / h;
+  const double m0 = second_[i], m1 = second_[i + 1];
+  *y = a * y_[i] + b * y_[i + 1] + ((a * a * a - a) * m0 + (b * b * b - b) * m1) * h * h / 6.0;
+  *dy = (y_[i + 1] - y_[i]) / h + ((1.0 - 3.0 * a * a) * m0 + (3.0 * b * b - 1.0) * m1) * h / 6.0;
+  *d2y = a * m0 + b * m1;
+  return true;
+}
+
+bool LinearTable::Evaluate(double at, double* value) const {
+  if (x.size() < 2 || !(at >= x.front() && at <= x.back())) return false;
+  const size_t k = std::min<size_t>(static_cast<size_t>(std::upper_bound(x.begin(), x.end(), at) - x.begin()),
+                                    x.size() - 1);
+  const size_t i = k == 0 ? 0 : k - 1;
+  const double w = (at - x[i]) / (x[i + 1] - x[i]);
+  *value = (1.0 - w) * y[i] + w * y[i + 1];
+  return true;
 }
 
 std::string Model::BodyName(int body) const {
@@ -95,6 +146,22 @@ absl::Status Model::Validate() const {
         !std::isfinite(s.actuator_force_n)) {
       return absl::InvalidArgumentError(absl::StrCat("spring ", s.name, ": free length must be >= 0 m and every "
                                                      "coefficient finite"));
+    }
+  }
+  for (const SpringDamper& s : springs) {
+    for (const LinearTable* table : {&s.deflection_curve, &s.velocity_curve}) {
+      if (table->empty()) continue;
+      bool increasing = table->x.size() >= 2 && table->x.size() == table->y.size();
+      for (size_t k = 1; increasing && k < table->x.size(); ++k) increasing = table->x[k] > table->x[k - 1];
+      if (!increasing) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "spring ", s.name, ": a force table needs 2 or more points, x strictly increasing, one force per x"));
+      }
+    }
+  }
+  for (const Driver& d : drivers) {
+    if (d.profile.kind == Profile::Kind::kTabulated && d.profile.table.empty()) {
+      return absl::InvalidArgumentError("a tabulated driver needs its table");
     }
   }
   for (const RotationalSpringDamper& r : rotational_springs) {

@@ -57,9 +57,35 @@ struct Joint {
   std::optional<double> initial_rate;
 };
 
+// A natural cubic spline through (x_k, y_k), x strictly increasing: C2, so a
+// tabulated driver has a continuous acceleration. Outside [x_0, x_n] it is
+// not defined (Evaluate returns false).
+class CubicSpline {
+ public:
+  CubicSpline() = default;
+  CubicSpline(std::vector<double> x, std::vector<double> y);
+  bool Evaluate(double x, double* y, double* dy, double* d2y) const;
+  bool empty() const { return x_.empty(); }
+  double front() const { return x_.front(); }
+  double back() const { return x_.back(); }
+
+ private:
+  std::vector<double> x_, y_, second_;  // second derivatives at the knots
+};
+
+// Piecewise-linear y(x) through a table, x strictly increasing; Evaluate
+// returns false outside the table (no extrapolation: a force curve measured
+// over a range says nothing beyond it).
+struct LinearTable {
+  std::vector<double> x, y;
+  bool Evaluate(double at, double* value) const;
+  bool empty() const { return x.empty(); }
+};
+
 // A prescribed joint coordinate q(t) with its first two derivatives.
 struct Profile {
-  enum class Kind { kConstantRate, kPolynomial, kHarmonic } kind = Kind::kConstantRate;
+  enum class Kind { kConstantRate, kPolynomial, kHarmonic, kTabulated } kind = Kind::kConstantRate;
+  CubicSpline table;                  // kTabulated: q through (t_k, q_k)
   double start = 0.0;                 // kConstantRate, kHarmonic: q0
   double rate = 0.0;                  // kConstantRate: dq/dt
   std::vector<double> coefficients;   // kPolynomial: c0 + c1 t + c2 t^2 + ...
@@ -79,7 +105,9 @@ struct Driver {
 };
 
 // Tension T = k (L - L0) + c dL/dt + actuator, pulling the two points
-// together when positive.
+// together when positive. With a deflection curve, its force at L - L0
+// replaces k (L - L0); with a velocity curve, its force at dL/dt replaces
+// c dL/dt.
 struct SpringDamper {
   std::string name;
   Point a, b;
@@ -87,6 +115,8 @@ struct SpringDamper {
   double stiffness_n_per_m = 0.0;
   double damping_n_s_per_m = 0.0;
   double actuator_force_n = 0.0;
+  LinearTable deflection_curve;  // force (N) against L - L0 (m)
+  LinearTable velocity_curve;    // force (N) against dL/dt (m/s)
 };
 
 // Torque on body b of a revolute joint: -k (theta - theta0) - c dtheta/dt

@@ -118,6 +118,10 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
         driver.profile.kind = Profile::Kind::kPolynomial;
         for (const spec::Number& c : d.coefficients) driver.profile.coefficients.push_back(c.Resolve(p));
         break;
+      case spec::MultibodyDriver::Profile::kTabulated:
+        driver.profile.kind = Profile::Kind::kTabulated;
+        driver.profile.table = CubicSpline(d.times_s, d.values);
+        break;
       case spec::MultibodyDriver::Profile::kHarmonic:
         driver.profile.kind = Profile::Kind::kHarmonic;
         driver.profile.start = d.start.Resolve(p);
@@ -129,9 +133,17 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
     m.drivers.push_back(std::move(driver));
   }
   for (const spec::MultibodySpring& s : sm.springs) {
-    m.springs.push_back(SpringDamper{s.name, PointOf(sm, s.a, p), PointOf(sm, s.b, p), s.free_length_m.Resolve(p),
-                                     s.stiffness_n_per_m.Resolve(p), s.damping_n_s_per_m.Resolve(p),
-                                     s.actuator_force_n.Resolve(p)});
+    SpringDamper spring;
+    spring.name = s.name;
+    spring.a = PointOf(sm, s.a, p);
+    spring.b = PointOf(sm, s.b, p);
+    spring.free_length_m = s.free_length_m.Resolve(p);
+    spring.stiffness_n_per_m = s.stiffness_n_per_m.Resolve(p);
+    spring.damping_n_s_per_m = s.damping_n_s_per_m.Resolve(p);
+    spring.actuator_force_n = s.actuator_force_n.Resolve(p);
+    spring.deflection_curve = LinearTable{s.deflection_m, s.deflection_force_n};
+    spring.velocity_curve = LinearTable{s.velocity_m_per_s, s.velocity_force_n};
+    m.springs.push_back(std::move(spring));
   }
   for (const spec::RotationalSpring& r : sm.rotational_springs) {
     m.rotational_springs.push_back(RotationalSpringDamper{r.name, r.joint, r.stiffness_n_m_per_rad.Resolve(p),
@@ -205,6 +217,9 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
       const auto& o = std::get<spec::MultibodyOutput>(scene.outputs[k].kind);
       const double value = OutputValue(mechanism, sm, o, p, s, &phi_q);
       if (!std::isfinite(value)) {
+        if (!mechanism.FailureReason().empty()) {
+          return spec::AnalysisFailure::Of(spec::FailureKind::kModelValidity, mechanism.FailureReason());
+        }
         return spec::AnalysisFailure::Of(
             spec::FailureKind::kNonFiniteValue,
             absl::StrFormat("output '%s' is not finite at t = %.6g s", scene.outputs[k].name, s.t_s));
