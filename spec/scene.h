@@ -162,13 +162,17 @@ struct RotationalSpring {
   int joint = -1;
   Number stiffness_n_m_per_rad, damping_n_m_s_per_rad, free_angle_rad;
 };
+// A time factor of a force or torque: a driver's profile without a joint.
+using TimeFactor = MultibodyDriver;
 struct MultibodyPointForce {
   MarkerRef at;
   Vec2 force_n;
+  std::optional<TimeFactor> factor;
 };
 struct MultibodyTorque {
   int body = -1;
   Number torque_n_m;
+  std::optional<TimeFactor> factor;
 };
 struct MultibodyModel {
   std::vector<LinkPoint> ground_markers;

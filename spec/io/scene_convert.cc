@@ -655,31 +655,12 @@ class SceneConverter {
           if (driver.coefficients.empty()) errors_.Add(pw, "coefficients", "a polynomial needs at least one coefficient");
           break;
         }
-        case v1::MultibodyDriver::kHarmonic: {
-          const Where pw = dw.Child("harmonic");
-          const v1::HarmonicProfile& h = d.harmonic();
-          driver.profile = MultibodyDriver::Profile::kHarmonic;
-          driver.start = Num(pw, "mean", h.has_mean(), h.mean(), Dimension::kAny, 0.0);
-          driver.amplitude = Num(pw, "amplitude", h.has_amplitude(), h.amplitude(), Dimension::kAny);
-          driver.angular_frequency_rad_per_s = Num(pw, "angular_frequency_rad_per_s", h.has_angular_frequency_rad_per_s(),
-                                                   h.angular_frequency_rad_per_s(), Dimension::kAngularVelocity);
-          driver.phase_rad = Num(pw, "phase_rad", h.has_phase_rad(), h.phase_rad(), Dimension::kAngle, 0.0);
+        case v1::MultibodyDriver::kHarmonic:
+          Harmonic(dw.Child("harmonic"), d.harmonic(), &driver);
           break;
-        }
-        case v1::MultibodyDriver::kTabulated: {
-          const Where pw = dw.Child("tabulated");
-          driver.profile = MultibodyDriver::Profile::kTabulated;
-          driver.times_s.assign(d.tabulated().times_s().begin(), d.tabulated().times_s().end());
-          driver.values.assign(d.tabulated().values().begin(), d.tabulated().values().end());
-          if (CheckTable(pw, "times_s", "values", driver.times_s, driver.values) && msg_.has_time_grid() &&
-              (driver.times_s.front() > 0.0 || driver.times_s.back() < msg_.time_grid().end_s())) {
-            errors_.Add(pw, "times_s",
-                        absl::StrFormat("the table covers %g..%g s; it must cover the motion from 0 to the time "
-                                        "grid's end, %g s",
-                                        driver.times_s.front(), driver.times_s.back(), msg_.time_grid().end_s()));
-          }
+        case v1::MultibodyDriver::kTabulated:
+          Tabulated(dw.Child("tabulated"), d.tabulated(), &driver);
           break;
-        }
         case v1::MultibodyDriver::PROFILE_NOT_SET:
           errors_.Add(dw, "", "a driver needs a profile: `constant_rate`, `polynomial` or `harmonic`");
           break;
@@ -733,6 +714,7 @@ class SceneConverter {
       MultibodyPointForce force;
       force.at = Marker(fw, "at", m.point_forces(i).at());
       force.force_n = Vec(fw, "force_n", m.point_forces(i).has_force_n(), m.point_forces(i).force_n(), Dimension::kForce);
+      force.factor = Factor(fw, m.point_forces(i));
       multibody_.point_forces.push_back(std::move(force));
     }
     for (int i = 0; i < m.torques_size(); ++i) {
@@ -745,9 +727,48 @@ class SceneConverter {
         torque.body = it->second;
       }
       torque.torque_n_m = Num(tw, "torque_n_m", m.torques(i).has_torque_n_m(), m.torques(i).torque_n_m(), Dimension::kTorque);
+      torque.factor = Factor(tw, m.torques(i));
       multibody_.torques.push_back(std::move(torque));
     }
     return multibody_;
+  }
+
+  void Harmonic(const Where& pw, const v1::HarmonicProfile& h, MultibodyDriver* out) {
+    out->profile = MultibodyDriver::Profile::kHarmonic;
+    out->start = Num(pw, "mean", h.has_mean(), h.mean(), Dimension::kAny, 0.0);
+    out->amplitude = Num(pw, "amplitude", h.has_amplitude(), h.amplitude(), Dimension::kAny);
+    out->angular_frequency_rad_per_s = Num(pw, "angular_frequency_rad_per_s", h.has_angular_frequency_rad_per_s(),
+                                           h.angular_frequency_rad_per_s(), Dimension::kAngularVelocity);
+    out->phase_rad = Num(pw, "phase_rad", h.has_phase_rad(), h.phase_rad(), Dimension::kAngle, 0.0);
+  }
+
+  // A table that must cover the motion, from 0 to the time grid's end.
+  void Tabulated(const Where& pw, const v1::TabulatedProfile& t, MultibodyDriver* out) {
+    out->profile = MultibodyDriver::Profile::kTabulated;
+    out->times_s.assign(t.times_s().begin(), t.times_s().end());
+    out->values.assign(t.values().begin(), t.values().end());
+    if (CheckTable(pw, "times_s", "values", out->times_s, out->values) && msg_.has_time_grid() &&
+        (out->times_s.front() > 0.0 || out->times_s.back() < msg_.time_grid().end_s())) {
+      errors_.Add(pw, "times_s",
+                  absl::StrFormat("the table covers %g..%g s; it must cover the motion from 0 to the time "
+                                  "grid's end, %g s",
+                                  out->times_s.front(), out->times_s.back(), msg_.time_grid().end_s()));
+    }
+  }
+
+  // The optional time factor of a point force or a torque.
+  template <class Message>
+  std::optional<TimeFactor> Factor(const Where& w, const Message& m) {
+    TimeFactor factor;
+    if (m.has_harmonic()) {
+      Harmonic(w.Child("harmonic"), m.harmonic(), &factor);
+      return factor;
+    }
+    if (m.has_tabulated()) {
+      Tabulated(w.Child("tabulated"), m.tabulated(), &factor);
+      return factor;
+    }
+    return std::nullopt;
   }
 
   // A table of at least two finite points, abscissae strictly increasing.

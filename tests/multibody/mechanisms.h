@@ -136,7 +136,7 @@ inline Model SundialsSliderCrank(double k, double c) {
   s.stiffness_n_per_m = k;
   s.damping_n_s_per_m = c;
   m.springs.push_back(s);
-  m.point_forces.push_back(PointForce{At(1, 1.0), Eigen::Vector2d(1.0, 0.0)});
+  m.point_forces.push_back(PointForce{At(1, 1.0), Eigen::Vector2d(1.0, 0.0), std::nullopt});
   return m;
 }
 

@@ -147,5 +147,28 @@ TEST(ForceCurve, LeavingTheTableIsAFailedAnalysisNamingTheSpring) {
   EXPECT_THAT(f.reason, HasSubstr("spring 'spring' left the range of its force table"));
 }
 
+// A mass on a frictionless slide pushed by F0 sin(w t) from rest:
+// x = x0 + F0 / (m w) (t - sin(w t) / w).
+TEST(TimeVaryingForce, HarmonicForceMovesTheMassAsTheClosedForm) {
+  constexpr double m_kg = 2.0, f0 = 3.0, w = 5.0, x0 = 1.0;
+  Model model = SpringMass(false, 0.0, x0);
+  model.springs.clear();
+  Profile factor;
+  factor.kind = Profile::Kind::kHarmonic;
+  factor.amplitude = 1.0;
+  factor.angular_frequency_rad_per_s = w;
+  model.point_forces.push_back(PointForce{At(0, 0.0), Eigen::Vector2d(f0, 0.0), factor});
+  ASSERT_EQ(model.bodies[0].mass_kg, m_kg);
+  spec::AnalysisFailure f;
+  const std::vector<double> x = Motion(model, &f);
+  ASSERT_TRUE(f.ok()) << f.reason;
+  ASSERT_EQ(x.size(), 101u);
+  constexpr double kAgreement = 1e-9;  // m, at rtol 1e-10 over 1 s
+  for (size_t k = 0; k < x.size(); ++k) {
+    const double t = 0.01 * static_cast<double>(k);
+    EXPECT_NEAR(x[k], x0 + f0 / (m_kg * w) * (t - std::sin(w * t) / w), kAgreement) << "t = " << t;
+  }
+}
+
 }  // namespace
 }  // namespace mbopt::multibody

@@ -167,7 +167,7 @@ Model SliderCrank(const oracle::SliderCrank& p) {
   guide.a = At(kGround, 0.0);
   guide.b = At(2, 0.0);
   m.joints.push_back(guide);
-  m.point_forces.push_back(PointForce{At(2, 0.0), Eigen::Vector2d(p.f_x, 0.0)});
+  m.point_forces.push_back(PointForce{At(2, 0.0), Eigen::Vector2d(p.f_x, 0.0), std::nullopt});
   return m;
 }
 

@@ -264,8 +264,10 @@ int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, Vec
     if (joint.b.body != kGround) (*forces)[3 * joint.b.body + 2] += torque;
     if (joint.a.body != kGround) (*forces)[3 * joint.a.body + 2] -= torque;
   }
-  for (const PointForce& f : model_.point_forces) apply(f.at, f.force_n);
-  for (const BodyTorque& t : model_.torques) (*forces)[3 * t.body + 2] += t.torque_n_m;
+  for (const PointForce& f : model_.point_forces) apply(f.at, f.factor ? f.force_n * f.factor->At(t).q : f.force_n);
+  for (const BodyTorque& torque : model_.torques) {
+    (*forces)[3 * torque.body + 2] += torque.factor ? torque.torque_n_m * torque.factor->At(t).q : torque.torque_n_m;
+  }
   return forces->allFinite() ? 0 : 1;
 }
 

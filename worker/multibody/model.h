@@ -129,14 +129,19 @@ struct RotationalSpringDamper {
   double free_angle_rad = 0.0;
 };
 
+// A force or torque varies in time when it has a profile: its value is then
+// the constant one times the profile's q(t) (a harmonic or tabulated
+// factor).
 struct PointForce {
   Point at;
-  Eigen::Vector2d force_n = Eigen::Vector2d::Zero();  // world axes, constant
+  Eigen::Vector2d force_n = Eigen::Vector2d::Zero();  // world axes
+  std::optional<Profile> factor;
 };
 
 struct BodyTorque {
   int body = 0;
-  double torque_n_m = 0.0;  // constant, counter-clockwise positive
+  double torque_n_m = 0.0;  // counter-clockwise positive
+  std::optional<Profile> factor;
 };
 
 struct Model {

@@ -27,6 +27,33 @@ Point PointOf(const spec::MultibodyModel& m, const spec::MarkerRef& ref, const s
   return Point{ref.body < 0 ? kGround : ref.body, Resolve(marker.position_m, p), marker.name};
 }
 
+Profile ProfileOf(const spec::MultibodyDriver& d, const std::vector<double>& p) {
+  Profile profile;
+  switch (d.profile) {
+    case spec::MultibodyDriver::Profile::kConstantRate:
+      profile.kind = Profile::Kind::kConstantRate;
+      profile.start = d.start.Resolve(p);
+      profile.rate = d.rate.Resolve(p);
+      break;
+    case spec::MultibodyDriver::Profile::kPolynomial:
+      profile.kind = Profile::Kind::kPolynomial;
+      for (const spec::Number& c : d.coefficients) profile.coefficients.push_back(c.Resolve(p));
+      break;
+    case spec::MultibodyDriver::Profile::kTabulated:
+      profile.kind = Profile::Kind::kTabulated;
+      profile.table = CubicSpline(d.times_s, d.values);
+      break;
+    case spec::MultibodyDriver::Profile::kHarmonic:
+      profile.kind = Profile::Kind::kHarmonic;
+      profile.start = d.start.Resolve(p);
+      profile.amplitude = d.amplitude.Resolve(p);
+      profile.angular_frequency_rad_per_s = d.angular_frequency_rad_per_s.Resolve(p);
+      profile.phase_rad = d.phase_rad.Resolve(p);
+      break;
+  }
+  return profile;
+}
+
 bool NeedsMultipliers(const spec::Scene& scene) {
   for (const spec::Output& o : scene.outputs) {
     const auto* m = std::get_if<spec::MultibodyOutput>(&o.kind);
@@ -105,33 +132,7 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
     if (j.initial_rate) joint.initial_rate = j.initial_rate->Resolve(p);
     m.joints.push_back(std::move(joint));
   }
-  for (const spec::MultibodyDriver& d : sm.drivers) {
-    Driver driver;
-    driver.joint = d.joint;
-    switch (d.profile) {
-      case spec::MultibodyDriver::Profile::kConstantRate:
-        driver.profile.kind = Profile::Kind::kConstantRate;
-        driver.profile.start = d.start.Resolve(p);
-        driver.profile.rate = d.rate.Resolve(p);
-        break;
-      case spec::MultibodyDriver::Profile::kPolynomial:
-        driver.profile.kind = Profile::Kind::kPolynomial;
-        for (const spec::Number& c : d.coefficients) driver.profile.coefficients.push_back(c.Resolve(p));
-        break;
-      case spec::MultibodyDriver::Profile::kTabulated:
-        driver.profile.kind = Profile::Kind::kTabulated;
-        driver.profile.table = CubicSpline(d.times_s, d.values);
-        break;
-      case spec::MultibodyDriver::Profile::kHarmonic:
-        driver.profile.kind = Profile::Kind::kHarmonic;
-        driver.profile.start = d.start.Resolve(p);
-        driver.profile.amplitude = d.amplitude.Resolve(p);
-        driver.profile.angular_frequency_rad_per_s = d.angular_frequency_rad_per_s.Resolve(p);
-        driver.profile.phase_rad = d.phase_rad.Resolve(p);
-        break;
-    }
-    m.drivers.push_back(std::move(driver));
-  }
+  for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p)});
   for (const spec::MultibodySpring& s : sm.springs) {
     SpringDamper spring;
     spring.name = s.name;
@@ -151,9 +152,13 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
                                                           r.free_angle_rad.Resolve(p)});
   }
   for (const spec::MultibodyPointForce& f : sm.point_forces) {
-    m.point_forces.push_back(PointForce{PointOf(sm, f.at, p), Resolve(f.force_n, p)});
+    m.point_forces.push_back(PointForce{PointOf(sm, f.at, p), Resolve(f.force_n, p),
+                                        f.factor ? std::optional<Profile>(ProfileOf(*f.factor, p)) : std::nullopt});
   }
-  for (const spec::MultibodyTorque& t : sm.torques) m.torques.push_back(BodyTorque{t.body, t.torque_n_m.Resolve(p)});
+  for (const spec::MultibodyTorque& t : sm.torques) {
+    m.torques.push_back(BodyTorque{t.body, t.torque_n_m.Resolve(p),
+                                   t.factor ? std::optional<Profile>(ProfileOf(*t.factor, p)) : std::nullopt});
+  }
   if (scene.effects.gravity_m_per_s2.has_value()) m.gravity_m_per_s2 = Resolve(*scene.effects.gravity_m_per_s2, p);
   if (absl::Status valid = m.Validate(); !valid.ok()) return valid;
   return m;
