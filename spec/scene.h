@@ -125,6 +125,7 @@ struct LumpedModel {
 struct MarkerRef {
   int body = -1;
   int marker = -1;
+  int input = -1;  // >= 0: a moving input point (MultibodyModel::inputs)
 };
 struct RigidBody {
   std::string name;
@@ -174,7 +175,14 @@ struct MultibodyTorque {
   Number torque_n_m;
   std::optional<TimeFactor> factor;
 };
+struct MultibodyInput {
+  std::string name;
+  Vec2 position_m;
+  double direction_x = 0.0, direction_y = 1.0;  // unit, literal
+  MultibodyDriver displacement;                 // its profile (no joint)
+};
 struct MultibodyModel {
+  std::vector<MultibodyInput> inputs;
   std::vector<LinkPoint> ground_markers;
   std::vector<RigidBody> bodies;
   std::vector<MultibodyJoint> joints;

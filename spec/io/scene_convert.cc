@@ -516,6 +516,18 @@ class SceneConverter {
       return out;
     }
     const std::string body = ref.substr(0, dot), marker = ref.substr(dot + 1);
+    if (body == "input") {
+      auto it = multibody_inputs_.find(marker);
+      if (it == multibody_inputs_.end()) {
+        errors_.Add(w, field, absl::StrCat("unknown input point \"", marker, "\" (inputs: ",
+                                           multibody_inputs_.empty() ? "none" : absl::StrJoin(Names(multibody_inputs_), ", "),
+                                           ")"));
+      } else {
+        out.input = it->second;
+        out.marker = 0;  // resolved
+      }
+      return out;
+    }
     const std::vector<LinkPoint>* markers = &multibody_.ground_markers;
     if (body != "ground") {
       auto it = multibody_bodies_.find(body);
@@ -577,6 +589,26 @@ class SceneConverter {
   MultibodyModel ConvertMultibody(const v1::MultibodyModel& m, const Where& w) {
     multibody_ = MultibodyModel{};
     multibody_.ground_markers = Markers(w, "ground_markers", m.ground_markers());
+    for (int i = 0; i < m.inputs_size(); ++i) {
+      const v1::InputPoint& in = m.inputs(i);
+      const Where iw = w.Child("inputs", i);
+      MultibodyInput input;
+      input.name = in.name();
+      if (in.name().empty()) errors_.Add(iw, "name", "an input point needs a name");
+      if (!multibody_inputs_.emplace(in.name(), i).second) {
+        errors_.Add(iw, "name", absl::StrCat("duplicate input name \"", in.name(), "\""));
+      }
+      input.position_m = Vec(iw, "position_m", in.has_position_m(), in.position_m(), Dimension::kLength);
+      Direction(iw, "direction", in.has_direction(), in.direction(), &input.direction_x, &input.direction_y);
+      if (in.has_harmonic()) {
+        Harmonic(iw.Child("harmonic"), in.harmonic(), &input.displacement);
+      } else if (in.has_tabulated()) {
+        Tabulated(iw.Child("tabulated"), in.tabulated(), &input.displacement);
+      } else {
+        errors_.Add(iw, "", "an input point needs a displacement: `harmonic { ... }` or `tabulated { ... }`");
+      }
+      multibody_.inputs.push_back(std::move(input));
+    }
     for (int i = 0; i < m.bodies_size(); ++i) {
       const v1::RigidBody& b = m.bodies(i);
       const Where bw = w.Child("bodies", i);
@@ -617,6 +649,10 @@ class SceneConverter {
       }
       joint.a = Marker(jw, "a", j.a());
       joint.b = Marker(jw, "b", j.b());
+      if (joint.a.input >= 0 || joint.b.input >= 0) {
+        errors_.Add(jw, joint.a.input >= 0 ? "a" : "b",
+                    "an input point takes springs and forces, not joints (it is not a body)");
+      }
       if (joint.a.marker >= 0 && joint.b.marker >= 0 && joint.a.body == joint.b.body) {
         errors_.Add(jw, "b", "a joint joins two different bodies (or a body and ground)");
       }
@@ -1058,7 +1094,7 @@ class SceneConverter {
   const v1::Scene& msg_;
   const Where& where_;
   MultibodyModel multibody_;
-  std::map<std::string, int> multibody_bodies_, multibody_joints_, multibody_springs_;
+  std::map<std::string, int> multibody_bodies_, multibody_joints_, multibody_springs_, multibody_inputs_;
   Errors& errors_;
   Scene scene_;
   std::vector<Dimension> units_;  // per parameter

@@ -241,11 +241,11 @@ int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, Vec
   }
   for (size_t k = 0; k < model_.springs.size(); ++k) {
     const SpringDamper& s = model_.springs[k];
-    const Vector2d d = PointPosition(s.b, q) - PointPosition(s.a, q);
+    const Vector2d d = PointPosition(s.b, q, t) - PointPosition(s.a, q, t);
     const double length = d.norm();
     if (!(length > 0.0)) return 1;  // coincident ends: no direction (the step is retried)
     const Vector2d u = d / length;
-    const double tension = SpringTension(static_cast<int>(k), q, v);
+    const double tension = SpringTension(static_cast<int>(k), q, v, t);
     if (!std::isfinite(tension)) {
       // Recoverable: a trial step may overshoot the table where the motion
       // itself stays inside; if the motion leaves it, the reason stays.
@@ -271,15 +271,28 @@ int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, Vec
   return forces->allFinite() ? 0 : 1;
 }
 
-Vector2d Mechanism::PointPosition(const Point& p, const VectorXd& q) const {
+Vector2d Mechanism::PointPosition(const Point& p, const VectorXd& q, double t) const {
+  if (p.input >= 0) {
+    const InputPoint& in = model_.inputs[static_cast<size_t>(p.input)];
+    return in.position_m + in.direction * in.displacement.At(t).q;
+  }
   return FrameOf(p.body, q, nullptr).Position(p.local_m);
 }
 
-Vector2d Mechanism::PointVelocity(const Point& p, const VectorXd& q, const VectorXd& v) const {
+Vector2d Mechanism::PointVelocity(const Point& p, const VectorXd& q, const VectorXd& v, double t) const {
+  if (p.input >= 0) {
+    const InputPoint& in = model_.inputs[static_cast<size_t>(p.input)];
+    return in.direction * in.displacement.At(t).q_dot;
+  }
   return FrameOf(p.body, q, &v).Velocity(p.local_m);
 }
 
-Vector2d Mechanism::PointAcceleration(const Point& p, const VectorXd& q, const VectorXd& v, const VectorXd& a) const {
+Vector2d Mechanism::PointAcceleration(const Point& p, const VectorXd& q, const VectorXd& v, const VectorXd& a,
+                                      double t) const {
+  if (p.input >= 0) {
+    const InputPoint& in = model_.inputs[static_cast<size_t>(p.input)];
+    return in.direction * in.displacement.At(t).q_ddot;
+  }
   if (p.body == kGround) return Vector2d::Zero();
   const Frame f = FrameOf(p.body, q, &v);
   const double phi_ddot = a[f.column + 2];
@@ -304,17 +317,17 @@ double Mechanism::JointRate(int joint, const VectorXd& q, const VectorXd& v) con
   return (fa.b * local_axis * fa.phi_dot).dot(d) + (fa.a * local_axis).dot(d_dot);
 }
 
-double Mechanism::SpringLength(int spring, const VectorXd& q) const {
+double Mechanism::SpringLength(int spring, const VectorXd& q, double t) const {
   const SpringDamper& s = model_.springs[static_cast<size_t>(spring)];
-  return (PointPosition(s.b, q) - PointPosition(s.a, q)).norm();
+  return (PointPosition(s.b, q, t) - PointPosition(s.a, q, t)).norm();
 }
 
-double Mechanism::SpringTension(int spring, const VectorXd& q, const VectorXd& v) const {
+double Mechanism::SpringTension(int spring, const VectorXd& q, const VectorXd& v, double t) const {
   const SpringDamper& s = model_.springs[static_cast<size_t>(spring)];
-  const Vector2d d = PointPosition(s.b, q) - PointPosition(s.a, q);
+  const Vector2d d = PointPosition(s.b, q, t) - PointPosition(s.a, q, t);
   const double length = d.norm();
   const double length_rate =
-      length > 0.0 ? d.dot(PointVelocity(s.b, q, v) - PointVelocity(s.a, q, v)) / length : 0.0;
+      length > 0.0 ? d.dot(PointVelocity(s.b, q, v, t) - PointVelocity(s.a, q, v, t)) / length : 0.0;
   const double deflection = length - s.free_length_m;
   double elastic = s.stiffness_n_per_m * deflection, viscous = s.damping_n_s_per_m * length_rate;
   // A curve evaluated outside its table: NaN, so that the analysis fails
@@ -334,7 +347,7 @@ double Mechanism::KineticEnergy(const VectorXd& v) const {
   return energy;
 }
 
-double Mechanism::PotentialEnergy(const VectorXd& q) const {
+double Mechanism::PotentialEnergy(const VectorXd& q, double t) const {
   double energy = 0.0;
   if (model_.gravity_m_per_s2.has_value()) {
     for (size_t i = 0; i < model_.bodies.size(); ++i) {
@@ -343,8 +356,9 @@ double Mechanism::PotentialEnergy(const VectorXd& q) const {
   }
   for (size_t k = 0; k < model_.springs.size(); ++k) {
     const SpringDamper& s = model_.springs[k];
-    const double stretch = SpringLength(static_cast<int>(k), q) - s.free_length_m;
-    energy += 0.5 * s.stiffness_n_per_m * stretch * stretch + s.actuator_force_n * SpringLength(static_cast<int>(k), q);
+    const double length = SpringLength(static_cast<int>(k), q, t);
+    const double stretch = length - s.free_length_m;
+    energy += 0.5 * s.stiffness_n_per_m * stretch * stretch + s.actuator_force_n * length;
   }
   for (const RotationalSpringDamper& r : model_.rotational_springs) {
     const double twist = JointCoordinate(r.joint, q) - r.free_angle_rad;

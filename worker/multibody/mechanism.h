@@ -61,17 +61,19 @@ class Mechanism : public ConstrainedSystem {
   Eigen::VectorXd InitialGuess() const;
 
   // Outputs of a state (SI).
-  Eigen::Vector2d PointPosition(const Point& p, const Eigen::VectorXd& q) const;
-  Eigen::Vector2d PointVelocity(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  // t_s matters only for moving input points.
+  Eigen::Vector2d PointPosition(const Point& p, const Eigen::VectorXd& q, double t_s = 0.0) const;
+  Eigen::Vector2d PointVelocity(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                double t_s = 0.0) const;
   Eigen::Vector2d PointAcceleration(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
-                                    const Eigen::VectorXd& a) const;
+                                    const Eigen::VectorXd& a, double t_s = 0.0) const;
   double JointCoordinate(int joint, const Eigen::VectorXd& q) const;
   double JointRate(int joint, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
-  double SpringLength(int spring, const Eigen::VectorXd& q) const;
-  double SpringTension(int spring, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  double SpringLength(int spring, const Eigen::VectorXd& q, double t_s = 0.0) const;
+  double SpringTension(int spring, const Eigen::VectorXd& q, const Eigen::VectorXd& v, double t_s = 0.0) const;
   double KineticEnergy(const Eigen::VectorXd& v) const;
   // Gravity (zero at y = 0 for g along -y) and the springs' strain energy.
-  double PotentialEnergy(const Eigen::VectorXd& q) const;
+  double PotentialEnergy(const Eigen::VectorXd& q, double t_s = 0.0) const;
 
   const MechanismCounters& counters() const { return counters_; }
   std::string FailureReason() const override { return failure_; }

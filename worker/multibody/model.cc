@@ -96,6 +96,9 @@ namespace {
 bool Finite(const Eigen::Vector2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
 
 absl::Status CheckPoint(const Model& m, const Point& p, const std::string& where) {
+  if (p.input >= 0 && (p.body != kGround || static_cast<size_t>(p.input) >= m.inputs.size())) {
+    return absl::InvalidArgumentError(absl::StrCat(where, ": unknown input point #", p.input));
+  }
   if (p.body != kGround && (p.body < 0 || static_cast<size_t>(p.body) >= m.bodies.size())) {
     return absl::InvalidArgumentError(absl::StrCat(where, ": unknown body #", p.body));
   }
@@ -122,6 +125,10 @@ absl::Status Model::Validate() const {
   for (const Joint& j : joints) {
     if (absl::Status s = CheckPoint(*this, j.a, "joint " + j.name); !s.ok()) return s;
     if (absl::Status s = CheckPoint(*this, j.b, "joint " + j.name); !s.ok()) return s;
+    if (j.a.input >= 0 || j.b.input >= 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("joint ", j.name, ": a moving input point takes springs and forces, not joints"));
+    }
     if (j.a.body == j.b.body) {
       return absl::InvalidArgumentError(absl::StrCat("joint ", j.name, " joins ", BodyName(j.a.body), " to itself"));
     }

@@ -43,6 +43,7 @@ struct Point {
   int body = kGround;
   Eigen::Vector2d local_m = Eigen::Vector2d::Zero();
   std::string name;  // for messages
+  int input = -1;    // >= 0: the moving input point Model::inputs[input] (body is ground)
 };
 
 enum class JointKind { kRevolute, kPrismatic, kFixed, kPointOnLine };
@@ -144,7 +145,18 @@ struct BodyTorque {
   std::optional<Profile> factor;
 };
 
+// A point of ground that moves in time along a fixed direction (a road
+// profile under a wheel, a shaker's table): position + direction * d(t).
+// Springs and forces may attach to it; joints may not (it is not a body).
+struct InputPoint {
+  std::string name;
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  Eigen::Vector2d direction = Eigen::Vector2d(0.0, 1.0);  // unit
+  Profile displacement;
+};
+
 struct Model {
+  std::vector<InputPoint> inputs;
   std::vector<Body> bodies;
   std::vector<Joint> joints;
   std::vector<Driver> drivers;

@@ -21,6 +21,7 @@ Eigen::Vector2d Resolve(const spec::Vec2& v, const std::vector<double>& p) {
 }
 
 Point PointOf(const spec::MultibodyModel& m, const spec::MarkerRef& ref, const std::vector<double>& p) {
+  if (ref.input >= 0) return Point{kGround, Eigen::Vector2d::Zero(), m.inputs[static_cast<size_t>(ref.input)].name, ref.input};
   const std::vector<spec::LinkPoint>& markers =
       ref.body < 0 ? m.ground_markers : m.bodies[static_cast<size_t>(ref.body)].markers;
   const spec::LinkPoint& marker = markers[static_cast<size_t>(ref.marker)];
@@ -69,10 +70,10 @@ double OutputValue(const Mechanism& mech, const spec::MultibodyModel& sm, const 
                    const std::vector<double>& p, const MotionSample& s, Eigen::MatrixXd* phi_q) {
   const int axis = o.axis == spec::Axis::kX ? 0 : 1;
   switch (o.quantity) {
-    case Quantity::kMarkerPosition: return mech.PointPosition(PointOf(sm, o.marker, p), s.q)[axis];
-    case Quantity::kMarkerVelocity: return mech.PointVelocity(PointOf(sm, o.marker, p), s.q, s.v)[axis];
+    case Quantity::kMarkerPosition: return mech.PointPosition(PointOf(sm, o.marker, p), s.q, s.t_s)[axis];
+    case Quantity::kMarkerVelocity: return mech.PointVelocity(PointOf(sm, o.marker, p), s.q, s.v, s.t_s)[axis];
     case Quantity::kMarkerAcceleration:
-      return mech.PointAcceleration(PointOf(sm, o.marker, p), s.q, s.v, s.a)[axis];
+      return mech.PointAcceleration(PointOf(sm, o.marker, p), s.q, s.v, s.a, s.t_s)[axis];
     case Quantity::kJointCoordinate: return mech.JointCoordinate(o.joint, s.q);
     case Quantity::kJointRate: return mech.JointRate(o.joint, s.q, s.v);
     case Quantity::kJointReaction: {
@@ -99,10 +100,10 @@ double OutputValue(const Mechanism& mech, const spec::MultibodyModel& sm, const 
       }
       return NAN;
     }
-    case Quantity::kSpringLength: return mech.SpringLength(o.spring, s.q);
-    case Quantity::kSpringForce: return mech.SpringTension(o.spring, s.q, s.v);
+    case Quantity::kSpringLength: return mech.SpringLength(o.spring, s.q, s.t_s);
+    case Quantity::kSpringForce: return mech.SpringTension(o.spring, s.q, s.v, s.t_s);
     case Quantity::kKineticEnergy: return mech.KineticEnergy(s.v);
-    case Quantity::kPotentialEnergy: return mech.PotentialEnergy(s.q);
+    case Quantity::kPotentialEnergy: return mech.PotentialEnergy(s.q, s.t_s);
   }
   return NAN;
 }
@@ -133,6 +134,10 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
     m.joints.push_back(std::move(joint));
   }
   for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p)});
+  for (const spec::MultibodyInput& in : sm.inputs) {
+    Eigen::Vector2d direction(in.direction_x, in.direction_y);
+    m.inputs.push_back(InputPoint{in.name, Resolve(in.position_m, p), direction, ProfileOf(in.displacement, p)});
+  }
   for (const spec::MultibodySpring& s : sm.springs) {
     SpringDamper spring;
     spring.name = s.name;
