@@ -47,6 +47,8 @@ const char* FormulationName(Formulation f) {
       return "dynamic";
     case Formulation::kElastodynamic:
       return "elastodynamic";
+    case Formulation::kStatic:
+      return "static";
   }
   return "unknown";
 }

@@ -17,6 +17,7 @@ enum class Formulation {
   kKinetostatic,   // driven rigid linkage + inertia loads: no time integration
   kDynamic,        // free degrees of freedom integrated in time (CVODES)
   kElastodynamic,  // beam-element links on the driven motion (CVODES, stiff)
+  kStatic,         // static equilibrium at each instant (KINSOL): no inertia, no damping
 };
 const char* FormulationName(Formulation f);
 

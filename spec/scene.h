@@ -182,6 +182,7 @@ struct MultibodyInput {
   MultibodyDriver displacement;                 // its profile (no joint)
 };
 struct MultibodyModel {
+  enum class Analysis { kFromDegreesOfFreedom, kStaticEquilibrium } analysis = Analysis::kFromDegreesOfFreedom;
   std::vector<MultibodyInput> inputs;
   std::vector<LinkPoint> ground_markers;
   std::vector<RigidBody> bodies;

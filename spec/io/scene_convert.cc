@@ -588,6 +588,16 @@ class SceneConverter {
 
   MultibodyModel ConvertMultibody(const v1::MultibodyModel& m, const Where& w) {
     multibody_ = MultibodyModel{};
+    switch (m.analysis()) {
+      case v1::MULTIBODY_ANALYSIS_FROM_DEGREES_OF_FREEDOM: break;
+      case v1::MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM:
+        multibody_.analysis = MultibodyModel::Analysis::kStaticEquilibrium;
+        break;
+      default:
+        errors_.Add(w, "analysis",
+                    "expected MULTIBODY_ANALYSIS_FROM_DEGREES_OF_FREEDOM or MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM");
+        break;
+    }
     multibody_.ground_markers = Markers(w, "ground_markers", m.ground_markers());
     for (int i = 0; i < m.inputs_size(); ++i) {
       const v1::InputPoint& in = m.inputs(i);
@@ -876,6 +886,15 @@ class SceneConverter {
       case v1::Output::kKineticEnergy: out.quantity = Q::kKineticEnergy; break;
       case v1::Output::kPotentialEnergy: out.quantity = Q::kPotentialEnergy; break;
       default: break;
+    }
+    const bool motion = out.quantity == Q::kMarkerVelocity || out.quantity == Q::kMarkerAcceleration ||
+                        out.quantity == Q::kJointRate || out.quantity == Q::kKineticEnergy;
+    if (motion && multibody_.analysis == MultibodyModel::Analysis::kStaticEquilibrium) {
+      errors_.Add(ow, "",
+                  absl::StrCat("output \"", o.name(),
+                               "\" is a rate, an acceleration or kinetic energy: a static-equilibrium analysis has "
+                               "no motion (ask for positions, joint coordinates, reactions, driver efforts, spring "
+                               "lengths and forces, potential energy)"));
     }
     return out;
   }

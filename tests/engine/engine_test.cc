@@ -29,6 +29,7 @@ TEST(Engine, FormulationNamesAreStable) {
   EXPECT_STREQ(FormulationName(Formulation::kKinetostatic), "kinetostatic");
   EXPECT_STREQ(FormulationName(Formulation::kDynamic), "dynamic");
   EXPECT_STREQ(FormulationName(Formulation::kElastodynamic), "elastodynamic");
+  EXPECT_STREQ(FormulationName(Formulation::kStatic), "static");
 }
 
 TEST(Engine, LumpedSceneIsADynamicAnalysisWithCountersAndWallTime) {

@@ -85,6 +85,11 @@ TEST(MultibodyDynamics, FreeFallWithoutConstraints) {
   model.bodies.push_back(b);
   model.gravity_m_per_s2 = Eigen::Vector2d(0.0, -9.81);
   const Mechanism m(model);
+  // Assembly of a body with no joint: nothing to close, three free
+  // coordinates (an empty residual once crashed it).
+  const Assembly assembled = Assemble(m, 0.0);
+  ASSERT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  EXPECT_EQ(assembled.degrees_of_freedom, 3);
   Eigen::VectorXd v0(3);
   v0 << 1.0, 2.0, 0.5;
   ForwardDynamicsCounters counters;

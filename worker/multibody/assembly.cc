@@ -69,7 +69,7 @@ spec::AnalysisFailure SolvePositions(const Mechanism& m, double t, const Assembl
   Eigen::MatrixXd phi_q;
   for (*iterations = 0; *iterations <= options.max_iterations; ++*iterations) {
     if (m.Constraints(t, *q, &phi) != 0) break;
-    if (phi.cwiseAbs().maxCoeff() <= options.position_tolerance) return spec::AnalysisFailure::Ok();
+    if (MaxAbs(phi) <= options.position_tolerance) return spec::AnalysisFailure::Ok();
     if (*iterations == options.max_iterations) break;
     m.ConstraintJacobian(t, *q, &phi_q);
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(phi_q);
@@ -99,7 +99,7 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
     for (size_t k = 0; k < held.size(); ++k) {
       phi[m.num_constraints() + static_cast<Eigen::Index>(k)] = m.JointCoordinate(held[k].joint, q) - held[k].value;
     }
-    residual = phi.allFinite() ? phi.cwiseAbs().maxCoeff() : INFINITY;
+    residual = phi.allFinite() ? MaxAbs(phi) : INFINITY;
     if (residual <= options.position_tolerance) {
       closed = true;
       out.newton_iterations = it;
@@ -118,7 +118,7 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
     for (int halving = 0; halving < 20; ++halving) {
       const Eigen::VectorXd trial = q + scale * step;
       m.Constraints(t, trial, &constraint_phi);
-      if (constraint_phi.allFinite() && constraint_phi.cwiseAbs().maxCoeff() < std::max(residual, 1e-300) * 1.0001) {
+      if (constraint_phi.allFinite() && MaxAbs(constraint_phi) < std::max(residual, 1e-300) * 1.0001) {
         break;
       }
       scale *= 0.5;
@@ -136,15 +136,19 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
   m.ConstraintJacobian(t, q, &constraint_jac);
   // Degrees of freedom and redundant rows: a pivoted QR of Phi_q^T picks
   // independent constraint rows; the rest are redundant.
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(constraint_jac.transpose());
-  qr.setThreshold(options.rank_tolerance);
-  qr.compute(constraint_jac.transpose());
-  const int rank = static_cast<int>(qr.rank());
-  out.degrees_of_freedom = n - rank;
-  for (int k = rank; k < m.num_constraints(); ++k) {
-    const int row = static_cast<int>(qr.colsPermutation().indices()[k]);
-    const std::string name = m.model().joints[static_cast<size_t>(m.joint_of_row(row))].name;
-    if (out.redundant.empty() || out.redundant.back() != name) out.redundant.push_back(name);
+  // (Eigen's QR of an empty matrix is undefined: a free body has no rows.)
+  out.degrees_of_freedom = n;
+  if (m.num_constraints() > 0) {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(constraint_jac.transpose());
+    qr.setThreshold(options.rank_tolerance);
+    qr.compute(constraint_jac.transpose());
+    const int rank = static_cast<int>(qr.rank());
+    out.degrees_of_freedom = n - rank;
+    for (int k = rank; k < m.num_constraints(); ++k) {
+      const int row = static_cast<int>(qr.colsPermutation().indices()[k]);
+      const std::string name = m.model().joints[static_cast<size_t>(m.joint_of_row(row))].name;
+      if (out.redundant.empty() || out.redundant.back() != name) out.redundant.push_back(name);
+    }
   }
   // Velocities: Phi_q v = -Phi_t, held rates, minimum norm otherwise.
   const std::vector<HeldCoordinate> rates = HeldCoordinates(m.model(), true);
@@ -158,7 +162,8 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
     vel_jac.row(m.num_constraints() + static_cast<Eigen::Index>(k)) = CoordinateGradient(m, rates[k].joint, q);
     vel_rhs[m.num_constraints() + static_cast<Eigen::Index>(k)] = rates[k].value;
   }
-  out.v = vel_jac.completeOrthogonalDecomposition().solve(vel_rhs);
+  out.v = vel_jac.rows() > 0 ? Eigen::VectorXd(vel_jac.completeOrthogonalDecomposition().solve(vel_rhs))
+                             : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
   out.q = std::move(q);
   return out;
 }

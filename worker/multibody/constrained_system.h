@@ -60,4 +60,8 @@ class ConstrainedSystem {
   virtual double* parameters() { return nullptr; }
 };
 
+// The largest magnitude of a residual; 0 for a system without constraints
+// (a free body), where Eigen's maxCoeff of an empty vector is undefined.
+inline double MaxAbs(const Eigen::VectorXd& v) { return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff(); }
+
 }  // namespace mbopt::multibody

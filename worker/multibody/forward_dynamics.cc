@@ -228,9 +228,9 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
       system.Constraints(t, sample.q, &phi);
       system.ConstraintJacobian(t, sample.q, &phi_q);
       system.ConstraintTimeDerivative(t, sample.q, &phi_t);
-      counters->max_position_drift = std::max(counters->max_position_drift, phi.cwiseAbs().maxCoeff());
+      counters->max_position_drift = std::max(counters->max_position_drift, MaxAbs(phi));
       counters->max_velocity_drift =
-          std::max(counters->max_velocity_drift, (phi_q * sample.v + phi_t).cwiseAbs().maxCoeff());
+          std::max(counters->max_velocity_drift, MaxAbs(phi_q * sample.v + phi_t));
     }
     if (spec::AnalysisFailure f = at_instant(sample); !f.ok()) return f;
   }

@@ -10,6 +10,7 @@
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/multibody/static_equilibrium.h"
 
 namespace mbopt::multibody {
 namespace {
@@ -239,7 +240,14 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
     return spec::AnalysisFailure::Ok();
   };
   spec::AnalysisFailure outcome;
-  if (assembled.degrees_of_freedom == 0) {
+  if (sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium) {
+    report.formulation = spec::Formulation::kStatic;
+    StaticCounters counters;
+    outcome = RunStaticEquilibrium(mechanism, assembled.q, times, StaticOptions{}, record, &counters);
+    report.counters.position_solves += counters.position_solves;
+    report.counters.newton_iterations += counters.newton_iterations;
+    report.counters.rhs_evaluations += counters.residual_evaluations;
+  } else if (assembled.degrees_of_freedom == 0) {
     KinematicOptions options;
     options.inverse_dynamics = NeedsMultipliers(scene);
     report.formulation = options.inverse_dynamics ? spec::Formulation::kKinetostatic : spec::Formulation::kKinematic;

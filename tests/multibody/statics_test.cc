@@ -1,0 +1,246 @@
+// Static equilibrium against closed forms (virtual work), its stability
+// test, and the scene-level contract: the formulation, the counters (no time
+// step, no mass matrix) and the outputs a static analysis refuses.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "spec/io/study_io.h"
+#include "tests/multibody/mechanisms.h"
+#include "worker/multibody/assembly.h"
+#include "worker/multibody/mechanism.h"
+#include "worker/multibody/scene_analysis.h"
+#include "worker/multibody/static_equilibrium.h"
+
+namespace mbopt::multibody {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::At;
+using testing::Bar;
+using testing::Revolute;
+
+struct Solved {
+  spec::AnalysisFailure failure;
+  std::vector<MotionSample> samples;
+  StaticCounters counters;
+};
+
+Solved SolveStatic(const Mechanism& mechanism, const std::vector<double>& times) {
+  Solved out;
+  const Assembly assembled = Assemble(mechanism, times.front());
+  EXPECT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  out.failure = RunStaticEquilibrium(
+      mechanism, assembled.q, times, StaticOptions{},
+      [&](const MotionSample& s) {
+        out.samples.push_back(s);
+        return spec::AnalysisFailure::Ok();
+      },
+      &out.counters);
+  return out;
+}
+
+// A uniform bar (m, L) pinned at one end to ground, with a rotational spring
+// k at the pin (free angle 0: horizontal), under gravity: equilibrium where
+// k theta = -m g (L/2) cos theta (theta from the horizontal). The pin carries
+// the weight: reaction (0, m g) on the bar.
+TEST(MultibodyStatics, SpringLoadedBarBalancesItsWeight) {
+  const double m = 2.0, length = 0.8, k = 20.0, g = 9.81;
+  Model model;
+  model.bodies.push_back(Bar("bar", m, length, {length / 2, 0.0}, 0.0));
+  model.joints.push_back(Revolute("pin", At(kGround, 0.0), At(0, -length / 2)));
+  model.rotational_springs.push_back(RotationalSpringDamper{"spring", 0, k, 0.0, 0.0});
+  model.gravity_m_per_s2 = Eigen::Vector2d(0.0, -g);
+  ASSERT_TRUE(model.Validate().ok());
+  const Mechanism mechanism(model);
+  const Solved solved = SolveStatic(mechanism, {0.0});
+  ASSERT_TRUE(solved.failure.ok()) << solved.failure.reason;
+  ASSERT_EQ(solved.samples.size(), 1u);
+
+  // Reference: scalar Newton on k th + m g L/2 cos th = 0.
+  double theta = 0.0;
+  for (int i = 0; i < 50; ++i) {
+    const double f = k * theta + m * g * length / 2 * std::cos(theta);
+    const double df = k - m * g * length / 2 * std::sin(theta);
+    theta -= f / df;
+  }
+  const MotionSample& s = solved.samples[0];
+  EXPECT_NEAR(mechanism.JointCoordinate(0, s.q), theta, 1e-10);
+  EXPECT_LT(theta, -0.3);  // a real deflection, not the start
+  // -Phi_q^T lambda on the bar's x, y: the force ground exerts on it.
+  Eigen::MatrixXd phi_q;
+  mechanism.ConstraintJacobian(0.0, s.q, &phi_q);
+  const Eigen::Vector2d reaction = -phi_q.block(0, 0, 2, 2).transpose() * s.lambda.head(2);
+  EXPECT_NEAR(reaction.x(), 0.0, 1e-9);
+  EXPECT_NEAR(reaction.y(), m * g, 1e-9);
+  EXPECT_GT(solved.counters.newton_iterations, 0);
+  EXPECT_EQ(solved.counters.position_solves, 1);
+  EXPECT_EQ(mechanism.counters().mass_matrix_evaluations, 0);
+}
+
+// A body on a vertical slide hung from a spring (k, free length L0) from a
+// ground point above: it settles m g / k below the free length.
+TEST(MultibodyStatics, HangingMassStretchesItsSpringByWeightOverStiffness) {
+  const double m = 3.0, k = 1500.0, free_length = 0.5, g = 9.81;
+  Model model;
+  Body block;
+  block.name = "block";
+  block.mass_kg = m;
+  block.inertia_kg_m2 = 0.01;
+  block.position_m = {0.0, -0.4};
+  model.bodies.push_back(block);
+  Joint slide;
+  slide.name = "slide";
+  slide.kind = JointKind::kPrismatic;
+  slide.a = At(kGround, 0.0);
+  slide.b = At(0, 0.0);
+  slide.axis_angle_rad = std::numbers::pi / 2;
+  model.joints.push_back(slide);
+  SpringDamper spring;
+  spring.name = "spring";
+  spring.a = At(kGround, 0.0, 0.0);
+  spring.b = At(0, 0.0);
+  spring.free_length_m = free_length;
+  spring.stiffness_n_per_m = k;
+  model.springs.push_back(spring);
+  model.gravity_m_per_s2 = Eigen::Vector2d(0.0, -g);
+  ASSERT_TRUE(model.Validate().ok());
+  const Mechanism mechanism(model);
+  const Solved solved = SolveStatic(mechanism, {0.0});
+  ASSERT_TRUE(solved.failure.ok()) << solved.failure.reason;
+  EXPECT_NEAR(solved.samples[0].q[1], -(free_length + m * g / k), 1e-12);
+  EXPECT_NEAR(mechanism.SpringTension(0, solved.samples[0].q, solved.samples[0].v), m * g, 1e-9);
+}
+
+// A driven slider-crank held against a constant force P on the slider: by
+// virtual work the static driver torque is T = -F_x dx/dth with
+// dx/dth = -r sin th - r^2 sin th cos th / sqrt(l^2 - r^2 sin^2 th), at every
+// crank angle along the driven motion (no inertia in a static analysis).
+TEST(MultibodyStatics, SliderCrankDriverTorqueIsTheVirtualWorkOfTheLoad) {
+  const double r = 0.1, l = 0.35, omega = 2.0, force = -250.0;
+  Model model = testing::SliderCrank(r, l, omega);
+  model.point_forces.push_back(PointForce{At(2, 0.0), Eigen::Vector2d(force, 0.0), std::nullopt});
+  model.gravity_m_per_s2 = Eigen::Vector2d(0.0, -9.81);  // balanced by the pin and the slide: no torque
+  ASSERT_TRUE(model.Validate().ok());
+  const Mechanism mechanism(model);
+  std::vector<double> times;
+  for (int i = 0; i <= 30; ++i) times.push_back(0.1 * i);
+  const Solved solved = SolveStatic(mechanism, times);
+  ASSERT_TRUE(solved.failure.ok()) << solved.failure.reason;
+  ASSERT_EQ(solved.samples.size(), times.size());
+  const int driver_row = mechanism.row_of_driver(0);
+  double worst = 0.0;
+  for (const MotionSample& s : solved.samples) {
+    const double th = omega * s.t_s;
+    const double root = std::sqrt(l * l - r * r * std::sin(th) * std::sin(th));
+    const double dx = -r * std::sin(th) - r * r * std::sin(th) * std::cos(th) / root;
+    // Weight of the crank and rod also does virtual work: their centres
+    // drop by d(y)/dth.
+    const double dy_crank = 0.5 * r * std::cos(th);
+    const double dy_rod = 0.5 * r * std::cos(th);  // the rod's centre is midway between tip and slider (y = 0)
+    const double expected = -force * dx + 9.81 * (1.0 * dy_crank + 2.0 * dy_rod);
+    worst = std::max(worst, std::abs(-s.lambda[driver_row] - expected));
+  }
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_EQ(solved.counters.position_solves, static_cast<long>(times.size()));
+}
+
+// An inverted pendulum is in equilibrium straight up, but not a stable one.
+TEST(MultibodyStatics, UnstableEquilibriumIsAFailedAnalysisNamingTheTime) {
+  Model model = testing::Pendulum(1.0, 1.0, std::numbers::pi);  // straight up
+  const Mechanism mechanism(model);
+  const Solved solved = SolveStatic(mechanism, {0.0});
+  ASSERT_FALSE(solved.failure.ok());
+  EXPECT_EQ(solved.failure.kind, spec::FailureKind::kModelValidity);
+  EXPECT_THAT(solved.failure.reason, HasSubstr("unstable"));
+  EXPECT_THAT(solved.failure.reason, HasSubstr("t = 0"));
+}
+
+// Hanging down, the same pendulum is stable and found from 60 degrees off.
+TEST(MultibodyStatics, PendulumSettlesStraightDownFromAnAngle) {
+  Model model = testing::Pendulum(1.0, 1.0, std::numbers::pi / 3);
+  const Mechanism mechanism(model);
+  const Solved solved = SolveStatic(mechanism, {0.0});
+  ASSERT_TRUE(solved.failure.ok()) << solved.failure.reason;
+  EXPECT_NEAR(solved.samples[0].q[0], 0.0, 1e-10);
+  EXPECT_NEAR(solved.samples[0].q[1], -0.5, 1e-10);
+}
+
+// No equilibrium exists: a free body under gravity with nothing to hold it.
+TEST(MultibodyStatics, NoEquilibriumIsAFailedAnalysis) {
+  Model model;
+  model.bodies.push_back(Bar("stone", 1.0, 0.1, {0.0, 0.0}, 0.0));
+  model.gravity_m_per_s2 = Eigen::Vector2d(0.0, -9.81);
+  const Mechanism mechanism(model);
+  const Solved solved = SolveStatic(mechanism, {0.0});
+  ASSERT_FALSE(solved.failure.ok());
+  EXPECT_EQ(solved.failure.kind, spec::FailureKind::kAssembly);
+  EXPECT_THAT(solved.failure.reason, HasSubstr("no static equilibrium found at t = 0"));
+}
+
+constexpr char kStaticArmScene[] = R"pb(
+name: "arm"
+parameters { name: "k" value: 20 }
+effects { gravity { acceleration_m_per_s2 { x { value: 0 } y { value: -9.81 } } } }
+multibody {
+  analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
+  bodies {
+    name: "arm"
+    mass_kg { value: 2 }
+    inertia_kg_m2 { value: 0.1067 }
+    position_m { x { value: 0.4 } }
+    markers { name: "pin" position_m { x { value: -0.4 } } }
+  }
+  joints { name: "pin" kind: JOINT_REVOLUTE a: "ground.origin" b: "arm.pin" }
+  ground_markers { name: "origin" }
+  rotational_springs { name: "spring" joint: "pin" stiffness_n_m_per_rad { param: "k" } }
+}
+outputs { name: "angle" joint_coordinate { joint: "pin" } }
+outputs { name: "pin_y" joint_reaction { joint: "pin" axis: AXIS_Y } }
+%s
+time_grid { start_s: 0 end_s: 0 points: 1 }
+)pb";
+
+std::string WriteScene(const std::string& extra_output) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("mbopt_static_" + std::to_string(::getpid()) + ".textproto");
+  std::string text(kStaticArmScene);
+  text.replace(text.find("%s"), 2, extra_output);
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(MultibodyStatics, SceneDeclaresTheAnalysisAndComputesNoMotion) {
+  const std::string path = WriteScene("");
+  absl::StatusOr<spec::Scene> scene = spec::io::LoadSceneFile(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const spec::AnalysisReport report = AnalyzeMultibodyScene(*scene, {20.0});
+  ASSERT_TRUE(report.ok()) << report.failure.reason;
+  EXPECT_EQ(report.formulation, spec::Formulation::kStatic);
+  EXPECT_EQ(report.counters.time_steps, 0);
+  EXPECT_EQ(report.counters.position_solves, 1);
+  EXPECT_GT(report.counters.newton_iterations, 0);
+  EXPECT_NEAR(report.outputs[1].series[0][0], 2.0 * 9.81, 1e-9);
+  EXPECT_LT(report.outputs[0].series[0][0], -0.3);
+}
+
+TEST(MultibodyStatics, SceneRefusesRatesInAStaticAnalysis) {
+  const std::string path = WriteScene(R"(outputs { name: "energy" kinetic_energy {} })");
+  absl::StatusOr<spec::Scene> scene = spec::io::LoadSceneFile(path);
+  std::filesystem::remove(path);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("static-equilibrium analysis has no motion"));
+  EXPECT_THAT(std::string(scene.status().message()), HasSubstr("energy"));
+}
+
+}  // namespace
+}  // namespace mbopt::multibody

@@ -1,0 +1,57 @@
+// Static (quasi-static) equilibrium of a constrained system at each output
+// instant: the coordinates q and multipliers lambda with
+//
+//   Q(t, q, 0) - Phi_q(t, q)^T lambda = 0     (n equations: forces balance)
+//   Phi(t, q) = 0                             (m constraints, drivers at t)
+//
+// solved by SUNDIALS KINSOL (Newton with a line search, the Jacobian by
+// difference quotients), each instant started from the previous one's
+// solution. The motion is taken as infinitely slow: drivers, moving inputs
+// and time-varying loads act with their values at t, inertia and damping not
+// at all, and the reported states have zero velocities and accelerations
+// (a scene analysed statically may not ask for rates, accelerations or
+// kinetic energy; the scene loader refuses them).
+//
+// An equilibrium that is not stable (the tangent stiffness reduced to the
+// free directions, N^T K N with N spanning the null space of Phi_q, has a
+// negative eigenvalue: an inverted pendulum) is a failed analysis naming the
+// time, because a mechanism would move away from it. Non-conservative loads
+// are judged by the symmetric part of K. A Newton failure (no equilibrium
+// near the start, a singular Jacobian at a dead centre) is a kAssembly
+// failure naming the time and KINSOL's reason.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "spec/analysis_outcome.h"
+#include "worker/multibody/constrained_system.h"
+#include "worker/multibody/motion.h"
+
+namespace mbopt::multibody {
+
+struct StaticOptions {
+  // Converged when every constraint residual is below this (m or rad) and
+  // every force residual below it times the force scale (the largest applied
+  // force at the start, at least 1 N).
+  double tolerance = 1e-10;
+  int max_iterations = 200;  // Newton iterations per instant
+  // Relative size of the most negative reduced stiffness eigenvalue (to the
+  // largest in magnitude) that still counts as neutral, not unstable.
+  double stability_tolerance = 1e-8;
+};
+
+struct StaticCounters {
+  std::int64_t position_solves = 0;      // one per instant
+  std::int64_t newton_iterations = 0;
+  std::int64_t residual_evaluations = 0;  // KINSOL's, Jacobian differences included
+};
+
+// From (q0) assembled at times_s.front(); `times_s` ascending.
+spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, const Eigen::VectorXd& q0,
+                                           const std::vector<double>& times_s, const StaticOptions& options,
+                                           const MotionCallback& at_instant, StaticCounters* counters);
+
+}  // namespace mbopt::multibody
