@@ -58,7 +58,8 @@ struct OptimizerSettings {
   bool central_differences = false;
   std::optional<double> finite_difference_relative_step;
   // Gradients from the simulator's forward sensitivity analysis instead of
-  // finite differences (lumped scenes only).
+  // finite differences (lumped and multibody scenes; not linkage scenes
+  // or static multibody analyses).
   bool simulator_sensitivities = false;
 };
 

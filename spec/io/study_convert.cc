@@ -279,10 +279,17 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
     s.central_differences = p.finite_difference() == v1::FINITE_DIFFERENCE_CENTRAL;
     s.simulator_sensitivities = p.sensitivity() == v1::SENSITIVITY_METHOD_SIMULATOR;
-    if (s.simulator_sensitivities && !std::holds_alternative<LumpedModel>(scene.model)) {
+    if (s.simulator_sensitivities && std::holds_alternative<LinkageModel>(scene.model)) {
       errors->Add(w, "sensitivity",
-                  "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: only "
-                  "lumped scenes have simulator sensitivities; use finite differences");
+                  "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: linkage scenes have no "
+                  "simulator sensitivities (write the mechanism as a multibody scene, or use finite differences)");
+    }
+    const auto* multibody = std::get_if<MultibodyModel>(&scene.model);
+    if (s.simulator_sensitivities && multibody != nullptr &&
+        multibody->analysis == MultibodyModel::Analysis::kStaticEquilibrium) {
+      errors->Add(w, "sensitivity",
+                  "SENSITIVITY_METHOD_SIMULATOR is not available for a static-equilibrium analysis yet; use "
+                  "finite differences");
     }
   }
 

@@ -87,6 +87,39 @@ TEST(IsolatorStudy, ConvergesWithTheSwingLimitActive) {
             << " N/m, c = " << run->design_si[1] << " N s/m after " << run->outcome.cycles << " cycles\n";
 }
 
+// Simulator sensitivities (multibody: IDAS forward sensitivities for the
+// isolator, the differentiated constraint equations for the press) give
+// the optimizer the gradients it would get from finite differences: the
+// same optimum, with one analysis per cycle instead of 1 + n.
+void ExpectSameOptimumWithFewerAnalyses(const char* path, double design_tolerance) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(path);
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<local_run::LocalRunResult> differences = local_run::RunStudyLocally(*study);
+  study->optimizer.simulator_sensitivities = true;
+  absl::StatusOr<local_run::LocalRunResult> simulator = local_run::RunStudyLocally(*study);
+  ASSERT_TRUE(differences.ok() && simulator.ok());
+  EXPECT_EQ(simulator->outcome.state, slp::RunState::kConverged) << simulator->end_reason;
+  for (size_t i = 0; i < simulator->design_si.size(); ++i) {
+    EXPECT_NEAR(simulator->design_si[i], differences->design_si[i],
+                design_tolerance * std::abs(differences->design_si[i]));
+  }
+  EXPECT_NEAR(simulator->outcome.objective, differences->outcome.objective,
+              5e-3 * std::abs(differences->outcome.objective));
+  EXPECT_LT(simulator->analyses_run, differences->analyses_run);
+  std::cout << path << ": " << simulator->outcome.cycles << " cycles, " << simulator->analyses_run
+            << " analyses with simulator sensitivities, F = " << simulator->outcome.objective << "; "
+            << differences->outcome.cycles << " cycles, " << differences->analyses_run
+            << " analyses with finite differences, F = " << differences->outcome.objective << "\n";
+}
+
+TEST(MultibodySensitivityStudies, PressReachesTheSameOptimumWithFewerAnalyses) {
+  ExpectSameOptimumWithFewerAnalyses(kPressStudy, 5e-3);
+}
+
+TEST(MultibodySensitivityStudies, IsolatorReachesTheSameOptimumWithFewerAnalyses) {
+  ExpectSameOptimumWithFewerAnalyses("examples/isolator/isolator.study.textproto", 2e-2);
+}
+
 TEST(MultibodySceneLoading, UnknownMarkerIsNamedWithFileLineAndTheMarkersThatExist) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mbopt_multibody_scene_test";
   std::filesystem::create_directories(dir);

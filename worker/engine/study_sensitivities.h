@@ -1,13 +1,15 @@
 // One analysis of a study at a scaled design point that also yields the
 // gradients of the study values with respect to the scaled design variables,
-// from the simulator's forward sensitivity analysis
-// (worker/solve/lumped_sensitivity.h) and the layout's chain rule
+// from the simulator's forward sensitivity analysis (lumped scenes:
+// worker/solve/lumped_sensitivity.h; multibody scenes:
+// worker/multibody/scene_analysis.h) and the layout's chain rule
 // (spec/study_gradients.h). Pure: no threads, no I/O.
 //
-// When the scene has no simulator sensitivities (a linkage scene, or a
-// design variable that sets something other than a mass, inertia,
-// stiffness or damping) the plain analysis is run and `gradients` is empty
-// with the reason: the caller then uses finite differences.
+// When the scene has no simulator sensitivities (a linkage scene, a static
+// multibody analysis, or a lumped design variable that sets something other
+// than a mass, inertia, stiffness or damping) the plain analysis is run and
+// `gradients` is empty with the reason: the caller then uses finite
+// differences.
 #pragma once
 
 #include <optional>

@@ -93,18 +93,19 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
   Eigen::MatrixXd jac(rows, n), constraint_jac;
   double residual = 0.0;
   bool closed = false;
-  for (int it = 0; it <= options.max_iterations; ++it) {
+  int polished = 0;
+  for (int it = 0; it <= options.max_iterations + options.polish_iterations; ++it) {
     m.Constraints(t, q, &constraint_phi);
     phi.head(m.num_constraints()) = constraint_phi;
     for (size_t k = 0; k < held.size(); ++k) {
       phi[m.num_constraints() + static_cast<Eigen::Index>(k)] = m.JointCoordinate(held[k].joint, q) - held[k].value;
     }
     residual = phi.allFinite() ? MaxAbs(phi) : INFINITY;
-    if (residual <= options.position_tolerance) {
+    if (residual <= options.position_tolerance && !closed) {
       closed = true;
       out.newton_iterations = it;
-      break;
     }
+    if (closed && (polished++ == options.polish_iterations || residual == 0.0)) break;
     m.ConstraintJacobian(t, q, &constraint_jac);
     jac.topRows(m.num_constraints()) = constraint_jac;
     for (size_t k = 0; k < held.size(); ++k) {

@@ -28,6 +28,10 @@ struct AssemblyOptions {
   // Relative threshold of the QR's diagonal below which a constraint row is
   // counted as redundant.
   double rank_tolerance = 1e-9;
+  // Newton steps taken after convergence: sensitivities difference
+  // assemblies of nearby designs, which needs positions closed to round-off,
+  // not to the tolerance.
+  int polish_iterations = 0;
 };
 
 struct Assembly {

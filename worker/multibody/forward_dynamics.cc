@@ -5,6 +5,7 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -27,10 +28,33 @@ struct Problem {
   double max_wall_seconds = 0.0;
   bool wall_time_exceeded = false;
   std::string callback_failure;
+  const std::vector<ParameterPerturbation>* parameters = nullptr;  // sensitivities, if any
   // Work space.
   Eigen::MatrixXd mass, phi_q;
   VectorXd forces, phi, phi_t;
 };
+
+// The GGL residual of system `s` at (t, y, y').
+template <class Y, class YDot, class R>
+int EvaluateResidual(const ConstrainedSystem& s, Problem* p, double t, const Y& y, const YDot& y_dot, R& r) {
+  const int n = p->n, m = p->m;
+  const VectorXd q = y.head(n), v = y.segment(n, n);
+  int flag = s.MassMatrix(q, &p->mass);
+  if (flag == 0) flag = s.AppliedForces(t, q, v, &p->forces);
+  if (flag == 0 && m > 0) flag = s.ConstraintJacobian(t, q, &p->phi_q);
+  if (flag == 0 && m > 0) flag = s.Constraints(t, q, &p->phi);
+  if (flag == 0 && m > 0) flag = s.ConstraintTimeDerivative(t, q, &p->phi_t);
+  if (flag != 0) return flag;
+  r.head(n) = y_dot.head(n) - v;
+  r.segment(n, n) = p->mass * y_dot.segment(n, n) - p->forces;
+  if (m > 0) {
+    r.head(n) += p->phi_q.transpose() * y.segment(2 * n + m, m);
+    r.segment(n, n) += p->phi_q.transpose() * y.segment(2 * n, m);
+    r.segment(2 * n, m) = p->phi;
+    r.segment(2 * n + m, m) = p->phi_q * v + p->phi_t;
+  }
+  return r.allFinite() ? 0 : 1;
+}
 
 int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
@@ -40,32 +64,102 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
       p->wall_time_exceeded = true;
       return -1;
     }
-    const int n = p->n, m = p->m;
-    const Map<const VectorXd> y(N_VGetArrayPointer(yy), 2 * n + 2 * m);
-    const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), 2 * n + 2 * m);
-    Map<VectorXd> r(N_VGetArrayPointer(rr), 2 * n + 2 * m);
-    const VectorXd q = y.head(n), v = y.segment(n, n);
-    const ConstrainedSystem& s = *p->system;
-    int flag = s.MassMatrix(q, &p->mass);
-    if (flag == 0) flag = s.AppliedForces(t, q, v, &p->forces);
-    if (flag == 0 && m > 0) flag = s.ConstraintJacobian(t, q, &p->phi_q);
-    if (flag == 0 && m > 0) flag = s.Constraints(t, q, &p->phi);
-    if (flag == 0 && m > 0) flag = s.ConstraintTimeDerivative(t, q, &p->phi_t);
-    if (flag != 0) return flag;
-    r.head(n) = y_dot.head(n) - v;
-    r.segment(n, n) = p->mass * y_dot.segment(n, n) - p->forces;
-    if (m > 0) {
-      r.head(n) += p->phi_q.transpose() * y.segment(2 * n + m, m);
-      r.segment(n, n) += p->phi_q.transpose() * y.segment(2 * n, m);
-      r.segment(2 * n, m) = p->phi;
-      r.segment(2 * n + m, m) = p->phi_q * v + p->phi_t;
-    }
-    return r.allFinite() ? 0 : 1;
+    const int size = 2 * p->n + 2 * p->m;
+    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
+    const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
+    Map<VectorXd> r(N_VGetArrayPointer(rr), size);
+    return EvaluateResidual(*p->system, p, t, y, y_dot, r);
   } catch (const std::exception& e) {
     p->callback_failure = e.what();
     return -1;
   } catch (...) {
     p->callback_failure = "unknown exception in the residual";
+    return -1;
+  }
+}
+
+// The sensitivity residuals F_y s_k + F_y' s_k' + F_p_k. F is linear in y'
+// and in the multipliers, and M is constant, so those terms are exact:
+// [s_q' + Phi_q^T s_mu; M s_v' + Phi_q^T s_lambda; 0; 0]. The rest are
+// central differences: along (s_q, s_v) with a step scaled to the state
+// (1e-6 of it), and in p between the systems rebuilt at p +- step_k at the
+// unchanged state, which is exactly zero in the rows the parameter does not
+// enter (a stiffness never enters the constraints). Differencing the whole
+// residual along (s, s', e_k) in one step was tried first: its round-off in
+// the constraint rows, divided by the parameter's step, is above the
+// sensitivities' absolute tolerance at rtol 1e-10, and IDAS's corrector
+// failed at the first step.
+int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vector /*rr*/, N_Vector* y_s,
+                        N_Vector* yp_s, N_Vector* rr_s, void* user_data, N_Vector, N_Vector, N_Vector) {
+  auto* p = static_cast<Problem*>(user_data);
+  try {
+    const int n = p->n, m = p->m, size = 2 * n + 2 * m;
+    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
+    const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
+    Eigen::MatrixXd mass, phi_q;
+    const VectorXd q = y.head(n);
+    if (int flag = p->system->MassMatrix(q, &mass); flag != 0) return flag;
+    if (m > 0) {
+      if (int flag = p->system->ConstraintJacobian(t, q, &phi_q); flag != 0) return flag;
+    }
+    const double state_scale = std::max(1.0, y.head(2 * n).cwiseAbs().maxCoeff());
+    VectorXd y_shift(size), r_plus(size), r_minus(size), result(size);
+    for (int k = 0; k < count; ++k) {
+      const ParameterPerturbation& dp = (*p->parameters)[static_cast<size_t>(k)];
+      const Map<const VectorXd> s(N_VGetArrayPointer(y_s[k]), size);
+      const Map<const VectorXd> s_dot(N_VGetArrayPointer(yp_s[k]), size);
+      result.setZero();
+      result.head(n) = s_dot.head(n);
+      result.segment(n, n) = mass * s_dot.segment(n, n);
+      if (m > 0) {
+        result.head(n) += phi_q.transpose() * s.segment(2 * n + m, m);
+        result.segment(n, n) += phi_q.transpose() * s.segment(2 * n, m);
+      }
+      const double direction = MaxAbs(s.head(2 * n));
+      if (direction > 0.0) {
+        const double sigma = 1e-6 * state_scale / direction;
+        y_shift = y;
+        y_shift.head(2 * n) += sigma * s.head(2 * n);
+        if (int flag = EvaluateResidual(*p->system, p, t, y_shift, y_dot, r_plus); flag != 0) return flag;
+        y_shift.head(2 * n) = y.head(2 * n) - sigma * s.head(2 * n);
+        if (int flag = EvaluateResidual(*p->system, p, t, y_shift, y_dot, r_minus); flag != 0) return flag;
+        result += (r_plus - r_minus) / (2.0 * sigma);
+      }
+      if (m > 0) {
+        // The constraint rows exactly: Phi_q s_q, and Phi_q s_v + d(Phi_q v
+        // + Phi_t)/dq s_q, whose second term is bilinear in (v, s_q) apart
+        // from Phi_qt: by polarization of gamma = -(Phi_q v)_q v -
+        // 2 Phi_qt v - Phi_tt it is -(gamma(v + w) - gamma(v - w)) / 4 for
+        // w = s_q (scaled to v's size against round-off). Differences of
+        // positions here would carry round-off of the order of rtol at tight
+        // tolerances.
+        result.segment(2 * n, m) = phi_q * s.head(n);
+        result.segment(2 * n + m, m) = phi_q * s.segment(n, n);
+        const double w_norm = MaxAbs(s.head(n));
+        if (w_norm > 0.0) {
+          const VectorXd v = y.segment(n, n);
+          const double alpha = std::max(MaxAbs(v), 1e-3) / w_norm;
+          VectorXd gamma_plus, gamma_minus;
+          if (int flag = p->system->AccelerationRightSide(t, q, v + alpha * s.head(n), &gamma_plus); flag != 0) {
+            return flag;
+          }
+          if (int flag = p->system->AccelerationRightSide(t, q, v - alpha * s.head(n), &gamma_minus); flag != 0) {
+            return flag;
+          }
+          result.segment(2 * n + m, m) -= (gamma_plus - gamma_minus) / (4.0 * alpha);
+        }
+      }
+      if (int flag = EvaluateResidual(*dp.plus, p, t, y, y_dot, r_plus); flag != 0) return flag;
+      if (int flag = EvaluateResidual(*dp.minus, p, t, y, y_dot, r_minus); flag != 0) return flag;
+      result += (r_plus - r_minus) / (2.0 * dp.step);
+      Map<VectorXd>(N_VGetArrayPointer(rr_s[k]), size) = result;
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    p->callback_failure = e.what();
+    return -1;
+  } catch (...) {
+    p->callback_failure = "unknown exception in the sensitivity residual";
     return -1;
   }
 }
@@ -88,24 +182,11 @@ spec::AnalysisFailure Failed(spec::FailureKind kind, std::string reason) {
   return spec::AnalysisFailure::Of(kind, std::move(reason));
 }
 
-}  // namespace
-
-spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t0, const VectorXd& q0,
-                                       const VectorXd& v0, const std::vector<double>& times,
-                                       const ForwardDynamicsOptions& options, const MotionCallback& at_instant,
-                                       ForwardDynamicsCounters* counters) {
-  Problem p;
-  p.system = &system;
-  p.n = system.num_coordinates();
-  p.m = system.num_constraints();
-  p.start = std::chrono::steady_clock::now();
-  p.max_wall_seconds = options.max_wall_seconds;
-  const int n = p.n, m = p.m, size = 2 * n + 2 * m;
-  if (q0.size() != n || v0.size() != n) {
-    return Failed(spec::FailureKind::kInvalidModel, "initial coordinates of the wrong size");
-  }
-
-  // Consistent accelerations and multipliers at t0.
+// (a0, lambda0) from [M Phi_q^T; Phi_q 0][a; lambda] = [Q; gamma] at a
+// state consistent with the constraints.
+spec::AnalysisFailure ConsistentAccelerations(const ConstrainedSystem& system, double t0, const VectorXd& q0,
+                                              const VectorXd& v0, VectorXd* out) {
+  const int n = system.num_coordinates(), m = system.num_constraints();
   Eigen::MatrixXd mass, phi_q;
   VectorXd forces, gamma;
   if (system.MassMatrix(q0, &mass) != 0 || system.AppliedForces(t0, q0, v0, &forces) != 0 ||
@@ -132,7 +213,33 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
                                   "(rank %d of %d)",
                                   t0, static_cast<int>(lu.rank()), n + m));
   }
-  const VectorXd accelerations_multipliers = lu.solve(rhs);
+  *out = lu.solve(rhs);
+  return spec::AnalysisFailure::Ok();
+}
+
+}  // namespace
+
+spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t0, const VectorXd& q0,
+                                       const VectorXd& v0, const std::vector<double>& times,
+                                       const ForwardDynamicsOptions& options, const MotionCallback& at_instant,
+                                       ForwardDynamicsCounters* counters,
+                                       const ForwardSensitivityInput* sensitivities) {
+  Problem p;
+  p.system = &system;
+  p.n = system.num_coordinates();
+  p.m = system.num_constraints();
+  p.start = std::chrono::steady_clock::now();
+  p.max_wall_seconds = options.max_wall_seconds;
+  const int n = p.n, m = p.m, size = 2 * n + 2 * m;
+  if (q0.size() != n || v0.size() != n) {
+    return Failed(spec::FailureKind::kInvalidModel, "initial coordinates of the wrong size");
+  }
+
+  // Consistent accelerations and multipliers at t0.
+  VectorXd accelerations_multipliers;
+  if (spec::AnalysisFailure f = ConsistentAccelerations(system, t0, q0, v0, &accelerations_multipliers); !f.ok()) {
+    return f;
+  }
 
   namespace sd = solve::sundials;
   struct Handles {
@@ -197,7 +304,58 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
             (options.max_step_size <= 0.0 || check(IDASetMaxStep(ida, options.max_step_size), "IDASetMaxStep"));
   if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
 
+  // Sensitivities: initial values by central differences of the consistent
+  // start along (dq0/dp_k, dv0/dp_k, e_k).
+  const int num_sens = sensitivities != nullptr ? static_cast<int>(sensitivities->parameters.size()) : 0;
+  sd::VectorArray y_s, yp_s, atol_s;
+  if (num_sens > 0) {
+    p.parameters = &sensitivities->parameters;
+    y_s = sd::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
+    yp_s = sd::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
+    atol_s = sd::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
+    if (!y_s || !yp_s || !atol_s) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
+    for (int k = 0; k < num_sens; ++k) {
+      const ParameterPerturbation& dp = sensitivities->parameters[static_cast<size_t>(k)];
+      const VectorXd& dq = sensitivities->q0[static_cast<size_t>(k)];
+      const VectorXd& dv = sensitivities->v0[static_cast<size_t>(k)];
+      VectorXd plus, minus;
+      if (spec::AnalysisFailure f =
+              ConsistentAccelerations(*dp.plus, t0, q0 + dp.step * dq, v0 + dp.step * dv, &plus);
+          !f.ok()) {
+        return f;
+      }
+      if (spec::AnalysisFailure f =
+              ConsistentAccelerations(*dp.minus, t0, q0 - dp.step * dq, v0 - dp.step * dv, &minus);
+          !f.ok()) {
+        return f;
+      }
+      const VectorXd d_accelerations_multipliers = (plus - minus) / (2.0 * dp.step);
+      Map<VectorXd> s0(N_VGetArrayPointer(y_s[k]), size), sp0(N_VGetArrayPointer(yp_s[k]), size),
+          tol(N_VGetArrayPointer(atol_s[k]), size);
+      s0.setZero();
+      sp0.setZero();
+      s0.head(n) = dq;
+      s0.segment(n, n) = dv;
+      if (m > 0) s0.segment(2 * n, m) = d_accelerations_multipliers.tail(m);
+      sp0.head(n) = dv;
+      sp0.segment(n, n) = d_accelerations_multipliers.head(n);
+      // The multipliers' sensitivities only enter Newton's convergence test
+      // (they are algebraic). Their residuals, central differences of force
+      // rows, carry round-off of order 1e-16 |F| / step; weighted like the
+      // coordinates (1e-10 / |p|) the corrector fails on it at once (seen on
+      // the isolator), so they get mu's weight.
+      tol.head(2 * n) = atol.head(2 * n) / dp.magnitude;
+      tol.tail(2 * m).setConstant(kMuTolerance / dp.magnitude);
+    }
+    ok = check(IDASensInit(ida, num_sens, IDA_STAGGERED, &SensitivityResidual, y_s.get(), yp_s.get()),
+               "IDASensInit") &&
+         check(IDASensSVtolerances(ida, options.relative_tolerance, atol_s.get()), "IDASensSVtolerances") &&
+         check(IDASetSensErrCon(ida, SUNTRUE), "IDASetSensErrCon");
+    if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+  }
+
   VectorXd phi, phi_t;
+  Eigen::MatrixXd phi_q;
   double t_reached = t0;
   for (double t : times) {
     if (t > t_reached) {
@@ -224,6 +382,24 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     sample.v = y.segment(n, n);
     sample.a = y_dot.segment(n, n);
     sample.lambda = y.segment(2 * n, m);
+    if (num_sens > 0) {
+      realtype t_sens = t;
+      // Before the first step y_s and yp_s still hold the initial values
+      // (and IDAS has no interpolant yet).
+      if (t > t0 && (!check(IDAGetSens(ida, &t_sens, y_s.get()), "IDAGetSens") ||
+                     !check(IDAGetSensDky(ida, t, 1, yp_s.get()), "IDAGetSensDky"))) {
+        return Failed(spec::FailureKind::kIntegrator, sundials_message);
+      }
+      sample.sensitivities.resize(static_cast<size_t>(num_sens));
+      for (int k = 0; k < num_sens; ++k) {
+        const Map<const VectorXd> s_k(N_VGetArrayPointer(y_s[k]), size), sp_k(N_VGetArrayPointer(yp_s[k]), size);
+        StateSensitivity& out = sample.sensitivities[static_cast<size_t>(k)];
+        out.q = s_k.head(n);
+        out.v = s_k.segment(n, n);
+        out.a = sp_k.segment(n, n);
+        out.lambda = s_k.segment(2 * n, m);
+      }
+    }
     if (m > 0) {
       system.Constraints(t, sample.q, &phi);
       system.ConstraintJacobian(t, sample.q, &phi_q);

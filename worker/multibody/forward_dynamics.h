@@ -51,11 +51,25 @@ struct ForwardDynamicsCounters {
   double max_velocity_drift = 0.0;
 };
 
+// Forward sensitivities with respect to parameters (IDAS's forward
+// sensitivity module, staggered corrector, sensitivities in the error test
+// with absolute tolerances divided by each parameter's magnitude). The
+// sensitivity residuals F_y s + F_y' s' + F_p are central differences of
+// the residual along (s, s', e_k), with the systems rebuilt at p_k +- step_k
+// (ParameterPerturbation); the initial sensitivities of lambda and the
+// accelerations follow from q0_k, v0_k the same way.
+struct ForwardSensitivityInput {
+  std::vector<ParameterPerturbation> parameters;
+  std::vector<Eigen::VectorXd> q0, v0;  // dq0/dp_k, dv0/dp_k of the assembled start
+};
+
 // From (t0, q0, v0), consistent with the constraints, to every instant of
-// `times_s` (ascending, >= t0); `at_instant` sees (t, q, v, a, lambda).
+// `times_s` (ascending, >= t0); `at_instant` sees (t, q, v, a, lambda) and,
+// with `sensitivities`, their derivatives per parameter.
 spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t0_s, const Eigen::VectorXd& q0,
                                        const Eigen::VectorXd& v0, const std::vector<double>& times_s,
                                        const ForwardDynamicsOptions& options, const MotionCallback& at_instant,
-                                       ForwardDynamicsCounters* counters);
+                                       ForwardDynamicsCounters* counters,
+                                       const ForwardSensitivityInput* sensitivities = nullptr);
 
 }  // namespace mbopt::multibody

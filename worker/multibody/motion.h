@@ -7,17 +7,36 @@
 #pragma once
 
 #include <functional>
+#include <vector>
 
 #include <Eigen/Dense>
 
 #include "spec/analysis_outcome.h"
+#include "worker/multibody/constrained_system.h"
 
 namespace mbopt::multibody {
+
+// Derivatives of a state with respect to one parameter.
+struct StateSensitivity {
+  Eigen::VectorXd q, v, a, lambda;
+};
 
 struct MotionSample {
   double t_s = 0.0;
   Eigen::VectorXd q, v, a;
   Eigen::VectorXd lambda;  // empty when not computed
+  // One per parameter when the analysis carries sensitivities, else empty.
+  std::vector<StateSensitivity> sensitivities;
+};
+
+// A system's parameter dependence for sensitivity analysis, as central
+// differences: the system rebuilt at p_k + step_k and p_k - step_k (same
+// structure: coordinates, rows). The systems outlive the analysis.
+struct ParameterPerturbation {
+  const ConstrainedSystem* plus = nullptr;
+  const ConstrainedSystem* minus = nullptr;
+  double step = 0.0;
+  double magnitude = 1.0;  // |p_k| (1 for p_k = 0): scales the sensitivities' absolute tolerances
 };
 
 // Sees every output instant in turn; a failure stops the analysis.

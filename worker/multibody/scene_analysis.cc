@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <string>
 #include <variant>
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/forward_dynamics.h"
+#include "worker/multibody/kinematic_sensitivity.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
 #include "worker/multibody/static_equilibrium.h"
@@ -170,25 +173,79 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
   return m;
 }
 
-spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& p) {
-  spec::AnalysisReport report;
+namespace {
+
+// The model rebuilt at p_k + step and p_k - step, for sensitivities.
+struct Variant {
+  std::vector<double> p;
+  Model model;
+  std::unique_ptr<Mechanism> mechanism;  // refers to `model`: a Variant never moves
+  Assembly assembled;
+};
+struct Perturbed {
+  std::unique_ptr<Variant> plus, minus;
+  double step = 0.0;
+  double magnitude = 1.0;  // |p_k|, or 1 for p_k = 0
+};
+
+constexpr double kRelativeParameterStep = 1e-5;
+
+// Builds and assembles one variant; empty string on success, else why not.
+std::string MakeVariant(const spec::Scene& scene, std::vector<double> p, const AssemblyOptions& options,
+                        const Mechanism& nominal, std::unique_ptr<Variant>* out) {
+  auto v = std::make_unique<Variant>();
+  v->p = std::move(p);
+  absl::StatusOr<Model> model = CompileModel(scene, v->p);
+  if (!model.ok()) return std::string(model.status().message());
+  v->model = *std::move(model);
+  v->mechanism = std::make_unique<Mechanism>(v->model);
+  if (v->mechanism->num_constraints() != nominal.num_constraints()) return "the constraint rows change with the parameter";
+  v->assembled = Assemble(*v->mechanism, 0.0, options);
+  if (!v->assembled.failure.ok()) return v->assembled.failure.reason;
+  *out = std::move(v);
+  return "";
+}
+
+// d output / dp along (state derivative, e_k): a central difference between
+// the variants.
+double OutputDerivative(const spec::MultibodyModel& sm, const spec::MultibodyOutput& o, const Perturbed& dp,
+                        const MotionSample& s, const StateSensitivity& ds, Eigen::MatrixXd* phi_q) {
+  const double h = dp.step;
+  auto shifted = [&](double sign) {
+    MotionSample x;
+    x.t_s = s.t_s;
+    x.q = s.q + sign * h * ds.q;
+    x.v = s.v + sign * h * ds.v;
+    x.a = s.a + sign * h * ds.a;
+    if (s.lambda.size() > 0 && ds.lambda.size() == s.lambda.size()) x.lambda = s.lambda + sign * h * ds.lambda;
+    return x;
+  };
+  const double plus = OutputValue(*dp.plus->mechanism, sm, o, dp.plus->p, shifted(1.0), phi_q);
+  const double minus = OutputValue(*dp.minus->mechanism, sm, o, dp.minus->p, shifted(-1.0), phi_q);
+  return (plus - minus) / (2.0 * h);
+}
+
+// The one analysis; with `parameters`, also the output derivatives.
+void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::vector<int>* parameters,
+             MultibodySensitivityResult* result) {
+  spec::AnalysisReport& report = result->report;
   report.times_s = scene.time_grid.Instants();
   report.formulation = spec::Formulation::kKinematic;
   if (!std::holds_alternative<spec::MultibodyModel>(scene.model) || p.size() != scene.parameters.size()) {
     report.Fail(spec::FailureKind::kInvalidModel,
                 absl::StrFormat("expected a multibody scene and %d parameter values", scene.parameters.size()));
-    return report;
+    return;
   }
   const auto& sm = std::get<spec::MultibodyModel>(scene.model);
   absl::StatusOr<Model> model = CompileModel(scene, p);
   if (!model.ok()) {
     report.Fail(spec::FailureKind::kInvalidModel, std::string(model.status().message()));
-    return report;
+    return;
   }
   for (const spec::Output& o : scene.outputs) {
     if (!std::holds_alternative<spec::MultibodyOutput>(o.kind)) {
       report.Fail(spec::FailureKind::kInvalidModel, absl::StrFormat("output '%s' is not a multibody output", o.name));
-      return report;
+      return;
     }
     spec::OutputValues values;
     values.name = o.name;
@@ -197,21 +254,53 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
     values.series[0].reserve(report.times_s.size());
     report.outputs.push_back(std::move(values));
   }
-  if (report.outputs.empty()) return report;  // nothing requested: nothing computed
+  if (report.outputs.empty()) return;  // nothing requested: nothing computed
 
+  const bool sensitivities = parameters != nullptr && !parameters->empty();
+  AssemblyOptions assembly_options;
+  // Variants are differenced: close every assembly to round-off.
+  if (sensitivities) assembly_options.polish_iterations = 3;
   const Mechanism mechanism(*model);
-  const Assembly assembled = Assemble(mechanism, 0.0);
+  const Assembly assembled = Assemble(mechanism, 0.0, assembly_options);
   report.counters.newton_iterations += assembled.newton_iterations;
   if (!assembled.failure.ok()) {
     report.Fail(assembled.failure.kind, assembled.failure.reason);
-    return report;
+    return;
   }
   if (!assembled.redundant.empty()) {
     report.Fail(spec::FailureKind::kInvalidModel,
                 absl::StrFormat("redundant constraints at joint(s) %s: a planar loop closes with one revolute "
                                 "joint fewer, or with a point-on-line joint",
                                 absl::StrJoin(assembled.redundant, ", ")));
-    return report;
+    return;
+  }
+  const bool is_static = sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium;
+  std::vector<Perturbed> perturbed;
+  if (sensitivities && is_static) result->unavailable = MultibodySensitivityUnavailable(scene);
+  if (sensitivities && result->unavailable.empty()) {
+    for (const int index : *parameters) {
+      Perturbed dp;
+      const double value = p[static_cast<size_t>(index)];
+      dp.magnitude = value != 0.0 ? std::abs(value) : 1.0;
+      dp.step = kRelativeParameterStep * dp.magnitude;
+      std::vector<double> plus = p, minus = p;
+      plus[static_cast<size_t>(index)] += dp.step;
+      minus[static_cast<size_t>(index)] -= dp.step;
+      std::string why = MakeVariant(scene, std::move(plus), assembly_options, mechanism, &dp.plus);
+      if (why.empty()) why = MakeVariant(scene, std::move(minus), assembly_options, mechanism, &dp.minus);
+      if (!why.empty()) {
+        result->unavailable = absl::StrFormat("parameter '%s' +- %g: %s", scene.parameters[static_cast<size_t>(index)].name,
+                                              dp.step, why);
+        perturbed.clear();
+        break;
+      }
+      perturbed.push_back(std::move(dp));
+    }
+  }
+  const bool with_derivatives = !perturbed.empty();
+  if (with_derivatives) {
+    result->output_derivatives.assign(perturbed.size(),
+                                      std::vector<std::vector<double>>(scene.outputs.size(), std::vector<double>()));
   }
   // The motion starts at t = 0; the grid may start later.
   std::vector<double> times;
@@ -219,6 +308,12 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
   times.insert(times.end(), report.times_s.begin(), report.times_s.end());
   size_t next_instant = 0;
   Eigen::MatrixXd phi_q;
+  std::vector<ParameterPerturbation> perturbations;
+  for (const Perturbed& dp : perturbed) {
+    perturbations.push_back(
+        ParameterPerturbation{dp.plus->mechanism.get(), dp.minus->mechanism.get(), dp.step, dp.magnitude});
+  }
+  const bool driven = assembled.degrees_of_freedom == 0;
   const MotionCallback record = [&](const MotionSample& s) {
     if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
       return spec::AnalysisFailure::Ok();
@@ -237,17 +332,35 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
       }
       report.outputs[k].series[0].push_back(value);
     }
+    if (!with_derivatives || !result->unavailable.empty()) return spec::AnalysisFailure::Ok();
+    for (size_t i = 0; i < perturbed.size(); ++i) {
+      StateSensitivity kinematic;
+      const StateSensitivity* ds = nullptr;
+      if (i < s.sensitivities.size()) {
+        ds = &s.sensitivities[i];
+      } else if (driven && KinematicStateSensitivity(mechanism, perturbations[i], s, &kinematic)) {
+        ds = &kinematic;
+      }
+      if (ds == nullptr) {
+        result->unavailable = absl::StrFormat("no state derivative at t = %.6g s", s.t_s);
+        return spec::AnalysisFailure::Ok();
+      }
+      for (size_t k = 0; k < scene.outputs.size(); ++k) {
+        const auto& o = std::get<spec::MultibodyOutput>(scene.outputs[k].kind);
+        result->output_derivatives[i][k].push_back(OutputDerivative(sm, o, perturbed[i], s, *ds, &phi_q));
+      }
+    }
     return spec::AnalysisFailure::Ok();
   };
   spec::AnalysisFailure outcome;
-  if (sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium) {
+  if (is_static) {
     report.formulation = spec::Formulation::kStatic;
     StaticCounters counters;
     outcome = RunStaticEquilibrium(mechanism, assembled.q, times, StaticOptions{}, record, &counters);
     report.counters.position_solves += counters.position_solves;
     report.counters.newton_iterations += counters.newton_iterations;
     report.counters.rhs_evaluations += counters.residual_evaluations;
-  } else if (assembled.degrees_of_freedom == 0) {
+  } else if (driven) {
     KinematicOptions options;
     options.inverse_dynamics = NeedsMultipliers(scene);
     report.formulation = options.inverse_dynamics ? spec::Formulation::kKinetostatic : spec::Formulation::kKinematic;
@@ -263,14 +376,49 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
     options.max_steps = scene.integrator.max_steps;
     options.max_wall_seconds = scene.integrator.max_wall_seconds;
     ForwardDynamicsCounters counters;
-    outcome = IntegrateForward(mechanism, 0.0, assembled.q, assembled.v, times, options, record, &counters);
+    ForwardSensitivityInput input;
+    if (with_derivatives) {
+      input.parameters = perturbations;
+      for (const Perturbed& dp : perturbed) {
+        input.q0.push_back((dp.plus->assembled.q - dp.minus->assembled.q) / (2.0 * dp.step));
+        input.v0.push_back((dp.plus->assembled.v - dp.minus->assembled.v) / (2.0 * dp.step));
+      }
+    }
+    outcome = IntegrateForward(mechanism, 0.0, assembled.q, assembled.v, times, options, record, &counters,
+                               with_derivatives ? &input : nullptr);
     report.counters.time_steps = counters.steps;
     report.counters.rhs_evaluations = counters.residual_evaluations;
     report.counters.jacobian_evaluations = counters.jacobian_evaluations;
     report.counters.newton_iterations += counters.nonlinear_iterations;
   }
   if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
-  return report;
+  if (!report.ok() || !result->unavailable.empty()) result->output_derivatives.clear();
+  if (sensitivities && !report.ok() && result->unavailable.empty()) result->unavailable = "the analysis failed";
+}
+
+}  // namespace
+
+spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& p) {
+  MultibodySensitivityResult result;
+  Analyze(scene, p, nullptr, &result);
+  return std::move(result.report);
+}
+
+MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Scene& scene,
+                                                                  const std::vector<double>& p,
+                                                                  const std::vector<int>& parameters) {
+  MultibodySensitivityResult result;
+  Analyze(scene, p, &parameters, &result);
+  return result;
+}
+
+std::string MultibodySensitivityUnavailable(const spec::Scene& scene) {
+  const auto* sm = std::get_if<spec::MultibodyModel>(&scene.model);
+  if (sm == nullptr) return "not a multibody scene";
+  if (sm->analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium) {
+    return "a static-equilibrium analysis has no simulator sensitivities yet";
+  }
+  return "";
 }
 
 }  // namespace mbopt::multibody

@@ -11,6 +11,7 @@
 // (kAssembly), the integrator giving up (kIntegrator), the wall-time limit.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -21,6 +22,29 @@
 namespace mbopt::multibody {
 
 spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si);
+
+// The same analysis with the derivatives of every output with respect to
+// the chosen scene parameters, whatever they set (a stiffness, a mass, a
+// link length through an expression): the model is also compiled at
+// p_k +- step_k (step 1e-5 |p_k|, or 1e-5 for p_k = 0) and the analysis
+// differentiates through those. Forward dynamics: IDAS forward
+// sensitivities (forward_dynamics.h); driven mechanisms: the differentiated
+// constraint equations at each instant (kinematic_sensitivity.h); outputs:
+// central differences along (state derivative, e_k).
+struct MultibodySensitivityResult {
+  spec::AnalysisReport report;
+  // [k][output][instant]: d output / d parameter_values_si[parameters[k]];
+  // empty when `unavailable` says why (the values in `report` still count).
+  std::vector<std::vector<std::vector<double>>> output_derivatives;
+  std::string unavailable;
+};
+MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Scene& scene,
+                                                                  const std::vector<double>& parameter_values_si,
+                                                                  const std::vector<int>& parameters);
+
+// Empty if the scene's analysis has simulator sensitivities; else why not
+// (a static-equilibrium analysis).
+std::string MultibodySensitivityUnavailable(const spec::Scene& scene);
 
 // The model of a multibody scene at the given parameter values (SI), checked
 // (Model::Validate). `scene.model` must hold a MultibodyModel.
