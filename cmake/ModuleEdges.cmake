@@ -104,7 +104,7 @@ function(mbopt_declare_modules)
     SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities, linkage solvers")
   mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
     LIBS mbopt_multibody
-    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS)")
+    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
   mbopt_module(engine DIRS worker/engine USES multibody solve model spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
     SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")

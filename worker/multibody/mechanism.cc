@@ -268,6 +268,14 @@ int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, Vec
   for (const BodyTorque& torque : model_.torques) {
     (*forces)[3 * torque.body + 2] += torque.factor ? torque.torque_n_m * torque.factor->At(t).q : torque.torque_n_m;
   }
+  for (const BeamElement& e : model_.beams) {
+    const BeamNodes x = BeamCoordinates(e, q);
+    BeamLoads loads;
+    if (!EvaluateBeam(e, x, &loads)) return 1;  // coincident nodes: the step is retried
+    const BeamNodes f = BeamInternalForces(x, loads);
+    forces->segment<3>(3 * e.a) -= f.head<3>();
+    forces->segment<3>(3 * e.b) -= f.tail<3>();
+  }
   return forces->allFinite() ? 0 : 1;
 }
 
@@ -347,6 +355,17 @@ double Mechanism::KineticEnergy(const VectorXd& v) const {
   return energy;
 }
 
+BeamNodes Mechanism::BeamCoordinates(const BeamElement& e, const VectorXd& q) const {
+  BeamNodes x;
+  x << q.segment<3>(3 * e.a), q.segment<3>(3 * e.b);
+  return x;
+}
+
+bool Mechanism::BeamEndLoads(int element, const VectorXd& q, BeamLoads* loads) const {
+  const BeamElement& e = model_.beams[static_cast<size_t>(element)];
+  return EvaluateBeam(e, BeamCoordinates(e, q), loads);
+}
+
 double Mechanism::PotentialEnergy(const VectorXd& q, double t) const {
   double energy = 0.0;
   if (model_.gravity_m_per_s2.has_value()) {
@@ -363,6 +382,10 @@ double Mechanism::PotentialEnergy(const VectorXd& q, double t) const {
   for (const RotationalSpringDamper& r : model_.rotational_springs) {
     const double twist = JointCoordinate(r.joint, q) - r.free_angle_rad;
     energy += 0.5 * r.stiffness_n_m_per_rad * twist * twist;
+  }
+  for (const BeamElement& e : model_.beams) {
+    BeamLoads loads;
+    if (EvaluateBeam(e, BeamCoordinates(e, q), &loads)) energy += BeamStrainEnergy(e, loads);
   }
   return energy;
 }

@@ -72,8 +72,11 @@ class Mechanism : public ConstrainedSystem {
   double SpringLength(int spring, const Eigen::VectorXd& q, double t_s = 0.0) const;
   double SpringTension(int spring, const Eigen::VectorXd& q, const Eigen::VectorXd& v, double t_s = 0.0) const;
   double KineticEnergy(const Eigen::VectorXd& v) const;
-  // Gravity (zero at y = 0 for g along -y) and the springs' strain energy.
+  // Gravity (zero at y = 0 for g along -y), the springs' and the beam
+  // elements' strain energy.
   double PotentialEnergy(const Eigen::VectorXd& q, double t_s = 0.0) const;
+  // Axial force and end moments of beam element `element` (Model::beams).
+  bool BeamEndLoads(int element, const Eigen::VectorXd& q, BeamLoads* loads) const;
 
   const MechanismCounters& counters() const { return counters_; }
   std::string FailureReason() const override { return failure_; }
@@ -82,6 +85,7 @@ class Mechanism : public ConstrainedSystem {
   // One evaluation of every row: whichever outputs are not null.
   void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
                     Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
+  BeamNodes BeamCoordinates(const BeamElement& e, const Eigen::VectorXd& q) const;
   double ReferenceAngle(int joint) const { return reference_angle_[static_cast<size_t>(joint)]; }
 
   const Model& model_;

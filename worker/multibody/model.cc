@@ -185,6 +185,18 @@ absl::Status Model::Validate() const {
       return absl::InvalidArgumentError(absl::StrCat("torque on unknown body #", t.body));
     }
   }
+  for (const BeamElement& e : beams) {
+    const int n = static_cast<int>(bodies.size());
+    if (e.a < 0 || e.b < 0 || e.a >= n || e.b >= n || e.a == e.b) {
+      return absl::InvalidArgumentError(absl::StrCat(e.name, ": its nodes must be two different bodies"));
+    }
+    if (!(e.length_m > 0.0) || !(e.axial_stiffness_n > 0.0) || !(e.bending_stiffness_n_m2 > 0.0) ||
+        !std::isfinite(e.length_m + e.axial_stiffness_n + e.bending_stiffness_n_m2 + e.angle_a_rad + e.angle_b_rad)) {
+      return absl::InvalidArgumentError(absl::StrCat(e.name, ": length, EA and EI must be finite and > 0, got ",
+                                                     e.length_m, " m, ", e.axial_stiffness_n, " N, ",
+                                                     e.bending_stiffness_n_m2, " N m^2"));
+    }
+  }
   return absl::OkStatus();
 }
 

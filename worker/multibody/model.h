@@ -24,6 +24,7 @@
 #include <Eigen/Dense>
 
 #include "absl/status/status.h"
+#include "worker/multibody/beam_element.h"
 
 namespace mbopt::multibody {
 
@@ -164,6 +165,8 @@ struct Model {
   std::vector<RotationalSpringDamper> rotational_springs;
   std::vector<PointForce> point_forces;
   std::vector<BodyTorque> torques;
+  // Co-rotational beam elements between node bodies: the flexible links.
+  std::vector<BeamElement> beams;
   std::optional<Eigen::Vector2d> gravity_m_per_s2;  // absent: no gravity computed
 
   // InvalidArgument naming the body, joint or element and what was expected.

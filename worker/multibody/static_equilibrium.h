@@ -35,7 +35,8 @@ namespace mbopt::multibody {
 struct StaticOptions {
   // Converged when every constraint residual is below this (m or rad) and
   // every force residual below it times the force scale (the largest applied
-  // force at the start, at least 1 N).
+  // force at the start, at least 1 N), or below its row's round-off floor
+  // (100 eps K_ii |q|, from the stiffness at the start) if that is higher.
   double tolerance = 1e-10;
   int max_iterations = 200;  // Newton iterations per instant
   // Relative size of the most negative reduced stiffness eigenvalue (to the
