@@ -50,6 +50,16 @@ OutputShape OutputShapeOf(const Scene& scene, int output) {
                        ? 1
                        : static_cast<int>(scene.time_grid.Instants().size());
   if (const auto* stress = std::get_if<BendingStressOutput>(&out.kind)) {
+    // A flexible link of a multibody model: every node, 0 (end a) to n (end b).
+    const auto* multibody = std::get_if<MultibodyModel>(&scene.model);
+    if (multibody != nullptr && stress->link >= 0 &&
+        stress->link < static_cast<int>(multibody->flexible_links.size())) {
+      const int elements = multibody->flexible_links[static_cast<size_t>(stress->link)].elements;
+      shape.series_labels.clear();
+      for (int j = 0; j <= elements; ++j) shape.series_labels.push_back(absl::StrCat("node ", j));
+      shape.series = elements + 1;
+      return shape;
+    }
     const auto* linkage = std::get_if<LinkageModel>(&scene.model);
     if (linkage != nullptr && stress->link >= 0 &&
         stress->link < static_cast<int>(linkage->links.size())) {

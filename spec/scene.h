@@ -126,6 +126,7 @@ struct MarkerRef {
   int body = -1;
   int marker = -1;
   int input = -1;  // >= 0: a moving input point (MultibodyModel::inputs)
+  int link = -1;   // >= 0: an end of MultibodyModel::flexible_links[link]; marker 0 is a, 1 is b
 };
 struct RigidBody {
   std::string name;
@@ -181,8 +182,19 @@ struct MultibodyInput {
   double direction_x = 0.0, direction_y = 1.0;  // unit, literal
   MultibodyDriver displacement;                 // its profile (no joint)
 };
+// A flexible link of a multibody model: co-rotational beam elements.
+struct MultibodyFlexibleLink {
+  std::string name;
+  Vec2 start_m;
+  Number angle_rad, length_m;
+  Section section;
+  int elements = 4;
+};
+inline constexpr int kMaxFlexibleLinkElements = 200;
+
 struct MultibodyModel {
   enum class Analysis { kFromDegreesOfFreedom, kStaticEquilibrium } analysis = Analysis::kFromDegreesOfFreedom;
+  std::vector<MultibodyFlexibleLink> flexible_links;
   std::vector<MultibodyInput> inputs;
   std::vector<LinkPoint> ground_markers;
   std::vector<RigidBody> bodies;

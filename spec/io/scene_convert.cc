@@ -427,20 +427,7 @@ class SceneConverter {
         link.length_m = Num(lw, "length_m", true, l.length_m(), Dimension::kLength);
         RequirePositive(lw, "length_m", *link.length_m);
       }
-      if (l.has_section()) {
-        const Where sw = lw.Child("section");
-        const v1::Section& s = l.section();
-        Section section;
-        section.area_m2 = Num(sw, "area_m2", s.has_area_m2(), s.area_m2(), Dimension::kArea);
-        RequirePositive(sw, "area_m2", section.area_m2);
-        section.youngs_modulus_pa = Num(sw, "youngs_modulus_pa", s.has_youngs_modulus_pa(),
-                                        s.youngs_modulus_pa(), Dimension::kPressure);
-        RequirePositive(sw, "youngs_modulus_pa", section.youngs_modulus_pa);
-        section.density_kg_per_m3 = Num(sw, "density_kg_per_m3", s.has_density_kg_per_m3(),
-                                        s.density_kg_per_m3(), Dimension::kDensity);
-        RequirePositive(sw, "density_kg_per_m3", section.density_kg_per_m3);
-        link.section = section;
-      }
+      if (l.has_section()) link.section = ConvertSection(lw.Child("section"), l.section());
       if (l.has_flexible()) {
         if (l.flexible().elements() < 1) {
           errors_.Add(lw.Child("flexible"), "elements",
@@ -506,6 +493,19 @@ class SceneConverter {
     return out;
   }
 
+  Section ConvertSection(const Where& sw, const v1::Section& s) {
+    Section section;
+    section.area_m2 = Num(sw, "area_m2", s.has_area_m2(), s.area_m2(), Dimension::kArea);
+    RequirePositive(sw, "area_m2", section.area_m2);
+    section.youngs_modulus_pa = Num(sw, "youngs_modulus_pa", s.has_youngs_modulus_pa(),
+                                    s.youngs_modulus_pa(), Dimension::kPressure);
+    RequirePositive(sw, "youngs_modulus_pa", section.youngs_modulus_pa);
+    section.density_kg_per_m3 = Num(sw, "density_kg_per_m3", s.has_density_kg_per_m3(),
+                                    s.density_kg_per_m3(), Dimension::kDensity);
+    RequirePositive(sw, "density_kg_per_m3", section.density_kg_per_m3);
+    return section;
+  }
+
   // ---------------------------------------------------------- multibody --
   // "body.marker" or "ground.marker" to a marker reference.
   MarkerRef Marker(const Where& w, const std::string& field, const std::string& ref) {
@@ -525,6 +525,16 @@ class SceneConverter {
       } else {
         out.input = it->second;
         out.marker = 0;  // resolved
+      }
+      return out;
+    }
+    if (auto link = multibody_links_.find(body); link != multibody_links_.end()) {
+      out.link = link->second;
+      if (marker == "a" || marker == "b") {
+        out.marker = marker == "a" ? 0 : 1;
+      } else {
+        errors_.Add(w, field, absl::StrCat("flexible link \"", body, "\" has ends \"a\" and \"b\", not \"", marker,
+                                           "\""));
       }
       return out;
     }
@@ -639,7 +649,33 @@ class SceneConverter {
       body.markers = Markers(bw, "markers", b.markers());
       multibody_.bodies.push_back(std::move(body));
     }
-    if (m.bodies_size() == 0) errors_.Add(w, "bodies", "a multibody model needs at least one body");
+    for (int i = 0; i < m.flexible_links_size(); ++i) {
+      const v1::FlexibleBeamLink& l = m.flexible_links(i);
+      const Where lw = w.Child("flexible_links", i);
+      MultibodyFlexibleLink link;
+      link.name = l.name();
+      if (l.name().empty() || l.name() == "ground" || l.name() == "input") {
+        errors_.Add(lw, "name", "a flexible link needs a name other than \"ground\" and \"input\"");
+      }
+      if (multibody_bodies_.count(l.name()) > 0 || !multibody_links_.emplace(l.name(), i).second) {
+        errors_.Add(lw, "name", absl::StrCat("duplicate body or link name \"", l.name(), "\""));
+      }
+      link.start_m = Vec(lw, "start_m", l.has_start_m(), l.start_m(), Dimension::kLength);
+      link.angle_rad = Num(lw, "angle_rad", l.has_angle_rad(), l.angle_rad(), Dimension::kAngle, 0.0);
+      link.length_m = Num(lw, "length_m", l.has_length_m(), l.length_m(), Dimension::kLength);
+      RequirePositive(lw, "length_m", link.length_m);
+      if (!l.has_section()) errors_.Add(lw, "section", "a flexible link needs a section (area, modulus, density)");
+      link.section = ConvertSection(lw.Child("section"), l.section());
+      link.elements = l.elements() == 0 ? 4 : l.elements();
+      if (link.elements < 1 || link.elements > kMaxFlexibleLinkElements) {
+        errors_.Add(lw, "elements", absl::StrFormat("expected 1 to %d elements (0 for the default 4), got %d",
+                                                    kMaxFlexibleLinkElements, l.elements()));
+      }
+      multibody_.flexible_links.push_back(std::move(link));
+    }
+    if (m.bodies_size() == 0 && m.flexible_links_size() == 0) {
+      errors_.Add(w, "bodies", "a multibody model needs at least one body or flexible link");
+    }
     for (int i = 0; i < m.joints_size(); ++i) {
       const v1::MultibodyJoint& j = m.joints(i);
       const Where jw = w.Child("joints", i);
@@ -663,7 +699,10 @@ class SceneConverter {
         errors_.Add(jw, joint.a.input >= 0 ? "a" : "b",
                     "an input point takes springs and forces, not joints (it is not a body)");
       }
-      if (joint.a.marker >= 0 && joint.b.marker >= 0 && joint.a.body == joint.b.body) {
+      const bool same_body = joint.a.link >= 0 || joint.b.link >= 0
+                                 ? joint.a.link == joint.b.link && joint.a.marker == joint.b.marker
+                                 : joint.a.body == joint.b.body;
+      if (joint.a.marker >= 0 && joint.b.marker >= 0 && same_body) {
         errors_.Add(jw, "b", "a joint joins two different bodies (or a body and ground)");
       }
       joint.axis_angle_rad = Num(jw, "axis_angle_rad", j.has_axis_angle_rad(), j.axis_angle_rad(), Dimension::kAngle, 0.0);
@@ -971,9 +1010,12 @@ class SceneConverter {
           break;
         }
         case v1::Output::kBendingStress: {
-          needs = "linkage";
+          needs = multibody ? "multibody" : "linkage";
           BendingStressOutput k;
           const Where kw = ow.Child("bending_stress");
+          if (multibody) {
+            k.link = lookup(multibody_links_, kw, "link", o.bending_stress().link(), "flexible link");
+          }
           if (linkage) {
             k.link = lookup(linkage_links_, kw, "link", o.bending_stress().link(), "link");
             const auto& linkage = std::get<LinkageModel>(scene_.model);
@@ -1113,7 +1155,8 @@ class SceneConverter {
   const v1::Scene& msg_;
   const Where& where_;
   MultibodyModel multibody_;
-  std::map<std::string, int> multibody_bodies_, multibody_joints_, multibody_springs_, multibody_inputs_;
+  std::map<std::string, int> multibody_bodies_, multibody_joints_, multibody_springs_, multibody_inputs_,
+      multibody_links_;
   Errors& errors_;
   Scene scene_;
   std::vector<Dimension> units_;  // per parameter

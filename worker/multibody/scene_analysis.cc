@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <variant>
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "worker/multibody/assembly.h"
+#include "spec/layout.h"
+#include "worker/multibody/flexible_link.h"
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/kinematic_sensitivity.h"
 #include "worker/multibody/kinematic_analysis.h"
@@ -24,7 +27,25 @@ Eigen::Vector2d Resolve(const spec::Vec2& v, const std::vector<double>& p) {
   return Eigen::Vector2d(v.x.Resolve(p), v.y.Resolve(p));
 }
 
+// The body of node `node` of flexible link `link`: the links' nodes follow
+// the rigid bodies, link after link (CompileModel).
+int LinkNode(const spec::MultibodyModel& m, int link, int node) {
+  int first = static_cast<int>(m.bodies.size());
+  for (int j = 0; j < link; ++j) first += m.flexible_links[static_cast<size_t>(j)].elements + 1;
+  return first + node;
+}
+int LinkFirstElement(const spec::MultibodyModel& m, int link) {
+  int first = 0;
+  for (int j = 0; j < link; ++j) first += m.flexible_links[static_cast<size_t>(j)].elements;
+  return first;
+}
+
 Point PointOf(const spec::MultibodyModel& m, const spec::MarkerRef& ref, const std::vector<double>& p) {
+  if (ref.link >= 0) {
+    const spec::MultibodyFlexibleLink& link = m.flexible_links[static_cast<size_t>(ref.link)];
+    return Point{LinkNode(m, ref.link, ref.marker == 0 ? 0 : link.elements), Eigen::Vector2d::Zero(),
+                 link.name + (ref.marker == 0 ? ".a" : ".b")};
+  }
   if (ref.input >= 0) return Point{kGround, Eigen::Vector2d::Zero(), m.inputs[static_cast<size_t>(ref.input)].name, ref.input};
   const std::vector<spec::LinkPoint>& markers =
       ref.body < 0 ? m.ground_markers : m.bodies[static_cast<size_t>(ref.body)].markers;
@@ -112,6 +133,30 @@ double OutputValue(const Mechanism& mech, const spec::MultibodyModel& sm, const 
   return NAN;
 }
 
+// Bending stress at every node of a flexible link (one value per node, Pa):
+// M r / I for the solid circular section (r = sqrt(A / pi), I = A^2 / 4 pi),
+// M the bending moment at the node (-Ma of the element that starts there,
+// Mb of the one that ends there; their mean at interior nodes).
+bool NodeStresses(const Mechanism& mech, const spec::MultibodyModel& sm, int link, const std::vector<double>& p,
+                  const Eigen::VectorXd& q, std::vector<double>* stresses) {
+  const spec::MultibodyFlexibleLink& l = sm.flexible_links[static_cast<size_t>(link)];
+  const double area = l.section.area_m2.Resolve(p);
+  const double fibre_per_inertia = std::sqrt(area / std::numbers::pi) / (area * area / (4.0 * std::numbers::pi));
+  const int first = LinkFirstElement(sm, link);
+  stresses->assign(static_cast<size_t>(l.elements + 1), 0.0);
+  std::vector<int> count(static_cast<size_t>(l.elements + 1), 0);
+  for (int e = 0; e < l.elements; ++e) {
+    BeamLoads loads;
+    if (!mech.BeamEndLoads(first + e, q, &loads)) return false;
+    (*stresses)[static_cast<size_t>(e)] -= loads.moment_a_n_m;
+    (*stresses)[static_cast<size_t>(e + 1)] += loads.moment_b_n_m;
+    ++count[static_cast<size_t>(e)];
+    ++count[static_cast<size_t>(e + 1)];
+  }
+  for (size_t k = 0; k < stresses->size(); ++k) (*stresses)[k] *= fibre_per_inertia / count[k];
+  return true;
+}
+
 }  // namespace
 
 absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<double>& p) {
@@ -120,6 +165,19 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
   for (const spec::RigidBody& b : sm.bodies) {
     m.bodies.push_back(Body{b.name, b.mass_kg.Resolve(p), b.inertia_kg_m2.Resolve(p), Resolve(b.position_m, p),
                             b.angle_rad.Resolve(p)});
+  }
+  for (const spec::MultibodyFlexibleLink& l : sm.flexible_links) {
+    FlexibleLinkSpec link;
+    link.name = l.name;
+    link.start_m = Resolve(l.start_m, p);
+    link.angle_rad = l.angle_rad.Resolve(p);
+    link.length_m = l.length_m.Resolve(p);
+    const double area = l.section.area_m2.Resolve(p), modulus = l.section.youngs_modulus_pa.Resolve(p);
+    link.axial_stiffness_n = modulus * area;
+    link.bending_stiffness_n_m2 = modulus * area * area / (4.0 * std::numbers::pi);
+    link.mass_per_length_kg_per_m = l.section.density_kg_per_m3.Resolve(p) * area;
+    link.elements = l.elements;
+    AddFlexibleLink(link, &m);
   }
   for (const spec::MultibodyJoint& j : sm.joints) {
     Joint joint;
@@ -242,16 +300,22 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     report.Fail(spec::FailureKind::kInvalidModel, std::string(model.status().message()));
     return;
   }
-  for (const spec::Output& o : scene.outputs) {
-    if (!std::holds_alternative<spec::MultibodyOutput>(o.kind)) {
+  bool has_stress = false;
+  for (size_t k = 0; k < scene.outputs.size(); ++k) {
+    const spec::Output& o = scene.outputs[k];
+    const auto* stress = std::get_if<spec::BendingStressOutput>(&o.kind);
+    if (!std::holds_alternative<spec::MultibodyOutput>(o.kind) &&
+        (stress == nullptr || stress->link < 0 || stress->link >= static_cast<int>(sm.flexible_links.size()))) {
       report.Fail(spec::FailureKind::kInvalidModel, absl::StrFormat("output '%s' is not a multibody output", o.name));
       return;
     }
+    has_stress = has_stress || stress != nullptr;
+    const spec::OutputShape shape = spec::OutputShapeOf(scene, static_cast<int>(k));
     spec::OutputValues values;
     values.name = o.name;
-    values.series_labels = {o.name};
-    values.series.assign(1, std::vector<double>());
-    values.series[0].reserve(report.times_s.size());
+    values.series_labels = shape.series_labels;
+    values.series.assign(static_cast<size_t>(shape.series), std::vector<double>());
+    for (std::vector<double>& series : values.series) series.reserve(report.times_s.size());
     report.outputs.push_back(std::move(values));
   }
   if (report.outputs.empty()) return;  // nothing requested: nothing computed
@@ -276,7 +340,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   const bool is_static = sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium;
   std::vector<Perturbed> perturbed;
-  if (sensitivities && is_static) result->unavailable = MultibodySensitivityUnavailable(scene);
+  if (sensitivities && (is_static || has_stress)) result->unavailable = MultibodySensitivityUnavailable(scene);
   if (sensitivities && result->unavailable.empty()) {
     for (const int index : *parameters) {
       Perturbed dp;
@@ -319,7 +383,16 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       return spec::AnalysisFailure::Ok();
     }
     ++next_instant;
+    std::vector<double> stresses;
     for (size_t k = 0; k < scene.outputs.size(); ++k) {
+      if (const auto* stress = std::get_if<spec::BendingStressOutput>(&scene.outputs[k].kind)) {
+        if (!NodeStresses(mechanism, sm, stress->link, p, s.q, &stresses)) {
+          return spec::AnalysisFailure::Of(spec::FailureKind::kNonFiniteValue,
+                                           absl::StrFormat("flexible link nodes coincide at t = %.6g s", s.t_s));
+        }
+        for (size_t j = 0; j < stresses.size(); ++j) report.outputs[k].series[j].push_back(stresses[j]);
+        continue;
+      }
       const auto& o = std::get<spec::MultibodyOutput>(scene.outputs[k].kind);
       const double value = OutputValue(mechanism, sm, o, p, s, &phi_q);
       if (!std::isfinite(value)) {
@@ -417,6 +490,11 @@ std::string MultibodySensitivityUnavailable(const spec::Scene& scene) {
   if (sm == nullptr) return "not a multibody scene";
   if (sm->analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium) {
     return "a static-equilibrium analysis has no simulator sensitivities yet";
+  }
+  for (const spec::Output& o : scene.outputs) {
+    if (std::holds_alternative<spec::BendingStressOutput>(o.kind)) {
+      return "bending-stress outputs of flexible links have no simulator sensitivities yet";
+    }
   }
   return "";
 }
