@@ -189,6 +189,7 @@ struct MultibodyFlexibleLink {
   Number angle_rad, length_m;
   Section section;
   int elements = 4;
+  bool rotary_inertia = false;
 };
 inline constexpr int kMaxFlexibleLinkElements = 200;
 

@@ -55,6 +55,11 @@ class SceneConverter {
                     "damping from its elements");
       }
     }
+    if (const auto* mb = std::get_if<MultibodyModel>(&scene_.model);
+        mb != nullptr && mb->flexible_links.empty() && msg_.effects().has_structural_damping()) {
+      errors_.Add(where_.Child("effects"), "structural_damping",
+                  "structural damping applies to flexible links; this multibody model has none");
+    }
     ConvertOutputs();
     ConvertGrid();
     ConvertIntegrator();
@@ -667,6 +672,7 @@ class SceneConverter {
       if (!l.has_section()) errors_.Add(lw, "section", "a flexible link needs a section (area, modulus, density)");
       link.section = ConvertSection(lw.Child("section"), l.section());
       link.elements = l.elements() == 0 ? 4 : l.elements();
+      link.rotary_inertia = l.rotary_inertia();
       if (link.elements < 1 || link.elements > kMaxFlexibleLinkElements) {
         errors_.Add(lw, "elements", absl::StrFormat("expected 1 to %d elements (0 for the default 4), got %d",
                                                     kMaxFlexibleLinkElements, l.elements()));

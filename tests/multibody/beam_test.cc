@@ -183,7 +183,7 @@ TEST(FlexibleLink, SwingingFlexiblePendulumConservesEnergy) {
         drift = std::max(drift, std::abs(m.KineticEnergy(s.v) + m.PotentialEnergy(s.q) - start));
         for (int e = 0; e < link.elements; ++e) {
           BeamLoads loads;
-          m.BeamEndLoads(e, s.q, &loads);
+          m.BeamEndLoads(e, s.q, s.v, &loads);
           strain = std::max({strain, std::abs(loads.moment_a_n_m), std::abs(loads.moment_b_n_m)});
         }
         return spec::AnalysisFailure::Ok();

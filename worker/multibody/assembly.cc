@@ -163,8 +163,13 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
     vel_jac.row(m.num_constraints() + static_cast<Eigen::Index>(k)) = CoordinateGradient(m, rates[k].joint, q);
     vel_rhs[m.num_constraints() + static_cast<Eigen::Index>(k)] = rates[k].value;
   }
-  out.v = vel_jac.rows() > 0 ? Eigen::VectorXd(vel_jac.completeOrthogonalDecomposition().solve(vel_rhs))
-                             : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
+  if (options.velocity_basis != nullptr && vel_jac.rows() > 0) {
+    const Eigen::MatrixXd& basis = *options.velocity_basis;
+    out.v = basis * Eigen::VectorXd((vel_jac * basis).completeOrthogonalDecomposition().solve(vel_rhs));
+  } else {
+    out.v = vel_jac.rows() > 0 ? Eigen::VectorXd(vel_jac.completeOrthogonalDecomposition().solve(vel_rhs))
+                               : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
+  }
   out.q = std::move(q);
   return out;
 }

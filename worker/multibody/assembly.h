@@ -32,6 +32,10 @@ struct AssemblyOptions {
   // assemblies of nearby designs, which needs positions closed to round-off,
   // not to the tolerance.
   int polish_iterations = 0;
+  // Velocities restricted to v = T w (n x r), the minimum-norm w: flexible
+  // links start with rigid-body velocities (each link's nodes move as one
+  // rigid body), not with the minimum-norm node velocities. Null: v free.
+  const Eigen::MatrixXd* velocity_basis = nullptr;
 };
 
 struct Assembly {

@@ -16,7 +16,7 @@ double Wrapped(double angle) {
 
 }  // namespace
 
-bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, BeamLoads* loads) {
+bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, const BeamNodes* x_dot, BeamLoads* loads) {
   const double dx = x[3] - x[0], dy = x[4] - x[1];
   const double length = std::hypot(dx, dy);
   if (!(length > 0.0)) return false;
@@ -28,6 +28,16 @@ bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, BeamLoads* loads) {
   loads->axial_n = e.axial_stiffness_n * loads->stretch_m / e.length_m;
   loads->moment_a_n_m = k * (2.0 * loads->rotation_a_rad + loads->rotation_b_rad);
   loads->moment_b_n_m = k * (loads->rotation_a_rad + 2.0 * loads->rotation_b_rad);
+  if (x_dot != nullptr && e.damping_s > 0.0) {
+    const double c = dx / length, s = dy / length;
+    const double stretch_rate = c * ((*x_dot)[3] - (*x_dot)[0]) + s * ((*x_dot)[4] - (*x_dot)[1]);
+    // d beta / dt = z . x' / l with z = (s, -c, 0, -s, c, 0).
+    const double chord_rate = (-s * ((*x_dot)[3] - (*x_dot)[0]) + c * ((*x_dot)[4] - (*x_dot)[1])) / length;
+    const double rate_a = (*x_dot)[2] - chord_rate, rate_b = (*x_dot)[5] - chord_rate;
+    loads->axial_n += e.damping_s * e.axial_stiffness_n * stretch_rate / e.length_m;
+    loads->moment_a_n_m += e.damping_s * k * (2.0 * rate_a + rate_b);
+    loads->moment_b_n_m += e.damping_s * k * (rate_a + 2.0 * rate_b);
+  }
   return true;
 }
 

@@ -9,7 +9,9 @@
 //   theta_b = phi_b - beta - b0  Mb = 2 EI / L0 (theta_a + 2 theta_b)
 //
 // (l, beta: the chord's current length and angle; a0, b0: each node's angle
-// to the chord in the undeformed state). Large rotations and the axial
+// to the chord in the undeformed state), plus beta_d times the same loads of
+// the local deformation rates (u' = r . x', theta_a' = phi_a' - z . x' / l,
+// ...) for stiffness-proportional damping. Large rotations and the axial
 // force's effect on bending come from the formulation, not from a
 // correction. The nodes are bodies of the mechanism (x, y, phi each); the
 // internal forces on (x_a, y_a, phi_a, x_b, y_b, phi_b) are
@@ -32,6 +34,9 @@ struct BeamElement {
   double axial_stiffness_n = 0.0;       // EA
   double bending_stiffness_n_m2 = 0.0;  // EI
   double angle_a_rad = 0.0, angle_b_rad = 0.0;  // a0, b0
+  // Stiffness-proportional structural damping C = beta K in the element's
+  // frame: beta times the local loads of the deformation rates.
+  double damping_s = 0.0;  // beta
 };
 
 using BeamNodes = Eigen::Matrix<double, 6, 1>;  // (x_a, y_a, phi_a, x_b, y_b, phi_b)
@@ -42,9 +47,9 @@ struct BeamLoads {
   double stretch_m = 0.0, rotation_a_rad = 0.0, rotation_b_rad = 0.0;
 };
 
-// The element's end loads at the nodes' coordinates; false if the nodes
-// coincide (no chord).
-bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, BeamLoads* loads);
+// The element's end loads at the nodes' coordinates (and, with `x_dot`,
+// their damping part); false if the nodes coincide (no chord).
+bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, const BeamNodes* x_dot, BeamLoads* loads);
 // The internal forces f (the element applies -f to its nodes).
 BeamNodes BeamInternalForces(const BeamNodes& x, const BeamLoads& loads);
 double BeamStrainEnergy(const BeamElement& e, const BeamLoads& loads);

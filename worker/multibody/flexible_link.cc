@@ -18,7 +18,8 @@ FlexibleLinkNodes AddFlexibleLink(const FlexibleLinkSpec& link, Model* model) {
     Body node;
     node.name = link.name + "#" + std::to_string(k);
     node.mass_kg = ends * element_mass / 2.0;
-    node.inertia_kg_m2 = ends * element_mass * element_length * element_length / 78.0;
+    node.inertia_kg_m2 = ends * (element_mass * element_length * element_length / 78.0 +
+                                 link.rotary_inertia_per_length_kg_m * element_length / 2.0);
     node.position_m = link.start_m + k * element_length * direction;
     node.angle_rad = link.angle_rad;
     model->bodies.push_back(node);
@@ -31,6 +32,7 @@ FlexibleLinkNodes AddFlexibleLink(const FlexibleLinkSpec& link, Model* model) {
     e.length_m = element_length;
     e.axial_stiffness_n = link.axial_stiffness_n;
     e.bending_stiffness_n_m2 = link.bending_stiffness_n_m2;
+    e.damping_s = link.damping_s;
     model->beams.push_back(e);
   }
   return nodes;

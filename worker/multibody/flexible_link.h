@@ -5,7 +5,8 @@
 // HRZ rule (Hinton, Rock and Zienkiewicz 1976: the diagonal of the consistent
 // mass matrix scaled to the element's mass): m_e / 2 and a rotary inertia
 // m_e L_e^2 / 78 per element end, so the mass matrix stays constant and
-// diagonal; the section's own rotary inertia is left out (slender links).
+// diagonal; the section's own rotary inertia rho I L_e / 2 per element end
+// is added when given.
 #pragma once
 
 #include <string>
@@ -24,6 +25,10 @@ struct FlexibleLinkSpec {
   double axial_stiffness_n = 0.0;       // EA
   double bending_stiffness_n_m2 = 0.0;  // EI
   double mass_per_length_kg_per_m = 0.0;
+  // The sections' own rotary inertia rho I per length, added at the nodes
+  // (0: left out, as for slender links).
+  double rotary_inertia_per_length_kg_m = 0.0;
+  double damping_s = 0.0;  // stiffness-proportional beta of every element
   int elements = 4;
 };
 

@@ -269,9 +269,9 @@ int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, Vec
     (*forces)[3 * torque.body + 2] += torque.factor ? torque.torque_n_m * torque.factor->At(t).q : torque.torque_n_m;
   }
   for (const BeamElement& e : model_.beams) {
-    const BeamNodes x = BeamCoordinates(e, q);
+    const BeamNodes x = BeamCoordinates(e, q), x_dot = BeamCoordinates(e, v);
     BeamLoads loads;
-    if (!EvaluateBeam(e, x, &loads)) return 1;  // coincident nodes: the step is retried
+    if (!EvaluateBeam(e, x, &x_dot, &loads)) return 1;  // coincident nodes: the step is retried
     const BeamNodes f = BeamInternalForces(x, loads);
     forces->segment<3>(3 * e.a) -= f.head<3>();
     forces->segment<3>(3 * e.b) -= f.tail<3>();
@@ -361,9 +361,11 @@ BeamNodes Mechanism::BeamCoordinates(const BeamElement& e, const VectorXd& q) co
   return x;
 }
 
-bool Mechanism::BeamEndLoads(int element, const VectorXd& q, BeamLoads* loads) const {
+bool Mechanism::BeamEndLoads(int element, const VectorXd& q, const VectorXd& v, BeamLoads* loads) const {
   const BeamElement& e = model_.beams[static_cast<size_t>(element)];
-  return EvaluateBeam(e, BeamCoordinates(e, q), loads);
+  if (v.size() != q.size()) return EvaluateBeam(e, BeamCoordinates(e, q), nullptr, loads);
+  const BeamNodes x_dot = BeamCoordinates(e, v);
+  return EvaluateBeam(e, BeamCoordinates(e, q), &x_dot, loads);
 }
 
 double Mechanism::PotentialEnergy(const VectorXd& q, double t) const {
@@ -385,7 +387,7 @@ double Mechanism::PotentialEnergy(const VectorXd& q, double t) const {
   }
   for (const BeamElement& e : model_.beams) {
     BeamLoads loads;
-    if (EvaluateBeam(e, BeamCoordinates(e, q), &loads)) energy += BeamStrainEnergy(e, loads);
+    if (EvaluateBeam(e, BeamCoordinates(e, q), nullptr, &loads)) energy += BeamStrainEnergy(e, loads);
   }
   return energy;
 }

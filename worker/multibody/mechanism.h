@@ -75,8 +75,9 @@ class Mechanism : public ConstrainedSystem {
   // Gravity (zero at y = 0 for g along -y), the springs' and the beam
   // elements' strain energy.
   double PotentialEnergy(const Eigen::VectorXd& q, double t_s = 0.0) const;
-  // Axial force and end moments of beam element `element` (Model::beams).
-  bool BeamEndLoads(int element, const Eigen::VectorXd& q, BeamLoads* loads) const;
+  // Axial force and end moments of beam element `element` (Model::beams),
+  // their damping part included when `v` is given (same size as q).
+  bool BeamEndLoads(int element, const Eigen::VectorXd& q, const Eigen::VectorXd& v, BeamLoads* loads) const;
 
   const MechanismCounters& counters() const { return counters_; }
   std::string FailureReason() const override { return failure_; }

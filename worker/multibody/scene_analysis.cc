@@ -138,7 +138,7 @@ double OutputValue(const Mechanism& mech, const spec::MultibodyModel& sm, const 
 // M the bending moment at the node (-Ma of the element that starts there,
 // Mb of the one that ends there; their mean at interior nodes).
 bool NodeStresses(const Mechanism& mech, const spec::MultibodyModel& sm, int link, const std::vector<double>& p,
-                  const Eigen::VectorXd& q, std::vector<double>* stresses) {
+                  const Eigen::VectorXd& q, const Eigen::VectorXd& v, std::vector<double>* stresses) {
   const spec::MultibodyFlexibleLink& l = sm.flexible_links[static_cast<size_t>(link)];
   const double area = l.section.area_m2.Resolve(p);
   const double fibre_per_inertia = std::sqrt(area / std::numbers::pi) / (area * area / (4.0 * std::numbers::pi));
@@ -147,7 +147,7 @@ bool NodeStresses(const Mechanism& mech, const spec::MultibodyModel& sm, int lin
   std::vector<int> count(static_cast<size_t>(l.elements + 1), 0);
   for (int e = 0; e < l.elements; ++e) {
     BeamLoads loads;
-    if (!mech.BeamEndLoads(first + e, q, &loads)) return false;
+    if (!mech.BeamEndLoads(first + e, q, v, &loads)) return false;
     (*stresses)[static_cast<size_t>(e)] -= loads.moment_a_n_m;
     (*stresses)[static_cast<size_t>(e + 1)] += loads.moment_b_n_m;
     ++count[static_cast<size_t>(e)];
@@ -166,6 +166,28 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
     m.bodies.push_back(Body{b.name, b.mass_kg.Resolve(p), b.inertia_kg_m2.Resolve(p), Resolve(b.position_m, p),
                             b.angle_rad.Resolve(p)});
   }
+  // Structural damping C = beta K with beta = 2 zeta / omega_1, omega_1 the
+  // lowest first bending frequency over the flexible links, each alone with
+  // its ends pinned, or clamped at a driven end (as the linkage model's).
+  double damping_s = 0.0;
+  if (scene.effects.structural_damping_ratio.has_value() && !sm.flexible_links.empty()) {
+    double lowest = INFINITY;
+    for (size_t i = 0; i < sm.flexible_links.size(); ++i) {
+      const spec::MultibodyFlexibleLink& l = sm.flexible_links[i];
+      bool clamped = false;
+      for (const spec::MultibodyDriver& d : sm.drivers) {
+        const spec::MultibodyJoint& j = sm.joints[static_cast<size_t>(d.joint)];
+        clamped = clamped || j.a.link == static_cast<int>(i) || j.b.link == static_cast<int>(i);
+      }
+      const double area = l.section.area_m2.Resolve(p), length = l.length_m.Resolve(p);
+      const double ei = l.section.youngs_modulus_pa.Resolve(p) * area * area / (4.0 * std::numbers::pi);
+      const double rho_a = l.section.density_kg_per_m3.Resolve(p) * area;
+      // First roots of the clamped-pinned and pinned-pinned beams, (beta L)^2.
+      const double root = clamped ? 15.4182057 : std::numbers::pi * std::numbers::pi;
+      lowest = std::min(lowest, root * std::sqrt(ei / (rho_a * std::pow(length, 4))));
+    }
+    if (std::isfinite(lowest) && lowest > 0.0) damping_s = 2.0 * *scene.effects.structural_damping_ratio / lowest;
+  }
   for (const spec::MultibodyFlexibleLink& l : sm.flexible_links) {
     FlexibleLinkSpec link;
     link.name = l.name;
@@ -176,6 +198,10 @@ absl::StatusOr<Model> CompileModel(const spec::Scene& scene, const std::vector<d
     link.axial_stiffness_n = modulus * area;
     link.bending_stiffness_n_m2 = modulus * area * area / (4.0 * std::numbers::pi);
     link.mass_per_length_kg_per_m = l.section.density_kg_per_m3.Resolve(p) * area;
+    if (l.rotary_inertia) {
+      link.rotary_inertia_per_length_kg_m = l.section.density_kg_per_m3.Resolve(p) * area * area / (4.0 * std::numbers::pi);
+    }
+    link.damping_s = damping_s;
     link.elements = l.elements;
     AddFlexibleLink(link, &m);
   }
@@ -325,6 +351,31 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   // Variants are differenced: close every assembly to round-off.
   if (sensitivities) assembly_options.polish_iterations = 3;
   const Mechanism mechanism(*model);
+  // Flexible links start with rigid-body velocities: v = T w, w holding per
+  // rigid body its (x', y', phi') and per link its end a's (x', y') and its
+  // angular rate.
+  Eigen::MatrixXd velocity_basis;
+  if (!sm.flexible_links.empty()) {
+    const int n = mechanism.num_coordinates();
+    const int rigid = static_cast<int>(sm.bodies.size());
+    velocity_basis = Eigen::MatrixXd::Zero(n, 3 * rigid + 3 * static_cast<int>(sm.flexible_links.size()));
+    velocity_basis.topLeftCorner(3 * rigid, 3 * rigid).setIdentity();
+    const Eigen::VectorXd q0 = mechanism.InitialGuess();
+    for (size_t i = 0; i < sm.flexible_links.size(); ++i) {
+      const int column = 3 * rigid + 3 * static_cast<int>(i);
+      const int a = LinkNode(sm, static_cast<int>(i), 0);
+      for (int k = 0; k <= sm.flexible_links[i].elements; ++k) {
+        const int node = LinkNode(sm, static_cast<int>(i), k);
+        const Eigen::Vector2d arm = q0.segment<2>(3 * node) - q0.segment<2>(3 * a);
+        velocity_basis(3 * node, column) = 1.0;
+        velocity_basis(3 * node + 1, column + 1) = 1.0;
+        velocity_basis(3 * node, column + 2) = -arm.y();
+        velocity_basis(3 * node + 1, column + 2) = arm.x();
+        velocity_basis(3 * node + 2, column + 2) = 1.0;
+      }
+    }
+    assembly_options.velocity_basis = &velocity_basis;
+  }
   const Assembly assembled = Assemble(mechanism, 0.0, assembly_options);
   report.counters.newton_iterations += assembled.newton_iterations;
   if (!assembled.failure.ok()) {
@@ -386,7 +437,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     std::vector<double> stresses;
     for (size_t k = 0; k < scene.outputs.size(); ++k) {
       if (const auto* stress = std::get_if<spec::BendingStressOutput>(&scene.outputs[k].kind)) {
-        if (!NodeStresses(mechanism, sm, stress->link, p, s.q, &stresses)) {
+        if (!NodeStresses(mechanism, sm, stress->link, p, s.q, s.v, &stresses)) {
           return spec::AnalysisFailure::Of(spec::FailureKind::kNonFiniteValue,
                                            absl::StrFormat("flexible link nodes coincide at t = %.6g s", s.t_s));
         }
