@@ -21,6 +21,10 @@ bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, const BeamNodes* x_d
   const double length = std::hypot(dx, dy);
   if (!(length > 0.0)) return false;
   const double beta = std::atan2(dy, dx);
+  const double c = dx / length, s = dy / length;
+  loads->chord_length_m = length;
+  loads->chord_cos = c;
+  loads->chord_sin = s;
   loads->stretch_m = length - e.length_m;
   loads->rotation_a_rad = Wrapped(x[2] - beta - e.angle_a_rad);
   loads->rotation_b_rad = Wrapped(x[5] - beta - e.angle_b_rad);
@@ -29,7 +33,6 @@ bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, const BeamNodes* x_d
   loads->moment_a_n_m = k * (2.0 * loads->rotation_a_rad + loads->rotation_b_rad);
   loads->moment_b_n_m = k * (loads->rotation_a_rad + 2.0 * loads->rotation_b_rad);
   if (x_dot != nullptr && e.damping_s > 0.0) {
-    const double c = dx / length, s = dy / length;
     const double stretch_rate = c * ((*x_dot)[3] - (*x_dot)[0]) + s * ((*x_dot)[4] - (*x_dot)[1]);
     // d beta / dt = z . x' / l with z = (s, -c, 0, -s, c, 0).
     const double chord_rate = (-s * ((*x_dot)[3] - (*x_dot)[0]) + c * ((*x_dot)[4] - (*x_dot)[1])) / length;
@@ -41,10 +44,8 @@ bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, const BeamNodes* x_d
   return true;
 }
 
-BeamNodes BeamInternalForces(const BeamNodes& x, const BeamLoads& loads) {
-  const double dx = x[3] - x[0], dy = x[4] - x[1];
-  const double length = std::hypot(dx, dy);
-  const double c = dx / length, s = dy / length;
+BeamNodes BeamInternalForces(const BeamLoads& loads) {
+  const double length = loads.chord_length_m, c = loads.chord_cos, s = loads.chord_sin;
   BeamNodes r, z;
   r << -c, -s, 0.0, c, s, 0.0;
   z << s, -c, 0.0, -s, c, 0.0;

@@ -45,13 +45,15 @@ struct BeamLoads {
   double axial_n = 0.0;                      // N, tension positive
   double moment_a_n_m = 0.0, moment_b_n_m = 0.0;  // Ma, Mb on the nodes' side
   double stretch_m = 0.0, rotation_a_rad = 0.0, rotation_b_rad = 0.0;
+  double chord_length_m = 0.0, chord_cos = 1.0, chord_sin = 0.0;  // l, cos beta, sin beta
 };
 
 // The element's end loads at the nodes' coordinates (and, with `x_dot`,
 // their damping part); false if the nodes coincide (no chord).
 bool EvaluateBeam(const BeamElement& e, const BeamNodes& x, const BeamNodes* x_dot, BeamLoads* loads);
-// The internal forces f (the element applies -f to its nodes).
-BeamNodes BeamInternalForces(const BeamNodes& x, const BeamLoads& loads);
+// The internal forces f (the element applies -f to its nodes), from the
+// loads and chord EvaluateBeam found.
+BeamNodes BeamInternalForces(const BeamLoads& loads);
 double BeamStrainEnergy(const BeamElement& e, const BeamLoads& loads);
 
 }  // namespace mbopt::multibody

@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <string>
 
 #include "absl/strings/str_format.h"
@@ -58,7 +57,7 @@ int EvaluateResidual(const ConstrainedSystem& s, Problem* p, double t, const Y& 
 
 int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
-  try {
+  return solve::sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
     if (p->max_wall_seconds > 0.0 &&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - p->start).count() > p->max_wall_seconds) {
       p->wall_time_exceeded = true;
@@ -69,13 +68,7 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
     Map<VectorXd> r(N_VGetArrayPointer(rr), size);
     return EvaluateResidual(*p->system, p, t, y, y_dot, r);
-  } catch (const std::exception& e) {
-    p->callback_failure = e.what();
-    return -1;
-  } catch (...) {
-    p->callback_failure = "unknown exception in the residual";
-    return -1;
-  }
+  });
 }
 
 // The sensitivity residuals F_y s_k + F_y' s_k' + F_p_k. F is linear in y'
@@ -92,7 +85,7 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
 int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vector /*rr*/, N_Vector* y_s,
                         N_Vector* yp_s, N_Vector* rr_s, void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
-  try {
+  return solve::sundials::GuardCallback(&p->callback_failure, "the sensitivity residual", [&]() -> int {
     const int n = p->n, m = p->m, size = 2 * n + 2 * m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
@@ -102,7 +95,7 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
     if (m > 0) {
       if (int flag = p->system->ConstraintJacobian(t, q, &phi_q); flag != 0) return flag;
     }
-    const double state_scale = std::max(1.0, y.head(2 * n).cwiseAbs().maxCoeff());
+    const double state_scale = std::max(1.0, MaxAbs(y.head(2 * n)));
     VectorXd y_shift(size), r_plus(size), r_minus(size), result(size);
     for (int k = 0; k < count; ++k) {
       const ParameterPerturbation& dp = (*p->parameters)[static_cast<size_t>(k)];
@@ -155,13 +148,7 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
       Map<VectorXd>(N_VGetArrayPointer(rr_s[k]), size) = result;
     }
     return 0;
-  } catch (const std::exception& e) {
-    p->callback_failure = e.what();
-    return -1;
-  } catch (...) {
-    p->callback_failure = "unknown exception in the sensitivity residual";
-    return -1;
-  }
+  });
 }
 
 void Accumulate(void* ida, ForwardDynamicsCounters* c) {

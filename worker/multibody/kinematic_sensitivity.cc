@@ -40,35 +40,44 @@ int ForceEquation(const ConstrainedSystem& s, double t, const VectorXd& q, const
 
 }  // namespace
 
-bool KinematicStateSensitivity(const ConstrainedSystem& system, const ParameterPerturbation& dp,
-                               const MotionSample& s, StateSensitivity* out) {
-  const double t = s.t_s, h = dp.step;
+bool KinematicStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
+                                 const MotionSample& s, std::vector<StateSensitivity>* sensitivities) {
+  const double t = s.t_s;
   MatrixXd phi_q;
   if (system.ConstraintJacobian(t, s.q, &phi_q) != 0 || phi_q.rows() != phi_q.cols()) return false;
   const Eigen::PartialPivLU<MatrixXd> lu(phi_q);
+  Eigen::PartialPivLU<MatrixXd> lu_t;
+  if (s.lambda.size() > 0) lu_t.compute(phi_q.transpose());
+  sensitivities->resize(parameters.size());
   VectorXd plus, minus;
-  if (dp.plus->Constraints(t, s.q, &plus) != 0 || dp.minus->Constraints(t, s.q, &minus) != 0) return false;
-  out->q = -lu.solve((plus - minus) / (2 * h));
-  if (VelocityEquation(*dp.plus, t, s.q + h * out->q, s.v, &plus) != 0 ||
-      VelocityEquation(*dp.minus, t, s.q - h * out->q, s.v, &minus) != 0) {
-    return false;
-  }
-  out->v = -lu.solve((plus - minus) / (2 * h));
-  if (AccelerationEquation(*dp.plus, t, s.q + h * out->q, s.v + h * out->v, s.a, &plus) != 0 ||
-      AccelerationEquation(*dp.minus, t, s.q - h * out->q, s.v - h * out->v, s.a, &minus) != 0) {
-    return false;
-  }
-  out->a = -lu.solve((plus - minus) / (2 * h));
-  out->lambda.resize(0);
-  if (s.lambda.size() > 0) {
-    if (ForceEquation(*dp.plus, t, s.q + h * out->q, s.v + h * out->v, s.a + h * out->a, s.lambda, &plus) != 0 ||
-        ForceEquation(*dp.minus, t, s.q - h * out->q, s.v - h * out->v, s.a - h * out->a, s.lambda, &minus) != 0) {
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    const ParameterPerturbation& dp = parameters[k];
+    const double h = dp.step;
+    StateSensitivity* out = &(*sensitivities)[k];
+    if (dp.plus->Constraints(t, s.q, &plus) != 0 || dp.minus->Constraints(t, s.q, &minus) != 0) return false;
+    out->q = -lu.solve((plus - minus) / (2 * h));
+    if (VelocityEquation(*dp.plus, t, s.q + h * out->q, s.v, &plus) != 0 ||
+        VelocityEquation(*dp.minus, t, s.q - h * out->q, s.v, &minus) != 0) {
       return false;
     }
-    const Eigen::PartialPivLU<MatrixXd> lu_t(phi_q.transpose());
-    out->lambda = -lu_t.solve((plus - minus) / (2 * h));
+    out->v = -lu.solve((plus - minus) / (2 * h));
+    if (AccelerationEquation(*dp.plus, t, s.q + h * out->q, s.v + h * out->v, s.a, &plus) != 0 ||
+        AccelerationEquation(*dp.minus, t, s.q - h * out->q, s.v - h * out->v, s.a, &minus) != 0) {
+      return false;
+    }
+    out->a = -lu.solve((plus - minus) / (2 * h));
+    out->lambda.resize(0);
+    if (s.lambda.size() > 0) {
+      if (ForceEquation(*dp.plus, t, s.q + h * out->q, s.v + h * out->v, s.a + h * out->a, s.lambda, &plus) != 0 ||
+          ForceEquation(*dp.minus, t, s.q - h * out->q, s.v - h * out->v, s.a - h * out->a, s.lambda, &minus) !=
+              0) {
+        return false;
+      }
+      out->lambda = -lu_t.solve((plus - minus) / (2 * h));
+    }
+    if (!(out->q.allFinite() && out->v.allFinite() && out->a.allFinite() && out->lambda.allFinite())) return false;
   }
-  return out->q.allFinite() && out->v.allFinite() && out->a.allFinite() && out->lambda.allFinite();
+  return true;
 }
 
 }  // namespace mbopt::multibody

@@ -10,9 +10,11 @@
 // where each right-hand side d(...) is the derivative along the parameter
 // with the unknowns solved so far moving with it and the current unknown
 // held: a central difference of the equations between the systems rebuilt
-// at p +- step (ParameterPerturbation). One LU of Phi_q per instant; no
-// position solve is repeated.
+// at p +- step (ParameterPerturbation). One LU of Phi_q (and of Phi_q^T)
+// per instant, shared by every parameter; no position solve is repeated.
 #pragma once
+
+#include <vector>
 
 #include "worker/multibody/constrained_system.h"
 #include "worker/multibody/motion.h"
@@ -20,9 +22,9 @@
 namespace mbopt::multibody {
 
 // `sample` as the kinematic analysis reports it (lambda empty: no
-// multipliers wanted). Returns false if an equation is not finite or
-// Phi_q is singular.
-bool KinematicStateSensitivity(const ConstrainedSystem& system, const ParameterPerturbation& parameter,
-                               const MotionSample& sample, StateSensitivity* out);
+// multipliers wanted); one derivative per parameter into `out`. Returns
+// false if an equation is not finite or Phi_q is not square.
+bool KinematicStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
+                                 const MotionSample& sample, std::vector<StateSensitivity>* out);
 
 }  // namespace mbopt::multibody

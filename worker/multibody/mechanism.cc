@@ -272,7 +272,7 @@ int Mechanism::AppliedForces(double t, const VectorXd& q, const VectorXd& v, Vec
     const BeamNodes x = BeamCoordinates(e, q), x_dot = BeamCoordinates(e, v);
     BeamLoads loads;
     if (!EvaluateBeam(e, x, &x_dot, &loads)) return 1;  // coincident nodes: the step is retried
-    const BeamNodes f = BeamInternalForces(x, loads);
+    const BeamNodes f = BeamInternalForces(loads);
     forces->segment<3>(3 * e.a) -= f.head<3>();
     forces->segment<3>(3 * e.b) -= f.tail<3>();
   }

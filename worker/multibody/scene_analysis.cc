@@ -429,6 +429,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
         ParameterPerturbation{dp.plus->mechanism.get(), dp.minus->mechanism.get(), dp.step, dp.magnitude});
   }
   const bool driven = assembled.degrees_of_freedom == 0;
+  std::vector<StateSensitivity> kinematic;  // work space of the driven path
   const MotionCallback record = [&](const MotionSample& s) {
     if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
       return spec::AnalysisFailure::Ok();
@@ -457,21 +458,20 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       report.outputs[k].series[0].push_back(value);
     }
     if (!with_derivatives || !result->unavailable.empty()) return spec::AnalysisFailure::Ok();
-    for (size_t i = 0; i < perturbed.size(); ++i) {
-      StateSensitivity kinematic;
-      const StateSensitivity* ds = nullptr;
-      if (i < s.sensitivities.size()) {
-        ds = &s.sensitivities[i];
-      } else if (driven && KinematicStateSensitivity(mechanism, perturbations[i], s, &kinematic)) {
-        ds = &kinematic;
-      }
-      if (ds == nullptr) {
+    // Forward dynamics brings the state's derivatives; a driven mechanism's
+    // come from its differentiated constraint equations.
+    const std::vector<StateSensitivity>* ds = &s.sensitivities;
+    if (ds->size() != perturbed.size()) {
+      if (!driven || !KinematicStateSensitivities(mechanism, perturbations, s, &kinematic)) {
         result->unavailable = absl::StrFormat("no state derivative at t = %.6g s", s.t_s);
         return spec::AnalysisFailure::Ok();
       }
+      ds = &kinematic;
+    }
+    for (size_t i = 0; i < perturbed.size(); ++i) {
       for (size_t k = 0; k < scene.outputs.size(); ++k) {
         const auto& o = std::get<spec::MultibodyOutput>(scene.outputs[k].kind);
-        result->output_derivatives[i][k].push_back(OutputDerivative(sm, o, perturbed[i], s, *ds, &phi_q));
+        result->output_derivatives[i][k].push_back(OutputDerivative(sm, o, perturbed[i], s, (*ds)[i], &phi_q));
       }
     }
     return spec::AnalysisFailure::Ok();

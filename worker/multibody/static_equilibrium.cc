@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <string>
 
@@ -55,7 +54,7 @@ int Evaluate(Problem* p, const VectorXd& x, VectorXd* f) {
 
 int Residual(N_Vector uu, N_Vector ff, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
-  try {
+  return solve::sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
     const int size = p->n + p->m;
     const VectorXd x = Map<const VectorXd>(N_VGetArrayPointer(uu), size);
     VectorXd f;
@@ -63,13 +62,7 @@ int Residual(N_Vector uu, N_Vector ff, void* user_data) {
     if (flag != 0) return flag;
     Map<VectorXd>(N_VGetArrayPointer(ff), size) = f;
     return 0;
-  } catch (const std::exception& e) {
-    p->callback_failure = e.what();
-    return -1;
-  } catch (...) {
-    p->callback_failure = "unknown exception in the residual";
-    return -1;
-  }
+  });
 }
 
 spec::AnalysisFailure Failed(spec::FailureKind kind, std::string reason) {

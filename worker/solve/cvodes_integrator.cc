@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <utility>
 
@@ -46,7 +45,7 @@ struct CvodesCallbacks {
         return -1;
       }
     }
-    try {
+    return solve::sundials::GuardCallback(&self->callback_failure_, "right-hand side", [&]() -> int {
       const int flag = self->rhs_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
       if (flag != 0) {
         if (flag < 0) {
@@ -64,18 +63,13 @@ struct CvodesCallbacks {
         }
       }
       return 0;
-    } catch (const std::exception& e) {
-      self->callback_failure_ = absl::StrCat("right-hand side threw: ", e.what());
-    } catch (...) {
-      self->callback_failure_ = "right-hand side threw a non-standard exception";
-    }
-    return -1;
+    });
   }
 
   static int Jacobian(realtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void* user_data, N_Vector,
                       N_Vector, N_Vector) {
     auto* self = static_cast<CvodesIntegrator*>(user_data);
-    try {
+    return solve::sundials::GuardCallback(&self->callback_failure_, "Jacobian", [&]() -> int {
       SUNMatZero(jac);
       const int flag = self->jacobian_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(fy),
                                        SUNDenseMatrix_Data(jac));
@@ -84,12 +78,7 @@ struct CvodesCallbacks {
             absl::StrFormat("Jacobian reported an unrecoverable error (%d) at t = %.9g", flag, t);
       }
       return flag;
-    } catch (const std::exception& e) {
-      self->callback_failure_ = absl::StrCat("Jacobian threw: ", e.what());
-    } catch (...) {
-      self->callback_failure_ = "Jacobian threw a non-standard exception";
-    }
-    return -1;
+    });
   }
 
   // The caller's Newton solver as a matrix-embedded SUNLinearSolver. CVODES
@@ -123,7 +112,7 @@ struct CvodesCallbacks {
       self->callback_failure_ = "Newton solver could not read the step's time and gamma";
       return SUNLS_PACKAGE_FAIL_UNREC;
     }
-    try {
+    return solve::sundials::GuardCallback(&self->callback_failure_, "Newton solver", [&]() -> int {
       N_VScale(1.0, b, x);
       bool refactored = false;
       const int flag = self->newton_solve_(t, gamma, N_VGetArrayPointer(x), &refactored);
@@ -133,12 +122,7 @@ struct CvodesCallbacks {
       self->callback_failure_ = absl::StrFormat(
           "Newton solver reported an unrecoverable error (%d) at t = %.9g", flag, t);
       return SUNLS_PACKAGE_FAIL_UNREC;
-    } catch (const std::exception& e) {
-      self->callback_failure_ = absl::StrCat("Newton solver threw: ", e.what());
-    } catch (...) {
-      self->callback_failure_ = "Newton solver threw a non-standard exception";
-    }
-    return SUNLS_PACKAGE_FAIL_UNREC;
+    }, SUNLS_PACKAGE_FAIL_UNREC);
   }
   // The content is the integrator, which outlives the solver; only the
   // shell is freed.

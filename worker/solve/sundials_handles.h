@@ -6,7 +6,9 @@
 // them in reverse, integrator memory first, context last.
 //
 // Also the one way SUNDIALS' own error messages are captured: into a string
-// that ends up in the caller's status or failure reason, never on stderr.
+// that ends up in the caller's status or failure reason, never on stderr;
+// and the one way a callback's exception is kept from crossing SUNDIALS' C
+// frames (GuardCallback).
 #pragma once
 
 #include <nvector/nvector_serial.h>
@@ -15,10 +17,12 @@
 #include <sundials/sundials_matrix.h>
 #include <sundials/sundials_nonlinearsolver.h>
 
+#include <exception>
 #include <memory>
 #include <string>
 #include <type_traits>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
 namespace mbopt::solve::sundials {
@@ -98,6 +102,22 @@ inline void CaptureMessage(int code, const char* module, const char* function, c
   *static_cast<std::string*>(user_data) =
       absl::StrFormat("%s %s (code %d): %s", module != nullptr ? module : "SUNDIALS",
                       function != nullptr ? function : "", code, message != nullptr ? message : "");
+}
+
+// Runs the body of a SUNDIALS callback (a C function: no exception may
+// leave it). An exception becomes `*failure` ("NAME threw: what") and the
+// return value `unrecoverable`, which SUNDIALS turns into a failed call whose
+// reason the caller reads from `*failure`.
+template <class Body>
+int GuardCallback(std::string* failure, const char* name, Body&& body, int unrecoverable = -1) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    *failure = absl::StrCat(name, " threw: ", e.what());
+  } catch (...) {
+    *failure = absl::StrCat(name, " threw a non-standard exception");
+  }
+  return unrecoverable;
 }
 
 }  // namespace mbopt::solve::sundials
