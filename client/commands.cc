@@ -2,23 +2,32 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <thread>
+#include <variant>
 
 #include "client/args.h"
 #include "client/connection.h"
 #include "client/exit_codes.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
+#include "client/local_cluster.h"
 #include "client/report/job_report_html.h"
 #include "client/report/report_from_proto.h"
 #include "client/study_file.h"
+#include "client/temp_dir.h"
 #include "client/watch.h"
 
 namespace mbopt::client {
 namespace {
 
-const ArgSpec kServerOnly{{"--server"}, {}};
+// Every command that reads a job takes --server, or --db: the database a
+// finished `mbopt run` kept, served by a private server for this command.
+const ArgSpec kServerOrDb{{"--server", "--db"}, {}};
 
 // Parses `args`, requiring exactly `positional` positional arguments.
 absl::StatusOr<ParsedArgs> Parse(const Args& args, const ArgSpec& spec, size_t positional,
@@ -32,13 +41,51 @@ absl::StatusOr<ParsedArgs> Parse(const Args& args, const ArgSpec& spec, size_t p
 }
 
 struct Connection {
+  // Declared first so that they go last: the client closes its channel
+  // before the private server stops, and that before its directory goes.
+  std::unique_ptr<TempDir> temp_dir;
+  std::unique_ptr<LocalCluster> local;
   std::string address;
   std::unique_ptr<v1::JobService::Stub> job_service;  // the gRPC client of the server's JobService
 };
 
-Connection Connect(const ParsedArgs& parsed) {
+struct ConnectFailure {
+  std::string message;
+  int exit_code = kExitBadInput;
+};
+
+// The server of --server, or with --db PATH a private one on 127.0.0.1 on
+// that database, with `workers` local workers (0: it only answers).
+std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int workers = 0) {
   Connection c;
-  c.address = ResolveServerAddress(parsed.Value("--server"));
+  const std::string db = parsed.Value("--db");
+  if (db.empty()) {
+    c.address = ResolveServerAddress(parsed.Value("--server"));
+    c.job_service = ConnectJobService(c.address);
+    return c;
+  }
+  if (!parsed.Value("--server").empty()) return ConnectFailure{"--db and --server exclude each other"};
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(db, ec)) {
+    return ConnectFailure{"no job database at " + db + " (--db names the file that `mbopt run` printed)"};
+  }
+  auto server_binary = FindMboptBinary("mbopt-server", "MBOPT_SERVER_BIN", "server/main");
+  if (!server_binary.ok()) return ConnectFailure{std::string(server_binary.status().message())};
+  auto worker_binary = FindMboptBinary("mbopt-worker", "MBOPT_WORKER_BIN", "worker/main");
+  if (!worker_binary.ok()) return ConnectFailure{std::string(worker_binary.status().message())};
+  Interrupts::Install();  // before the cluster's and gRPC's threads
+  c.temp_dir = std::make_unique<TempDir>();
+  if (c.temp_dir->path().empty()) return ConnectFailure{"cannot create a temporary directory"};
+  LocalClusterOptions options;
+  options.server_binary = *server_binary;
+  options.worker_binary = *worker_binary;
+  options.db_path = db;
+  options.log_dir = c.temp_dir->path();
+  options.workers = workers;
+  auto cluster = LocalCluster::Start(options);
+  if (!cluster.ok()) return ConnectFailure{std::string(cluster.status().message()), kExitUnreachable};
+  c.local = *std::move(cluster);
+  c.address = c.local->address();
   c.job_service = ConnectJobService(c.address);
   return c;
 }
@@ -71,10 +118,14 @@ int Follow(Connection& c, const std::string& job_id) {
   }
   if (!outcome.ok) return Fail(outcome.failure.message, outcome.failure.exit_code);
   const auto& s = outcome.summary;
-  std::printf("%s: %s after %d cycles, %lld analyses, F = %.10g %s, max violation %.4g\n",
-              job_id.c_str(), StateName(s.state()).c_str(), s.cycles(),
-              static_cast<long long>(s.analyses()), s.objective(), s.objective_unit().c_str(),
-              s.max_violation());
+  std::printf("%s: %s after %d cycles, %lld analyses", job_id.c_str(), StateName(s.state()).c_str(),
+              s.cycles(), static_cast<long long>(s.analyses()));
+  if (std::isfinite(s.objective())) {
+    std::printf(", F = %.10g %s, max violation %.4g\n", s.objective(), s.objective_unit().c_str(),
+                s.max_violation());
+  } else {
+    std::printf(", no design analysed\n");
+  }
   if (!s.message().empty()) std::printf("%s\n", s.message().c_str());
   return ExitCodeForState(s.state());
 }
@@ -94,7 +145,9 @@ int SubmitCommand(const Args& args) {
   auto study = ReadStudyForSubmission(path);
   if (!study.ok()) return Fail(std::string(study.status().message()), kExitBadInput);
   if (parsed->Has("--watch")) Interrupts::Install();  // before gRPC starts threads
-  Connection c = Connect(*parsed);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
   v1::SubmitJobRequest request;
   *request.mutable_study() = *std::move(study);
   request.set_source_name(path);
@@ -110,17 +163,21 @@ int SubmitCommand(const Args& args) {
 }
 
 int WatchCommand(const Args& args) {
-  auto parsed = Parse(args, kServerOnly, 1, "mbopt watch JOB [--server ADDRESS]");
+  auto parsed = Parse(args, kServerOrDb, 1, "mbopt watch JOB [--server ADDRESS | --db PATH]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   Interrupts::Install();  // before gRPC starts threads
-  Connection c = Connect(*parsed);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
   return Follow(c, parsed->positional[0]);
 }
 
 int StatusCommand(const Args& args) {
-  auto parsed = Parse(args, kServerOnly, 1, "mbopt status JOB [--server ADDRESS]");
+  auto parsed = Parse(args, kServerOrDb, 1, "mbopt status JOB [--server ADDRESS | --db PATH]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
-  Connection c = Connect(*parsed);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, parsed->positional[0], &response);
   if (!status.ok()) return FailRpc(status, c.address);
@@ -129,9 +186,11 @@ int StatusCommand(const Args& args) {
 }
 
 int ListCommand(const Args& args) {
-  auto parsed = Parse(args, kServerOnly, 0, "mbopt list [--server ADDRESS]");
+  auto parsed = Parse(args, kServerOrDb, 0, "mbopt list [--server ADDRESS | --db PATH]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
-  Connection c = Connect(*parsed);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
   v1::ListJobsResponse response;
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
@@ -144,14 +203,13 @@ int ListCommand(const Args& args) {
 
 namespace {
 
-int CancelOrResume(const Args& args, bool cancel) {
-  auto parsed = Parse(args, kServerOnly, 1,
-                      cancel ? "mbopt cancel JOB [--server ADDRESS]"
-                             : "mbopt resume JOB [--server ADDRESS]");
-  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
-  Connection c = Connect(*parsed);
+int CancelOrResume(const ParsedArgs& parsed, bool cancel, int workers) {
+  auto connected = Connect(parsed, workers);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
+  const std::string job_id = parsed.positional[0];
   v1::JobRef ref;
-  ref.set_job_id(parsed->positional[0]);
+  ref.set_job_id(job_id);
   v1::JobSummary summary;
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
@@ -159,22 +217,43 @@ int CancelOrResume(const Args& args, bool cancel) {
                                : c.job_service->Resume(&context, ref, &summary);
   if (!status.ok()) return FailRpc(status, c.address);
   std::printf("%s: %s\n", summary.job_id().c_str(), StateName(summary.state()).c_str());
+  std::fflush(stdout);
+  // A private server stops with this command: stay until the job ends.
+  if (c.local != nullptr && !cancel) return Follow(c, job_id);
   return kExitOk;
 }
 
 }  // namespace
 
-int CancelCommand(const Args& args) { return CancelOrResume(args, true); }
-int ResumeCommand(const Args& args) { return CancelOrResume(args, false); }
+int CancelCommand(const Args& args) {
+  auto parsed = Parse(args, {{"--server"}, {}}, 1, "mbopt cancel JOB [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  return CancelOrResume(*parsed, true, 0);
+}
+
+int ResumeCommand(const Args& args) {
+  auto parsed = Parse(args, {{"--server", "--db", "--workers"}, {}}, 1,
+                      "mbopt resume JOB [--server ADDRESS | --db PATH [--workers N]]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  auto workers = parsed->IntValue("--workers", 1);
+  if (!workers.ok()) return Fail(std::string(workers.status().message()), kExitBadInput);
+  if (workers->has_value() && parsed->Value("--db").empty()) {
+    return Fail("--workers needs --db (a server's own workers are started with mbopt-worker)", kExitBadInput);
+  }
+  return CancelOrResume(*parsed, false,
+                        workers->value_or(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))));
+}
 
 int ResultsCommand(const Args& args) {
-  auto parsed = Parse(args, {{"--server"}, {"--csv", "--json"}}, 1,
-                      "mbopt results JOB [--csv | --json] [--server ADDRESS]");
+  auto parsed = Parse(args, {{"--server", "--db"}, {"--csv", "--json"}}, 1,
+                      "mbopt results JOB [--csv | --json] [--server ADDRESS | --db PATH]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   if (parsed->Has("--csv") && parsed->Has("--json")) {
     return Fail("--csv and --json exclude each other", kExitBadInput);
   }
-  Connection c = Connect(*parsed);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, parsed->positional[0], &response);
   if (!status.ok()) return FailRpc(status, c.address);
@@ -194,13 +273,15 @@ int ReportCommand(const Args& args) {
   for (std::string& a : spelled) {
     if (a == "-o") a = "--output";
   }
-  auto parsed = Parse(spelled, {{"--server", "--output"}, {}}, 1,
-                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS]");
+  auto parsed = Parse(spelled, {{"--server", "--db", "--output"}, {}}, 1,
+                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   const std::string job_id = parsed->positional[0];
   std::string path = parsed->Value("--output");
   if (path.empty()) path = job_id + ".html";
-  Connection c = Connect(*parsed);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, job_id, &response);
   if (!status.ok()) return FailRpc(status, c.address);

@@ -19,6 +19,7 @@ int ResumeCommand(const Args& args);
 int ResultsCommand(const Args& args);
 int ReportCommand(const Args& args);   // `mbopt report`: HTML page of a job
 int RunCommandMain(const Args& args);  // `mbopt run`
+int ValidateCommand(const Args& args);  // `mbopt validate`: a study checked offline
 
 // Prints "mbopt: <message>" on stderr and returns `exit_code`.
 int Fail(const std::string& message, int exit_code);

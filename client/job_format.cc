@@ -95,17 +95,17 @@ int ExitCodeForState(v1::JobState state) {
 
 std::string CycleTableHeader() {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%5s %3s %14s %10s %10s %4s %4s %9s %9s %9s", "cycle", "att",
-                "F", "maxg", "maxfout", "feas", "acc", "ml_min", "ml_max", "analyses");
+  std::snprintf(buf, sizeof buf, "%5s %3s %14s %10s %10s %9s %4s %4s %9s %9s %9s", "cycle",
+                "att", "F", "maxg", "maxfout", "kkt", "feas", "acc", "ml_min", "ml_max", "analyses");
   return buf;
 }
 
 std::string CycleTableRow(const v1::CycleRecord& r) {
   auto [ml_min, ml_max] = MinMax(r.move_limits());
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%5d %3d %14.7g %10.4g %10.4g %4s %4s %9.3g %9.3g %9lld",
+  std::snprintf(buf, sizeof buf, "%5d %3d %14.7g %10.4g %10.4g %9.3g %4s %4s %9.3g %9.3g %9lld",
                 r.cycle(), r.attempt(), r.objective_trial(), r.max_violation_trial(),
-                r.max_approximation_error(), r.lp_feasible() ? "yes" : "no",
+                r.max_approximation_error(), r.optimality_residual(), r.lp_feasible() ? "yes" : "no",
                 r.accepted() ? "yes" : "no", ml_min, ml_max,
                 static_cast<long long>(r.analyses_total()));
   return buf;
@@ -132,9 +132,13 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   out += "cycles:        " + std::to_string(s.cycles()) +
          (s.max_cycles() > 0 ? " (of at most " + std::to_string(s.max_cycles()) + ")" : "") + "\n";
   out += "analyses:      " + std::to_string(s.analyses()) + "\n";
-  out += "objective:     " + Format("%.10g", s.objective()) +
-         (s.objective_unit().empty() ? "" : " " + s.objective_unit()) + "\n";
-  out += "max violation: " + Format("%.4g", s.max_violation()) + "\n";
+  if (std::isfinite(s.objective())) {
+    out += "objective:     " + Format("%.10g", s.objective()) +
+           (s.objective_unit().empty() ? "" : " " + s.objective_unit()) + "\n";
+    out += "max violation: " + Format("%.4g", s.max_violation()) + "\n";
+  } else {
+    out += "objective:     none (no design was analysed)\n";
+  }
   out += "wall time:     " + Format("%.2f", s.wall_seconds()) + " s\n";
   if (!s.message().empty()) out += "message:       " + s.message() + "\n";
   if (!s.failed_analyses_by_kind().empty()) out += "failed:        " + FailedAnalysesText(s) + "\n";
@@ -151,9 +155,10 @@ std::string ListHeader() {
 
 std::string ListRow(const v1::JobSummary& s) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6d %9lld %14.7g", s.job_id().c_str(),
+  const std::string objective = std::isfinite(s.objective()) ? Format("%.7g", s.objective()) : "-";
+  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6d %9lld %14s", s.job_id().c_str(),
                 s.study_name().c_str(), StateName(s.state()).c_str(), s.cycles(),
-                static_cast<long long>(s.analyses()), s.objective());
+                static_cast<long long>(s.analyses()), objective.c_str());
   return buf;
 }
 
@@ -174,7 +179,7 @@ std::string ResultsTable(const v1::GetJobResponse& job) {
 std::string ResultsCsv(const v1::GetJobResponse& job) {
   const auto& s = job.summary();
   std::string out = "cycle,attempt,accepted,objective,max_violation,max_approximation_error,"
-                    "lp_feasible,move_limit_min,move_limit_max,analyses";
+                    "optimality_residual,lp_feasible,move_limit_min,move_limit_max,analyses";
   for (const auto& name : s.design_names()) out += "," + name;
   out += "\n";
   for (const auto& r : job.cycles()) {
@@ -183,6 +188,7 @@ std::string ResultsCsv(const v1::GetJobResponse& job) {
            (r.accepted() ? "1" : "0") + "," + JsonWriter::FormatDouble(r.objective_trial()) +
            "," + JsonWriter::FormatDouble(r.max_violation_trial()) + "," +
            JsonWriter::FormatDouble(r.max_approximation_error()) + "," +
+           JsonWriter::FormatDouble(r.optimality_residual()) + "," +
            (r.lp_feasible() ? "1" : "0") + "," + JsonWriter::FormatDouble(ml_min) + "," +
            JsonWriter::FormatDouble(ml_max) + "," + std::to_string(r.analyses_total());
     for (int i = 0; i < s.design_names_size(); ++i) {
@@ -255,6 +261,7 @@ std::string ResultsJson(const v1::GetJobResponse& job) {
     w.Field("objective", r.objective_trial());
     w.Field("max_violation", r.max_violation_trial());
     w.Field("max_approximation_error", r.max_approximation_error());
+    w.Field("optimality_residual", r.optimality_residual());
     w.Field("lp_feasible", r.lp_feasible());
     w.Field("analyses", static_cast<long long>(r.analyses_total()));
     w.NumberArray("move_limits", ToVector(r.move_limits()));

@@ -15,21 +15,25 @@ constexpr char kUsage[] =
     "usage: mbopt COMMAND [ARGS]\n"
     "\n"
     "commands:\n"
-    "  run FILE [--workers N] [--db PATH] [--json] [--quiet]\n"
-    "                        start a local server and N workers, optimize, print the result\n"
+    "  run FILE [--workers N] [--db PATH | --discard-db] [--json] [--quiet]\n"
+    "                        start a local server and N workers, optimize, print the result;\n"
+    "                        keeps the job database (its path is printed) unless --discard-db\n"
+    "  validate FILE         check a study and its scene offline; print its layout\n"
     "  submit FILE [--watch] submit a study to a server; prints the job id\n"
     "  watch JOB             follow a job's cycles until it ends\n"
     "  status JOB            a job's state, objective and design\n"
     "  list                  all jobs on the server\n"
     "  cancel JOB            stop a job\n"
-    "  resume JOB            continue an interrupted job\n"
+    "  resume JOB [--db PATH [--workers N]]\n"
+    "                        continue an interrupted job\n"
     "  results JOB [--csv|--json]\n"
     "                        a job's result and cycle history\n"
     "  report JOB [-o FILE]  write a self-contained HTML page of the job's history\n"
     "                        (default FILE: JOB.html)\n"
     "\n"
-    "every command but run takes --server HOST:PORT (default $MBOPT_SERVER, else\n"
-    "127.0.0.1:50051). See docs/cli.md for the exit codes.\n";
+    "every command but run and validate takes --server HOST:PORT (default $MBOPT_SERVER,\n"
+    "else 127.0.0.1:50051); watch, status, list, results, report and resume take\n"
+    "--db PATH instead to read a database `mbopt run` kept. See docs/cli.md.\n";
 
 }  // namespace
 
@@ -54,6 +58,7 @@ int main(int argc, char** argv) {
   if (command == "resume") return ResumeCommand(args);
   if (command == "results") return ResultsCommand(args);
   if (command == "report") return ReportCommand(args);
+  if (command == "validate") return ValidateCommand(args);
   std::fprintf(stderr, "mbopt: unknown command '%s'\n\n%s", command.c_str(), kUsage);
   return kExitBadInput;
 }

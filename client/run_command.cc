@@ -1,11 +1,15 @@
 // `mbopt run`: the embedded default. Server, workers, submission, watch and
-// result in one command; everything it started is stopped and its temporary
-// database removed on the way out, also after Ctrl-C.
+// result in one command; everything it started is stopped on the way out,
+// also after Ctrl-C. The job database is kept (DefaultRunDatabasePath) so that
+// `report`, `results` and `resume` can read it with --db afterwards.
 #include <stdlib.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <thread>
 
@@ -18,38 +22,54 @@
 #include "client/job_format.h"
 #include "client/local_cluster.h"
 #include "client/study_file.h"
+#include "client/temp_dir.h"
 #include "client/watch.h"
 
 namespace mbopt::client {
 namespace {
 
-// A directory for the port file, logs and (by default) the database, removed
-// when the run ends unless the user asked to keep its database.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-run-XXXXXX").string();
-    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
+// Where `mbopt run` keeps its job database unless --db or --discard-db says
+// otherwise: $XDG_STATE_HOME/mbopt/runs (default ~/.local/state/mbopt/runs),
+// one file per run named after the study file and the UTC start time. Empty
+// when neither variable gives a directory that can be made.
+std::string DefaultRunDatabasePath(const std::string& study_path) {
+  std::filesystem::path base;
+  if (const char* state = std::getenv("XDG_STATE_HOME"); state != nullptr && *state == '/') {
+    base = state;
+  } else if (const char* home = std::getenv("HOME"); home != nullptr && *home == '/') {
+    base = std::filesystem::path(home) / ".local" / "state";
+  } else {
+    return "";
   }
-  ~TempDir() {
-    if (path_.empty()) return;
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
+  const std::filesystem::path dir = base / "mbopt" / "runs";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return "";
+  // Job databases hold the study and every result: not for other users.
+  std::filesystem::permissions(dir, std::filesystem::perms::owner_all, ec);
+  std::string stem = std::filesystem::path(study_path).filename().string();
+  for (const char* suffix : {".textproto", ".json", ".study"}) {
+    if (stem.size() > std::strlen(suffix) && stem.ends_with(suffix)) stem.resize(stem.size() - std::strlen(suffix));
   }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
+  return (dir / (stem + "-" + stamp + "-" + std::to_string(getpid()) + ".db")).string();
+}
 
 }  // namespace
 
 int RunCommandMain(const Args& args) {
-  auto parsed = ParseArgs(args, {{"--workers", "--db"}, {"--json", "--quiet"}});
+  auto parsed = ParseArgs(args, {{"--workers", "--db"}, {"--json", "--quiet", "--discard-db"}});
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   if (parsed->positional.size() != 1) {
-    return Fail("usage: mbopt run STUDY_FILE [--workers N] [--db PATH] [--json] [--quiet]",
+    return Fail("usage: mbopt run STUDY_FILE [--workers N] [--db PATH | --discard-db] [--json] [--quiet]",
                 kExitBadInput);
+  }
+  if (!parsed->Value("--db").empty() && parsed->Has("--discard-db")) {
+    return Fail("--db and --discard-db exclude each other", kExitBadInput);
   }
   auto workers = parsed->IntValue("--workers", 1);
   if (!workers.ok()) return Fail(std::string(workers.status().message()), kExitBadInput);
@@ -73,7 +93,11 @@ int RunCommandMain(const Args& args) {
   LocalClusterOptions cluster_options;
   cluster_options.server_binary = *server_binary;
   cluster_options.worker_binary = *worker_binary;
-  cluster_options.db_path = parsed->Value("--db", temp.path() + "/mbopt.db");
+  std::string db_path = parsed->Value("--db");
+  if (db_path.empty() && !parsed->Has("--discard-db")) db_path = DefaultRunDatabasePath(path);
+  const bool keep_db = !db_path.empty();
+  if (!keep_db) db_path = temp.path() + "/mbopt.db";
+  cluster_options.db_path = db_path;
   cluster_options.log_dir = temp.path();
   cluster_options.workers = num_workers;
   auto cluster = LocalCluster::Start(cluster_options);
@@ -120,9 +144,14 @@ int RunCommandMain(const Args& args) {
   (*cluster)->Stop();
 
   if (outcome.interrupted) {
-    std::fprintf(stderr, "mbopt run: interrupted; server and workers stopped%s\n",
-                 parsed->Value("--db").empty() ? ", temporary database removed"
-                                               : ", the job can be resumed from the database");
+    if (keep_db) {
+      std::fprintf(stderr,
+                   "mbopt run: interrupted; server and workers stopped; continue with\n"
+                   "  mbopt resume %s --db %s\n",
+                   job_id.c_str(), db_path.c_str());
+    } else {
+      std::fprintf(stderr, "mbopt run: interrupted; server and workers stopped, temporary database removed\n");
+    }
     if (json && get_status.ok()) {
       job.mutable_summary()->set_state(v1::JOB_STATE_INTERRUPTED);
       std::fputs(ResultsJson(job).c_str(), stdout);
@@ -138,6 +167,11 @@ int RunCommandMain(const Args& args) {
     std::fputs(ResultsJson(job).c_str(), stdout);
   } else if (!quiet) {
     std::printf("\n%s", SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr).c_str());
+    if (keep_db) {
+      std::printf("database:      %s\n"
+                  "report:        mbopt report %s --db %s\n",
+                  db_path.c_str(), job_id.c_str(), db_path.c_str());
+    }
   }
   return ExitCodeForState(job.summary().state());
 }

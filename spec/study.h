@@ -54,6 +54,7 @@ struct OptimizerSettings {
   std::optional<int> max_cycles;
   std::optional<double> convergence_objective_tolerance;
   std::optional<double> convergence_violation_tolerance;
+  std::optional<double> convergence_optimality_tolerance;
   std::optional<double> screening_threshold;
   bool central_differences = false;
   std::optional<double> finite_difference_relative_step;

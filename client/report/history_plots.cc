@@ -181,6 +181,8 @@ PlotSpec ApproximationErrorPlot(const ReportData& data) {
                                       [](const ReportCycle& r) { return r.max_approximation_error; }));
   spec.series.push_back(accepted_only("e_o (objective)", SeriesColor(1),
                                       [](const ReportCycle& r) { return r.objective_error; }));
+  spec.series.push_back(accepted_only("KKT residual", SeriesColor(2),
+                                      [](const ReportCycle& r) { return r.optimality_residual; }));
   spec.series.push_back(RejectedPoints(data, "rejected trial maxfout", kRejectedColor,
                                        [](const ReportCycle& r) { return r.max_approximation_error; }));
   PlotSeries rejected_eo = RejectedPoints(data, "rejected trial e_o", SeriesColor(1),

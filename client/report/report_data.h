@@ -43,6 +43,7 @@ struct ReportCycle {
   std::string worst_constraint;  // row name of maxg at x*, empty if none
   double objective_error = 0.0;           // e_o
   double max_approximation_error = 0.0;   // maxfout
+  double optimality_residual = 0.0;       // KKT residual of the LP solution
   std::string worst_approximation;        // "objective" or a row name
   bool lp_feasible = true;
   double infeasibility = 0.0;

@@ -44,6 +44,7 @@ ReportCycle FromProto(const v1::CycleRecord& r) {
   c.worst_constraint = r.worst_constraint();
   c.objective_error = r.objective_error();
   c.max_approximation_error = r.max_approximation_error();
+  c.optimality_residual = r.optimality_residual();
   c.worst_approximation = r.worst_approximation();
   c.lp_feasible = r.lp_feasible();
   c.infeasibility = r.infeasibility();

@@ -156,7 +156,7 @@ std::string CycleTableHtml(const ReportData& data) {
   std::string out =
       "<table class=\"cycles\">\n<thead><tr><th>cycle</th><th>attempt</th><th>F(x0)</th>"
       "<th>F(x*)</th><th>F~(x*)</th><th>maxg(x*)</th><th>worst row</th><th>e_o</th>"
-      "<th>maxfout</th><th>worst approximation</th><th>feas</th><th>LP</th><th>analyses</th>"
+      "<th>maxfout</th><th>worst approximation</th><th>KKT residual</th><th>feas</th><th>LP</th><th>analyses</th>"
       "<th>result</th></tr></thead>\n<tbody>\n";
   for (const ReportCycle& r : data.records) {
     std::string result;
@@ -172,6 +172,7 @@ std::string CycleTableHtml(const ReportData& data) {
            Num(r.objective_predicted) + Num(r.max_violation_trial, 4) +
            Cell(EscapeHtml(r.worst_constraint)) + Num(r.objective_error, 4) +
            Num(r.max_approximation_error, 4) + Cell(EscapeHtml(r.worst_approximation)) +
+           Num(r.optimality_residual, 3) +
            Cell(r.lp_feasible ? "yes" : "no (s = " + EscapeHtml(FormatValue(r.infeasibility, 3)) + ")") +
            Cell(EscapeHtml(r.lp_status)) + Cell(std::to_string(r.analyses_total), "num") +
            Cell(EscapeHtml(result)) + "</tr>\n";

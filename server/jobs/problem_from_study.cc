@@ -52,6 +52,8 @@ absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study) {
       s.convergence_objective_tolerance.value_or(options.convergence_objective_tolerance);
   options.convergence_violation_tolerance =
       s.convergence_violation_tolerance.value_or(options.convergence_violation_tolerance);
+  options.convergence_optimality_tolerance =
+      s.convergence_optimality_tolerance.value_or(options.convergence_optimality_tolerance);
   options.screening_threshold = s.screening_threshold.value_or(options.screening_threshold);
   options.finite_difference =
       s.central_differences ? slp::FiniteDifferenceScheme::kCentral : slp::FiniteDifferenceScheme::kForward;

@@ -8,7 +8,8 @@
 namespace mbopt::jobs {
 namespace {
 
-constexpr unsigned char kVersion = 1;
+// 2: optimality_residual after max_approximation_error's row.
+constexpr unsigned char kVersion = 2;
 
 class Writer {
  public:
@@ -121,6 +122,7 @@ std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   w.Double(r.objective_error);
   w.Double(r.max_approximation_error);
   w.Int(r.worst_approximation_row);
+  w.Double(r.optimality_residual);
   w.Bool(r.lp_feasible);
   w.Double(r.infeasibility);
   w.String(r.lp_status);
@@ -158,6 +160,7 @@ absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
   c.objective_error = r.Double();
   c.max_approximation_error = r.Double();
   c.worst_approximation_row = r.Int();
+  c.optimality_residual = r.Double();
   c.lp_feasible = r.Bool();
   c.infeasibility = r.Double();
   c.lp_status = r.String();

@@ -249,6 +249,44 @@ std::vector<FinishedTask> Scheduler::ExpireLeases() {
   return given_up;
 }
 
+std::vector<FinishedTask> Scheduler::WorkerLost(const std::string& worker_id) {
+  std::vector<FinishedTask> given_up;
+  bool requeued = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto worker = workers_.find(worker_id);
+    if (worker == workers_.end()) return given_up;
+    const std::string name = worker->second.name;
+    workers_.erase(worker);
+    std::vector<Key> held;
+    for (const auto& [task_id, key] : leases_) {
+      if (entries_.at(key).worker_id == worker_id) held.push_back(key);
+    }
+    for (const Key& key : held) {
+      const Entry& entry = entries_.at(key);
+      std::optional<FinishedTask> done = FailLocked(
+          key, absl::StrCat("worker ", worker_id, " (", name, ") disconnected with task ", entry.task_id));
+      if (done) {
+        given_up.push_back(std::move(*done));
+      } else {
+        requeued = true;
+      }
+    }
+  }
+  if (requeued) task_available_.notify_all();
+  return given_up;
+}
+
+bool Scheduler::IsKnownWorker(const std::string& worker_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return workers_.count(worker_id) > 0;
+}
+
+bool Scheduler::WaitForShutdown(std::int64_t wait_ms) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  return shutdown_signal_.wait_for(lock, std::chrono::milliseconds(wait_ms), [this] { return shutdown_; });
+}
+
 void Scheduler::DropJob(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
   queues_.erase(job_id);
@@ -267,6 +305,7 @@ void Scheduler::Shutdown() {
     shutdown_ = true;
   }
   task_available_.notify_all();
+  shutdown_signal_.notify_all();
 }
 
 int Scheduler::QueuedCount() const {

@@ -124,6 +124,16 @@ class Scheduler {
   // Handles every lease past its deadline; returns the tasks given up.
   std::vector<FinishedTask> ExpireLeases();
 
+  // The worker's connection closed (its process ended, or the network
+  // went): every task leased to it is a failed attempt now, as if its lease
+  // had expired, and the worker is forgotten (a live one registers again).
+  // Returns the tasks given up. Unknown workers are ignored.
+  std::vector<FinishedTask> WorkerLost(const std::string& worker_id);
+
+  bool IsKnownWorker(const std::string& worker_id) const;
+  // Waits up to `wait_ms` (real time) for Shutdown(); true once it happened.
+  bool WaitForShutdown(std::int64_t wait_ms) const;
+
   // Forgets every queued and leased task of `job_id` (cancelled or ended).
   void DropJob(const std::string& job_id);
 
@@ -166,6 +176,7 @@ class Scheduler {
   const SchedulerOptions options_;
   mutable std::mutex mutex_;
   std::condition_variable task_available_;
+  mutable std::condition_variable shutdown_signal_;
   bool shutdown_ = false;
   std::int64_t next_worker_ = 1;
   std::map<std::string, Worker> workers_;

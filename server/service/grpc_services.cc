@@ -149,6 +149,26 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::Tas
   return grpc::Status::OK;
 }
 
+grpc::Status WorkerServiceImpl::Attach(grpc::ServerContext* context, const v1::AttachRequest* request,
+                                       grpc::ServerWriter<v1::AttachEvent>* writer) {
+  const std::string& worker_id = request->worker_id();
+  if (!scheduler_->IsKnownWorker(worker_id)) {
+    return ToGrpcStatus(absl::NotFoundError(absl::StrCat("no worker '", worker_id, "': register again")));
+  }
+  // Tells the worker it is attached: it takes tasks only after this.
+  if (!writer->Write(v1::AttachEvent())) {
+    manager_->WorkerLost(worker_id);
+    return grpc::Status::CANCELLED;
+  }
+  // The sync API has no callback for a closed connection, so the stream
+  // looks every kAttachPollMs: that bounds how late a loss is noticed.
+  while (!context->IsCancelled()) {
+    if (scheduler_->WaitForShutdown(kAttachPollMs)) return grpc::Status::OK;  // the server stops
+  }
+  manager_->WorkerLost(worker_id);
+  return grpc::Status::CANCELLED;
+}
+
 grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const v1::HeartbeatRequest* request,
                                           v1::HeartbeatResponse* response) {
   std::vector<std::string> task_ids(request->task_ids().begin(), request->task_ids().end());

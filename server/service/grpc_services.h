@@ -46,9 +46,13 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
                             v1::ReportResultResponse* response) override;
   grpc::Status Heartbeat(grpc::ServerContext* context, const v1::HeartbeatRequest* request,
                          v1::HeartbeatResponse* response) override;
+  grpc::Status Attach(grpc::ServerContext* context, const v1::AttachRequest* request,
+                      grpc::ServerWriter<v1::AttachEvent>* writer) override;
 
   // The longest a long poll waits, whatever the worker asks.
   static constexpr std::int64_t kMaxWaitMs = 30'000;
+  // How often an Attach stream checks whether its worker's connection closed.
+  static constexpr std::int64_t kAttachPollMs = 20;
 
  private:
   JobManager* manager_;

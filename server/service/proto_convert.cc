@@ -80,6 +80,7 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const std::vector<std::string
   out.set_worst_constraint(RowName(r.worst_constraint_trial, row_names));
   out.set_objective_error(r.objective_error);
   out.set_max_approximation_error(r.max_approximation_error);
+  out.set_optimality_residual(r.optimality_residual);
   out.set_worst_approximation(r.worst_approximation_row < 0 ? "objective"
                                                             : RowName(r.worst_approximation_row, row_names));
   out.set_lp_feasible(r.lp_feasible);

@@ -31,6 +31,57 @@ double MinOverBox(const Eigen::VectorXd& grad, const MoveBox& box) {
 
 double ObjectiveValue(const Eigen::VectorXd& terms) { return terms.maxCoeff(); }
 
+double OptimalityResidual(const ProblemSpec& spec, const SlpOptions& o, const Linearization& lin,
+                          const MoveBox& box, const CycleLp& cycle_lp,
+                          const lp::LpSolution& solution) {
+  if (solution.x[cycle_lp.s_column] > o.infeasibility_tolerance) return kInf;
+  const double f0 = ObjectiveValue(lin.terms0);
+  const double relative_to = std::max(std::abs(f0), o.objective_magnitude_floor);
+  double residual = 0;
+  for (int i = 0; i < spec.num_variables(); ++i) {
+    if (lin.frozen[i]) continue;
+    const double w = box.half_width[i];
+    const double d = solution.x[i];
+    const double reduced_cost = solution.reduced_costs[i];
+    // LP vertices sit on a bound up to the solver's rounding.
+    const double slack = 1e-9 * std::max(w, 1e-300);
+    const bool at_upper = d >= box.d_upper[i] - slack;
+    const bool at_lower = d <= box.d_lower[i] + slack;
+    const bool upper_is_bound = spec.upper[i] - lin.x0[i] <= w;
+    const bool lower_is_bound = lin.x0[i] - spec.lower[i] <= w;
+    double unbalanced = std::abs(reduced_cost);
+    if (at_upper && upper_is_bound) {
+      unbalanced = std::max(0.0, reduced_cost);  // a minimum there has reduced cost <= 0
+    } else if (at_lower && lower_is_bound) {
+      unbalanced = std::max(0.0, -reduced_cost);
+    }
+    const double range = spec.upper[i] - spec.lower[i];
+    const double typical =
+        std::max(std::abs(lin.x0[i]), o.move_limit_floor_fraction_of_range * range);
+    residual = std::max(residual, unbalanced * cycle_lp.objective_scale * typical / relative_to);
+  }
+  // Complementarity at x0: a row that carries a multiplier must be active at
+  // x0, not only at x*. A min-max term below F0, or a constraint below its
+  // limit, with a multiplier says that the LP's optimum x* lies away from x0
+  // (a vertex of other rows), however small the reduced costs are there.
+  const bool minmax = cycle_lp.beta_column >= 0;
+  double complementarity = 0;
+  int row = 0;
+  if (minmax) {
+    for (int j : cycle_lp.kept_terms) {
+      const double gap = (f0 - lin.terms0[j]) / cycle_lp.objective_scale;
+      complementarity += std::abs(solution.row_duals[row]) * std::max(0.0, gap);
+      ++row;
+    }
+  }
+  for (int h : cycle_lp.kept_constraints) {
+    const double slack = (spec.constraint_limits[h] - lin.constraints0[h]) / spec.constraint_scales[h];
+    complementarity += std::abs(solution.row_duals[row]) * std::max(0.0, slack);
+    ++row;
+  }
+  return std::max(residual, complementarity * cycle_lp.objective_scale / relative_to);
+}
+
 MoveBox ComputeMoveBox(const ProblemSpec& spec, const SlpOptions& o, const Eigen::VectorXd& x0,
                        const Eigen::VectorXd& move_limits, const std::vector<bool>& frozen) {
   const int n = spec.num_variables();

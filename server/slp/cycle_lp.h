@@ -59,6 +59,30 @@ struct CycleLp {
 CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& options,
                      const Linearization& lin, const MoveBox& box);
 
+// First-order optimality of the cycle's LP solution, dimensionless (>= 0;
+// +infinity when the LP needed its infeasibility variable s, i.e. the
+// linearized constraints cannot all be met inside the box).
+//
+// At the LP's optimum the gradient of the objective (for min-max, of the
+// terms weighted by their multipliers) plus the constraint gradients
+// weighted by theirs is balanced by the reduced costs of the step columns d_i.
+// A reduced cost on a side of the box that is a design bound is a bound
+// multiplier of the problem itself (counted only if of the wrong sign); one
+// on a side set by a move limit is gradient that only the move limit holds
+// back, the stationarity residual of the KKT conditions. Per variable it is
+// made relative as the move limit is:
+//   r_i = |reduced cost_i| * S * max(|x0_i|, floor_fraction * range_i) / max(|F0|, floor)
+// i.e. the relative change of F per unit of the relative move limit f_i that
+// the linearization still offers along x_i. Complementarity is measured at x0:
+//   c = S * sum_rows |multiplier_r| * max(0, slack_r(x0)) / max(|F0|, floor)
+// with slack (F0 - f_j(x0)) / S for a min-max term and (c_h - g_h(x0)) /
+// scale_h for a constraint: a row that holds the LP's optimum must be active
+// at x0 too, or that optimum lies away from x0. The residual is
+// max(max_i r_i, c); 0 at a KKT point of the linearized problem at x0.
+double OptimalityResidual(const ProblemSpec& spec, const SlpOptions& options,
+                          const Linearization& lin, const MoveBox& box, const CycleLp& cycle_lp,
+                          const lp::LpSolution& solution);
+
 // max_j f_j over the given values: the objective F of either form.
 double ObjectiveValue(const Eigen::VectorXd& terms);
 

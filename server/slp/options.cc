@@ -35,6 +35,7 @@ absl::Status SlpOptions::Validate() const {
       {"oscillation_objective_change", oscillation_objective_change},
       {"convergence_objective_tolerance", convergence_objective_tolerance},
       {"convergence_violation_tolerance", convergence_violation_tolerance},
+      {"convergence_optimality_tolerance", convergence_optimality_tolerance},
       {"infeasibility_penalty", infeasibility_penalty},
       {"infeasibility_tolerance", infeasibility_tolerance},
       {"objective_magnitude_floor", objective_magnitude_floor},

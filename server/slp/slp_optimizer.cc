@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/check.h"
+#include "server/slp/best_design.h"
 #include "server/slp/cycle_lp.h"
 #include "server/slp/finite_difference.h"
 #include "server/slp/move_limit_strategy.h"
@@ -72,7 +73,10 @@ Eigen::VectorXd Stack(const AnalysisResult& r) {
 class SlpOptimizer::Impl {
  public:
   Impl(ProblemSpec spec, SlpOptions options, std::unique_ptr<lp::LpSolver> lp_solver)
-      : spec_(std::move(spec)), options_(options), lp_solver_(std::move(lp_solver)) {
+      : spec_(std::move(spec)),
+        options_(options),
+        lp_solver_(std::move(lp_solver)),
+        best_(options_.convergence_violation_tolerance) {
     MBOPT_CHECK(spec_.Validate().ok(), "invalid ProblemSpec (call Validate first)");
     MBOPT_CHECK(options_.Validate().ok(), "invalid SlpOptions (call Validate first)");
     MBOPT_CHECK(lp_solver_ != nullptr, "no LP solver");
@@ -152,6 +156,10 @@ class SlpOptimizer::Impl {
   const Eigen::VectorXd& current_design() const { return x0_; }
   double current_objective() const { return have_x0_ ? v0_.objective : kNaN; }
   double current_max_violation() const { return have_x0_ ? v0_.max_violation : kNaN; }
+  DesignPoint best_design() const {
+    if (best_.best().has_value()) return *best_.best();
+    return DesignPoint{x0_, current_objective(), current_max_violation()};
+  }
   int cycles_completed() const { return cycles_completed_; }
   std::int64_t analyses_used() const { return analyses_used_; }
   const ProblemSpec& spec() const { return spec_; }
@@ -328,6 +336,11 @@ class SlpOptimizer::Impl {
     return r;
   }
 
+  void Emit(CycleRecord record) {
+    best_.OfferRecord(record);
+    new_records_.push_back(std::move(record));
+  }
+
   void Stall(const std::string& why) {
     state_ = RunState::kStalled;
     failure_reason_ = why;
@@ -360,6 +373,7 @@ class SlpOptimizer::Impl {
       r.objective_trial = kNaN;
       r.objective_predicted = kNaN;
       r.max_violation_trial = kNaN;
+      r.optimality_residual = kNaN;
       r.lp_status = lp::LpStatusName(sol.status);
       r.lp_iterations = sol.iterations;
       r.rows_screened_in = static_cast<int>(cycle_lp_.kept_constraints.size());
@@ -372,7 +386,7 @@ class SlpOptimizer::Impl {
       r.on_move_limit.assign(spec_.num_variables(), false);
       r.on_bound.assign(spec_.num_variables(), false);
       r.analyses_total = analyses_used_;
-      new_records_.push_back(std::move(r));
+      Emit(std::move(r));
       if (!NextAttempt()) return;
     }
 
@@ -429,6 +443,7 @@ class SlpOptimizer::Impl {
     r.rows_screened_in = static_cast<int>(cycle_lp_.kept_constraints.size());
     r.infeasibility = sol.x[cycle_lp_.s_column];
     r.lp_feasible = r.infeasibility <= options_.infeasibility_tolerance;
+    r.optimality_residual = OptimalityResidual(spec_, options_, lin_, box_, cycle_lp_, sol);
     r.on_move_limit.assign(n, false);
     r.on_bound.assign(n, false);
     for (int i = 0; i < n; ++i) {
@@ -502,7 +517,7 @@ class SlpOptimizer::Impl {
     r.analyses_total = analyses_used_;
 
     if (!decision.accept) {
-      new_records_.push_back(std::move(r));
+      Emit(std::move(r));
       if (NextAttempt()) SolveAndRequestTrial();
       return;
     }
@@ -512,6 +527,7 @@ class SlpOptimizer::Impl {
         v0_.objective, trial.objective, options_.objective_magnitude_floor);
     const bool converged = relative_change < options_.convergence_objective_tolerance &&
                            trial.max_violation < options_.convergence_violation_tolerance &&
+                           r.optimality_residual < options_.convergence_optimality_tolerance &&
                            !AnyFrozen();
     dx_old_ = d;
     dF_old_ = trial.objective - v0_.objective;
@@ -520,7 +536,7 @@ class SlpOptimizer::Impl {
     ++cycles_completed_;
     previous_rejection_at_min_ = false;
     r.converged = converged;
-    new_records_.push_back(std::move(r));
+    Emit(std::move(r));
     if (converged) {
       state_ = RunState::kConverged;
       return;
@@ -551,6 +567,7 @@ class SlpOptimizer::Impl {
   std::map<std::int64_t, AnalysisRequest> batch_;        // every request of the batch
   std::map<std::int64_t, AnalysisResult> received_;      // answers of the batch
   std::vector<CycleRecord> new_records_;
+  BestDesign best_;
 
   Phase phase_ = Phase::kStartAndPerturb;
   int cycle_ = 1;
@@ -592,6 +609,7 @@ const std::string& SlpOptimizer::end_reason() const { return impl_->end_reason()
 const Eigen::VectorXd& SlpOptimizer::current_design() const { return impl_->current_design(); }
 double SlpOptimizer::current_objective() const { return impl_->current_objective(); }
 double SlpOptimizer::current_max_violation() const { return impl_->current_max_violation(); }
+DesignPoint SlpOptimizer::best_design() const { return impl_->best_design(); }
 int SlpOptimizer::cycles_completed() const { return impl_->cycles_completed(); }
 std::int64_t SlpOptimizer::analyses_used() const { return impl_->analyses_used(); }
 const ProblemSpec& SlpOptimizer::spec() const { return impl_->spec(); }

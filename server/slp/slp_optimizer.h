@@ -74,9 +74,17 @@ struct AnalysisResult {
   bool has_gradients() const { return objective_gradients.size() > 0; }
 };
 
+// A design and its values: x (scaled), F, maxg (normalized).
+struct DesignPoint {
+  Eigen::VectorXd x;
+  double objective = 0;
+  double max_violation = 0;
+};
+
 enum class RunState {
   kRunning,     // PendingRequests() is not empty
-  kConverged,   // the convergence test of METHOD.md section 3 held
+  kConverged,   // the convergence test of METHOD.md section 3 held, and the
+                // KKT residual was below convergence_optimality_tolerance
   kMaxCycles,   // SlpOptions::max_cycles cycles were run
   kStalled,     // move limits collapsed or every trial point failed
   kFailed,      // x0 of the first cycle could not be analysed
@@ -103,6 +111,9 @@ struct CycleRecord {
   double objective_error = 0;       // e_o
   double max_approximation_error = 0;  // maxfout
   int worst_approximation_row = -1;    // -1: the objective
+  // First-order optimality of this attempt's LP solution (cycle_lp.h,
+  // OptimalityResidual); NaN when the LP was not solved.
+  double optimality_residual = 0;
   bool lp_feasible = true;          // feas: infeasibility variable s == 0
   double infeasibility = 0;         // s at the LP optimum
   std::string lp_status;            // LpStatusName of the LP solve
@@ -142,12 +153,15 @@ class SlpOptimizer {
   // Why the run ended stalled or failed (empty otherwise).
   const std::string& end_reason() const;
   // The current design x0 (scaled): the last accepted trial point, or the
-  // initial design before any acceptance; the method's result when the run
-  // ends. Its values: F (the maximum term for min-max) and maxg (0 without
-  // constraints); NaN before x0 was analysed.
+  // initial design before any acceptance. Its values: F (the maximum term
+  // for min-max) and maxg (0 without constraints); NaN before x0 was
+  // analysed.
   const Eigen::VectorXd& current_design() const;
   double current_objective() const;
   double current_max_violation() const;
+  // The run's result: the best design analysed so far (best_design.h), or
+  // the current design before any cycle record exists.
+  DesignPoint best_design() const;
   int cycles_completed() const;
   std::int64_t analyses_used() const;
   const ProblemSpec& spec() const;

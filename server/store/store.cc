@@ -1,8 +1,13 @@
 #include "server/store/store.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <sqlite3.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <optional>
 #include <utility>
 
@@ -219,6 +224,19 @@ absl::Status InTransaction(sqlite3* db, Body body) {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path) {
+  // A job database holds studies and every result: readable by its owner
+  // only. SQLite gives the -wal and -shm files the database file's mode, so
+  // creating the file 0600 before SQLite does covers all three. An existing
+  // file keeps the mode its owner gave it.
+  if (path != ":memory:") {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd >= 0) {
+      ::close(fd);
+    } else if (errno != EEXIST) {
+      return absl::UnavailableError(absl::StrCat("cannot create the job database ", path, ": ",
+                                                 std::strerror(errno)));
+    }
+  }
   sqlite3* db = nullptr;
   const int code = sqlite3_open_v2(path.c_str(), &db,
                                    SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,

@@ -269,6 +269,8 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
              &s.convergence_objective_tolerance);
     positive("convergence_violation_tolerance", p.convergence_violation_tolerance(),
              &s.convergence_violation_tolerance);
+    positive("convergence_optimality_tolerance", p.convergence_optimality_tolerance(),
+             &s.convergence_optimality_tolerance);
     positive("finite_difference_relative_step", p.finite_difference_relative_step(),
              &s.finite_difference_relative_step);
     if (p.max_cycles() < 0) {

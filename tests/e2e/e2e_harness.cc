@@ -2,6 +2,7 @@
 
 #include <stdlib.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -83,7 +84,14 @@ client::Subprocess::Output Mbopt(const std::vector<std::string>& args,
                                  const std::vector<std::string>& extra_env) {
   std::vector<std::string> argv = {MboptBinary()};
   argv.insert(argv.end(), args.begin(), args.end());
-  auto out = client::RunCommand(argv, kGuard, extra_env);
+  // Databases that `mbopt run` keeps go to this test program's own state
+  // directory, removed at exit, never to the user's.
+  static const ScratchDir state;
+  std::vector<std::string> env = extra_env;
+  if (std::none_of(env.begin(), env.end(), [](const std::string& e) { return e.rfind("XDG_STATE_HOME=", 0) == 0; })) {
+    env.push_back("XDG_STATE_HOME=" + state.path());
+  }
+  auto out = client::RunCommand(argv, kGuard, env);
   if (!out.ok()) {
     client::Subprocess::Output failed;
     failed.exit_code = -1;

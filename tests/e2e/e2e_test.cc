@@ -5,8 +5,11 @@
 // its numbers are printed with 17 significant digits, so equal text is
 // bit-identical doubles.
 #include <signal.h>
+#include <sys/stat.h>
 
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -178,6 +181,41 @@ TEST(EndToEnd, WorkerKilledMidCycleDoesNotChangeTheResult) {
   EXPECT_EQ(server->process->Stop(kGuard), 0);
 }
 
+// With a lease far longer than the job, only the closed connection can
+// tell the server that the worker died: its task must be handed out again
+// at once (docs/workers.md, "A worker that dies").
+TEST(EndToEnd, KilledWorkersTaskIsRequeuedWithoutWaitingForItsLease) {
+  const std::string reference = Comparable(ReferenceResult(1));
+  ASSERT_FALSE(reference.empty());
+
+  ScratchDir dir;
+  constexpr int kLongLeaseMs = 300'000;
+  auto server = StartServer(dir.File("jobs.db"), {"--lease-ms", std::to_string(kLongLeaseMs)}, "127.0.0.1:0",
+                            dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  Subprocess doomed = StartWorker(server->address, {"--die-after-tasks", "3", "--name", "doomed"},
+                                  dir.File("doomed.log"));
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto died = doomed.Wait(kGuard);
+  ASSERT_TRUE(died.ok()) << died.status();
+  EXPECT_EQ(*died, kKilledBySigkill);
+  Subprocess survivor = StartWorker(server->address, {"--name", "survivor"}, dir.File("survivor.log"));
+
+  auto watched = Mbopt({"watch", job, "--server", server->address});
+  ASSERT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
+  auto results = Mbopt({"results", job, "--json", "--server", server->address});
+  EXPECT_EQ(Comparable(results.stdout_text), reference);
+  // The job's own clock: a lost lease would have added 300 s.
+  auto status = Mbopt({"status", job, "--server", server->address});
+  const size_t at = status.stdout_text.find("wall time:");
+  ASSERT_NE(at, std::string::npos) << Describe(status);
+  EXPECT_LT(std::stod(status.stdout_text.substr(at + 10)), 0.2 * kLongLeaseMs / 1000.0) << Describe(status);
+  survivor.Stop(kGuard);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
 // Runs `study` with 2 workers on a server that kills itself after its
 // second cycle commit, restarts it on the same database and port, and checks
 // that the resumed job ends with the uninterrupted run's result, bit for bit.
@@ -282,6 +320,55 @@ TEST(EndToEnd, RunJsonStartsEverythingAndPrintsOneJsonObject) {
   EXPECT_EQ(json.back(), '}');
   EXPECT_EQ(json.find("\n}"), json.size() - 2) << "exactly one object on stdout";
   EXPECT_EQ(Comparable(run.stdout_text), reference);
+}
+
+// From `mbopt run` to the report page in two commands: run keeps its
+// database (0600) and prints where, and report, results and status read it
+// with --db, without a server started by hand.
+TEST(EndToEnd, RunKeepsItsDatabaseForReportAndResults) {
+  ScratchDir state;
+  const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary(),
+                                        "XDG_STATE_HOME=" + state.path()};
+  auto run = Mbopt({"run", VehicleStudy(), "--workers", "2"}, env);
+  ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);
+  const size_t at = run.stdout_text.find("database:");
+  ASSERT_NE(at, std::string::npos) << Describe(run);
+  const std::string db = Trim(run.stdout_text.substr(at + 9, run.stdout_text.find('\n', at) - at - 9));
+  EXPECT_EQ(db.rfind(state.path() + "/mbopt/runs/vehicle-", 0), 0u) << db;
+  struct stat st {};
+  ASSERT_EQ(stat(db.c_str(), &st), 0) << db;
+  EXPECT_EQ(st.st_mode & 0777, 0600u) << "a job database is for its owner only";
+
+  ScratchDir out;
+  const std::string page = out.File("vehicle.html");
+  auto report = Mbopt({"report", "job-1", "--db", db, "-o", page}, env);
+  ASSERT_EQ(report.exit_code, kExitOk) << Describe(report);
+  std::ifstream html(page);
+  std::stringstream text;
+  text << html.rdbuf();
+  EXPECT_NE(text.str().find("6.389"), std::string::npos) << "the page shows the optimum";
+  auto results = Mbopt({"results", "job-1", "--json", "--db", db}, env);
+  ASSERT_EQ(results.exit_code, kExitOk) << Describe(results);
+  EXPECT_EQ(Comparable(results.stdout_text), Comparable(ReferenceResult(2)));
+  EXPECT_EQ(Mbopt({"status", "job-1", "--db", out.File("missing.db")}, env).exit_code, kExitBadInput);
+  EXPECT_EQ(Mbopt({"status", "job-1", "--db", db, "--server", "127.0.0.1:1"}, env).exit_code, kExitBadInput);
+
+  auto discarded = Mbopt({"run", VehicleStudy(), "--workers", "1", "--discard-db"}, env);
+  ASSERT_EQ(discarded.exit_code, kExitOk) << Describe(discarded);
+  EXPECT_EQ(discarded.stdout_text.find("database:"), std::string::npos) << Describe(discarded);
+}
+
+TEST(EndToEnd, ValidatePrintsTheLayoutWithoutAServer) {
+  auto out = Mbopt({"validate", VehicleStudy()});
+  ASSERT_EQ(out.exit_code, kExitOk) << Describe(out);
+  for (const char* expected : {"variables:   6", "x1", "k1", "objective:", "constraints:", "rows", "valid"}) {
+    EXPECT_NE(out.stdout_text.find(expected), std::string::npos) << expected << "\n" << out.stdout_text;
+  }
+  ScratchDir dir;
+  const std::string path = dir.Write("broken.study.textproto", "name: \"broken\"\nvariables {\n  lower: 1.0\n");
+  auto bad = Mbopt({"validate", path});
+  EXPECT_EQ(bad.exit_code, kExitBadInput) << Describe(bad);
+  EXPECT_NE(bad.stderr_text.find("broken.study.textproto:"), std::string::npos) << bad.stderr_text;
 }
 
 // ------------------------------------------------------------- bad input --

@@ -4,6 +4,7 @@
 // state with finite numbers; a design that cannot be analysed must come back
 // as a failed analysis with a reason, never as a crash or a NaN result.
 #include <cmath>
+#include <numbers>
 #include <algorithm>
 #include <iostream>
 #include <map>
@@ -127,7 +128,9 @@ TEST(HardcaseStiffVehicle, StiffTyresAnalyseAndOptimizeToAFiniteEnd) {
 // steps cross the lock, rejects those trials, never accepts a failed
 // design, and ends converged or stalled with theta within 0.01 rad below the
 // lock (F within 0.005 m of 0.135 m).
-constexpr double kThetaLock = 0.724151;  // rad, acos(-0.6625) - pi/2
+// rad, acos(-0.6625) - pi/2: a run that ends on the boundary gets closer
+// to it than a rounded value.
+const double kThetaLock = std::acos(-0.6625) - std::numbers::pi / 2;
 
 TEST(HardcaseLock, DesignPastTheLockFailsNamingTimeAndJoint) {
   const spec::Study study = Load(kLockStudy);

@@ -114,6 +114,45 @@ TEST(Scheduler, ExpiredLeaseRequeuesTheTaskForAnotherWorker) {
   EXPECT_NE(second->front().task_id, first->front().task_id);
 }
 
+TEST(Scheduler, LostWorkerRequeuesItsTasksAtOnceAndIsForgotten) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 5, {0.5});
+  scheduler.Enqueue("job-1", 6, {0.6});
+  const std::string lost = scheduler.RegisterWorker("lost", 2);
+  const std::string other = scheduler.RegisterWorker("other", 1);
+  ASSERT_EQ(scheduler.Acquire(lost, 2)->size(), 2u);
+  EXPECT_EQ(scheduler.QueuedCount(), 0);
+
+  // No time passes: the connection closed, nothing waits for the lease.
+  EXPECT_TRUE(scheduler.WorkerLost(lost).empty());  // re-queued, not given up
+  EXPECT_EQ(scheduler.QueuedCount(), 2);
+  EXPECT_EQ(scheduler.LeasedCount(), 0);
+  EXPECT_FALSE(scheduler.IsKnownWorker(lost));
+  EXPECT_TRUE(scheduler.IsKnownWorker(other));
+  EXPECT_FALSE(scheduler.Heartbeat(lost, {}).known);  // a live one registers again
+  auto retried = scheduler.Acquire(other, 1);
+  ASSERT_TRUE(retried.ok());
+  ASSERT_EQ(retried->size(), 1u);
+  EXPECT_EQ(retried->front().attempt, 2);  // the lost attempt counts
+  EXPECT_TRUE(scheduler.WorkerLost(lost).empty());  // already forgotten: nothing happens
+}
+
+TEST(Scheduler, LostWorkersUseUpAttemptsLikeExpiredLeases) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {});
+  std::vector<FinishedTask> given_up;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    const std::string w = scheduler.RegisterWorker("crashes on this task", 1);
+    ASSERT_EQ(scheduler.Acquire(w, 1)->size(), 1u);
+    given_up = scheduler.WorkerLost(w);
+  }
+  ASSERT_EQ(given_up.size(), 1u);
+  EXPECT_NE(given_up.front().failure_reason.find("disconnected"), std::string::npos)
+      << given_up.front().failure_reason;
+}
+
 TEST(Scheduler, RetryGoesToTheSameWorkerWhenItIsTheOnlyOne) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());

@@ -33,9 +33,10 @@ absl::StatusOr<RunOutcome> RunToCompletion(SlpOptimizer& optimizer, const Evalua
     for (CycleRecord& r : optimizer.TakeNewRecords()) out.records.push_back(std::move(r));
   }
   out.state = optimizer.state();
-  out.design = optimizer.current_design();
-  out.objective = optimizer.current_objective();
-  out.max_violation = optimizer.current_max_violation();
+  const slp::DesignPoint best = optimizer.best_design();
+  out.design = best.x;
+  out.objective = best.objective;
+  out.max_violation = best.max_violation;
   out.cycles = optimizer.cycles_completed();
   out.analyses = optimizer.analyses_used();
   return out;

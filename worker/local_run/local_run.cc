@@ -35,9 +35,10 @@ absl::StatusOr<LocalRunResult> RunStudyLocally(const spec::Study& study, const L
 
   const slp::SlpOptimizer& optimizer = job->optimizer();
   run.state = optimizer.state();
-  run.design = optimizer.current_design();
-  run.objective = optimizer.current_objective();
-  run.max_violation = optimizer.current_max_violation();
+  const slp::DesignPoint best = optimizer.best_design();
+  run.design = best.x;
+  run.objective = best.objective;
+  run.max_violation = best.max_violation;
   run.cycles = optimizer.cycles_completed();
   run.analyses = optimizer.analyses_used();
   out.end_reason = optimizer.end_reason();

@@ -28,6 +28,8 @@ namespace {
 using Clock = std::chrono::system_clock;
 
 constexpr int kDefaultHeartbeatMs = 1000;
+// The longest the acquiring thread waits for the server to confirm Attach.
+constexpr auto kAttachWait = std::chrono::seconds(5);
 constexpr auto kShortCallDeadline = std::chrono::seconds(10);
 // How long a finished result is retried while the server is unreachable; past
 // that its lease has long expired and the task runs elsewhere.
@@ -111,6 +113,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
     std::vector<std::thread> threads;
     for (int i = 0; i < options_.slots; ++i) threads.emplace_back([this] { SlotLoop(); });
     threads.emplace_back([this] { HeartbeatLoop(); });
+    threads.emplace_back([this] { PresenceLoop(); });
     AcquireLoop();
     HandleStop();
     for (auto& t : threads) t.join();
@@ -156,6 +159,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
     registered_ = true;
     Log(absl::StrCat("registered with ", options_.server_address, " as ", worker_id_, " (",
                      options_.slots, " slots)"));
+    cv_.notify_all();  // the presence thread attaches this registration
     return true;
   }
 
@@ -173,6 +177,14 @@ class Worker : public std::enable_shared_from_this<Worker> {
           continue;
         }
         backoff.Reset();
+      }
+      {
+        // Tasks only once the server would notice this process die (or
+        // once it turned out that it cannot: then the lease is the backstop).
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait_for(lock, kAttachWait, [this] { return stopping_ || !registered_ || attach_settled_ == worker_id_; });
+        if (stopping_) break;
+        if (!registered_) continue;
       }
       int free_slots;
       std::string worker_id;
@@ -395,6 +407,53 @@ class Worker : public std::enable_shared_from_this<Worker> {
     }
   }
 
+  // Holds the server's Attach stream open while registered, so that the
+  // server notices at once when this process dies (its connection closes)
+  // and requeues the tasks in hand. The acquiring thread handles
+  // reconnection; this one only follows the registration.
+  void PresenceLoop() {
+    while (true) {
+      std::string worker_id;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return stopping_ || (registered_ && attached_ != worker_id_); });
+        if (stopping_) return;
+        worker_id = worker_id_;
+        attached_ = worker_id;
+      }
+      v1::AttachRequest request;
+      request.set_worker_id(worker_id);
+      grpc::ClientContext context;
+      grpc::Status status;
+      {
+        ScopedCall scoped(calls_, &context);
+        std::unique_ptr<grpc::ClientReader<v1::AttachEvent>> reader = stub_->Attach(&context, request);
+        v1::AttachEvent event;
+        const bool attached = reader->Read(&event);
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          attach_settled_ = worker_id;
+        }
+        cv_.notify_all();
+        if (attached) {
+          while (reader->Read(&event)) {
+          }
+        }
+        status = reader->Finish();
+      }
+      if (status.error_code() == grpc::StatusCode::UNIMPLEMENTED && !attach_unavailable_logged_) {
+        Log("the server cannot watch this worker's connection; a lost task waits for its lease");
+        attach_unavailable_logged_ = true;
+      }
+      // Ended: the server stopped, restarted or forgot this registration.
+      // Attach again once the acquiring thread has registered (or found the
+      // registration still valid).
+      if (stop_.WaitFor(std::chrono::milliseconds(500))) return;
+      std::lock_guard<std::mutex> lock(mutex_);
+      attached_.clear();
+    }
+  }
+
   WorkerOptions options_;
   StopSignal& stop_;
   const std::uint64_t backoff_seed_;
@@ -410,6 +469,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
   std::deque<QueuedTask> queue_;
   int busy_ = 0;                          // tasks queued or being evaluated
   std::map<std::string, bool> cancelled_; // task id -> cancelled, for tasks in hand
+  std::string attached_;        // the registration the presence thread holds (or tries)
+  std::string attach_settled_;  // the registration whose Attach was answered
+  bool attach_unavailable_logged_ = false;  // presence thread only
 
   std::mutex study_mutex_;
   std::map<std::string, std::shared_ptr<const PreparedStudy>> studies_;

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
+#include "server/jobs/job_result.h"
 #include "server/jobs/problem_from_study.h"
 #include "server/jobs/record_codec.h"
 
@@ -400,6 +401,10 @@ absl::Status JobManager::ReportWorkerError(const std::string& worker_id, const s
   return absl::OkStatus();
 }
 
+void JobManager::WorkerLost(const std::string& worker_id) {
+  for (const scheduler::FinishedTask& task : scheduler_->WorkerLost(worker_id)) GiveUp(task);
+}
+
 void JobManager::ExpireLeases() {
   for (const scheduler::FinishedTask& task : scheduler_->ExpireLeases()) GiveUp(task);
 }
@@ -415,13 +420,16 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   s.cycles = entry.row.cycles;
   s.analyses = entry.row.analyses;
   Eigen::VectorXd design;
+  std::optional<slp::SlpOptions> options;
   if (entry.study_ok) {
     s.objective_unit = entry.study.objective.unit;
     if (entry.job != nullptr) {
-      s.max_cycles = entry.job->options().max_cycles;
-    } else if (absl::StatusOr<slp::SlpOptions> options = jobs::SlpOptionsFromStudy(entry.study); options.ok()) {
-      s.max_cycles = options->max_cycles;
+      options = entry.job->options();
+    } else if (absl::StatusOr<slp::SlpOptions> from_study = jobs::SlpOptionsFromStudy(entry.study);
+               from_study.ok()) {
+      options = *from_study;
     }
+    if (options.has_value()) s.max_cycles = options->max_cycles;
     design.resize(static_cast<Eigen::Index>(entry.study.variables.size()));
     for (size_t i = 0; i < entry.study.variables.size(); ++i) {
       const spec::DesignVariable& v = entry.study.variables[i];
@@ -440,25 +448,17 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
       s.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
     }
     if (!entry.records.empty()) {
-      design = optimizer.current_design();
-      s.objective = optimizer.current_objective();
-      s.max_violation = optimizer.current_max_violation();
+      const slp::DesignPoint best = optimizer.best_design();
+      design = best.x;
+      s.objective = best.objective;
+      s.max_violation = best.max_violation;
     }
-  } else if (!entry.records.empty()) {
-    // Not running in this process: the best design is the last accepted
-    // trial point, or the first x0 when none was accepted.
-    const slp::CycleRecord* accepted = nullptr;
-    for (const slp::CycleRecord& r : entry.records) {
-      if (r.accepted) accepted = &r;
-    }
-    if (accepted != nullptr) {
-      design = accepted->x_trial;
-      s.objective = accepted->objective_trial;
-      s.max_violation = accepted->max_violation_trial;
-    } else {
-      design = entry.records.front().x0;
-      s.objective = entry.records.front().objective_x0;
-      s.max_violation = entry.records.front().max_violation_x0;
+  } else if (!entry.records.empty() && options.has_value()) {
+    // Not running in this process: the same choice from the logged records.
+    if (std::optional<slp::DesignPoint> best = jobs::BestDesignOfRecords(entry.records, *options)) {
+      design = best->x;
+      s.objective = best->objective;
+      s.max_violation = best->max_violation;
     }
   }
   if (entry.study_ok && static_cast<size_t>(design.size()) == entry.study.variables.size()) {

@@ -23,6 +23,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -63,9 +64,11 @@ struct JobSummaryData {
   jobs::JobState state = jobs::JobState::kQueued;
   int cycles = 0;
   std::int64_t analyses = 0;
-  double objective = 0;           // in objective_unit
+  // The result's F, in objective_unit, and maxg (normalized, > 0 violated);
+  // NaN while no design has been analysed (and for a job that failed there).
+  double objective = std::numeric_limits<double>::quiet_NaN();
   std::string objective_unit;
-  double max_violation = 0;       // normalized, > 0 violated
+  double max_violation = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::string> design_names;
   std::vector<double> design;     // physical: scale * x, parameter units
   std::vector<std::string> design_units;
@@ -145,6 +148,9 @@ class JobManager {
   // Expires overdue leases; tasks that used up their attempts go to their
   // optimizers as failed analyses. Call periodically.
   void ExpireLeases();
+  // The worker's connection closed: its tasks are requeued now
+  // (Scheduler::WorkerLost), and those out of attempts reported as failed.
+  void WorkerLost(const std::string& worker_id);
 
   // The stored study of a job (for workers). NotFound for an unknown job.
   absl::StatusOr<std::string> StudyBytes(const std::string& job_id);

@@ -1,0 +1,106 @@
+// `mbopt validate FILE`: checks a study and its scene as a server would
+// (spec/io, then the study's layout) without a server, and prints the
+// optimization layout: variables, objective, constraints and their rows.
+#include <cstdio>
+#include <map>
+#include <string>
+#include <variant>
+
+#include "absl/strings/str_format.h"
+#include "client/args.h"
+#include "client/commands.h"
+#include "client/exit_codes.h"
+#include "spec/io/study_io.h"
+#include "spec/layout.h"
+#include "spec/study.h"
+
+namespace mbopt::client {
+namespace {
+
+const char* ModelName(const spec::Scene& scene) {
+  if (std::holds_alternative<spec::LinkageModel>(scene.model)) return "linkage";
+  if (std::holds_alternative<spec::LumpedModel>(scene.model)) return "lumped";
+  return "multibody";
+}
+
+const char* ReductionName(spec::Reduction r) {
+  switch (r) {
+    case spec::Reduction::kMax: return "max";
+    case spec::Reduction::kMaxAbs: return "max_abs";
+    case spec::Reduction::kMin: return "min";
+    case spec::Reduction::kFinal: return "final";
+  }
+  return "?";
+}
+
+std::string OutputName(const spec::Study& study, int output) {
+  return output >= 0 && static_cast<size_t>(output) < study.scene.outputs.size()
+             ? study.scene.outputs[static_cast<size_t>(output)].name
+             : "?";
+}
+
+std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& layout) {
+  const spec::Objective& o = study.objective;
+  switch (o.form) {
+    case spec::Objective::Form::kMinimizeMaxOf:
+      return absl::StrFormat("minimize the %s of %s over the grid (%d terms, min-max form)",
+                             ReductionName(o.reduction), OutputName(study, o.output),
+                             layout.num_objective_terms());
+    case spec::Objective::Form::kMinimize:
+      return "minimize " + OutputName(study, o.output);
+    case spec::Objective::Form::kTargetDistance: {
+      std::string text = "distance to targets:";
+      for (const spec::TargetTerm& t : o.terms) {
+        text += absl::StrFormat(" %s -> %g%s%s", OutputName(study, t.output), t.target,
+                                t.unit.empty() ? "" : " ", t.unit);
+      }
+      return text;
+    }
+  }
+  return "?";
+}
+
+}  // namespace
+
+int ValidateCommand(const Args& args) {
+  auto parsed = ParseArgs(args, {{}, {}});
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  if (parsed->positional.size() != 1) return Fail("usage: mbopt validate STUDY_FILE", kExitBadInput);
+  const std::string path = parsed->positional[0];
+  // The same two steps as a submission: the file as sent, then the server's
+  // own reading of it.
+  auto message = spec::io::ReadStudyProto(path);
+  if (!message.ok()) return Fail(std::string(message.status().message()), kExitBadInput);
+  auto study = spec::io::StudyFromProto(*message, path);
+  if (!study.ok()) return Fail(std::string(study.status().message()), kExitBadInput);
+  auto layout = spec::MakeStudyLayout(*study);
+  if (!layout.ok()) return Fail(std::string(layout.status().message()), kExitBadInput);
+
+  const spec::Scene& scene = study->scene;
+  std::printf("study:       %s (%s)\n", study->name.c_str(), path.c_str());
+  std::printf("scene:       %s, %s model, %d instants from %g s to %g s, %zu outputs\n",
+              scene.name.c_str(), ModelName(scene), scene.time_grid.points, scene.time_grid.start_s,
+              scene.time_grid.end_s, scene.outputs.size());
+  std::printf("variables:   %zu\n", study->variables.size());
+  for (const spec::DesignVariable& v : study->variables) {
+    const spec::Parameter& p = scene.parameters[static_cast<size_t>(v.parameter)];
+    const std::string unit = p.unit.empty() ? "" : " " + p.unit;
+    std::printf("  %-12s sets %-20s initial %-12g in [%g, %g]%s\n", v.name.c_str(), p.name.c_str(),
+                v.scale * v.initial, v.scale * v.lower, v.scale * v.upper, unit.c_str());
+  }
+  std::printf("objective:   %s\n", ObjectiveText(*study, *layout).c_str());
+  std::map<int, int> rows_per_constraint;
+  for (const spec::ConstraintRow& row : layout->rows) ++rows_per_constraint[row.constraint];
+  std::printf("constraints: %zu, %d rows\n", study->constraints.size(), layout->num_constraints());
+  for (size_t k = 0; k < study->constraints.size(); ++k) {
+    const spec::Constraint& c = study->constraints[k];
+    const char* relation = c.reduction == spec::Reduction::kMin ? ">=" : "<=";
+    std::printf("  %-12s %s of %s %s %g%s%s (%d rows)\n", c.name.c_str(), ReductionName(c.reduction),
+                OutputName(*study, c.output).c_str(), relation, c.limit, c.unit.empty() ? "" : " ",
+                c.unit.c_str(), rows_per_constraint[static_cast<int>(k)]);
+  }
+  std::printf("valid\n");
+  return kExitOk;
+}
+
+}  // namespace mbopt::client

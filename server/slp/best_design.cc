@@ -1,0 +1,25 @@
+#include "server/slp/best_design.h"
+
+#include <cmath>
+
+namespace mbopt::slp {
+
+bool BestDesign::Better(const DesignPoint& a, const DesignPoint& b) const {
+  const bool a_feasible = a.max_violation < violation_tolerance_;
+  const bool b_feasible = b.max_violation < violation_tolerance_;
+  if (a_feasible != b_feasible) return a_feasible;
+  if (a_feasible) return a.objective < b.objective;
+  return a.max_violation < b.max_violation;
+}
+
+void BestDesign::Offer(const DesignPoint& point) {
+  if (!std::isfinite(point.objective) || !std::isfinite(point.max_violation)) return;
+  if (!best_.has_value() || Better(point, *best_)) best_ = point;
+}
+
+void BestDesign::OfferRecord(const CycleRecord& record) {
+  Offer(DesignPoint{record.x0, record.objective_x0, record.max_violation_x0});
+  Offer(DesignPoint{record.x_trial, record.objective_trial, record.max_violation_trial});
+}
+
+}  // namespace mbopt::slp

@@ -1,0 +1,42 @@
+// The result of a run: the best design it analysed. The method's own last
+// point (SlpOptimizer::current_design) can be worse than an earlier one: an
+// accepted step may raise F within the acceptance thresholds, and a rejected
+// trial may be better than the point the run ended on.
+//
+// Order: a feasible design (maxg < convergence_violation_tolerance, the
+// method's own notion of satisfied constraints) beats an infeasible one;
+// among feasible designs the lower F wins, among infeasible ones the lower
+// maxg. Ties keep the earlier design, so the choice depends only on the
+// sequence of cycle records: the optimizer and a reader of the job's logged
+// records make the same choice.
+#pragma once
+
+#include <optional>
+
+#include <Eigen/Dense>
+
+#include "server/slp/options.h"
+#include "server/slp/slp_optimizer.h"
+
+namespace mbopt::slp {
+
+class BestDesign {
+ public:
+  explicit BestDesign(double violation_tolerance) : violation_tolerance_(violation_tolerance) {}
+
+  // Offers a design; one whose values are not finite (a failed analysis) is
+  // ignored.
+  void Offer(const DesignPoint& point);
+  // Offers a cycle record's designs: x0, then the trial point.
+  void OfferRecord(const CycleRecord& record);
+
+  const std::optional<DesignPoint>& best() const { return best_; }
+
+ private:
+  bool Better(const DesignPoint& a, const DesignPoint& b) const;
+
+  double violation_tolerance_;
+  std::optional<DesignPoint> best_;
+};
+
+}  // namespace mbopt::slp
