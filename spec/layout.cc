@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "spec/limits.h"
 
 namespace mbopt::spec {
 namespace {
@@ -114,8 +115,48 @@ Dimension OutputDimension(const Output& output) {
                     output.kind);
 }
 
+StudyFootprint EstimateStudyFootprint(const Study& study) {
+  const Scene& scene = study.scene;
+  const int num_outputs = static_cast<int>(scene.outputs.size());
+  auto values = [&](int output) -> std::int64_t {
+    if (output < 0 || output >= num_outputs) return 0;
+    const OutputShape shape = OutputShapeOf(scene, output);
+    return static_cast<std::int64_t>(shape.series) * shape.instants;
+  };
+  StudyFootprint f;
+  const Objective& objective = study.objective;
+  f.objective_terms = objective.form == Objective::Form::kMinimizeMaxOf
+                          ? values(objective.output) * (objective.reduction == Reduction::kMaxAbs ? 2 : 1)
+                          : 1;
+  for (const Constraint& c : study.constraints) {
+    const std::int64_t all = values(c.output);
+    const std::int64_t series = c.output >= 0 && c.output < num_outputs ? OutputShapeOf(scene, c.output).series : 0;
+    switch (c.reduction) {
+      case Reduction::kFinal: f.constraint_rows += series; break;
+      case Reduction::kMaxAbs: f.constraint_rows += 2 * all; break;
+      default: f.constraint_rows += all; break;
+    }
+  }
+  const std::int64_t n = static_cast<std::int64_t>(study.variables.size());
+  const std::int64_t per_value = 8 * ((n + 1)            // x0's and the perturbations' values
+                                      + n                // the linearization's gradient
+                                      + 5 * (n + 2) / 2) // the dense LP row and the solver's copy
+                                 + 120;                  // the row's layout entry and name
+  f.memory_bytes = (f.objective_terms + f.constraint_rows) * per_value;
+  return f;
+}
+
 absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
   const Scene& scene = study.scene;
+  if (const StudyFootprint f = EstimateStudyFootprint(study); f.memory_bytes > kMaxStudyMemoryBytes) {
+    return LayoutError(
+        study, "constraints",
+        absl::StrFormat("the study needs about %.1f GB of memory for its %d objective terms and %d constraint rows "
+                        "with %d variables, more than the limit of %.0f GB; use fewer time points "
+                        "(analysis.time_grid_points) or fewer constraints on time series",
+                        static_cast<double>(f.memory_bytes) / 1e9, f.objective_terms, f.constraint_rows,
+                        study.variables.size(), static_cast<double>(kMaxStudyMemoryBytes) / (1 << 30)));
+  }
   StudyLayout layout;
   layout.instants_s = scene.time_grid.Instants();
   for (size_t o = 0; o < scene.outputs.size(); ++o) {

@@ -25,6 +25,7 @@
 //    (g - c) / scale is docs/method.md's g/c - 1.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -88,8 +89,20 @@ struct StudyLayout {
   int num_constraints() const { return static_cast<int>(rows.size()); }
 };
 
+// What laying a study out will cost, counted from its shapes before any row
+// exists: objective terms, constraint rows, and the optimizer's memory for
+// them (values, gradients, a batch of finite-difference results, the LP and
+// the solver's copy of it, the rows' names).
+struct StudyFootprint {
+  std::int64_t objective_terms = 0;
+  std::int64_t constraint_rows = 0;
+  std::int64_t memory_bytes = 0;
+};
+StudyFootprint EstimateStudyFootprint(const Study& study);
+
 // InvalidArgument (naming the study file and the field) if the study's
-// objective or constraints cannot be laid out, e.g. minimize_max_of with
+// objective or constraints cannot be laid out, or would need more memory
+// than kMaxStudyMemoryBytes (spec/limits.h), e.g. minimize_max_of with
 // reduction MIN, or minimize on a multi-series output.
 absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study);
 

@@ -11,6 +11,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "spec/layout.h"
+#include "spec/limits.h"
 #include "spec/units.h"
 
 namespace mbopt::spec::io {
@@ -434,9 +435,9 @@ class SceneConverter {
       }
       if (l.has_section()) link.section = ConvertSection(lw.Child("section"), l.section());
       if (l.has_flexible()) {
-        if (l.flexible().elements() < 1) {
+        if (l.flexible().elements() < 1 || l.flexible().elements() > kMaxLinkageFlexibleElements) {
           errors_.Add(lw.Child("flexible"), "elements",
-                      absl::StrCat("a flexible link needs at least 1 element, got ",
+                      absl::StrCat("a flexible link needs 1 to ", kMaxLinkageFlexibleElements, " elements, got ",
                                    l.flexible().elements()));
         }
         if (!l.has_section()) {
@@ -1113,6 +1114,9 @@ class SceneConverter {
     scene_.time_grid.start_s = g.start_s();
     scene_.time_grid.end_s = g.end_s();
     scene_.time_grid.points = g.points();
+    if (g.points() > kMaxTimeGridPoints) {
+      errors_.Add(w, "points", absl::StrCat(g.points(), " is more than the limit of ", kMaxTimeGridPoints, " instants"));
+    }
     if (g.points() < 1) {
       errors_.Add(w, "points", absl::StrCat("must be at least 1, got ", g.points()));
     }
@@ -1146,7 +1150,9 @@ class SceneConverter {
     } else if (s.absolute_tolerance() > 0.0) {
       out.absolute_tolerance = s.absolute_tolerance();
     }
-    if (s.max_steps() < 0) {
+    if (s.max_steps() > kMaxIntegratorSteps) {
+      errors_.Add(w, "max_steps", absl::StrCat(s.max_steps(), " is more than the limit of ", kMaxIntegratorSteps));
+    } else if (s.max_steps() < 0) {
       errors_.Add(w, "max_steps", "must be positive (0 for the default 100000)");
     } else if (s.max_steps() > 0) {
       out.max_steps = static_cast<long>(s.max_steps());

@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "spec/layout.h"
+#include "spec/limits.h"
 #include "spec/units.h"
 
 namespace mbopt::spec::io {
@@ -71,10 +72,19 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     const Where w = where.Child("analysis");
     const v1::AnalysisOverrides& a = m.analysis();
     if (a.time_grid_points() < 0) errors->Add(w, "time_grid_points", "must not be negative");
+    if (a.time_grid_points() > kMaxTimeGridPoints) {
+      errors->Add(w, "time_grid_points",
+                  absl::StrFormat("%d is more than the limit of %d instants", a.time_grid_points(), kMaxTimeGridPoints));
+    }
     if (a.relative_tolerance() < 0) errors->Add(w, "relative_tolerance", "must not be negative");
     if (a.absolute_tolerance() < 0) errors->Add(w, "absolute_tolerance", "must not be negative");
     if (a.elements_per_flexible_link() < 0) {
       errors->Add(w, "elements_per_flexible_link", "must not be negative");
+    }
+    if (a.elements_per_flexible_link() > kMaxLinkageFlexibleElements) {
+      errors->Add(w, "elements_per_flexible_link",
+                  absl::StrFormat("%d is more than the limit of %d elements per link", a.elements_per_flexible_link(),
+                                  kMaxLinkageFlexibleElements));
     }
     study.analysis.time_grid_points = a.time_grid_points();
     study.analysis.relative_tolerance = a.relative_tolerance();
@@ -96,6 +106,10 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
 
   std::set<std::string> names;
   std::set<int> bound;
+  if (m.variables_size() > kMaxDesignVariables) {
+    errors->Add(where, "variables",
+                absl::StrFormat("%d design variables, more than the limit of %d", m.variables_size(), kMaxDesignVariables));
+  }
   for (int i = 0; i < m.variables_size(); ++i) {
     const v1::DesignVariable& v = m.variables(i);
     const Where w = where.Child("variables", i);
@@ -273,6 +287,28 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
              &s.convergence_optimality_tolerance);
     positive("finite_difference_relative_step", p.finite_difference_relative_step(),
              &s.finite_difference_relative_step);
+    // The ranges of slp::SlpOptions::Validate, checked here so that a client
+    // refuses what the server would.
+    if (p.initial_move_limit() > 1.0) {
+      errors->Add(w, "initial_move_limit",
+                  absl::StrFormat("must be at most 1 (a relative move limit; 0 for the default 0.2), got %g",
+                                  p.initial_move_limit()));
+    }
+    if (p.finite_difference_relative_step() > 0.1) {
+      errors->Add(w, "finite_difference_relative_step",
+                  absl::StrFormat("must be at most 0.1 (a larger step is no derivative), got %g",
+                                  p.finite_difference_relative_step()));
+    }
+    if (!std::isfinite(p.screening_threshold()) || p.screening_threshold() > 0.0 ||
+        p.screening_threshold() < -1e6) {
+      errors->Add(w, "screening_threshold",
+                  absl::StrFormat("must be finite, <= 0 (a positive threshold drops violated constraints) and "
+                                  ">= -1e6, got %g",
+                                  p.screening_threshold()));
+    }
+    if (p.max_cycles() > kMaxOptimizerCycles) {
+      errors->Add(w, "max_cycles", absl::StrFormat("%d is more than the limit of %d", p.max_cycles(), kMaxOptimizerCycles));
+    }
     if (p.max_cycles() < 0) {
       errors->Add(w, "max_cycles", "must be positive (0 for the default)");
     } else if (p.max_cycles() > 0) {

@@ -10,11 +10,13 @@
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "common/status_macros.h"
 #include "spec/io/locator.h"
 #include "spec/io/scene_convert.h"
 #include "spec/io/study_convert.h"
+#include "spec/limits.h"
 
 namespace mbopt::spec::io {
 namespace {
@@ -44,6 +46,20 @@ class CollectErrors : public google::protobuf::io::ErrorCollector {
 };
 
 absl::StatusOr<std::string> ReadFile(const std::string& path) {
+  // A device or a FIFO (/dev/zero, a pipe) would be read forever, and a huge
+  // file would be parsed into memory first: refuse both before reading.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) return absl::NotFoundError(absl::StrCat(path, ": cannot open file"));
+  if (!std::filesystem::is_regular_file(status)) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": not a regular file"));
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > static_cast<std::uintmax_t>(kMaxInputFileBytes)) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s: %.1f MB, larger than the %d MB limit for study and scene files",
+                                                      path, static_cast<double>(size) / (1 << 20),
+                                                      static_cast<int>(kMaxInputFileBytes >> 20)));
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open file"));
   std::ostringstream content;

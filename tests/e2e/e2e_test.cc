@@ -393,6 +393,38 @@ std::string InlinedVehicleStudy(v1::Study* study) {
   return text;
 }
 
+// One validation path: `mbopt validate` (the client's check before submit
+// and run) and `mbopt-worker eval` refuse the same hostile files with the
+// same message, and neither hangs or crashes.
+TEST(BadInput, ValidateAndWorkerEvalAgreeOnHostileFiles) {
+  ScratchDir dir;
+  v1::Study study;
+  const std::string text = InlinedVehicleStudy(&study);
+  ASSERT_FALSE(text.empty());
+  const std::string zero_scene =
+      dir.Write("zero.study.textproto", "name: \"z\"\nscene_file: \"/dev/zero\"\n");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"grid", text + "analysis { time_grid_points: 10000000 }\n"},
+      {"memory", text + "analysis { time_grid_points: 1000000 }\n"},
+      {"move_limit", text + "optimizer { initial_move_limit: 1e300 }\n"},
+      {"nan_screening", text + "optimizer { screening_threshold: nan }\n"},
+      {"cycles", text + "optimizer { max_cycles: 2147483647 }\n"},
+  };
+  std::vector<std::string> paths = {zero_scene};
+  for (const auto& [name, body] : cases) paths.push_back(dir.Write(name + ".study.textproto", body));
+  for (const std::string& path : paths) {
+    auto validated = Mbopt({"validate", path});
+    EXPECT_EQ(validated.exit_code, kExitBadInput) << Describe(validated);
+    auto evaluated = client::RunCommand({WorkerBinary(), "eval", path}, kGuard);
+    ASSERT_TRUE(evaluated.ok()) << evaluated.status();
+    EXPECT_NE(evaluated->exit_code, 0) << path;
+    const std::string prefix = "mbopt: ";
+    ASSERT_EQ(validated.stderr_text.rfind(prefix, 0), 0u) << validated.stderr_text;
+    EXPECT_NE(evaluated->stderr_text.find(Trim(validated.stderr_text.substr(prefix.size()))), std::string::npos)
+        << "validate: " << validated.stderr_text << "eval: " << evaluated->stderr_text;
+  }
+}
+
 TEST(BadInput, UnknownFieldIsNamed) {
   ScratchDir dir;
   v1::Study study;

@@ -10,6 +10,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "spec/layout.h"
+#include "spec/limits.h"
+
 namespace mbopt::spec::io {
 namespace {
 
@@ -364,6 +367,64 @@ TEST_F(StudyFiles, GravityInALumpedSceneIsRejectedNotIgnored) {
   const std::string error = LoadError(scene, kStudy);
   EXPECT_THAT(error, HasSubstr(SceneAt("effects", scene)));
   EXPECT_THAT(error, HasSubstr("effects.gravity"));
+}
+
+// Resource limits (spec/limits.h): refused at load, naming the field and the
+// limit, before anything of that size is allocated or read.
+TEST_F(StudyFiles, DeviceOrDirectoryAsASceneFileIsNotARegularFile) {
+  for (const char* path : {"/dev/zero", "/tmp"}) {
+    auto loaded = LoadStudyFile(Write("oscillator.study.textproto",
+                                      Replace(kStudy, "oscillator.scene.textproto", path)));
+    ASSERT_FALSE(loaded.ok()) << path;
+    EXPECT_THAT(loaded.status().message(), HasSubstr(std::string(path) + ": not a regular file"));
+  }
+}
+
+TEST_F(StudyFiles, OversizedFileIsRefusedBeforeItIsRead) {
+  Write("oscillator.scene.textproto", std::string(kScene) + std::string(kMaxInputFileBytes, '#'));
+  auto loaded = LoadStudyFile(Write("oscillator.study.textproto", kStudy));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_THAT(loaded.status().message(), HasSubstr("larger than the 16 MB limit"));
+}
+
+TEST_F(StudyFiles, CountsAboveTheirLimitsAreNamed) {
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "analysis { time_grid_points: 10000000 }\n"),
+              HasSubstr("analysis.time_grid_points: 10000000 is more than the limit of 1000000 instants"));
+  EXPECT_THAT(LoadError(Replace(kScene, "points: 11", "points: 2147483647"), kStudy),
+              HasSubstr("time_grid.points: 2147483647 is more than the limit"));
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { max_cycles: 2147483647 }\n"),
+              HasSubstr("optimizer.max_cycles: 2147483647 is more than the limit"));
+}
+
+TEST_F(StudyFiles, OptimizerSettingsOutsideTheMethodsRangesAreRefusedAtLoad) {
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { initial_move_limit: 1e300 }\n"),
+              HasSubstr("optimizer.initial_move_limit: must be at most 1"));
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { screening_threshold: nan }\n"),
+              HasSubstr("optimizer.screening_threshold: must be finite"));
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { finite_difference_relative_step: 0.5 }\n"),
+              HasSubstr("optimizer.finite_difference_relative_step: must be at most 0.1"));
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { convergence_optimality_tolerance: inf }\n"),
+              HasSubstr("optimizer.convergence_optimality_tolerance"));
+}
+
+TEST_F(StudyFiles, StudyTooLargeForMemoryIsRefusedWithItsEstimate) {
+  // The file's 11 instants: two objective terms and two constraint rows each.
+  Write("oscillator.scene.textproto", kScene);
+  auto small = LoadStudyFile(Write("oscillator.study.textproto", kStudy));
+  ASSERT_TRUE(small.ok()) << small.status();
+  const StudyFootprint f = EstimateStudyFootprint(*small);
+  EXPECT_EQ(f.objective_terms, 22);
+  EXPECT_EQ(f.constraint_rows, 22);
+  EXPECT_GT(f.memory_bytes, 0);
+  // 1e6 instants and ten such constraints: 2.2e7 values, about 4.4 GB.
+  std::string study = std::string(kStudy) + "analysis { time_grid_points: 1000000 }\n";
+  for (int k = 0; k < 10; ++k) {
+    study += "constraints { name: \"c" + std::to_string(k) +
+             "\" output: \"x\" reduction: REDUCTION_MAX_ABS limit: 5 unit: \"mm\" }\n";
+  }
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr("GB of memory"));
+  EXPECT_THAT(error, HasSubstr("more than the limit of 2 GB"));
 }
 
 TEST_F(StudyFiles, MissingFileIsNotFound) {

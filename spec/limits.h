@@ -1,0 +1,26 @@
+// The bounds of the study and scene schema (docs/study.md, "Limits"): what a
+// study may ask for before anything is allocated. They are checked once,
+// where files and messages become spec types (spec/io) and where a study is
+// laid out (MakeStudyLayout), so `mbopt validate`, `submit`, `run`, the
+// server and `mbopt-worker eval` accept and refuse the same inputs.
+#pragma once
+
+#include <cstdint>
+
+namespace mbopt::spec {
+
+// Study and scene files: regular files no larger than this.
+inline constexpr std::int64_t kMaxInputFileBytes = 16 << 20;
+
+// Counts.
+inline constexpr int kMaxTimeGridPoints = 1'000'000;
+inline constexpr int kMaxLinkageFlexibleElements = 200;  // per linkage link
+inline constexpr int kMaxDesignVariables = 10'000;
+inline constexpr std::int64_t kMaxIntegratorSteps = 100'000'000;  // per analysis
+inline constexpr int kMaxOptimizerCycles = 100'000;
+
+// The optimizer's memory for one study, estimated from its layout before
+// any row exists (EstimateStudyMemoryBytes in spec/layout.h).
+inline constexpr std::int64_t kMaxStudyMemoryBytes = std::int64_t{2} << 30;
+
+}  // namespace mbopt::spec
