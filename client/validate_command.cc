@@ -29,6 +29,10 @@ const char* ReductionName(spec::Reduction r) {
     case spec::Reduction::kMaxAbs: return "max_abs";
     case spec::Reduction::kMin: return "min";
     case spec::Reduction::kFinal: return "final";
+    case spec::Reduction::kRms: return "rms";
+    case spec::Reduction::kIntegral: return "integral";
+    case spec::Reduction::kRange: return "range";
+    case spec::Reduction::kMean: return "mean";
   }
   return "?";
 }
@@ -39,6 +43,12 @@ std::string OutputName(const spec::Study& study, int output) {
              : "?";
 }
 
+std::string WindowText(const spec::TimeWindow& w) {
+  if (w.whole_grid()) return "";
+  return absl::StrFormat(" from %s to %s", w.from_s ? absl::StrFormat("%g s", *w.from_s) : "the start",
+                         w.to_s ? absl::StrFormat("%g s", *w.to_s) : "the end");
+}
+
 std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& layout) {
   const spec::Objective& o = study.objective;
   switch (o.form) {
@@ -47,7 +57,8 @@ std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& lay
                              ReductionName(o.reduction), OutputName(study, o.output),
                              layout.num_objective_terms());
     case spec::Objective::Form::kMinimize:
-      return "minimize " + OutputName(study, o.output);
+      return absl::StrFormat("minimize the %s of %s%s", ReductionName(o.reduction), OutputName(study, o.output),
+                             WindowText(o.window));
     case spec::Objective::Form::kTargetDistance: {
       std::string text = "distance to targets:";
       for (const spec::TargetTerm& t : o.terms) {
@@ -94,10 +105,21 @@ int ValidateCommand(const Args& args) {
   std::printf("constraints: %zu, %d rows\n", study->constraints.size(), layout->num_constraints());
   for (size_t k = 0; k < study->constraints.size(); ++k) {
     const spec::Constraint& c = study->constraints[k];
-    const char* relation = c.reduction == spec::Reduction::kMin ? ">=" : "<=";
-    std::printf("  %-12s %s of %s %s %g%s%s (%d rows)\n", c.name.c_str(), ReductionName(c.reduction),
-                OutputName(*study, c.output).c_str(), relation, c.limit, c.unit.empty() ? "" : " ",
-                c.unit.c_str(), rows_per_constraint[static_cast<int>(k)]);
+    std::string bound;
+    if (spec::IsWholeSeriesReduction(c.reduction)) {
+      if (c.lower && c.upper) {
+        bound = absl::StrFormat("in [%g, %g]", *c.lower, *c.upper);
+      } else if (c.upper) {
+        bound = absl::StrFormat("<= %g", *c.upper);
+      } else if (c.lower) {
+        bound = absl::StrFormat(">= %g", *c.lower);
+      }
+    } else {
+      bound = absl::StrFormat("%s %g", c.reduction == spec::Reduction::kMin ? ">=" : "<=", c.limit);
+    }
+    std::printf("  %-12s %s of %s%s %s%s%s (%d rows)\n", c.name.c_str(), ReductionName(c.reduction),
+                OutputName(*study, c.output).c_str(), WindowText(c.window).c_str(), bound.c_str(),
+                c.unit.empty() ? "" : " ", c.unit.c_str(), rows_per_constraint[static_cast<int>(k)]);
   }
   std::printf("valid\n");
   return kExitOk;

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "common/status_macros.h"
 #include "spec/limits.h"
 
 namespace mbopt::spec {
@@ -42,7 +43,111 @@ std::string RowName(const std::string& constraint, const OutputShape& shape, int
   return name;
 }
 
+bool IsScalarOutput(const Scene& scene, int output) {
+  return std::holds_alternative<MassOutput>(scene.outputs[static_cast<size_t>(output)].kind);
+}
+
+ValueRef At(int output, int series, int instant, double sign) {
+  return ValueRef{output, series, instant, sign, Over::kInstant, instant, instant};
+}
+
+Over OverOf(Reduction r) {
+  switch (r) {
+    case Reduction::kRms: return Over::kRms;
+    case Reduction::kIntegral: return Over::kIntegral;
+    case Reduction::kRange: return Over::kRange;
+    case Reduction::kMean: return Over::kMean;
+    default: return Over::kInstant;
+  }
+}
+
+// The grid instants inside `window`, as [first, last]; an error naming
+// `field` when none is, or when the output has no time series.
+absl::StatusOr<std::pair<int, int>> WindowInstants(const Study& study, const std::string& field, const TimeWindow& window,
+                                                   const std::vector<double>& instants_s, bool scalar_output,
+                                                   bool needs_series) {
+  if (scalar_output) {
+    if (!window.whole_grid() || needs_series) {
+      return LayoutError(study, field, "a scalar output (mass) has no time series to window or reduce");
+    }
+    return std::pair<int, int>{0, 0};
+  }
+  const double span = instants_s.empty() ? 0.0 : instants_s.back() - instants_s.front();
+  const double slack = 1e-9 * std::max(span, 1e-300);  // instants are computed, limits typed
+  int first = -1, last = -1;
+  for (int i = 0; i < static_cast<int>(instants_s.size()); ++i) {
+    const double t = instants_s[static_cast<size_t>(i)];
+    if (window.from_s && t < *window.from_s - slack) continue;
+    if (window.to_s && t > *window.to_s + slack) continue;
+    if (first < 0) first = i;
+    last = i;
+  }
+  if (first < 0) {
+    return LayoutError(study, field + ".window",
+                       absl::StrFormat("holds no instant of the time grid (%g s to %g s)",
+                                       instants_s.empty() ? 0.0 : instants_s.front(),
+                                       instants_s.empty() ? 0.0 : instants_s.back()));
+  }
+  return std::pair<int, int>{first, last};
+}
+
 }  // namespace
+
+double RefValue(const ValueRef& ref, const std::vector<double>& f, const std::vector<double>& t,
+                std::vector<double>* weights) {
+  const size_t first = static_cast<size_t>(ref.over == Over::kInstant ? ref.instant : ref.first);
+  const size_t last = static_cast<size_t>(ref.over == Over::kInstant ? ref.instant : ref.last);
+  const size_t count = last - first + 1;
+  if (weights != nullptr) weights->assign(count, 0.0);
+  double value = 0.0;
+  switch (ref.over) {
+    case Over::kInstant:
+      value = f[first];
+      if (weights != nullptr) (*weights)[0] = 1.0;
+      break;
+    case Over::kMean:
+      for (size_t i = first; i <= last; ++i) value += f[i];
+      value /= static_cast<double>(count);
+      if (weights != nullptr) weights->assign(count, 1.0 / static_cast<double>(count));
+      break;
+    case Over::kRms: {
+      double sum = 0.0;
+      for (size_t i = first; i <= last; ++i) sum += f[i] * f[i];
+      value = std::sqrt(sum / static_cast<double>(count));
+      if (weights != nullptr && value > 0.0) {
+        for (size_t i = first; i <= last; ++i) (*weights)[i - first] = f[i] / (static_cast<double>(count) * value);
+      }
+      break;
+    }
+    case Over::kIntegral:
+      for (size_t i = first; i < last; ++i) {
+        const double h = t[i + 1] - t[i];
+        value += 0.5 * h * (f[i] + f[i + 1]);
+        if (weights != nullptr) {
+          (*weights)[i - first] += 0.5 * h;
+          (*weights)[i + 1 - first] += 0.5 * h;
+        }
+      }
+      break;
+    case Over::kRange: {
+      size_t hi = first, lo = first;
+      for (size_t i = first; i <= last; ++i) {
+        if (f[i] > f[hi]) hi = i;
+        if (f[i] < f[lo]) lo = i;
+      }
+      value = f[hi] - f[lo];
+      if (weights != nullptr && hi != lo) {
+        (*weights)[hi - first] = 1.0;
+        (*weights)[lo - first] = -1.0;
+      }
+      break;
+    }
+  }
+  if (weights != nullptr) {
+    for (double& w : *weights) w *= ref.sign;
+  }
+  return ref.sign * value;
+}
 
 OutputShape OutputShapeOf(const Scene& scene, int output) {
   OutputShape shape;
@@ -131,10 +236,10 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
   for (const Constraint& c : study.constraints) {
     const std::int64_t all = values(c.output);
     const std::int64_t series = c.output >= 0 && c.output < num_outputs ? OutputShapeOf(scene, c.output).series : 0;
-    switch (c.reduction) {
-      case Reduction::kFinal: f.constraint_rows += series; break;
-      case Reduction::kMaxAbs: f.constraint_rows += 2 * all; break;
-      default: f.constraint_rows += all; break;
+    if (IsWholeSeriesReduction(c.reduction)) {
+      f.constraint_rows += series * std::max(1, (c.upper ? 1 : 0) + (c.lower ? 1 : 0));
+    } else {
+      f.constraint_rows += c.reduction == Reduction::kMaxAbs ? 2 * all : all;
     }
   }
   const std::int64_t n = static_cast<std::int64_t>(study.variables.size());
@@ -177,11 +282,14 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       }
       layout.objective_form = ObjectiveForm::kMinMax;
       const OutputShape& shape = layout.outputs[static_cast<size_t>(objective.output)];
-      for (int i = 0; i < shape.instants; ++i) {
+      MBOPT_ASSIGN_OR_RETURN(const auto window,
+                             WindowInstants(study, "objective", objective.window, layout.instants_s,
+                                            IsScalarOutput(scene, objective.output), false));
+      for (int i = window.first; i <= window.second; ++i) {
         for (int s = 0; s < shape.series; ++s) {
-          layout.objective_terms.push_back({objective.output, s, i, 1.0});
+          layout.objective_terms.push_back(At(objective.output, s, i, 1.0));
           if (objective.reduction == Reduction::kMaxAbs) {
-            layout.objective_terms.push_back({objective.output, s, i, -1.0});
+            layout.objective_terms.push_back(At(objective.output, s, i, -1.0));
           }
         }
       }
@@ -199,7 +307,17 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
                          " series; minimize needs a single value"));
       }
       layout.objective_form = ObjectiveForm::kScalar;
-      layout.objective_terms.push_back({objective.output, 0, shape.instants - 1, 1.0});
+      const bool reduced = objective.reduction != Reduction::kFinal;
+      MBOPT_ASSIGN_OR_RETURN(const auto window,
+                             WindowInstants(study, "objective", objective.window, layout.instants_s,
+                                            IsScalarOutput(scene, objective.output), reduced));
+      ValueRef ref = At(objective.output, 0, window.second, 1.0);
+      if (reduced) {
+        ref.over = OverOf(objective.reduction);
+        ref.first = window.first;
+        ref.last = window.second;
+      }
+      layout.objective_terms.push_back(ref);
       break;
     }
     case Objective::Form::kTargetDistance: {
@@ -230,38 +348,69 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
                          "names no scene output");
     }
     const OutputShape& shape = layout.outputs[static_cast<size_t>(constraint.output)];
-    const bool time_series =
-        shape.instants > 1 || !std::holds_alternative<MassOutput>(
-                                  scene.outputs[static_cast<size_t>(constraint.output)].kind);
-    const double c = constraint.limit * constraint.si_per_unit;
-    const int first = constraint.reduction == Reduction::kFinal ? shape.instants - 1 : 0;
-    for (int i = first; i < shape.instants; ++i) {
-      const double t = std::holds_alternative<MassOutput>(
-                           scene.outputs[static_cast<size_t>(constraint.output)].kind)
-                           ? 0.0
-                           : layout.instants_s[static_cast<size_t>(i)];
+    const bool scalar_output = IsScalarOutput(scene, constraint.output);
+    const std::string field = absl::StrCat("constraints[", k, "]");
+    const bool reduced = IsWholeSeriesReduction(constraint.reduction) && constraint.reduction != Reduction::kFinal;
+    MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, constraint.window, layout.instants_s,
+                                                             scalar_output, reduced));
+    auto add = [&](ValueRef value, double limit, const std::string& name, double t) {
+      ConstraintRow row;
+      row.name = name;
+      row.constraint = static_cast<int>(k);
+      row.value = value;
+      row.limit_si = limit;
+      row.scale = limit != 0.0 ? std::abs(limit) : 1.0;
+      row.time_s = t;
+      layout.rows.push_back(std::move(row));
+    };
+    if (IsWholeSeriesReduction(constraint.reduction)) {
+      // One value per series, bounded from either side.
+      const double t = scalar_output ? 0.0 : layout.instants_s[static_cast<size_t>(window.second)];
       for (int s = 0; s < shape.series; ++s) {
-        auto add = [&](double sign, double limit, const char* side) {
-          ConstraintRow row;
-          row.name = RowName(constraint.name, shape, s, time_series, t, decimals, side);
-          row.constraint = static_cast<int>(k);
-          row.value = {constraint.output, s, i, sign};
-          row.limit_si = limit;
-          row.scale = limit != 0.0 ? std::abs(limit) : 1.0;
-          row.time_s = t;
-          layout.rows.push_back(std::move(row));
+        ValueRef ref = At(constraint.output, s, window.second, 1.0);
+        if (reduced) {
+          ref.over = OverOf(constraint.reduction);
+          ref.first = window.first;
+          ref.last = window.second;
+        }
+        auto name = [&](const char* side) {
+          if (!reduced) {  // FINAL: named by its instant, like the rows of an instant
+            return RowName(constraint.name, shape, s, !scalar_output || shape.instants > 1, t, decimals, side);
+          }
+          return (shape.series > 1 ? absl::StrCat(constraint.name, "[", shape.series_labels[s], "]")
+                                   : constraint.name) +
+                 " " + side;
+        };
+        // Neither bound given: `limit` from above, as FINAL always had it.
+        const std::optional<double> upper =
+            constraint.upper || constraint.lower ? constraint.upper : std::optional<double>(constraint.limit);
+        if (upper) add(ref, *upper * constraint.si_per_unit, name("upper"), t);
+        if (constraint.lower) {
+          ref.sign = -1.0;
+          add(ref, -*constraint.lower * constraint.si_per_unit, name("lower"), t);
+        }
+      }
+      continue;
+    }
+    const double c = constraint.limit * constraint.si_per_unit;
+    for (int i = window.first; i <= window.second; ++i) {
+      const double t = scalar_output ? 0.0 : layout.instants_s[static_cast<size_t>(i)];
+      for (int s = 0; s < shape.series; ++s) {
+        auto name = [&](const char* side) {
+          return RowName(constraint.name, shape, s, !scalar_output || shape.instants > 1, t, decimals, side);
         };
         switch (constraint.reduction) {
           case Reduction::kMax:
-          case Reduction::kFinal:
-            add(1.0, c, "upper");
+            add(At(constraint.output, s, i, 1.0), c, name("upper"), t);
             break;
           case Reduction::kMin:
-            add(-1.0, -c, "lower");
+            add(At(constraint.output, s, i, -1.0), -c, name("lower"), t);
             break;
           case Reduction::kMaxAbs:
-            add(1.0, c, "upper");
-            add(-1.0, c, "lower");
+            add(At(constraint.output, s, i, 1.0), c, name("upper"), t);
+            add(At(constraint.output, s, i, -1.0), c, name("lower"), t);
+            break;
+          default:
             break;
         }
       }
@@ -292,9 +441,8 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
     }
   }
   auto value = [&](const ValueRef& ref) {
-    return ref.sign *
-           (*outputs_si[static_cast<size_t>(ref.output)])[static_cast<size_t>(ref.series)]
-                                                         [static_cast<size_t>(ref.instant)];
+    return RefValue(ref, (*outputs_si[static_cast<size_t>(ref.output)])[static_cast<size_t>(ref.series)],
+                    layout.instants_s);
   };
 
   StudyValues values;

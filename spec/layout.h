@@ -57,18 +57,30 @@ Dimension OutputDimension(const Output& output);
 
 enum class ObjectiveForm { kScalar, kMinMax };
 
-// A reference to one value of an analysis: output, series, instant, sign.
+// A reference to one value of an analysis: output, series, sign, and either
+// one instant or a reduction of the series over the instants [first, last].
+enum class Over { kInstant, kRms, kIntegral, kRange, kMean };
 struct ValueRef {
   int output = -1;
   int series = 0;
-  int instant = 0;
+  int instant = 0;  // kInstant; otherwise `last` (the time a row is shown at)
   double sign = 1.0;
+  Over over = Over::kInstant;
+  int first = 0;
+  int last = 0;
 };
+
+// The value `ref` takes on `series` (one output series, SI) with the grid's
+// `instants_s`; with `weights`, also d value / d series[first + k] for k in
+// [0, last - first] (RANGE: +1 at the first maximum, -1 at the first
+// minimum; RMS of all zeros: 0).
+double RefValue(const ValueRef& ref, const std::vector<double>& series, const std::vector<double>& instants_s,
+                std::vector<double>* weights = nullptr);
 
 struct ConstraintRow {
   std::string name;     // e.g. "s1@t=1.750s upper"
   int constraint = -1;  // index into study.constraints
-  ValueRef value;       // g_h = sign * f (SI)
+  ValueRef value;       // g_h = sign * f, or sign * a reduction of f (SI)
   double limit_si = 0;  // c_h
   double scale = 1;     // > 0
   double time_s = 0;    // the instant (0 for scalar outputs)

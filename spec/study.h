@@ -19,7 +19,21 @@ struct DesignVariable {
   double upper = 0.0;     // scaled
 };
 
-enum class Reduction { kMax, kMaxAbs, kMin, kFinal };
+enum class Reduction { kMax, kMaxAbs, kMin, kFinal, kRms, kIntegral, kRange, kMean };
+
+// FINAL and the reductions over a window give one value per series; the
+// others one per instant.
+inline bool IsWholeSeriesReduction(Reduction r) {
+  return r == Reduction::kFinal || r == Reduction::kRms || r == Reduction::kIntegral || r == Reduction::kRange ||
+         r == Reduction::kMean;
+}
+
+// Instants with from_s <= t <= to_s; an absent end is open.
+struct TimeWindow {
+  std::optional<double> from_s;
+  std::optional<double> to_s;
+  bool whole_grid() const { return !from_s.has_value() && !to_s.has_value(); }
+};
 
 struct TargetTerm {
   int output = -1;
@@ -36,15 +50,21 @@ struct Objective {
   std::vector<TargetTerm> terms;   // kTargetDistance
   std::string unit;
   double si_per_unit = 1.0;
+  TimeWindow window;
 };
 
 struct Constraint {
   std::string name;
   int output = -1;
   Reduction reduction = Reduction::kMaxAbs;
-  double limit = 0.0;        // in `unit`
+  double limit = 0.0;        // in `unit`; MAX, MAX_ABS, MIN
+  // Whole-series reductions: the bounds of the value, in `unit` (at least
+  // one; `limit` and `equals` +- tolerance are written as these at load).
+  std::optional<double> lower;
+  std::optional<double> upper;
   std::string unit;
   double si_per_unit = 1.0;
+  TimeWindow window;
 };
 
 // What the study file sets of the optimizer. An unset value is the method's

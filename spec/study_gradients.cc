@@ -31,9 +31,19 @@ absl::Status CheckShapes(const Study& study, const StudyLayout& layout,
   return absl::OkStatus();
 }
 
-double At(const std::vector<const Series*>& outputs, const ValueRef& ref) {
-  return ref.sign * (*outputs[static_cast<size_t>(ref.output)])[static_cast<size_t>(ref.series)]
-                                                               [static_cast<size_t>(ref.instant)];
+// d(value of ref) / d(parameter): the reduction's weights at the analysed
+// values times the output's derivatives over the same instants.
+double Derivative(const std::vector<const Series*>& values, const std::vector<const Series*>& derivatives,
+                  const std::vector<double>& instants_s, const ValueRef& ref) {
+  const size_t o = static_cast<size_t>(ref.output);
+  const size_t s = static_cast<size_t>(ref.series);
+  std::vector<double> weights;
+  RefValue(ref, (*values[o])[s], instants_s, &weights);
+  const std::vector<double>& d = (*derivatives[o])[s];
+  const size_t first = static_cast<size_t>(ref.over == Over::kInstant ? ref.instant : ref.first);
+  double sum = 0.0;
+  for (size_t k = 0; k < weights.size(); ++k) sum += weights[k] * d[first + k];
+  return sum;
 }
 
 }  // namespace
@@ -90,14 +100,16 @@ absl::StatusOr<StudyGradients> ComputeStudyGradients(
     for (const ValueRef& ref : layout.objective_terms) {
       std::vector<double> row(n);
       for (size_t i = 0; i < n; ++i) {
-        row[i] = At(derivatives_si[i], ref) / objective.si_per_unit * factor[i];
+        row[i] = Derivative(outputs_si, derivatives_si[i], layout.instants_s, ref) / objective.si_per_unit * factor[i];
       }
       out.objective_terms.push_back(std::move(row));
     }
   }
   for (const ConstraintRow& c : layout.rows) {
     std::vector<double> row(n);
-    for (size_t i = 0; i < n; ++i) row[i] = At(derivatives_si[i], c.value) * factor[i];
+    for (size_t i = 0; i < n; ++i) {
+      row[i] = Derivative(outputs_si, derivatives_si[i], layout.instants_s, c.value) * factor[i];
+    }
     out.constraint_rows.push_back(std::move(row));
   }
   return out;

@@ -4,6 +4,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <variant>
 
 #include "absl/strings/str_cat.h"
@@ -55,9 +56,34 @@ std::optional<Reduction> ToReduction(v1::Reduction r) {
       return Reduction::kMin;
     case v1::REDUCTION_FINAL:
       return Reduction::kFinal;
+    case v1::REDUCTION_RMS:
+      return Reduction::kRms;
+    case v1::REDUCTION_INTEGRAL:
+      return Reduction::kIntegral;
+    case v1::REDUCTION_RANGE:
+      return Reduction::kRange;
+    case v1::REDUCTION_MEAN:
+      return Reduction::kMean;
     default:
       return std::nullopt;
   }
+}
+
+TimeWindow ConvertWindow(const Where& w, const v1::TimeWindow& m, Errors* errors) {
+  TimeWindow window;
+  if (m.has_from_s()) {
+    if (!std::isfinite(m.from_s())) errors->Add(w, "from_s", "must be a finite number");
+    window.from_s = m.from_s();
+  }
+  if (m.has_to_s()) {
+    if (!std::isfinite(m.to_s())) errors->Add(w, "to_s", "must be a finite number");
+    window.to_s = m.to_s();
+  }
+  if (window.from_s && window.to_s && !(*window.from_s <= *window.to_s)) {
+    errors->Add(w, "to_s", absl::StrFormat("the window ends (%g s) before it starts (%g s)", *window.to_s,
+                                           *window.from_s));
+  }
+  return window;
 }
 
 }  // namespace
@@ -179,17 +205,20 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
       }
       break;
     }
-    case v1::Objective::kMinimize:
+    case v1::Objective::kMinimize: {
       obj.form = Objective::Form::kMinimize;
       obj.output = FindOutput(scene, ow, "minimize", o.minimize(), errors);
-      if (o.reduction() != v1::REDUCTION_UNSPECIFIED && o.reduction() != v1::REDUCTION_FINAL) {
+      const std::optional<Reduction> r =
+          o.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(o.reduction());
+      if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
         errors->Add(ow, "reduction",
-                    "minimize takes the final value: leave reduction out or "
-                    "use REDUCTION_FINAL (for a maximum over time use "
+                    "minimize takes one value per run: REDUCTION_FINAL (the default), REDUCTION_RMS, "
+                    "REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN (for a maximum over time use "
                     "minimize_max_of)");
       }
-      obj.reduction = Reduction::kFinal;
+      obj.reduction = r.value_or(Reduction::kFinal);
       break;
+    }
     case v1::Objective::kTargetDistance: {
       obj.form = Objective::Form::kTargetDistance;
       const Where tw = ow.Child("target_distance");
@@ -223,6 +252,12 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
                   "`target_distance`");
       break;
   }
+  if (o.has_window()) {
+    if (obj.form == Objective::Form::kTargetDistance) {
+      errors->Add(ow, "window", "target_distance takes final values; it has no window");
+    }
+    obj.window = ConvertWindow(ow.Child("window"), o.window(), errors);
+  }
   if (obj.form != Objective::Form::kTargetDistance) {
     obj.si_per_unit =
         UnitFactor(ow, "unit", o.unit(),
@@ -247,14 +282,58 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
       out.reduction = *r;
     } else {
       errors->Add(w, "reduction",
-                  "missing: expected REDUCTION_MAX, REDUCTION_MAX_ABS, "
-                  "REDUCTION_MIN or REDUCTION_FINAL");
+                  "missing: expected REDUCTION_MAX, REDUCTION_MAX_ABS, REDUCTION_MIN, REDUCTION_FINAL, "
+                  "REDUCTION_RMS, REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN");
     }
-    out.limit = c.limit();
-    if (!std::isfinite(c.limit())) errors->Add(w, "limit", "must be a finite number");
-    if (out.reduction == Reduction::kMaxAbs && !(c.limit() > 0.0)) {
-      errors->Add(w, "limit",
-                  absl::StrFormat("REDUCTION_MAX_ABS needs a positive limit, got %g", c.limit()));
+    if (c.has_window()) out.window = ConvertWindow(w.Child("window"), c.window(), errors);
+    for (const auto& [field, present, value] :
+         {std::tuple{"limit", true, c.limit()}, std::tuple{"lower", c.has_lower(), c.lower()},
+          std::tuple{"upper", c.has_upper(), c.upper()}, std::tuple{"equals", c.has_equals(), c.equals()},
+          std::tuple{"tolerance", true, c.tolerance()}}) {
+      if (present && !std::isfinite(value)) errors->Add(w, field, "must be a finite number");
+    }
+    const bool bounds = c.has_lower() || c.has_upper();
+    const bool limit_given = c.limit() != 0.0;
+    if (IsWholeSeriesReduction(out.reduction)) {
+      // One value per series: limit (<=), lower/upper, or equals +- tolerance.
+      if (c.has_equals()) {
+        if (bounds || limit_given) {
+          errors->Add(w, "equals", "give equals (with tolerance) or limit or lower/upper, not several");
+        }
+        if (!(c.tolerance() > 0.0)) {
+          errors->Add(w, "tolerance",
+                      absl::StrFormat("an equality constraint needs a tolerance > 0 (the band it may lie in), got %g",
+                                      c.tolerance()));
+        }
+        out.lower = c.equals() - c.tolerance();
+        out.upper = c.equals() + c.tolerance();
+      } else if (bounds) {
+        if (limit_given) errors->Add(w, "limit", "give limit or lower/upper, not both");
+        if (c.has_lower()) out.lower = c.lower();
+        if (c.has_upper()) out.upper = c.upper();
+        if (out.lower && out.upper && !(*out.lower <= *out.upper)) {
+          errors->Add(w, "upper", absl::StrFormat("upper (%g) is below lower (%g)", *out.upper, *out.lower));
+        }
+      } else {
+        out.upper = c.limit();
+      }
+    } else {
+      // One row per instant: the limit's side is the reduction's.
+      if (c.has_equals() || c.tolerance() != 0.0) {
+        errors->Add(w, "equals", "equals and tolerance need a reduction with one value per series (FINAL, RMS, "
+                                 "INTEGRAL, RANGE, MEAN)");
+      }
+      const bool upper_side = out.reduction != Reduction::kMin;
+      if (c.has_lower() && upper_side) {
+        errors->Add(w, "lower", "REDUCTION_MAX and REDUCTION_MAX_ABS bound from above: use limit or upper");
+      }
+      if (c.has_upper() && !upper_side) errors->Add(w, "upper", "REDUCTION_MIN bounds from below: use limit or lower");
+      if ((c.has_upper() || c.has_lower()) && limit_given) errors->Add(w, "limit", "give limit or the bound, not both");
+      out.limit = c.has_upper() ? c.upper() : c.has_lower() ? c.lower() : c.limit();
+      if (out.reduction == Reduction::kMaxAbs && !(out.limit > 0.0)) {
+        errors->Add(w, "limit",
+                    absl::StrFormat("REDUCTION_MAX_ABS needs a positive limit, got %g", out.limit));
+      }
     }
     out.unit = c.unit();
     out.si_per_unit =

@@ -81,6 +81,24 @@ TEST(RunStudyLocally, VehicleReachesReportOptimum) {
   std::cout << "\n";
 }
 
+// Ride comfort (examples/vehicle/vehicle_comfort.study.textproto): the RMS
+// seat acceleration over a window, with the report's travel limits and a
+// two-sided limit on the seat's mean deflection over the last second. The
+// reference is NLopt's MMA on the same analyses (bench/compare, docs/comparison.md):
+// F = 1.4860 m/s^2 with max violation 1e-8.
+TEST(RunStudyLocally, RideComfortReachesThePeersOptimum) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_comfort.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<LocalRunResult> result = RunStudyLocally(*study, LocalRunOptions{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  const RunOutcome& run = result->outcome;
+  EXPECT_EQ(run.state, slp::RunState::kConverged) << result->end_reason;
+  EXPECT_NEAR(run.objective, 1.4860, 2e-3 * 1.4860);
+  EXPECT_LT(run.max_violation, 0.005);
+  std::cout << "vehicle comfort: F " << run.objective << " maxg " << run.max_violation << " analyses "
+            << run.analyses << "\n";
+}
+
 TEST(RunStudyLocally, InjectedFailureOfFirstDesignEndsRunFailed) {
   const spec::Study study = LoadVehicle();
   ASSERT_FALSE(study.variables.empty());

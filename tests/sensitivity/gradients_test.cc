@@ -56,8 +56,7 @@ Eigen::VectorXd Stacked(const engine::StudyEvaluation& e) {
   return out;
 }
 
-TEST(SimulatorSensitivities, VehicleGradientsMatchCentralDifferences) {
-  const spec::Study study = TightVehicle();
+void ExpectGradientsMatchCentralDifferences(const spec::Study& study) {
   ASSERT_FALSE(study.variables.empty());
   absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok()) << layout.status();
@@ -98,6 +97,32 @@ TEST(SimulatorSensitivities, VehicleGradientsMatchCentralDifferences) {
     EXPECT_LT(disagreement, kAgreement) << "variable " << study.variables[static_cast<size_t>(i)].name;
   }
   std::cout << "worst relative disagreement simulator vs central differences: " << worst << "\n";
+}
+
+TEST(SimulatorSensitivities, VehicleGradientsMatchCentralDifferences) {
+  ExpectGradientsMatchCentralDifferences(TightVehicle());
+}
+
+// The chain rule through reductions over a window: ride comfort as the RMS
+// seat acceleration from 0.5 s to 4 s, a mean and an integral of
+// deflections, and a final value between two bounds.
+TEST(SimulatorSensitivities, ReductionsOverAWindowMatchCentralDifferences) {
+  spec::Study study = TightVehicle();
+  ASSERT_GE(study.constraints.size(), 3u);
+  study.objective.form = spec::Objective::Form::kMinimize;
+  study.objective.reduction = spec::Reduction::kRms;
+  study.objective.window = {0.5, 4.0};
+  study.constraints[0].reduction = spec::Reduction::kMean;
+  study.constraints[0].window = {1.0, std::nullopt};
+  study.constraints[0].lower = -1.0;
+  study.constraints[0].upper = 1.0;
+  study.constraints[1].reduction = spec::Reduction::kIntegral;
+  study.constraints[1].upper = 10.0;
+  study.constraints[2].reduction = spec::Reduction::kFinal;
+  study.constraints[2].lower = -1.0;
+  study.constraints[2].upper = 1.0;
+  study.constraints.resize(3);
+  ExpectGradientsMatchCentralDifferences(study);
 }
 
 TEST(SimulatorSensitivities, GradientsComeWithTheValuesOfAPlainAnalysis) {

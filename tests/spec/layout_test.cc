@@ -155,6 +155,99 @@ TEST(StudyValues, WrongShapeIsRejected) {
   EXPECT_EQ(values.status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+// Reductions over a window (RefValue) against closed forms on a grid.
+std::vector<double> Grid(int points) {
+  std::vector<double> t(static_cast<size_t>(points));
+  for (int i = 0; i < points; ++i) t[static_cast<size_t>(i)] = static_cast<double>(i) / (points - 1);
+  return t;
+}
+
+ValueRef Over01(Over over, int points, double sign = 1.0) {
+  return ValueRef{0, 0, points - 1, sign, over, 0, points - 1};
+}
+
+TEST(Reductions, RmsMeanRangeAndIntegralMatchClosedForms) {
+  const std::vector<double> t = Grid(1001);
+  std::vector<double> f(t.size()), g(t.size());
+  for (size_t i = 0; i < t.size(); ++i) {
+    f[i] = std::sin(2 * M_PI * t[i]);
+    g[i] = t[i] * t[i];
+  }
+  // sum_i sin^2(2 pi i / 1000) over i = 0..1000 is exactly 500.
+  EXPECT_NEAR(RefValue(Over01(Over::kRms, 1001), f, t), std::sqrt(500.0 / 1001.0), 1e-14);
+  EXPECT_NEAR(RefValue(Over01(Over::kMean, 1001), g, t), (1000.0 * 1001 * 2001 / 6 / 1e6) / 1001, 1e-14);
+  EXPECT_NEAR(RefValue(Over01(Over::kRange, 1001), f, t), 2.0, 1e-14);  // t = 0.25 and 0.75 are instants
+  // The trapezoidal rule integrates t^2 with error h^2 / 6 on [0, 1].
+  EXPECT_NEAR(RefValue(Over01(Over::kIntegral, 1001), g, t), 1.0 / 3.0 + 1e-6 / 6.0, 1e-14);
+  EXPECT_NEAR(RefValue(Over01(Over::kIntegral, 1001, -1.0), g, t), -(1.0 / 3.0 + 1e-6 / 6.0), 1e-14);
+  // A window: the mean of t^2 over the instants 0.5 .. 1.0.
+  const ValueRef half{0, 0, 1000, 1.0, Over::kMean, 500, 1000};
+  double sum = 0;
+  for (int i = 500; i <= 1000; ++i) sum += g[static_cast<size_t>(i)];
+  EXPECT_NEAR(RefValue(half, g, t), sum / 501, 1e-14);
+}
+
+TEST(Reductions, WeightsAreTheDerivativesOfTheValue) {
+  const std::vector<double> t = Grid(21);
+  std::vector<double> f(t.size());
+  for (size_t i = 0; i < t.size(); ++i) f[i] = std::cos(3 * t[i]) + 0.3 * t[i];
+  for (Over over : {Over::kRms, Over::kMean, Over::kIntegral, Over::kRange, Over::kInstant}) {
+    const ValueRef ref{0, 0, 20, -1.0, over, 3, 17};
+    std::vector<double> weights;
+    RefValue(ref, f, t, &weights);
+    const size_t first = over == Over::kInstant ? 20 : 3;
+    for (size_t k = 0; k < weights.size(); ++k) {
+      std::vector<double> up = f, down = f;
+      const double h = 1e-6;
+      up[first + k] += h;
+      down[first + k] -= h;
+      const double fd = (RefValue(ref, up, t) - RefValue(ref, down, t)) / (2 * h);
+      EXPECT_NEAR(weights[k], fd, 1e-8) << static_cast<int>(over) << " k " << k;
+    }
+  }
+}
+
+TEST(StudyLayout, WindowKeepsOnlyItsInstantsAndWholeSeriesReductionsGiveOneRowPerSide) {
+  Study study = SmallStudy();
+  study.scene.time_grid = {0.0, 1.0, 11};
+  study.objective.window.from_s = 0.3;
+  study.constraints[0].window = {0.45, 0.75};
+  Constraint rms = study.constraints[0];
+  rms.name = "rms";
+  rms.reduction = Reduction::kRms;
+  rms.window = {};
+  rms.lower = 1.0;
+  rms.upper = 3.0;
+  study.constraints.push_back(rms);
+  auto layout = MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  EXPECT_EQ(layout->num_objective_terms(), 2 * 8);  // t = 0.3 .. 1.0
+  EXPECT_EQ(layout->objective_terms.front().instant, 3);
+  ASSERT_EQ(layout->num_constraints(), 2 * 3 + 2);  // t = 0.5, 0.6, 0.7; then rms upper and lower
+  EXPECT_NEAR(layout->rows[0].time_s, 0.5, 1e-12);
+  EXPECT_EQ(layout->rows[6].name, "rms upper");
+  EXPECT_EQ(layout->rows[6].value.over, Over::kRms);
+  EXPECT_EQ(layout->rows[6].value.first, 0);
+  EXPECT_EQ(layout->rows[6].value.last, 10);
+  EXPECT_NEAR(layout->rows[6].limit_si, 3e-3, 1e-15);
+  EXPECT_EQ(layout->rows[7].name, "rms lower");
+  EXPECT_EQ(layout->rows[7].value.sign, -1.0);
+  EXPECT_NEAR(layout->rows[7].limit_si, -1e-3, 1e-15);
+
+  // Values: the RMS of s over the grid, against its bounds.
+  std::vector<std::vector<double>> a = {std::vector<double>(11, 0.0)};
+  std::vector<std::vector<double>> s = {std::vector<double>(11, 2e-3)};
+  auto values = ComputeStudyValues(study, *layout, {&a, &s});
+  ASSERT_TRUE(values.ok()) << values.status();
+  EXPECT_NEAR(values->constraint_values[6], 2e-3, 1e-15);
+  EXPECT_NEAR(values->constraint_values[7], -2e-3, 1e-15);
+
+  study.constraints[0].window = {2.0, 3.0};
+  auto empty = MakeStudyLayout(study);
+  ASSERT_FALSE(empty.ok());
+  EXPECT_THAT(empty.status().message(), ::testing::HasSubstr("constraints[0].window: holds no instant"));
+}
+
 TEST(OutputShape, BendingStressHasOneSeriesPerUnpinnedNode) {
   Scene scene;
   LinkageModel linkage;
