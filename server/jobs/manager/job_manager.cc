@@ -25,8 +25,11 @@ struct JobManager::Entry {
 
   bool study_ok = false;
   spec::Study study;
-  spec::StudyLayout layout;
-  std::unique_ptr<jobs::Job> job;  // the optimizer of the current run
+  spec::StudyLayout layout;  // empty once the job stopped (views recompute it)
+  bool layout_released = false;
+  std::unique_ptr<jobs::Job> job;  // the optimizer of the current run; none once it stopped
+  // Failed analyses by kind, kept when the optimizer is released.
+  std::map<std::string, std::int64_t> failed_analyses_by_kind;
 
   std::vector<slp::CycleRecord> records;
   std::int64_t version = 0;
@@ -86,6 +89,24 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
     if (entry.timing) entry.wall_before_s = WallSecondsLocked(entry);
     entry.timing = false;
     scheduler_->DropJob(id);
+    if (!Running(to) && entry.job != nullptr) {
+      // A stopped job keeps what its summary and views need (records,
+      // counts, failures); the optimizer's state (linearization, LP,
+      // buffered results) is released, so a server's memory does not grow
+      // with every finished job. A resume rebuilds it from the log.
+      const slp::SlpOptimizer& optimizer = entry.job->optimizer();
+      entry.row.cycles = optimizer.cycles_completed();
+      entry.row.analyses = optimizer.analyses_used();
+      entry.failed_analyses_by_kind.clear();
+      for (const auto& [kind, count] : entry.job->failures_by_kind()) {
+        entry.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
+      }
+      entry.job.reset();
+    }
+    if (!Running(to) && entry.study_ok && !entry.layout_released) {
+      entry.layout = spec::StudyLayout{};  // its rows' names are most of a job's memory
+      entry.layout_released = true;
+    }
   }
   entry.state = to;
   entry.message = std::move(message);
@@ -124,8 +145,12 @@ absl::Status JobManager::Start() {
       absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
       if (layout.ok()) {
         entry->study = *std::move(study);
-        entry->layout = *std::move(layout);
         entry->study_ok = true;
+        if (Running(entry->state)) {
+          entry->layout = *std::move(layout);
+        } else {
+          entry->layout_released = true;  // a stopped job's views recompute it
+        }
       } else {
         entry->message = std::string(layout.status().message());
       }
@@ -229,6 +254,8 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", unlogged.status().message()));
     return unlogged.status();
   }
+  entry.layout = (*job)->layout();
+  entry.layout_released = false;
   entry.job = *std::move(job);
   entry.records = std::move(decoded);
   absl::Status status = EnterStateLocked(
@@ -440,6 +467,7 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
       design[static_cast<Eigen::Index>(i)] = v.initial;
     }
   }
+  s.failed_analyses_by_kind = entry.failed_analyses_by_kind;
   if (entry.job != nullptr) {
     const slp::SlpOptimizer& optimizer = entry.job->optimizer();
     s.cycles = optimizer.cycles_completed();
@@ -477,7 +505,13 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
   view.version = entry.version;
   view.ended = !Running(entry.state);
   if (entry.study_ok) {
-    for (const spec::ConstraintRow& row : entry.layout.rows) view.row_names.push_back(row.name);
+    std::optional<spec::StudyLayout> recomputed;
+    if (entry.layout_released) {
+      absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(entry.study);
+      if (layout.ok()) recomputed = *std::move(layout);
+    }
+    const spec::StudyLayout& layout = recomputed.has_value() ? *recomputed : entry.layout;
+    for (const spec::ConstraintRow& row : layout.rows) view.row_names.push_back(row.name);
     for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
   }
   view.study_bytes = entry.row.study;
