@@ -96,7 +96,9 @@ int ValidateCommand(const Args& args) {
   for (const spec::DesignVariable& v : study->variables) {
     const spec::Parameter& p = scene.parameters[static_cast<size_t>(v.parameter)];
     const std::string unit = p.unit.empty() ? "" : " " + p.unit;
-    std::printf("  %-12s sets %-20s initial %-12g in [%g, %g]%s\n", v.name.c_str(), p.name.c_str(),
+    std::string sets = p.name;
+    for (int also : v.also_sets) sets += "," + scene.parameters[static_cast<size_t>(also)].name;
+    std::printf("  %-12s sets %-20s initial %-12g in [%g, %g]%s\n", v.name.c_str(), sets.c_str(),
                 v.scale * v.initial, v.scale * v.lower, v.scale * v.upper, unit.c_str());
   }
   std::printf("objective:   %s\n", ObjectiveText(*study, *layout).c_str());

@@ -10,7 +10,9 @@ std::vector<double> Study::ParameterValuesAt(const std::vector<double>& x_scaled
   for (size_t k = 0; k < variables.size(); ++k) {
     const DesignVariable& v = variables[k];
     const Parameter& p = scene.parameters[static_cast<size_t>(v.parameter)];
-    values[static_cast<size_t>(v.parameter)] = v.scale * x_scaled[k] * p.si_per_unit;
+    const double si = v.scale * x_scaled[k] * p.si_per_unit;
+    values[static_cast<size_t>(v.parameter)] = si;
+    for (int also : v.also_sets) values[static_cast<size_t>(also)] = si;
   }
   return values;
 }

@@ -13,6 +13,7 @@ namespace mbopt::spec {
 struct DesignVariable {
   std::string name;
   int parameter = -1;     // index into scene.parameters
+  std::vector<int> also_sets;  // further parameters given the same SI value
   double scale = 1.0;     // parameter value (in the parameter's unit) = scale * x
   double initial = 0.0;   // scaled
   double lower = 0.0;     // scaled

@@ -153,6 +153,17 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
           w, "parameter",
           absl::StrCat("parameter \"", v.parameter(), "\" is already bound to another variable"));
     }
+    for (int a = 0; a < v.also_sets_size(); ++a) {
+      const int also = scene.FindParameter(v.also_sets(a));
+      if (also < 0) {
+        errors->Add(w, "also_sets", a, absl::StrCat("unknown scene parameter \"", v.also_sets(a), "\""));
+      } else if (!bound.insert(also).second) {
+        errors->Add(w, "also_sets", a,
+                    absl::StrCat("parameter \"", v.also_sets(a), "\" is already set by a variable"));
+      } else {
+        out.also_sets.push_back(also);
+      }
+    }
     out.scale = v.scale() == 0.0 ? 1.0 : v.scale();
     if (!(out.scale > 0.0) || !std::isfinite(out.scale)) {
       errors->Add(w, "scale", absl::StrFormat("must be positive, got %g", v.scale()));
@@ -396,6 +407,16 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
     s.central_differences = p.finite_difference() == v1::FINITE_DIFFERENCE_CENTRAL;
     s.simulator_sensitivities = p.sensitivity() == v1::SENSITIVITY_METHOD_SIMULATOR;
+    if (s.simulator_sensitivities) {
+      for (const DesignVariable& v : study.variables) {
+        if (!v.also_sets.empty()) {
+          errors->Add(w, "sensitivity",
+                      absl::StrCat("SENSITIVITY_METHOD_SIMULATOR is not available yet for a variable that sets several "
+                                   "parameters (\"", v.name, "\" has also_sets); use finite differences"));
+          break;
+        }
+      }
+    }
     if (s.simulator_sensitivities && std::holds_alternative<LinkageModel>(scene.model)) {
       errors->Add(w, "sensitivity",
                   "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: linkage scenes have no "

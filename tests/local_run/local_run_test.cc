@@ -99,6 +99,40 @@ TEST(RunStudyLocally, RideComfortReachesThePeersOptimum) {
             << run.analyses << "\n";
 }
 
+// One variable for both tyre stiffnesses (k2 = k3, `also_sets`): the tied
+// study converges, its optimum is a design of the untied study with x3 = x2
+// whose analysis there gives the same F bit for bit, and it is no worse than
+// the untied run's own (local) optimum.
+TEST(RunStudyLocally, TiedTyreStiffnessesAreOneVariableOfTheUntiedStudy) {
+  spec::Study untied = LoadVehicle();
+  ASSERT_EQ(untied.variables.size(), 6u);
+  absl::StatusOr<LocalRunResult> reference = RunStudyLocally(untied, LocalRunOptions{});
+  ASSERT_TRUE(reference.ok()) << reference.status();
+
+  spec::Study tied = untied;
+  const int k3 = tied.scene.FindParameter("k3");
+  ASSERT_GE(k3, 0);
+  ASSERT_EQ(tied.variables[2].parameter, k3);
+  ASSERT_EQ(tied.variables[1].scale, tied.variables[2].scale);
+  tied.variables[1].also_sets = {k3};
+  tied.variables.erase(tied.variables.begin() + 2);
+  absl::StatusOr<LocalRunResult> result = RunStudyLocally(tied, LocalRunOptions{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  const RunOutcome& run = result->outcome;
+  EXPECT_EQ(run.state, slp::RunState::kConverged) << result->end_reason;
+  EXPECT_LE(run.objective, reference->outcome.objective * (1 + 1e-3));
+
+  Eigen::VectorXd x_untied(6);
+  x_untied << run.design[0], run.design[1], run.design[1], run.design[2], run.design[3], run.design[4];
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(untied);
+  ASSERT_TRUE(layout.ok());
+  absl::StatusOr<engine::StudyEvaluation> same = EvaluateDesign(untied, *layout, x_untied);
+  ASSERT_TRUE(same.ok() && same->ok());
+  EXPECT_EQ(same->values->objective, run.objective);
+  std::cout << "tied: F " << run.objective << " in " << run.analyses << " analyses; untied "
+            << reference->outcome.objective << " in " << reference->outcome.analyses << "\n";
+}
+
 TEST(RunStudyLocally, InjectedFailureOfFirstDesignEndsRunFailed) {
   const spec::Study study = LoadVehicle();
   ASSERT_FALSE(study.variables.empty());

@@ -427,6 +427,25 @@ TEST_F(StudyFiles, StudyTooLargeForMemoryIsRefusedWithItsEstimate) {
   EXPECT_THAT(error, HasSubstr("more than the limit of 2 GB"));
 }
 
+TEST_F(StudyFiles, VariableThatSetsSeveralParametersGivesThemTheSameSiValue) {
+  const std::string scene = Replace(kScene, "parameters { name: \"mass\" value: 2 unit: \"kg\" }",
+                                    "parameters { name: \"mass\" value: 2 unit: \"kg\" }\n"
+                                    "parameters { name: \"k_rear\" value: 1 unit: \"lbf/in\" }");
+  Write("oscillator.scene.textproto", scene);
+  const std::string study = Replace(kStudy, "parameter: \"k\"", "parameter: \"k\" also_sets: \"k_rear\"");
+  auto loaded = LoadStudyFile(Write("oscillator.study.textproto", study));
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  const std::vector<double> p = loaded->ParameterValuesAt({12.0});
+  EXPECT_DOUBLE_EQ(p[0], 120.0);  // N/m
+  EXPECT_DOUBLE_EQ(p[2], 120.0);  // the same stiffness, whatever unit the scene wrote it in
+  EXPECT_THAT(LoadError(scene, Replace(kStudy, "parameter: \"k\"", "parameter: \"k\" also_sets: \"nope\"")),
+              HasSubstr("variables[0].also_sets[0]: unknown scene parameter \"nope\""));
+  EXPECT_THAT(LoadError(scene, Replace(kStudy, "parameter: \"k\"", "parameter: \"k\" also_sets: \"k\"")),
+              HasSubstr("already set by a variable"));
+  EXPECT_THAT(LoadError(scene, study + "optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }\n"),
+              HasSubstr("optimizer.sensitivity: SENSITIVITY_METHOD_SIMULATOR is not available yet"));
+}
+
 TEST_F(StudyFiles, MissingFileIsNotFound) {
   auto loaded = LoadSceneFile((dir_ / "absent.scene.textproto").string());
   EXPECT_EQ(loaded.status().code(), absl::StatusCode::kNotFound);
