@@ -224,26 +224,35 @@ HeartbeatReply Scheduler::Heartbeat(const std::string& worker_id, const std::vec
   return reply;
 }
 
+std::vector<FinishedTask> Scheduler::FailLeasesLocked(const std::function<bool(const Entry&)>& lost,
+                                                     const std::function<std::string(const Entry&)>& reason,
+                                                     bool* requeued) {
+  std::vector<Key> keys;
+  for (const auto& [task_id, key] : leases_) {
+    if (lost(entries_.at(key))) keys.push_back(key);
+  }
+  std::vector<FinishedTask> given_up;
+  for (const Key& key : keys) {
+    std::optional<FinishedTask> done = FailLocked(key, reason(entries_.at(key)));
+    if (done) {
+      given_up.push_back(std::move(*done));
+    } else {
+      *requeued = true;
+    }
+  }
+  return given_up;
+}
+
 std::vector<FinishedTask> Scheduler::ExpireLeases() {
   std::vector<FinishedTask> given_up;
   bool requeued = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const std::int64_t now = clock_->NowMs();
-    std::vector<Key> expired;
-    for (const auto& [task_id, key] : leases_) {
-      if (entries_.at(key).lease_deadline_ms <= now) expired.push_back(key);
-    }
-    for (const Key& key : expired) {
-      const Entry& entry = entries_.at(key);
-      std::optional<FinishedTask> done =
-          FailLocked(key, absl::StrCat("lease of task ", entry.task_id, " on worker ", entry.worker_id, " expired"));
-      if (done) {
-        given_up.push_back(std::move(*done));
-      } else {
-        requeued = true;
-      }
-    }
+    given_up = FailLeasesLocked(
+        [now](const Entry& e) { return e.lease_deadline_ms <= now; },
+        [](const Entry& e) { return absl::StrCat("lease of task ", e.task_id, " on worker ", e.worker_id, " expired"); },
+        &requeued);
   }
   if (requeued) task_available_.notify_all();
   return given_up;
@@ -258,20 +267,12 @@ std::vector<FinishedTask> Scheduler::WorkerLost(const std::string& worker_id) {
     if (worker == workers_.end()) return given_up;
     const std::string name = worker->second.name;
     workers_.erase(worker);
-    std::vector<Key> held;
-    for (const auto& [task_id, key] : leases_) {
-      if (entries_.at(key).worker_id == worker_id) held.push_back(key);
-    }
-    for (const Key& key : held) {
-      const Entry& entry = entries_.at(key);
-      std::optional<FinishedTask> done = FailLocked(
-          key, absl::StrCat("worker ", worker_id, " (", name, ") disconnected with task ", entry.task_id));
-      if (done) {
-        given_up.push_back(std::move(*done));
-      } else {
-        requeued = true;
-      }
-    }
+    given_up = FailLeasesLocked(
+        [&worker_id](const Entry& e) { return e.worker_id == worker_id; },
+        [&](const Entry& e) {
+          return absl::StrCat("worker ", worker_id, " (", name, ") disconnected with task ", e.task_id);
+        },
+        &requeued);
   }
   if (requeued) task_available_.notify_all();
   return given_up;
