@@ -59,6 +59,15 @@ std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& lay
     case spec::Objective::Form::kMinimize:
       return absl::StrFormat("minimize the %s of %s%s", ReductionName(o.reduction), OutputName(study, o.output),
                              WindowText(o.window));
+    case spec::Objective::Form::kWeightedSum: {
+      std::string text = "minimize the weighted sum:";
+      for (const spec::WeightedTerm& t : o.sum_terms) {
+        text += absl::StrFormat(" %+g x %s of %s%s%s%s", t.weight, ReductionName(t.reduction),
+                                OutputName(study, t.output), WindowText(t.window), t.unit.empty() ? "" : " in ",
+                                t.unit);
+      }
+      return text;
+    }
     case spec::Objective::Form::kTargetDistance: {
       std::string text = "distance to targets:";
       for (const spec::TargetTerm& t : o.terms) {

@@ -320,6 +320,31 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       layout.objective_terms.push_back(ref);
       break;
     }
+    case Objective::Form::kWeightedSum: {
+      if (objective.sum_terms.empty()) {
+        return LayoutError(study, "objective.minimize_sum.terms", "needs at least one term");
+      }
+      for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
+        const WeightedTerm& term = objective.sum_terms[k];
+        const std::string field = absl::StrCat("objective.minimize_sum.terms[", k, "]");
+        if (!valid_output(term.output)) return LayoutError(study, field, "names no scene output");
+        if (layout.outputs[static_cast<size_t>(term.output)].series != 1) {
+          return LayoutError(study, field, "a term needs a single-series output");
+        }
+        const bool reduced = term.reduction != Reduction::kFinal;
+        MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, term.window, layout.instants_s,
+                                                                 IsScalarOutput(scene, term.output), reduced));
+        ValueRef ref = At(term.output, 0, window.second, 1.0);
+        if (reduced) {
+          ref.over = OverOf(term.reduction);
+          ref.first = window.first;
+          ref.last = window.second;
+        }
+        layout.sum_refs.push_back(ref);
+      }
+      layout.objective_form = ObjectiveForm::kScalar;
+      break;
+    }
     case Objective::Form::kTargetDistance: {
       if (objective.terms.empty()) {
         return LayoutError(study, "objective.target_distance.terms", "needs at least one term");
@@ -456,6 +481,14 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
     }
     values.objective = std::sqrt(sum);
     values.objective_terms = {values.objective};
+  } else if (objective.form == Objective::Form::kWeightedSum) {
+    double sum = 0.0;
+    for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
+      const WeightedTerm& term = objective.sum_terms[k];
+      sum += term.weight * value(layout.sum_refs[k]) / term.si_per_unit;
+    }
+    values.objective = sum;
+    values.objective_terms = {sum};
   } else {
     values.objective_terms.reserve(layout.objective_terms.size());
     for (const ValueRef& ref : layout.objective_terms) {

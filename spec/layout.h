@@ -91,6 +91,8 @@ struct StudyLayout {
   // kMinMax: one per term. kScalar with minimize: the one value. kScalar
   // with target_distance: empty (the term combines several outputs).
   std::vector<ValueRef> objective_terms;
+  // kScalar with minimize_sum: one per term of study.objective.sum_terms.
+  std::vector<ValueRef> sum_refs;
   std::vector<ConstraintRow> rows;
   std::vector<OutputShape> outputs;  // one per scene output
   std::vector<double> instants_s;    // the grid

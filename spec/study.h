@@ -44,8 +44,19 @@ struct TargetTerm {
   std::string unit;
 };
 
+// A term of a weighted-sum objective: weight * (reduced output / unit).
+struct WeightedTerm {
+  int output = -1;
+  Reduction reduction = Reduction::kFinal;
+  TimeWindow window;
+  double weight = 1.0;
+  std::string unit;
+  double si_per_unit = 1.0;
+};
+
 struct Objective {
-  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance } form = Form::kMinimize;
+  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance, kWeightedSum } form = Form::kMinimize;
+  std::vector<WeightedTerm> sum_terms;  // kWeightedSum
   int output = -1;                 // kMinimizeMaxOf, kMinimize
   Reduction reduction = Reduction::kMax;
   std::vector<TargetTerm> terms;   // kTargetDistance

@@ -96,6 +96,17 @@ absl::StatusOr<StudyGradients> ComputeStudyGradients(
       row[i] *= factor[i];
     }
     out.objective_terms.push_back(std::move(row));
+  } else if (objective.form == Objective::Form::kWeightedSum) {
+    std::vector<double> row(n, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
+        const WeightedTerm& term = objective.sum_terms[k];
+        row[i] += term.weight * Derivative(outputs_si, derivatives_si[i], layout.instants_s, layout.sum_refs[k]) /
+                  term.si_per_unit;
+      }
+      row[i] *= factor[i];
+    }
+    out.objective_terms.push_back(std::move(row));
   } else {
     for (const ValueRef& ref : layout.objective_terms) {
       std::vector<double> row(n);

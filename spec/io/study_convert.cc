@@ -257,9 +257,41 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
       }
       break;
     }
+    case v1::Objective::kMinimizeSum: {
+      obj.form = Objective::Form::kWeightedSum;
+      const Where sw = ow.Child("minimize_sum");
+      if (o.minimize_sum().terms_size() == 0) errors->Add(sw, "terms", "minimize_sum needs at least one term");
+      if (!o.unit().empty()) {
+        errors->Add(ow, "unit", "a weighted sum has no unit of its own: each term's `unit` says how it is taken");
+      }
+      for (int k = 0; k < o.minimize_sum().terms_size(); ++k) {
+        const v1::WeightedTerm& t = o.minimize_sum().terms(k);
+        const Where kw = sw.Child("terms", k);
+        WeightedTerm term;
+        term.output = FindOutput(scene, kw, "output", t.output(), errors);
+        const std::optional<Reduction> r =
+            t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
+        if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
+          errors->Add(kw, "reduction",
+                      "a term takes one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
+                      "REDUCTION_RANGE or REDUCTION_MEAN");
+        }
+        term.reduction = r.value_or(Reduction::kFinal);
+        if (t.has_window()) term.window = ConvertWindow(kw.Child("window"), t.window(), errors);
+        term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
+        if (!std::isfinite(term.weight)) errors->Add(kw, "weight", "must be a finite number");
+        term.unit = t.unit();
+        term.si_per_unit = UnitFactor(
+            kw, "unit", t.unit(),
+            term.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(term.output)]) : Dimension::kAny,
+            errors);
+        obj.sum_terms.push_back(std::move(term));
+      }
+      break;
+    }
     case v1::Objective::FORM_NOT_SET:
       errors->Add(where, "objective",
-                  "missing: expected `minimize_max_of`, `minimize` or "
+                  "missing: expected `minimize_max_of`, `minimize`, `minimize_sum` or "
                   "`target_distance`");
       break;
   }
@@ -269,7 +301,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     }
     obj.window = ConvertWindow(ow.Child("window"), o.window(), errors);
   }
-  if (obj.form != Objective::Form::kTargetDistance) {
+  if (obj.form != Objective::Form::kTargetDistance && obj.form != Objective::Form::kWeightedSum) {
     obj.si_per_unit =
         UnitFactor(ow, "unit", o.unit(),
                    obj.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(obj.output)])

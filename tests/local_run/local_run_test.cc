@@ -133,6 +133,33 @@ TEST(RunStudyLocally, TiedTyreStiffnessesAreOneVariableOfTheUntiedStudy) {
             << reference->outcome.objective << " in " << reference->outcome.analyses << "\n";
 }
 
+// A weighted sum of one term is that term times its weight: the ride-comfort
+// study with minimize_sum { 2 x RMS } reaches the same design as with
+// minimize RMS, at twice the objective.
+TEST(RunStudyLocally, WeightedSumOfOneTermIsThatTermWeighted) {
+  absl::StatusOr<spec::Study> comfort = spec::io::LoadStudyFile("examples/vehicle/vehicle_comfort.study.textproto");
+  ASSERT_TRUE(comfort.ok()) << comfort.status();
+  spec::Study summed = *comfort;
+  spec::WeightedTerm term;
+  term.output = comfort->objective.output;
+  term.reduction = comfort->objective.reduction;
+  term.window = comfort->objective.window;
+  term.weight = 2.0;
+  term.unit = comfort->objective.unit;
+  term.si_per_unit = comfort->objective.si_per_unit;
+  summed.objective.form = spec::Objective::Form::kWeightedSum;
+  summed.objective.sum_terms = {term};
+  absl::StatusOr<LocalRunResult> plain = RunStudyLocally(*comfort, LocalRunOptions{});
+  absl::StatusOr<LocalRunResult> sum = RunStudyLocally(summed, LocalRunOptions{});
+  ASSERT_TRUE(plain.ok() && sum.ok());
+  EXPECT_EQ(sum->outcome.state, slp::RunState::kConverged) << sum->end_reason;
+  EXPECT_NEAR(sum->outcome.objective, 2 * plain->outcome.objective, 1e-3 * plain->outcome.objective);
+  for (Eigen::Index i = 0; i < plain->outcome.design.size(); ++i) {
+    EXPECT_NEAR(sum->outcome.design[i], plain->outcome.design[i], 1e-2 * (1 + std::abs(plain->outcome.design[i])))
+        << "variable " << i;
+  }
+}
+
 TEST(RunStudyLocally, InjectedFailureOfFirstDesignEndsRunFailed) {
   const spec::Study study = LoadVehicle();
   ASSERT_FALSE(study.variables.empty());

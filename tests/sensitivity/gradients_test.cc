@@ -125,6 +125,28 @@ TEST(SimulatorSensitivities, ReductionsOverAWindowMatchCentralDifferences) {
   ExpectGradientsMatchCentralDifferences(study);
 }
 
+// The chain rule through a weighted sum of reduced outputs, one weight
+// negative (a maximized term).
+TEST(SimulatorSensitivities, WeightedSumMatchesCentralDifferences) {
+  spec::Study study = TightVehicle();
+  const int seat = study.scene.FindOutput("seat_acceleration");
+  const int s1 = study.scene.FindOutput("s1");
+  ASSERT_GE(seat, 0);
+  ASSERT_GE(s1, 0);
+  study.objective.form = spec::Objective::Form::kWeightedSum;
+  spec::WeightedTerm rms;
+  rms.output = seat;
+  rms.reduction = spec::Reduction::kRms;
+  rms.window = {0.5, std::nullopt};
+  spec::WeightedTerm travel;
+  travel.output = s1;
+  travel.reduction = spec::Reduction::kRange;
+  travel.weight = -0.5;
+  travel.si_per_unit = 0.0254;  // in
+  study.objective.sum_terms = {rms, travel};
+  ExpectGradientsMatchCentralDifferences(study);
+}
+
 TEST(SimulatorSensitivities, GradientsComeWithTheValuesOfAPlainAnalysis) {
   // The values of the sensitivity analysis are the plain analysis' values
   // up to the integration tolerance.

@@ -446,6 +446,32 @@ TEST_F(StudyFiles, VariableThatSetsSeveralParametersGivesThemTheSameSiValue) {
               HasSubstr("optimizer.sensitivity: SENSITIVITY_METHOD_SIMULATOR is not available yet"));
 }
 
+TEST_F(StudyFiles, WeightedSumTermsCarryTheirOwnUnitsAndReductions) {
+  const std::string objective = "objective { minimize_max_of: \"acc\" reduction: REDUCTION_MAX_ABS unit: \"m/s^2\" }";
+  const std::string sum =
+      "objective { minimize_sum { terms { output: \"acc\" reduction: REDUCTION_RMS window { from_s: 0.2 } "
+      "unit: \"m/s^2\" } terms { output: \"x\" reduction: REDUCTION_RANGE weight: -2 unit: \"mm\" } } }";
+  Write("oscillator.scene.textproto", kScene);
+  auto loaded = LoadStudyFile(Write("oscillator.study.textproto", Replace(kStudy, objective, sum)));
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  ASSERT_EQ(loaded->objective.sum_terms.size(), 2u);
+  EXPECT_EQ(loaded->objective.sum_terms[0].reduction, Reduction::kRms);
+  EXPECT_EQ(loaded->objective.sum_terms[1].weight, -2.0);
+  EXPECT_DOUBLE_EQ(loaded->objective.sum_terms[1].si_per_unit, 1e-3);
+  auto layout = MakeStudyLayout(*loaded);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  EXPECT_EQ(layout->num_objective_terms(), 1);
+  ASSERT_EQ(layout->sum_refs.size(), 2u);
+  EXPECT_EQ(layout->sum_refs[0].first, 2);  // t = 0.2 s on the 11-point grid
+  EXPECT_THAT(LoadError(kScene, Replace(kStudy, objective,
+                                        "objective { minimize_sum { terms { output: \"acc\" "
+                                        "reduction: REDUCTION_MAX } } }")),
+              HasSubstr("objective.minimize_sum.terms[0].reduction: a term takes one value"));
+  EXPECT_THAT(LoadError(kScene, Replace(kStudy, objective,
+                                        "objective { minimize_sum { terms { output: \"acc\" } } unit: \"m/s^2\" }")),
+              HasSubstr("objective.unit: a weighted sum has no unit of its own"));
+}
+
 TEST_F(StudyFiles, MissingFileIsNotFound) {
   auto loaded = LoadSceneFile((dir_ / "absent.scene.textproto").string());
   EXPECT_EQ(loaded.status().code(), absl::StatusCode::kNotFound);

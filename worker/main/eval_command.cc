@@ -203,7 +203,8 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return kExitAnalysisFailed;
   }
   const std::string objective_unit =
-      study.objective.form == spec::Objective::Form::kTargetDistance
+      study.objective.form == spec::Objective::Form::kTargetDistance ||
+              study.objective.form == spec::Objective::Form::kWeightedSum
           ? ""
           : (study.objective.unit.empty() ? "SI" : study.objective.unit);
 
