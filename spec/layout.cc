@@ -61,6 +61,17 @@ Over OverOf(Reduction r) {
   }
 }
 
+// The value of a whole-series reduction (FINAL: the window's last instant).
+ValueRef SeriesRef(int output, int series, Reduction reduction, const std::pair<int, int>& window) {
+  ValueRef ref = At(output, series, window.second, 1.0);
+  if (reduction != Reduction::kFinal) {
+    ref.over = OverOf(reduction);
+    ref.first = window.first;
+    ref.last = window.second;
+  }
+  return ref;
+}
+
 // The grid instants inside `window`, as [first, last]; an error naming
 // `field` when none is, or when the output has no time series.
 absl::StatusOr<std::pair<int, int>> WindowInstants(const Study& study, const std::string& field, const TimeWindow& window,
@@ -311,13 +322,7 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       MBOPT_ASSIGN_OR_RETURN(const auto window,
                              WindowInstants(study, "objective", objective.window, layout.instants_s,
                                             IsScalarOutput(scene, objective.output), reduced));
-      ValueRef ref = At(objective.output, 0, window.second, 1.0);
-      if (reduced) {
-        ref.over = OverOf(objective.reduction);
-        ref.first = window.first;
-        ref.last = window.second;
-      }
-      layout.objective_terms.push_back(ref);
+      layout.objective_terms.push_back(SeriesRef(objective.output, 0, objective.reduction, window));
       break;
     }
     case Objective::Form::kWeightedSum: {
@@ -334,13 +339,7 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
         const bool reduced = term.reduction != Reduction::kFinal;
         MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, term.window, layout.instants_s,
                                                                  IsScalarOutput(scene, term.output), reduced));
-        ValueRef ref = At(term.output, 0, window.second, 1.0);
-        if (reduced) {
-          ref.over = OverOf(term.reduction);
-          ref.first = window.first;
-          ref.last = window.second;
-        }
-        layout.sum_refs.push_back(ref);
+        layout.sum_refs.push_back(SeriesRef(term.output, 0, term.reduction, window));
       }
       layout.objective_form = ObjectiveForm::kScalar;
       break;
@@ -392,12 +391,7 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       // One value per series, bounded from either side.
       const double t = scalar_output ? 0.0 : layout.instants_s[static_cast<size_t>(window.second)];
       for (int s = 0; s < shape.series; ++s) {
-        ValueRef ref = At(constraint.output, s, window.second, 1.0);
-        if (reduced) {
-          ref.over = OverOf(constraint.reduction);
-          ref.first = window.first;
-          ref.last = window.second;
-        }
+        ValueRef ref = SeriesRef(constraint.output, s, constraint.reduction, window);
         auto name = [&](const char* side) {
           if (!reduced) {  // FINAL: named by its instant, like the rows of an instant
             return RowName(constraint.name, shape, s, !scalar_output || shape.instants > 1, t, decimals, side);
