@@ -94,7 +94,14 @@ int RunCommandMain(const Args& args) {
   cluster_options.server_binary = *server_binary;
   cluster_options.worker_binary = *worker_binary;
   std::string db_path = parsed->Value("--db");
-  if (db_path.empty() && !parsed->Has("--discard-db")) db_path = DefaultRunDatabasePath(path);
+  if (db_path.empty() && !parsed->Has("--discard-db")) {
+    db_path = DefaultRunDatabasePath(path);
+    if (db_path.empty()) {
+      std::fprintf(stderr,
+                   "mbopt run: cannot make $XDG_STATE_HOME/mbopt/runs or ~/.local/state/mbopt/runs; the job "
+                   "database is temporary this time (--db PATH keeps it elsewhere)\n");
+    }
+  }
   const bool keep_db = !db_path.empty();
   if (!keep_db) db_path = temp.path() + "/mbopt.db";
   cluster_options.db_path = db_path;

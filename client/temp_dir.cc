@@ -10,6 +10,7 @@ namespace mbopt::client {
 TempDir::TempDir() {
   std::error_code ec;
   const std::filesystem::path base = std::filesystem::temp_directory_path(ec);
+  // mkdtemp's template: it replaces the trailing XXXXXX with a unique name.
   std::string pattern = ((ec ? std::filesystem::path("/tmp") : base) / "mbopt-XXXXXX").string();
   if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
 }

@@ -31,19 +31,29 @@ absl::Status CheckShapes(const Study& study, const StudyLayout& layout,
   return absl::OkStatus();
 }
 
-// d(value of ref) / d(parameter): the reduction's weights at the analysed
-// values times the output's derivatives over the same instants.
-double Derivative(const std::vector<const Series*>& values, const std::vector<const Series*>& derivatives,
-                  const std::vector<double>& instants_s, const ValueRef& ref) {
+// d(value of ref) / d(parameter of variable i) for every variable: the
+// reduction's weights at the analysed values (computed once per ref) times
+// the output's derivatives over the same instants.
+std::vector<double> RefGradient(const std::vector<const Series*>& values,
+                                const std::vector<std::vector<const Series*>>& derivatives,
+                                const std::vector<double>& instants_s, const ValueRef& ref) {
   const size_t o = static_cast<size_t>(ref.output);
   const size_t s = static_cast<size_t>(ref.series);
+  std::vector<double> gradient(derivatives.size(), 0.0);
+  if (ref.over == Over::kInstant) {
+    for (size_t i = 0; i < derivatives.size(); ++i) {
+      gradient[i] = ref.sign * (*derivatives[i][o])[s][static_cast<size_t>(ref.instant)];
+    }
+    return gradient;
+  }
   std::vector<double> weights;
   RefValue(ref, (*values[o])[s], instants_s, &weights);
-  const std::vector<double>& d = (*derivatives[o])[s];
-  const size_t first = static_cast<size_t>(ref.over == Over::kInstant ? ref.instant : ref.first);
-  double sum = 0.0;
-  for (size_t k = 0; k < weights.size(); ++k) sum += weights[k] * d[first + k];
-  return sum;
+  const size_t first = static_cast<size_t>(ref.first);
+  for (size_t i = 0; i < derivatives.size(); ++i) {
+    const std::vector<double>& d = (*derivatives[i][o])[s];
+    for (size_t k = 0; k < weights.size(); ++k) gradient[i] += weights[k] * d[first + k];
+  }
+  return gradient;
 }
 
 }  // namespace
@@ -98,29 +108,22 @@ absl::StatusOr<StudyGradients> ComputeStudyGradients(
     out.objective_terms.push_back(std::move(row));
   } else if (objective.form == Objective::Form::kWeightedSum) {
     std::vector<double> row(n, 0.0);
-    for (size_t i = 0; i < n; ++i) {
-      for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
-        const WeightedTerm& term = objective.sum_terms[k];
-        row[i] += term.weight * Derivative(outputs_si, derivatives_si[i], layout.instants_s, layout.sum_refs[k]) /
-                  term.si_per_unit;
-      }
-      row[i] *= factor[i];
+    for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
+      const WeightedTerm& term = objective.sum_terms[k];
+      const std::vector<double> g = RefGradient(outputs_si, derivatives_si, layout.instants_s, layout.sum_refs[k]);
+      for (size_t i = 0; i < n; ++i) row[i] += term.weight * g[i] / term.si_per_unit * factor[i];
     }
     out.objective_terms.push_back(std::move(row));
   } else {
     for (const ValueRef& ref : layout.objective_terms) {
-      std::vector<double> row(n);
-      for (size_t i = 0; i < n; ++i) {
-        row[i] = Derivative(outputs_si, derivatives_si[i], layout.instants_s, ref) / objective.si_per_unit * factor[i];
-      }
+      std::vector<double> row = RefGradient(outputs_si, derivatives_si, layout.instants_s, ref);
+      for (size_t i = 0; i < n; ++i) row[i] = row[i] / objective.si_per_unit * factor[i];
       out.objective_terms.push_back(std::move(row));
     }
   }
   for (const ConstraintRow& c : layout.rows) {
-    std::vector<double> row(n);
-    for (size_t i = 0; i < n; ++i) {
-      row[i] = Derivative(outputs_si, derivatives_si[i], layout.instants_s, c.value) * factor[i];
-    }
+    std::vector<double> row = RefGradient(outputs_si, derivatives_si, layout.instants_s, c.value);
+    for (size_t i = 0; i < n; ++i) row[i] *= factor[i];
     out.constraint_rows.push_back(std::move(row));
   }
   return out;
