@@ -125,7 +125,7 @@ function(mbopt_declare_modules)
   mbopt_module(service DIRS server/service USES job_manager jobs lp scheduler store spec spec_io proto common
     LIBS mbopt_service
     SUMMARY "boundary: the gRPC services and the server object")
-  mbopt_module(server_main DIRS server/main USES service common
+  mbopt_module(server_main DIRS server/main USES service store jobs common
     LIBS mbopt-server
     SUMMARY "the `mbopt-server` program")
   mbopt_module(worker_service DIRS worker/service USES engine spec spec_io proto common

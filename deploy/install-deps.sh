@@ -17,6 +17,7 @@ packages=(
   libnlopt-cxx-dev
   libsimbody-dev
   chromium zlib1g-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()

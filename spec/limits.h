@@ -19,6 +19,12 @@ inline constexpr int kMaxDesignVariables = 10'000;
 inline constexpr std::int64_t kMaxIntegratorSteps = 100'000'000;  // per analysis
 inline constexpr int kMaxOptimizerCycles = 100'000;
 
+// Wall time of one analysis (integrator.max_wall_seconds): the default when
+// a scene does not say, and the most it may say. Over it, the analysis ends
+// as a `time_limit` failure.
+inline constexpr double kDefaultAnalysisWallSeconds = 600.0;
+inline constexpr double kMaxAnalysisWallSeconds = 7 * 86'400.0;
+
 // The optimizer's memory for one study, estimated from its layout before
 // any row exists (EstimateStudyMemoryBytes in spec/layout.h).
 inline constexpr std::int64_t kMaxStudyMemoryBytes = std::int64_t{2} << 30;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "spec/expression.h"
+#include "spec/limits.h"
 
 namespace mbopt::spec {
 
@@ -251,7 +252,7 @@ struct IntegratorSettings {
   double relative_tolerance = 1e-6;
   double absolute_tolerance = 1e-9;
   long max_steps = 100000;
-  double max_wall_seconds = 0.0;  // 0: no limit
+  double max_wall_seconds = kDefaultAnalysisWallSeconds;  // <= 0: no limit (not from a file)
 };
 
 struct Scene {

@@ -14,6 +14,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "server/main/gc_command.h"
 #include "server/service/server.h"
 
 namespace {
@@ -21,6 +22,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--crash-after-cycles N]\n"
+    "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
+    "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
     "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port)\n"
     "  --db PATH              job database (default mbopt.db; created if missing)\n"
     "  --port-file FILE       write the port listened on to FILE once ready\n"
@@ -109,6 +112,7 @@ bool WritePortFile(const std::string& path, int port) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "gc") return mbopt::server_main::RunGcCommand(argc - 2, argv + 2);
   Flags flags;
   if (!ParseFlags(argc, argv, &flags)) return 2;
   if (flags.server.heartbeat_ms >= flags.server.lease_ms) {

@@ -21,6 +21,17 @@ absl::Status SqliteStatus(sqlite3* db, int code, const std::string& what);
 // Runs SQL without results (may hold several statements).
 absl::Status Exec(sqlite3* db, const std::string& sql);
 
+// Runs `body` inside BEGIN IMMEDIATE .. COMMIT, rolling back on any error.
+template <typename Body>
+absl::Status InTransaction(sqlite3* db, Body body) {
+  absl::Status status = Exec(db, "BEGIN IMMEDIATE");
+  if (!status.ok()) return status;
+  status = body();
+  if (status.ok()) status = Exec(db, "COMMIT");
+  if (!status.ok()) (void)Exec(db, "ROLLBACK");
+  return status;
+}
+
 class Statement {
  public:
   static absl::StatusOr<Statement> Prepare(sqlite3* db, const std::string& sql);

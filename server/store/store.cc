@@ -104,6 +104,15 @@ ALTER TABLE analyses ADD COLUMN failure_kind TEXT NOT NULL DEFAULT 'ok';
 UPDATE analyses SET failure_kind = 'unclassified' WHERE ok = 0;
 UPDATE schema_version SET version = 3;
 )sql",
+    // 3 -> 4: the last job number given, so that an id is never given twice
+    // once pruning (mbopt-server gc) has deleted the newest jobs.
+    R"sql(
+CREATE TABLE job_sequence (
+  last_seq INTEGER NOT NULL
+);
+INSERT INTO job_sequence(last_seq) SELECT coalesce(max(seq), 0) FROM jobs;
+UPDATE schema_version SET version = 4;
+)sql",
 };
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kSchemaVersion - 1,
               "one migration step per schema version after the first");
@@ -211,16 +220,6 @@ constexpr const char* kJobColumns =
     "id, seq, study_name, source_name, study, state, message, created_unix_ms, "
     "updated_unix_ms, records, cycles, analyses, wall_seconds";
 
-// Runs `body` inside BEGIN IMMEDIATE .. COMMIT, rolling back on any error.
-template <typename Body>
-absl::Status InTransaction(sqlite3* db, Body body) {
-  MBOPT_RETURN_IF_ERROR(Exec(db, "BEGIN IMMEDIATE"));
-  absl::Status status = body();
-  if (status.ok()) status = Exec(db, "COMMIT");
-  if (!status.ok()) (void)Exec(db, "ROLLBACK");
-  return status;
-}
-
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path) {
@@ -290,8 +289,11 @@ absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {
   if (stored.created_unix_ms == 0) stored.created_unix_ms = now;
   stored.updated_unix_ms = now;
   MBOPT_RETURN_IF_ERROR(InTransaction(db_, [&]() -> absl::Status {
-    MBOPT_ASSIGN_OR_RETURN(std::int64_t last, QueryInt(db_, "SELECT coalesce(max(seq), 0) FROM jobs"));
+    MBOPT_ASSIGN_OR_RETURN(std::int64_t last,
+                           QueryInt(db_, "SELECT max((SELECT coalesce(max(seq), 0) FROM jobs), "
+                                         "(SELECT coalesce(max(last_seq), 0) FROM job_sequence))"));
     stored.seq = last + 1;
+    MBOPT_RETURN_IF_ERROR(Exec(db_, absl::StrCat("UPDATE job_sequence SET last_seq = ", stored.seq)));
     stored.id = absl::StrCat("job-", stored.seq);
     MBOPT_ASSIGN_OR_RETURN(Statement stmt,
                            Statement::Prepare(db_, absl::StrCat("INSERT INTO jobs(", kJobColumns,

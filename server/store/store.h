@@ -30,7 +30,7 @@ namespace mbopt::store {
 // The schema version this code writes. A database with a newer version is
 // refused; older versions are migrated on open (docs/store.md lists the
 // versions and their migrations).
-inline constexpr int kSchemaVersion = 3;
+inline constexpr int kSchemaVersion = 4;
 // PRAGMA application_id of an mbopt database ("mbop").
 inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 
@@ -69,6 +69,17 @@ class Store {
   absl::Status AddEvent(const std::string& job_id, const std::string& kind,
                         const std::string& message);
   absl::StatusOr<std::vector<EventRow>> LoadEvents(const std::string& job_id);
+
+  // Pruning (store_prune.cc). Deletes a job and everything logged for it in
+  // one transaction; its id is never given to another job. NotFound for an
+  // unknown id.
+  absl::Status DeleteJob(const std::string& job_id);
+  // Copies the jobs, with every row logged for them, into the mbopt
+  // database at `path` (created if missing, migrated if older), in one
+  // transaction. AlreadyExists naming the job when `path` holds its id.
+  absl::Status ExportJobs(const std::vector<std::string>& job_ids, const std::string& path);
+  // Gives the pages of deleted rows back to the file system (VACUUM).
+  absl::Status Compact();
 
  private:
   Store(std::string path, sqlite3* db);

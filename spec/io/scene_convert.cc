@@ -1158,8 +1158,13 @@ class SceneConverter {
       out.max_steps = static_cast<long>(s.max_steps());
     }
     if (s.max_wall_seconds() < 0.0 || !std::isfinite(s.max_wall_seconds())) {
-      errors_.Add(w, "max_wall_seconds", "must not be negative (0: no limit)");
-    } else {
+      errors_.Add(w, "max_wall_seconds",
+                  absl::StrCat("must be positive (0 for the default ", kDefaultAnalysisWallSeconds, " s)"));
+    } else if (s.max_wall_seconds() > kMaxAnalysisWallSeconds) {
+      errors_.Add(w, "max_wall_seconds",
+                  absl::StrCat(s.max_wall_seconds(), " is more than the limit of ", kMaxAnalysisWallSeconds,
+                               " s (7 days)"));
+    } else if (s.max_wall_seconds() > 0.0) {
       out.max_wall_seconds = s.max_wall_seconds();
     }
   }

@@ -16,6 +16,7 @@
 #include "spec/io/locator.h"
 #include "spec/io/scene_convert.h"
 #include "spec/io/study_convert.h"
+#include "spec/io/utf8_check.h"
 #include "spec/limits.h"
 
 namespace mbopt::spec::io {
@@ -70,30 +71,36 @@ absl::StatusOr<std::string> ReadFile(const std::string& path) {
 
 bool IsJson(const std::string& path) { return std::filesystem::path(path).extension() == ".json"; }
 
-// Parses `path` into `message`; `tree` receives field locations (text only).
-absl::Status ParseFile(const std::string& path, google::protobuf::Message* message,
+// Parses `text` (from `name`: JSON when it ends in ".json", else text
+// format) into `message`; `tree` receives field locations (text only).
+absl::Status ParseText(const std::string& text, const std::string& name, google::protobuf::Message* message,
                        TextFormat::ParseInfoTree* tree) {
-  MBOPT_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
-  if (IsJson(path)) {
+  if (IsJson(name)) {
     google::protobuf::util::JsonParseOptions options;
     const auto status = google::protobuf::util::JsonStringToMessage(text, message, options);
     if (!status.ok()) {
-      return absl::InvalidArgumentError(absl::StrCat(path, ": not a valid ",
+      return absl::InvalidArgumentError(absl::StrCat(name, ": not a valid ",
                                                      message->GetDescriptor()->name(),
                                                      " in JSON: ", status.message().as_string()));
     }
     return absl::OkStatus();
   }
-  CollectErrors collector(path);
+  CollectErrors collector(name);
   TextFormat::Parser parser;
   parser.RecordErrorsTo(&collector);
   parser.WriteLocationsTo(tree);
   if (!parser.ParseFromString(text, message) || !collector.messages().empty()) {
     std::string all = absl::StrJoin(collector.messages(), "\n");
-    if (all.empty()) all = absl::StrCat(path, ": could not parse");
+    if (all.empty()) all = absl::StrCat(name, ": could not parse");
     return absl::InvalidArgumentError(all);
   }
   return absl::OkStatus();
+}
+
+absl::Status ParseFile(const std::string& path, google::protobuf::Message* message,
+                       TextFormat::ParseInfoTree* tree) {
+  MBOPT_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
+  return ParseText(text, path, message, tree);
 }
 
 // A study file and its scene, parsed, with locations for both.
@@ -105,8 +112,13 @@ struct ParsedStudy {
   std::string scene_file;  // resolved path, empty if inline
 };
 
-absl::Status ParseStudy(const std::string& path, ParsedStudy* parsed) {
-  MBOPT_RETURN_IF_ERROR(ParseFile(path, &parsed->study, &parsed->study_tree));
+// Takes the scene of a parsed study: from its scene_file (resolved against
+// the study's directory) unless `inline_only`, or inline.
+absl::Status ResolveScene(const std::string& path, bool inline_only, ParsedStudy* parsed) {
+  if (inline_only && parsed->study.scene_source_case() == v1::Study::kSceneFile) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        path, ": scene_file: the study must carry its scene inline here (a scene_file cannot be resolved)"));
+  }
   switch (parsed->study.scene_source_case()) {
     case v1::Study::kSceneFile: {
       std::filesystem::path scene_path(parsed->study.scene_file());
@@ -134,6 +146,11 @@ absl::Status ParseStudy(const std::string& path, ParsedStudy* parsed) {
   return absl::OkStatus();
 }
 
+absl::Status ParseStudy(const std::string& path, ParsedStudy* parsed) {
+  MBOPT_RETURN_IF_ERROR(ParseFile(path, &parsed->study, &parsed->study_tree));
+  return ResolveScene(path, /*inline_only=*/false, parsed);
+}
+
 absl::StatusOr<Study> ConvertParsed(const std::string& path, const ParsedStudy& parsed) {
   Errors errors;
   const Where study_where(path, v1::Study::descriptor(), &parsed.study_tree);
@@ -141,6 +158,9 @@ absl::StatusOr<Study> ConvertParsed(const std::string& path, const ParsedStudy& 
       parsed.scene_file.empty()
           ? study_where.Child("scene")
           : Where(parsed.scene_file, v1::Scene::descriptor(), &parsed.scene_file_tree);
+  CheckUtf8Strings(parsed.study, study_where, &errors);  // an inline scene too
+  if (!parsed.scene_file.empty()) CheckUtf8Strings(parsed.scene, scene_where, &errors);
+  if (!errors.empty()) return errors.ToStatus();
   Scene scene = ConvertScene(parsed.scene, scene_where, &errors);
   if (!errors.empty()) return errors.ToStatus();
   Study study = ConvertStudy(parsed.study, std::move(scene), study_where, &errors);
@@ -151,13 +171,8 @@ absl::StatusOr<Study> ConvertParsed(const std::string& path, const ParsedStudy& 
 }  // namespace
 
 absl::StatusOr<Scene> LoadSceneFile(const std::string& path) {
-  v1::Scene message;
-  TextFormat::ParseInfoTree tree;
-  MBOPT_RETURN_IF_ERROR(ParseFile(path, &message, &tree));
-  Errors errors;
-  Scene scene = ConvertScene(message, Where(path, v1::Scene::descriptor(), &tree), &errors);
-  MBOPT_RETURN_IF_ERROR(errors.ToStatus());
-  return scene;
+  MBOPT_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
+  return ParseSceneText(text, path);
 }
 
 absl::StatusOr<Study> LoadStudyFile(const std::string& path) {
@@ -166,13 +181,41 @@ absl::StatusOr<Study> LoadStudyFile(const std::string& path) {
   return ConvertParsed(path, parsed);
 }
 
-absl::StatusOr<v1::Study> ReadStudyProto(const std::string& path) {
-  ParsedStudy parsed;
-  MBOPT_RETURN_IF_ERROR(ParseStudy(path, &parsed));
+namespace {
+
+absl::StatusOr<v1::Study> Inlined(const std::string& path, const ParsedStudy& parsed) {
   MBOPT_RETURN_IF_ERROR(ConvertParsed(path, parsed).status());
   v1::Study inlined = parsed.study;
   *inlined.mutable_scene() = parsed.scene;  // replaces scene_file (oneof)
   return inlined;
+}
+
+}  // namespace
+
+absl::StatusOr<v1::Study> ReadStudyProto(const std::string& path) {
+  ParsedStudy parsed;
+  MBOPT_RETURN_IF_ERROR(ParseStudy(path, &parsed));
+  return Inlined(path, parsed);
+}
+
+absl::StatusOr<v1::Study> ParseStudyText(const std::string& text, const std::string& source_name) {
+  ParsedStudy parsed;
+  MBOPT_RETURN_IF_ERROR(ParseText(text, source_name, &parsed.study, &parsed.study_tree));
+  MBOPT_RETURN_IF_ERROR(ResolveScene(source_name, /*inline_only=*/true, &parsed));
+  return Inlined(source_name, parsed);
+}
+
+absl::StatusOr<Scene> ParseSceneText(const std::string& text, const std::string& source_name) {
+  v1::Scene message;
+  TextFormat::ParseInfoTree tree;
+  MBOPT_RETURN_IF_ERROR(ParseText(text, source_name, &message, &tree));
+  Errors errors;
+  const Where where(source_name, v1::Scene::descriptor(), &tree);
+  CheckUtf8Strings(message, where, &errors);
+  if (!errors.empty()) return errors.ToStatus();
+  Scene scene = ConvertScene(message, where, &errors);
+  MBOPT_RETURN_IF_ERROR(errors.ToStatus());
+  return scene;
 }
 
 absl::StatusOr<Scene> SceneFromProto(const v1::Scene& message, const std::string& source_name) {

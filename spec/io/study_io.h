@@ -30,6 +30,12 @@ absl::StatusOr<Study> LoadStudyFile(const std::string& path);
 // the scene), validated like LoadStudyFile: what a client sends to a server.
 absl::StatusOr<v1::Study> ReadStudyProto(const std::string& path);
 
+// The same from text already in memory (the format follows `source_name`,
+// as for files), for a study with its scene inline: a scene_file is refused.
+// What the fuzzing targets (tests/fuzz) drive.
+absl::StatusOr<v1::Study> ParseStudyText(const std::string& text, const std::string& source_name);
+absl::StatusOr<Scene> ParseSceneText(const std::string& text, const std::string& source_name);
+
 // Validates a study message that has its scene inlined (a server's input).
 // `source_name` names it in messages (there are no line numbers).
 absl::StatusOr<Study> StudyFromProto(const v1::Study& study, const std::string& source_name);

@@ -21,6 +21,7 @@
 #include "mbopt/v1/service.grpc.pb.h"
 #include "spec/io/study_io.h"
 #include "tests/e2e/e2e_harness.h"
+#include "tests/fuzz/mutate.h"
 
 namespace mbopt::e2e {
 namespace {
@@ -343,6 +344,47 @@ TEST(EndToEnd, RunKeepsItsDatabaseForReportAndResults) {
   EXPECT_EQ(discarded.stdout_text.find("database:"), std::string::npos) << Describe(discarded);
 }
 
+// mbopt-server gc prunes finished jobs, exports them readable by --db, never
+// gives a pruned id again, and refuses a database a server is using.
+TEST(EndToEnd, GcPrunesFinishedJobsAndExportsThemReadably) {
+  ScratchDir dir;
+  const std::string db = dir.File("jobs.db"), archive = dir.File("archive.db");
+  const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()};
+  std::string first_result;
+  {
+    auto server = StartServer(db, {}, "127.0.0.1:0", dir.File("server.log"));
+    ASSERT_TRUE(server.ok()) << server.status();
+    Subprocess worker = StartWorker(server->address);
+    first_result = SubmitWatchAndGetResults(server->address);
+    SubmitWatchAndGetResults(server->address);
+    SubmitWatchAndGetResults(server->address);
+    auto busy = client::RunCommand({ServerBinary(), "gc", "--db", db, "--keep", "0"}, kGuard);
+    ASSERT_TRUE(busy.ok()) << busy.status();
+    EXPECT_EQ(busy->exit_code, 1) << busy->stdout_text << busy->stderr_text;
+    EXPECT_NE(busy->stderr_text.find("in use"), std::string::npos) << busy->stderr_text;
+    worker.Stop(kGuard);
+    EXPECT_EQ(server->process->Stop(kGuard), 0);
+  }
+  auto usage = client::RunCommand({ServerBinary(), "gc", "--db", db}, kGuard);
+  ASSERT_TRUE(usage.ok());
+  EXPECT_EQ(usage->exit_code, 2) << "which jobs must be said";
+  auto gc = client::RunCommand({ServerBinary(), "gc", "--db", db, "--keep", "1", "--export", archive}, kGuard);
+  ASSERT_TRUE(gc.ok()) << gc.status();
+  ASSERT_EQ(gc->exit_code, 0) << gc->stdout_text << gc->stderr_text;
+  EXPECT_NE(gc->stdout_text.find("pruned 2 of 3 jobs (job-1 .. job-2)"), std::string::npos) << gc->stdout_text;
+
+  auto kept = Mbopt({"list", "--db", db}, env);
+  ASSERT_EQ(kept.exit_code, kExitOk) << Describe(kept);
+  EXPECT_EQ(kept.stdout_text.find("job-1 "), std::string::npos) << kept.stdout_text;
+  EXPECT_NE(kept.stdout_text.find("job-3"), std::string::npos) << kept.stdout_text;
+  auto exported = Mbopt({"results", "job-1", "--json", "--db", archive}, env);
+  ASSERT_EQ(exported.exit_code, kExitOk) << Describe(exported);
+  EXPECT_EQ(Comparable(exported.stdout_text), Comparable(first_result)) << "the archive holds the job bit for bit";
+  auto again = client::RunCommand({ServerBinary(), "gc", "--db", db, "--keep", "0", "--dry-run"}, kGuard);
+  ASSERT_TRUE(again.ok());
+  EXPECT_NE(again->stdout_text.find("would prune 1 of 1 jobs"), std::string::npos) << again->stdout_text;
+}
+
 TEST(EndToEnd, ValidatePrintsTheLayoutWithoutAServer) {
   auto out = Mbopt({"validate", VehicleStudy()});
   ASSERT_EQ(out.exit_code, kExitOk) << Describe(out);
@@ -408,6 +450,40 @@ TEST(BadInput, ValidateAndWorkerEvalAgreeOnHostileFiles) {
     EXPECT_NE(evaluated->stderr_text.find(Trim(validated.stderr_text.substr(prefix.size()))), std::string::npos)
         << "validate: " << validated.stderr_text << "eval: " << evaluated->stderr_text;
   }
+}
+
+// The property of tests/fuzz between the programs themselves: a mutated
+// example is refused by `mbopt validate` exactly when `mbopt-worker eval`
+// refuses it as bad input, with the same message. An accepted mutant may
+// take long to analyse (its values pushed to extremes): eval still running
+// after a few seconds has accepted it.
+TEST(BadInput, MutatedExamplesAgreeBetweenValidateAndWorkerEval) {
+  ScratchDir dir;
+  v1::Study study;
+  const std::string text = InlinedVehicleStudy(&study);
+  ASSERT_FALSE(text.empty());
+  int refused = 0, accepted = 0, index = 0;
+  for (const std::string& mutant : fuzz::MutateStudyText(text, 30, 2026)) {
+    const std::string path = dir.Write(absl::StrCat("m", index++, ".study.textproto"), mutant);
+    auto validated = Mbopt({"validate", path});
+    ASSERT_TRUE(validated.exit_code == kExitOk || validated.exit_code == kExitBadInput) << Describe(validated);
+    auto evaluated = client::RunCommand({WorkerBinary(), "eval", path}, std::chrono::seconds(3));
+    if (validated.exit_code == kExitBadInput) {
+      ++refused;
+      ASSERT_TRUE(evaluated.ok()) << path << ": eval went on with a file validate refused\n" << validated.stderr_text;
+      EXPECT_EQ(evaluated->exit_code, kExitBadInput) << path;
+      const std::string message = Trim(validated.stderr_text.substr(std::string("mbopt: ").size()));
+      EXPECT_NE(evaluated->stderr_text.find(message), std::string::npos)
+          << "validate: " << validated.stderr_text << "eval: " << evaluated->stderr_text;
+    } else {
+      ++accepted;
+      if (evaluated.ok()) {
+        EXPECT_NE(evaluated->exit_code, kExitBadInput) << path << ": validate accepted it\n" << evaluated->stderr_text;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(accepted, 0);
 }
 
 TEST(BadInput, UnknownFieldIsNamed) {

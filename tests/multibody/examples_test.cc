@@ -42,6 +42,59 @@ TEST(PressStudy, LoadsAndIsAnalysedKinetostatically) {
 // the reach limit l - r <= 0.45 m ties them, so the optimum is the smallest
 // crank (the stroke's bound, r = 0.1 m) with l = 0.55 m, the obliquity
 // (0.1 / 0.55 rad at most) well inside its limit.
+// The wall-time limit covers sweeps that do not integrate: a kinetostatic
+// press (multibody) and the landing gear's kinematic sweep (linkage), each
+// with a limit that is over before the first instant.
+TEST(WallTimeLimit, SweepsWithoutAnIntegratorEndAsNamedTimeLimitFailures) {
+  struct Case {
+    const char* study;
+    std::vector<double> x0;
+  };
+  for (const Case& c : {Case{kPressStudy, {1.5, 8.0}},
+                        Case{"examples/landing_gear/landing_gear.study.textproto", {}}}) {
+    absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(c.study);
+    ASSERT_TRUE(study.ok()) << study.status();
+    EXPECT_EQ(study->scene.integrator.max_wall_seconds, spec::kDefaultAnalysisWallSeconds) << "the default applies";
+    study->scene.integrator.max_wall_seconds = 1e-12;
+    absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
+    ASSERT_TRUE(layout.ok()) << layout.status();
+    Eigen::VectorXd x0(static_cast<Eigen::Index>(study->variables.size()));
+    for (size_t i = 0; i < study->variables.size(); ++i) {
+      x0[static_cast<Eigen::Index>(i)] = c.x0.empty() ? study->variables[i].initial : c.x0[i];
+    }
+    absl::StatusOr<engine::StudyEvaluation> e = local_run::EvaluateDesign(*study, *layout, x0);
+    ASSERT_TRUE(e.ok()) << e.status();
+    EXPECT_FALSE(e->ok()) << c.study;
+    EXPECT_EQ(e->failure.kind, spec::FailureKind::kTimeLimit) << c.study << ": " << e->failure.reason;
+    EXPECT_THAT(e->failure.reason, HasSubstr("wall-time limit")) << c.study;
+  }
+}
+
+// Issue 16's hostile values: a parameter of 1e20 or 2147483647 (a
+// stiffness, a damping, a mass) ends within the step budget, as a result or
+// as a named failure, never as an analysis that runs without end.
+TEST(HostileParameters, ExtremeValuesEndWithinTheBudgetsAsResultOrNamedFailure) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const Eigen::Index n = static_cast<Eigen::Index>(study->variables.size());
+  for (const double extreme : {1e20, 2147483647.0}) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      Eigen::VectorXd x(n);
+      for (Eigen::Index j = 0; j < n; ++j) x[j] = study->variables[static_cast<size_t>(j)].initial;
+      x[i] = extreme / study->variables[static_cast<size_t>(i)].scale;
+      absl::StatusOr<engine::StudyEvaluation> e = local_run::EvaluateDesign(*study, *layout, x);
+      ASSERT_TRUE(e.ok()) << e.status();
+      EXPECT_LE(e->counters.time_steps, study->scene.integrator.max_steps);
+      if (!e->ok()) {
+        EXPECT_NE(e->failure.kind, spec::FailureKind::kUnclassified) << e->failure.reason;
+        EXPECT_FALSE(e->failure.reason.empty());
+      }
+    }
+  }
+}
+
 TEST(PressStudy, OptimumIsTheStrokeBoundWithTheReachLimitActive) {
   absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kPressStudy);
   ASSERT_TRUE(study.ok()) << study.status();

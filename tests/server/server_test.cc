@@ -422,6 +422,34 @@ TEST_F(ServerTest, FinishedJobIsServedFromTheLogAfterRestart) {
   EXPECT_TRUE(worker.Acquire(100).empty());
 }
 
+TEST_F(ServerTest, FinishedJobsKeepOnlyTheirSummaryInMemory) {
+  auto server = StartServer("a.db");
+  const std::string first = Submit(*server, OscillatorStudy("first"));
+  {
+    FakeWorker worker(server->InProcessChannel(), 1);
+    worker.Run();
+  }
+  const std::string second = Submit(*server, OscillatorStudy("second"));
+  EXPECT_EQ(server->manager().ResidentJobs(), 1u) << "only the running job";
+  const v1::GetJobResponse view = Get(*server, first);  // read back from the database
+  EXPECT_EQ(view.summary().state(), v1::JOB_STATE_CONVERGED);
+  EXPECT_GT(view.cycles_size(), 0);
+  EXPECT_TRUE(view.has_study()) << "the study bytes come back from the database";
+  EXPECT_EQ(server->manager().ResidentJobs(), 1u) << "a view does not keep the finished job in memory";
+  {
+    FakeWorker worker(server->InProcessChannel(), 2);
+    worker.Run();
+  }
+  EXPECT_EQ(server->manager().ResidentJobs(), 0u);
+  // The summary kept in memory is the one the full view gives.
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::ListJobsResponse jobs;
+  ASSERT_TRUE(stub->List(&context, v1::ListJobsRequest(), &jobs).ok());
+  ASSERT_EQ(jobs.jobs_size(), 2);
+  EXPECT_EQ(jobs.jobs(0).SerializeAsString(), view.summary().SerializeAsString());
+}
+
 TEST_F(ServerTest, JobsAreListedInSubmissionOrder) {
   auto server = StartServer("a.db");
   std::vector<std::string> ids;

@@ -396,6 +396,19 @@ TEST_F(StudyFiles, CountsAboveTheirLimitsAreNamed) {
               HasSubstr("optimizer.max_cycles: 2147483647 is more than the limit"));
 }
 
+// A server would refuse the message such a file becomes (proto3 strings are
+// UTF-8): the file is refused first, naming the field and its line.
+TEST_F(StudyFiles, TextThatIsNotUtf8IsRefusedNamingTheField) {
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "description: \"caf\xe9\"\n"),
+              HasSubstr(StudyPath() + ":" + std::to_string(LineOf(std::string(kStudy) + "description:", "description:")) +
+                        ":1: description: text is not valid UTF-8"));
+  EXPECT_THAT(LoadError(Replace(kScene, "name: \"", "name: \"\xff"), kStudy),
+              HasSubstr("text is not valid UTF-8"));
+  Write("oscillator.scene.textproto", kScene);
+  EXPECT_TRUE(LoadStudyFile(Write("utf8.study.textproto", std::string(kStudy) + "description: \"caf\xc3\xa9\"\n")).ok())
+      << "valid UTF-8 is accepted";
+}
+
 TEST_F(StudyFiles, OptimizerSettingsOutsideTheMethodsRangesAreRefusedAtLoad) {
   EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { initial_move_limit: 1e300 }\n"),
               HasSubstr("optimizer.initial_move_limit: must be at most 1"));

@@ -188,6 +188,67 @@ TEST_F(StoreTest, EverythingSurvivesCloseAndReopen) {
   EXPECT_NE(second->id, job_id);
 }
 
+// A job with one analysis, two cycle records and an event.
+std::string AddLoggedJob(Store& store, const JobRow& row) {
+  auto job = store.CreateJob(row);
+  EXPECT_TRUE(job.ok()) << job.status();
+  if (!job.ok()) return "";
+  jobs::AnalysisRecord a;
+  a.request_id = 0;
+  a.objective_terms = AwkwardDoubles();
+  EXPECT_TRUE(store.AddAnalysis(job->id, a).ok());
+  EXPECT_TRUE(store.CommitCycle(job->id, {{0, 1, 0, "r1"}, {0, 2, 0, "r2"}}, {"CONVERGED", "", 2, 1, 0.5}).ok());
+  EXPECT_TRUE(store.AddEvent(job->id, "ended", "converged").ok());
+  return job->id;
+}
+
+TEST_F(StoreTest, DeletedJobLeavesNoRowsAndItsIdIsNotGivenAgain) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  const std::string first = AddLoggedJob(**store, SampleJob());
+  const std::string second = AddLoggedJob(**store, SampleJob());
+  ASSERT_TRUE((*store)->DeleteJob(second).ok());
+  EXPECT_TRUE(absl::IsNotFound((*store)->GetJob(second).status()));
+  EXPECT_TRUE((*store)->LoadAnalyses(second)->empty());
+  EXPECT_TRUE((*store)->LoadCycles(second)->empty());
+  EXPECT_TRUE((*store)->LoadEvents(second)->empty());
+  EXPECT_EQ((*store)->LoadCycles(first)->size(), 2u) << "the other job is untouched";
+  EXPECT_TRUE(absl::IsNotFound((*store)->DeleteJob(second)));
+  ASSERT_TRUE((*store)->Compact().ok());
+  auto third = (*store)->CreateJob(SampleJob());
+  ASSERT_TRUE(third.ok());
+  EXPECT_NE(third->id, second) << "an id is never reused, even after the newest job was pruned";
+  EXPECT_EQ(third->seq, 3);
+}
+
+TEST_F(StoreTest, ExportedJobsAreReadBackBitForBit) {
+  const std::string export_path = (dir_ / "archive.db").string();
+  std::string id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    id = AddLoggedJob(**store, SampleJob());
+    ASSERT_TRUE((*store)->ExportJobs({id}, export_path).ok());
+    const absl::Status again = (*store)->ExportJobs({id}, export_path);
+    EXPECT_TRUE(absl::IsAlreadyExists(again)) << again;
+    EXPECT_THAT(again.message(), HasSubstr(id));
+  }
+  auto archive = Store::Open(export_path);
+  ASSERT_TRUE(archive.ok()) << archive.status();
+  auto job = (*archive)->GetJob(id);
+  ASSERT_TRUE(job.ok()) << job.status();
+  EXPECT_EQ(job->study, SampleJob().study);
+  EXPECT_EQ(job->state, "CONVERGED");
+  auto analyses = (*archive)->LoadAnalyses(id);
+  ASSERT_TRUE(analyses.ok() && analyses->size() == 1u);
+  EXPECT_TRUE(BitIdentical((*analyses)[0].objective_terms, AwkwardDoubles()));
+  EXPECT_EQ((*archive)->LoadCycles(id)->size(), 2u);
+  EXPECT_EQ((*archive)->LoadEvents(id)->size(), 1u);
+  auto next = (*archive)->CreateJob(SampleJob());
+  ASSERT_TRUE(next.ok());
+  EXPECT_NE(next->id, id) << "the archive numbers its own jobs after the imported ones";
+}
+
 TEST_F(StoreTest, UnknownJobIsNotFoundNamingTheId) {
   auto store = Store::Open(path_);
   ASSERT_TRUE(store.ok());
@@ -256,6 +317,7 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
          "ALTER TABLE analyses DROP COLUMN constraint_gradients;"
          "ALTER TABLE analyses DROP COLUMN gradients_unavailable;"
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
+         "DROP TABLE job_sequence;"
          "UPDATE schema_version SET version = 1;");
   ASSERT_EQ(SchemaVersionOf(path_), 1);
 
@@ -305,6 +367,7 @@ TEST_F(StoreTest, VersionTwoFailuresBecomeUnclassified) {
   }
   RunSql(path_,
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
+         "DROP TABLE job_sequence;"
          "UPDATE schema_version SET version = 2;");
   auto store = Store::Open(path_);
   ASSERT_TRUE(store.ok()) << store.status();

@@ -17,6 +17,7 @@
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
 #include "worker/multibody/static_equilibrium.h"
+#include "worker/solve/wall_time_budget.h"
 
 namespace mbopt::multibody {
 namespace {
@@ -430,7 +431,9 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   const bool driven = assembled.degrees_of_freedom == 0;
   std::vector<StateSensitivity> kinematic;  // work space of the driven path
+  const solve::WallTimeBudget budget(scene.integrator.max_wall_seconds);
   const MotionCallback record = [&](const MotionSample& s) {
+    if (budget.Exceeded()) return budget.Failure(s.t_s);
     if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
       return spec::AnalysisFailure::Ok();
     }

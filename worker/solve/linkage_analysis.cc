@@ -11,6 +11,7 @@
 #include "worker/solve/elastodynamic_solver.h"
 #include "worker/solve/kinematic_solver.h"
 #include "worker/solve/kinetostatic_solver.h"
+#include "worker/solve/wall_time_budget.h"
 
 namespace mbopt::solve {
 
@@ -217,7 +218,13 @@ AnalysisReport AnalyzeLinkage(const spec::Scene& scene,
 
   KinetostaticSolver statics(sys);
   KinetostaticLoads loads;
+  const WallTimeBudget budget(scene.integrator.max_wall_seconds);
   for (size_t i = 0; i < nt; ++i) {
+    if (budget.Exceeded()) {
+      count();
+      Fail(&report, budget.Failure(report.times_s[i]));
+      return finish();
+    }
     if (KinematicOutcome o = kinematics.AdvanceTo(report.times_s[i]); !o.ok()) {
       count();
       Fail(&report, o);

@@ -34,6 +34,13 @@ struct JobManager::Entry {
   std::vector<slp::CycleRecord> records;
   std::int64_t version = 0;
 
+  // Whether the study, its bytes and the records are in memory. A stopped
+  // job keeps only its summary (stopped_summary); views read the rest from
+  // the database on demand (RestoreLocked), so the server's memory does not
+  // grow with the number of finished jobs.
+  bool resident = true;
+  JobSummaryData stopped_summary;
+
   double wall_before_s = 0;  // running time of earlier runs
   bool timing = false;
   std::int64_t run_started_ms = 0;
@@ -125,8 +132,74 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
       if (first_error.ok()) first_error = status;
     }
   }
+  if (!Running(to)) EvictLocked(entry);
   Changed(entry);
   return first_error;
+}
+
+void JobManager::EvictLocked(Entry& entry) {
+  if (!entry.resident || Running(entry.state) || entry.job != nullptr) return;
+  entry.stopped_summary = SummaryLocked(entry);
+  std::vector<slp::CycleRecord>().swap(entry.records);
+  entry.study = spec::Study{};
+  entry.layout = spec::StudyLayout{};
+  entry.layout_released = true;
+  std::string().swap(entry.row.study);
+  entry.resident = false;
+}
+
+void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {
+  entry.study_ok = false;
+  absl::StatusOr<spec::Study> study = decoder_(entry.row.study, entry.row.source_name);
+  if (study.ok()) {
+    // The layout is checked here so that a study this build cannot lay out
+    // is known before a resume is tried; it is kept only while running.
+    absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
+    if (layout.ok()) {
+      entry.study = *std::move(study);
+      entry.study_ok = true;
+      if (Running(entry.state)) {
+        entry.layout = *std::move(layout);
+        entry.layout_released = false;
+      } else {
+        entry.layout_released = true;  // a stopped job's views recompute it
+      }
+    } else {
+      entry.message = std::string(layout.status().message());
+    }
+  } else {
+    entry.message = std::string(study.status().message());
+  }
+  entry.records.clear();
+  absl::StatusOr<std::vector<store::CycleRow>> cycles = store_->LoadCycles(entry.row.id);
+  if (cycles.ok()) {
+    for (const store::CycleRow& c : *cycles) {
+      absl::StatusOr<slp::CycleRecord> record = jobs::DecodeCycleRecord(c.record);
+      if (!record.ok()) {
+        cycles = record.status();
+        break;
+      }
+      entry.records.push_back(*std::move(record));
+    }
+  }
+  *cycles_status = cycles.status();
+  entry.resident = true;
+}
+
+absl::Status JobManager::RestoreLocked(Entry& entry) {
+  if (entry.resident) return absl::OkStatus();
+  MBOPT_ASSIGN_OR_RETURN(store::JobRow row, store_->GetJob(entry.row.id));
+  entry.row.study = std::move(row.study);
+  // A stored message (why it failed) stays what the summary says.
+  const std::string message = entry.message;
+  absl::Status cycles;
+  LoadContentLocked(entry, &cycles);
+  entry.message = message;
+  if (!cycles.ok()) {
+    EvictLocked(entry);
+    return absl::DataLossError(absl::StrCat("job '", entry.row.id, "': cannot read the cycle log: ", cycles.message()));
+  }
+  return absl::OkStatus();
 }
 
 absl::Status JobManager::Start() {
@@ -140,40 +213,14 @@ absl::Status JobManager::Start() {
     entry->message = state ? row.message : absl::StrCat("unknown state '", row.state, "' in the database");
     entry->wall_before_s = row.wall_seconds;
     entry->row = std::move(row);
-    absl::StatusOr<spec::Study> study = decoder_(entry->row.study, entry->row.source_name);
-    if (study.ok()) {
-      absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
-      if (layout.ok()) {
-        entry->study = *std::move(study);
-        entry->study_ok = true;
-        if (Running(entry->state)) {
-          entry->layout = *std::move(layout);
-        } else {
-          entry->layout_released = true;  // a stopped job's views recompute it
-        }
-      } else {
-        entry->message = std::string(layout.status().message());
-      }
-    } else {
-      entry->message = std::string(study.status().message());
-    }
-    absl::StatusOr<std::vector<store::CycleRow>> cycles = store_->LoadCycles(id);
-    if (cycles.ok()) {
-      for (const store::CycleRow& c : *cycles) {
-        absl::StatusOr<slp::CycleRecord> record = jobs::DecodeCycleRecord(c.record);
-        if (!record.ok()) {
-          cycles = record.status();
-          break;
-        }
-        entry->records.push_back(*std::move(record));
-      }
-    }
+    absl::Status cycles;
+    LoadContentLocked(*entry, &cycles);
     {
       std::lock_guard<std::mutex> jobs_lock(mutex_);
       jobs_[id] = entry;
     }
     if (!cycles.ok()) {
-      FailJobLocked(*entry, absl::StrCat("cannot read the cycle log: ", cycles.status().message()));
+      FailJobLocked(*entry, absl::StrCat("cannot read the cycle log: ", cycles.message()));
       continue;
     }
     if (Running(entry->state) || entry->state == JobState::kInterrupted) {
@@ -181,6 +228,8 @@ absl::Status JobManager::Start() {
                                                                      : "the server ended without stopping the job";
       absl::Status resumed = ResumeLocked(*entry, absl::StrCat("resumed on start (", why, ")"));
       if (!resumed.ok()) LogError(id, resumed);
+    } else {
+      EvictLocked(*entry);
     }
   }
   return absl::OkStatus();
@@ -437,6 +486,13 @@ void JobManager::ExpireLeases() {
 }
 
 JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
+  if (!entry.resident) {
+    JobSummaryData s = entry.stopped_summary;
+    s.state = entry.state;
+    s.message = entry.message;
+    s.wall_seconds = WallSecondsLocked(entry);
+    return s;
+  }
   JobSummaryData s;
   s.job_id = entry.row.id;
   s.study_name = entry.row.study_name;
@@ -521,7 +577,14 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
 absl::StatusOr<JobView> JobManager::Get(const std::string& job_id, std::size_t first_record) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
-  return ViewLocked(*entry, first_record);
+  return RestoredViewLocked(*entry, first_record);
+}
+
+absl::StatusOr<JobView> JobManager::RestoredViewLocked(Entry& entry, std::size_t first_record) {
+  MBOPT_RETURN_IF_ERROR(RestoreLocked(entry));
+  JobView view = ViewLocked(entry, first_record);
+  EvictLocked(entry);
+  return view;
 }
 
 absl::StatusOr<std::vector<JobSummaryData>> JobManager::List() {
@@ -566,6 +629,7 @@ absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id) {
     return absl::FailedPreconditionError(absl::StrCat("job '", job_id, "' has ended (",
                                                       jobs::JobStateName(entry->state), ") and cannot be resumed"));
   }
+  MBOPT_RETURN_IF_ERROR(RestoreLocked(*entry));
   MBOPT_RETURN_IF_ERROR(ResumeLocked(*entry, "resumed on request"));
   return SummaryLocked(*entry);
 }
@@ -577,12 +641,30 @@ absl::StatusOr<JobView> JobManager::WaitForChange(const std::string& job_id, std
   // A real-time wait: watchers are people, not the job's clock.
   entry->changed.wait_for(lock, std::chrono::milliseconds(std::max<std::int64_t>(0, max_wait_ms)),
                           [&] { return entry->version != version_seen; });
-  return ViewLocked(*entry, first_record);
+  return RestoredViewLocked(*entry, first_record);
+}
+
+std::size_t JobManager::ResidentJobs() {
+  std::vector<std::shared_ptr<Entry>> entries;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [id, entry] : jobs_) entries.push_back(entry);
+  }
+  std::size_t resident = 0;
+  for (const auto& entry : entries) {
+    std::lock_guard<std::mutex> lock(entry->mutex);
+    if (entry->resident) ++resident;
+  }
+  return resident;
 }
 
 absl::StatusOr<std::string> JobManager::StudyBytes(const std::string& job_id) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
+  if (!entry->resident) {
+    MBOPT_ASSIGN_OR_RETURN(store::JobRow row, store_->GetJob(job_id));
+    return row.study;
+  }
   return entry->row.study;
 }
 

@@ -152,6 +152,11 @@ class JobManager {
   // (Scheduler::WorkerLost), and those out of attempts reported as failed.
   void WorkerLost(const std::string& worker_id);
 
+  // Jobs whose study and records are in memory: the running ones (a
+  // stopped job keeps only its summary; views read the rest from the
+  // database). For tests and the memory benchmark.
+  std::size_t ResidentJobs();
+
   // The stored study of a job (for workers). NotFound for an unknown job.
   absl::StatusOr<std::string> StudyBytes(const std::string& job_id);
 
@@ -174,6 +179,17 @@ class JobManager {
   absl::Status EnterStateLocked(Entry& entry, jobs::JobState to, std::string message, const std::string& event,
                                 const std::string& event_detail, Persist persist = Persist::kSetState);
   absl::Status ResumeLocked(Entry& entry, const std::string& why);
+  // Loads the study (decoded and laid out) and the cycle records of the
+  // entry's row (row.study must be set); `cycles_status` says whether the
+  // cycle log could be read. A study that cannot be decoded leaves study_ok
+  // false and the reason in message.
+  void LoadContentLocked(Entry& entry, absl::Status* cycles_status);
+  // A stopped job gives up its study and records, keeping its summary; a
+  // running one is left alone. RestoreLocked reads them back.
+  void EvictLocked(Entry& entry);
+  absl::Status RestoreLocked(Entry& entry);
+  // The view of a job whose records may have to be read from the database.
+  absl::StatusOr<JobView> RestoredViewLocked(Entry& entry, std::size_t first_record);
   absl::Status DeliverLocked(Entry& entry, const jobs::AnalysisRecord& record);
   absl::Status CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records);
   void ScheduleLocked(Entry& entry);

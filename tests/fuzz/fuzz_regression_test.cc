@@ -1,0 +1,106 @@
+// Replays through the fuzzing targets' checks, in the ordinary build: every
+// example study (as the seeds are made), every input kept under
+// tests/fuzz/regressions/<target>/ (each a finding of a fuzzer, now fixed),
+// and deterministic mutations of the examples. A check that fails aborts
+// the test binary, which fails the test.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <google/protobuf/text_format.h>
+#include <gtest/gtest.h>
+
+#include "spec/io/study_io.h"
+#include "tests/fuzz/fuzz_checks.h"
+#include "tests/fuzz/mutate.h"
+
+namespace mbopt::fuzz {
+namespace {
+
+std::vector<std::string> ExampleStudies() {
+  std::vector<std::string> paths;
+  for (const auto& dir : std::filesystem::directory_iterator("examples")) {
+    if (!dir.is_directory()) continue;
+    for (const auto& file : std::filesystem::directory_iterator(dir.path())) {
+      const std::string name = file.path().filename().string();
+      if (name.size() > 16 && name.substr(name.size() - 16) == ".study.textproto") paths.push_back(file.path());
+    }
+  }
+  std::sort(paths.begin(), paths.end());
+  return paths;
+}
+
+std::string InlinedText(const std::string& path, v1::Study* study) {
+  absl::StatusOr<v1::Study> read = spec::io::ReadStudyProto(path);
+  EXPECT_TRUE(read.ok()) << read.status();
+  if (!read.ok()) return "";
+  *study = *read;
+  std::string text;
+  google::protobuf::TextFormat::PrintToString(*read, &text);
+  return text;
+}
+
+std::string ReadAll(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+TEST(FuzzSeeds, EveryExampleStudyPassesEveryCheck) {
+  const std::vector<std::string> studies = ExampleStudies();
+  ASSERT_GE(studies.size(), 8u) << "the examples directory was not found from " << std::filesystem::current_path();
+  for (const std::string& path : studies) {
+    v1::Study study;
+    const std::string text = InlinedText(path, &study);
+    ASSERT_FALSE(text.empty()) << path;
+    CheckStudyText(text);
+    CheckStudyBinary(study.SerializeAsString());
+    std::string scene;
+    google::protobuf::TextFormat::PrintToString(study.scene(), &scene);
+    CheckSceneText(scene);
+    // The seed is accepted by the text path itself, not only "handled".
+    EXPECT_TRUE(spec::io::ParseStudyText(text, "seed.study.textproto").ok()) << path;
+  }
+}
+
+TEST(FuzzRegressions, EveryKeptFindingIsHandled) {
+  const std::filesystem::path root = "tests/fuzz/regressions";
+  ASSERT_TRUE(std::filesystem::is_directory(root));
+  int replayed = 0;
+  for (const auto& [target, check] : std::vector<std::pair<std::string, void (*)(std::string_view)>>{
+           {"study_text", &CheckStudyText}, {"scene_text", &CheckSceneText}, {"study_binary", &CheckStudyBinary}}) {
+    if (!std::filesystem::is_directory(root / target)) continue;
+    for (const auto& file : std::filesystem::directory_iterator(root / target)) {
+      SCOPED_TRACE(file.path().string());
+      check(ReadAll(file.path()));
+      ++replayed;
+    }
+  }
+  EXPECT_GT(replayed, 0);
+}
+
+// The property: whatever a user does to an example file, the file path and
+// the server's path agree on it (CheckStudyText aborts when they do not),
+// and nothing crashes. 60 mutants of each example.
+TEST(FuzzMutations, MutatedExamplesAreAcceptedOrRefusedAlikeOnEveryPath) {
+  int refused = 0, accepted = 0;
+  std::uint32_t seed = 1;
+  for (const std::string& path : ExampleStudies()) {
+    v1::Study study;
+    const std::string text = InlinedText(path, &study);
+    ASSERT_FALSE(text.empty()) << path;
+    for (const std::string& mutant : MutateStudyText(text, 60, seed++)) {
+      CheckStudyText(mutant);
+      (spec::io::ParseStudyText(mutant, "m.study.textproto").ok() ? accepted : refused) += 1;
+    }
+  }
+  // Both outcomes occur: the mutations reach the validation, not only the parser.
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(accepted, 0);
+}
+
+}  // namespace
+}  // namespace mbopt::fuzz
