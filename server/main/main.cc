@@ -21,7 +21,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--db PATH] [--port-file FILE]\n"
-    "                    [--lease-ms N] [--heartbeat-ms N] [--crash-after-cycles N]\n"
+    "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
+    "                    [--crash-after-cycles N]\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
     "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port)\n"
@@ -29,6 +30,8 @@ constexpr const char* kUsage =
     "  --port-file FILE       write the port listened on to FILE once ready\n"
     "  --lease-ms N           lease of a task given to a worker (default 30000)\n"
     "  --heartbeat-ms N       heartbeat interval asked of workers (default 5000)\n"
+    "  --max-message-mb N     largest message taken or sent, a result or a study\n"
+    "                         (default 256, at most 2047)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n";
 
@@ -78,6 +81,13 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     } else if (name == "--heartbeat-ms") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->server.heartbeat_ms = number;
+    } else if (name == "--max-message-mb") {
+      if (!ParseInt(name, value, 1, &number)) return false;
+      if (number > 2047) {
+        std::cerr << "mbopt-server: --max-message-mb is at most 2047 (gRPC's limit is 2 GB), got " << number << "\n";
+        return false;
+      }
+      flags->server.max_message_bytes = number << 20;
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

@@ -100,6 +100,7 @@ grpc::Status WorkerServiceImpl::Register(grpc::ServerContext*, const v1::Registe
   response->set_worker_id(scheduler_->RegisterWorker(request->name(), request->slots()));
   response->set_heartbeat_interval_ms(static_cast<std::int32_t>(scheduler_->options().heartbeat_interval_ms));
   response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));
+  response->set_max_message_bytes(max_message_bytes_);
   return grpc::Status::OK;
 }
 

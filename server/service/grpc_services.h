@@ -33,8 +33,10 @@ class JobServiceImpl final : public v1::JobService::Service {
 class WorkerServiceImpl final : public v1::WorkerService::Service {
  public:
   // The clock is the scheduler's (lease deadlines are on it).
-  WorkerServiceImpl(JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock)
-      : manager_(manager), scheduler_(scheduler), clock_(clock) {}
+  // `max_message_bytes` is what workers are told the server receives.
+  WorkerServiceImpl(JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock,
+                    std::int64_t max_message_bytes)
+      : manager_(manager), scheduler_(scheduler), clock_(clock), max_message_bytes_(max_message_bytes) {}
 
   grpc::Status Register(grpc::ServerContext* context, const v1::RegisterWorkerRequest* request,
                         v1::RegisterWorkerResponse* response) override;
@@ -58,6 +60,7 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   JobManager* manager_;
   scheduler::Scheduler* scheduler_;
   const scheduler::Clock* clock_;
+  std::int64_t max_message_bytes_;
 };
 
 }  // namespace mbopt::service

@@ -38,6 +38,9 @@ struct ServerOptions {
   const scheduler::Clock* clock = nullptr;
   // Checks for expired leases run this often (real time); 0: lease_ms / 4.
   std::int64_t reaper_interval_ms = 0;
+  // The largest message the server receives or sends (a study, a result, a
+  // job's records); workers are told it when they register.
+  std::int64_t max_message_bytes = std::int64_t{256} << 20;
   JobManagerOptions manager;
 };
 

@@ -13,9 +13,34 @@
 #include "client/json_writer.h"
 #include "client/local_cluster.h"
 #include "worker/service/backoff.h"
+#include "worker/service/result_size.h"
 
 namespace mbopt {
 namespace {
+
+TEST(ResultSize, ResultOverTheServersLimitBecomesANamedServiceFailure) {
+  v1::TaskResult result;
+  result.set_task_id("job-1/0/1");
+  result.set_job_id("job-1");
+  result.set_request_id(0);
+  result.set_ok(true);
+  for (int i = 0; i < 200'000; ++i) result.add_constraint_values(0.5);  // 1.6 MB
+  v1::TaskResult small = result;
+  small.clear_constraint_values();
+  EXPECT_FALSE(worker::FitResultToServerLimit(0, &result)) << "no limit known";
+  EXPECT_FALSE(worker::FitResultToServerLimit(4 << 20, &result));
+  EXPECT_TRUE(result.ok());
+  EXPECT_FALSE(worker::FitResultToServerLimit(1 << 20, &small));
+  ASSERT_TRUE(worker::FitResultToServerLimit(1 << 20, &result));
+  EXPECT_FALSE(result.ok());
+  EXPECT_FALSE(result.retry()) << "another worker would send the same size";
+  EXPECT_EQ(result.failure_kind(), v1::ANALYSIS_FAILURE_SERVICE);
+  EXPECT_EQ(result.constraint_values_size(), 0);
+  EXPECT_EQ(result.task_id(), "job-1/0/1");
+  EXPECT_NE(result.failure_reason().find("the result is 1.5 MB, more than the server takes (1.0 MB"),
+            std::string::npos)
+      << result.failure_reason();
+}
 
 TEST(JsonWriter, WritesNestedDocumentsWithCommas) {
   client::JsonWriter w(0);

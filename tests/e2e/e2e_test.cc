@@ -486,6 +486,27 @@ TEST(BadInput, MutatedExamplesAgreeBetweenValidateAndWorkerEval) {
   EXPECT_GT(accepted, 0);
 }
 
+// A result larger than the server takes fails its analysis at once, naming
+// both sizes (before: refused by gRPC on every try, the job stalled for three
+// leases and failed with "lease expired").
+TEST(BadInput, ResultOverTheServersMessageLimitIsANamedFailure) {
+  ScratchDir dir;
+  v1::Study study;
+  const std::string text = InlinedVehicleStudy(&study);
+  ASSERT_FALSE(text.empty());
+  const std::string path = dir.Write("fine.study.textproto", text + "analysis { time_grid_points: 20001 }\n");
+  auto server = StartServer(dir.File("jobs.db"), {"--max-message-mb", "1"}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  Subprocess worker = StartWorker(server->address);
+  auto submitted = Mbopt({"submit", path, "--watch", "--server", server->address});
+  constexpr int kExitJobFailed = 4;
+  EXPECT_EQ(submitted.exit_code, kExitJobFailed) << Describe(submitted);
+  auto results = Mbopt({"results", "job-1", "--server", server->address});
+  EXPECT_NE(results.stdout_text.find("more than the server takes (1.0 MB"), std::string::npos) << Describe(results);
+  worker.Stop(kGuard);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
 TEST(BadInput, UnknownFieldIsNamed) {
   ScratchDir dir;
   v1::Study study;

@@ -20,6 +20,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "mbopt/v1/service.grpc.pb.h"
+#include "worker/service/result_size.h"
 #include "worker/service/task_evaluator.h"
 
 namespace mbopt::worker {
@@ -156,6 +157,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
     worker_id_ = response.worker_id();
     heartbeat_ms_ = response.heartbeat_interval_ms() > 0 ? response.heartbeat_interval_ms()
                                                          : kDefaultHeartbeatMs;
+    max_message_bytes_ = response.max_message_bytes();
     registered_ = true;
     Log(absl::StrCat("registered with ", options_.server_address, " as ", worker_id_, " (",
                      options_.slots, " slots)"));
@@ -262,6 +264,12 @@ class Worker : public std::enable_shared_from_this<Worker> {
       bool deliver = true;
       if (study != nullptr) {
         EvaluateTask(*study, task, &result);
+        std::int64_t max_message_bytes = 0;
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          max_message_bytes = max_message_bytes_;
+        }
+        FitResultToServerLimit(max_message_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
         result.set_ok(false);
@@ -466,6 +474,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
   bool registered_ = false;
   std::string worker_id_;
   int heartbeat_ms_ = kDefaultHeartbeatMs;
+  std::int64_t max_message_bytes_ = 0;  // the server's, from registration; 0: unknown
   std::deque<QueuedTask> queue_;
   int busy_ = 0;                          // tasks queued or being evaluated
   std::map<std::string, bool> cancelled_; // task id -> cancelled, for tasks in hand

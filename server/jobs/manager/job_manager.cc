@@ -146,6 +146,7 @@ void JobManager::EvictLocked(Entry& entry) {
   entry.layout_released = true;
   std::string().swap(entry.row.study);
   entry.resident = false;
+  evictions_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {

@@ -20,6 +20,7 @@
 // thread under the job's mutex; the store's commits are the only I/O.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -156,6 +157,10 @@ class JobManager {
   // stopped job keeps only its summary; views read the rest from the
   // database). For tests and the memory benchmark.
   std::size_t ResidentJobs();
+  // How many times a stopped job gave up its study and records (a count
+  // that only grows): the server returns freed memory to the system when
+  // it changes.
+  std::int64_t Evictions() const { return evictions_.load(std::memory_order_relaxed); }
 
   // The stored study of a job (for workers). NotFound for an unknown job.
   absl::StatusOr<std::string> StudyBytes(const std::string& job_id);
@@ -214,6 +219,7 @@ class JobManager {
   std::map<std::string, std::shared_ptr<Entry>> jobs_;
   bool shutdown_ = false;
   std::int64_t records_committed_ = 0;
+  std::atomic<std::int64_t> evictions_{0};
 };
 
 }  // namespace mbopt::service
