@@ -10,19 +10,21 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "server/main/gc_command.h"
 #include "server/service/server.h"
+#include "server/store/store.h"
 
 namespace {
 
 constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
-    "                    [--crash-after-cycles N]\n"
+    "                    [--durability full|normal] [--crash-after-cycles N]\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
     "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port)\n"
@@ -30,6 +32,9 @@ constexpr const char* kUsage =
     "  --port-file FILE       write the port listened on to FILE once ready\n"
     "  --lease-ms N           lease of a task given to a worker (default 30000)\n"
     "  --heartbeat-ms N       heartbeat interval asked of workers (default 5000)\n"
+    "  --durability full|normal  full (default): every commit synced to disk;\n"
+    "                         normal: a machine crash may lose the last commits,\n"
+    "                         which a resume analyses again (docs/store.md)\n"
     "  --max-message-mb N     largest message taken or sent, a result or a study\n"
     "                         (default 256, at most 2047)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
@@ -81,6 +86,13 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     } else if (name == "--heartbeat-ms") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->server.heartbeat_ms = number;
+    } else if (name == "--durability") {
+      const std::optional<mbopt::store::Durability> durability = mbopt::store::ParseDurability(value);
+      if (!durability) {
+        std::cerr << "mbopt-server: --durability is full or normal, got '" << value << "'\n";
+        return false;
+      }
+      flags->server.durability = *durability;
     } else if (name == "--max-message-mb") {
       if (!ParseInt(name, value, 1, &number)) return false;
       if (number > 2047) {

@@ -41,6 +41,8 @@ struct ServerOptions {
   // The largest message the server receives or sends (a study, a result, a
   // job's records); workers are told it when they register.
   std::int64_t max_message_bytes = std::int64_t{256} << 20;
+  // What a machine crash may take from the job database (store.h).
+  store::Durability durability = store::Durability::kFull;
   JobManagerOptions manager;
 };
 

@@ -222,7 +222,17 @@ constexpr const char* kJobColumns =
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path) {
+const char* DurabilityName(Durability durability) {
+  return durability == Durability::kFull ? "full" : "normal";
+}
+
+std::optional<Durability> ParseDurability(const std::string& name) {
+  if (name == "full") return Durability::kFull;
+  if (name == "normal") return Durability::kNormal;
+  return std::nullopt;
+}
+
+absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path, Durability durability) {
   // A job database holds studies and every result: readable by its owner
   // only. SQLite gives the -wal and -shm files the database file's mode, so
   // creating the file 0600 before SQLite does covers all three. An existing
@@ -263,7 +273,9 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path) {
       status = absl::UnavailableError(absl::StrCat("SQLite refused WAL mode (journal_mode is ", *mode, ")"));
     }
   }
-  if (status.ok()) status = Exec(db, "PRAGMA synchronous = FULL");
+  if (status.ok()) {
+    status = Exec(db, durability == Durability::kFull ? "PRAGMA synchronous = FULL" : "PRAGMA synchronous = NORMAL");
+  }
   if (status.ok()) status = Exec(db, "PRAGMA foreign_keys = ON");
   if (status.ok()) status = Exec(db, "BEGIN EXCLUSIVE; COMMIT");
   if (absl::IsUnavailable(status)) {

@@ -2,8 +2,8 @@
 // analysis result, every cycle record and an event log. The schema, the
 // version rule and what survives a crash are written down in docs/store.md.
 //
-// Durability: WAL journal with synchronous=FULL, so a call that returned OK
-// has reached the disk. An analysis is committed on its own when it arrives;
+// Durability: WAL journal with synchronous=FULL by default, so a call that
+// returned OK has reached the disk (Durability says what NORMAL changes). An analysis is committed on its own when it arrives;
 // a cycle's records are committed in one transaction with the job's progress,
 // so after a crash the database holds either all of a cycle or none of it.
 //
@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,13 +35,32 @@ inline constexpr int kSchemaVersion = 4;
 // PRAGMA application_id of an mbopt database ("mbop").
 inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 
+// How much of the log a machine crash (power loss, kernel panic) may take
+// with it; a crash of the server process alone loses nothing committed at
+// either level (docs/store.md, "Durability").
+enum class Durability {
+  // Every commit is synced to disk (synchronous = FULL): one fdatasync per
+  // analysis and per cycle.
+  kFull,
+  // Commits reach the operating system, which writes them soon
+  // (synchronous = NORMAL): a machine crash may lose the last commits. A
+  // job resumes from what is left, analyses again what was lost and ends
+  // with the same result, bit for bit.
+  kNormal,
+};
+
+// "full" / "normal".
+const char* DurabilityName(Durability durability);
+std::optional<Durability> ParseDurability(const std::string& name);
+
 class Store {
  public:
   // Opens or creates the database at `path`. FailedPrecondition for a file
   // that is not an mbopt database (another SQLite database, or not SQLite at
   // all) or one written by a newer mbopt; DataLoss when SQLite reports
   // corruption; Unavailable when the file cannot be opened.
-  static absl::StatusOr<std::unique_ptr<Store>> Open(const std::string& path);
+  static absl::StatusOr<std::unique_ptr<Store>> Open(const std::string& path,
+                                                     Durability durability = Durability::kFull);
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;

@@ -485,6 +485,21 @@ TEST_F(StoreTest, SecondOpenWhileTheFirstIsOpenIsRefused) {
   EXPECT_TRUE(Store::Open(path_).ok());
 }
 
+TEST_F(StoreTest, DurabilityLevelsSetTheSyncModeAndNamesRoundTrip) {
+  for (const Durability d : {Durability::kFull, Durability::kNormal}) {
+    EXPECT_EQ(ParseDurability(DurabilityName(d)), d);
+    {
+      auto store = Store::Open(path_, d);
+      ASSERT_TRUE(store.ok()) << store.status();
+      ASSERT_TRUE((*store)->CreateJob(SampleJob()).ok());
+    }
+    auto reopened = Store::Open(path_, d);
+    ASSERT_TRUE(reopened.ok()) << reopened.status();
+    EXPECT_FALSE((*reopened)->ListJobs()->empty());
+  }
+  EXPECT_FALSE(ParseDurability("fast").has_value());
+}
+
 TEST_F(StoreTest, DatabaseUsesWalJournal) {
   { ASSERT_TRUE(Store::Open(path_).ok()); }
   sqlite3* db = nullptr;
