@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# What the service itself costs, around the analyses (docs/benchmarks.md,
+# "Service"). For each worker count W it runs STUDY JOBS times, one job at a
+# time, on a fresh mbopt-server with W workers on 127.0.0.1, then reads the
+# job database and prints medians over the jobs:
+#   wall        the job's wall time (the server's measure)
+#   analyses    analyses per job; work = the sum of their own wall times
+#   per_s       analyses per second of job wall
+#   efficiency  work / (W x wall): the share of the workers' time spent analysing
+#   critical    cycles x (1 + ceil(n / W)) x the mean analysis time: one trial
+#               point, then n finite-difference perturbations spread over W
+#               workers, per cycle (n design variables). An estimate: the
+#               analyses of a cycle do not all take the mean time.
+#   overhead    (wall - critical) / cycles: what the service adds per cycle
+#   server_cpu  the server's CPU time (user + system) per analysis, over the
+#               whole run of that W (start and stop included)
+#
+#   bash bench/service/service_bench.sh [STUDY] [JOBS] [W...]
+# Defaults: the vehicle, 7 jobs, W = 1 2 4.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+STUDY=${1:-examples/vehicle/vehicle.study.textproto}
+JOBS=${2:-7}
+shift $(( $# >= 2 ? 2 : $# ))
+WORKER_COUNTS=("$@")
+[ ${#WORKER_COUNTS[@]} -eq 0 ] && WORKER_COUNTS=(1 2 4)
+B=build
+command -v sqlite3 > /dev/null || { echo "service_bench: needs the sqlite3 shell (deploy/install-deps.sh)" >&2; exit 1; }
+DIR=$(mktemp -d)
+trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
+TICKS=$(getconf CLK_TCK)
+
+median() { sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
+
+printf '%-3s %8s %9s %8s %7s %10s %9s %9s %11s\n' W wall_s analyses work_s per_s efficiency critical_s overhead_ms server_cpu_ms
+for W in "${WORKER_COUNTS[@]}"; do
+  rm -f "$DIR"/jobs.db* "$DIR/port"
+  "$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" \
+    > /dev/null 2> "$DIR/server.log" &
+  server=$!
+  while [ ! -s "$DIR/port" ]; do sleep 0.05; done
+  address="127.0.0.1:$(cat "$DIR/port")"
+  for i in $(seq "$W"); do "$B/worker/main/mbopt-worker" serve --server "$address" --name "w$i" 2> /dev/null & done
+  sleep 0.5  # the workers register
+  for _ in $(seq "$JOBS"); do
+    job=$("$B/client/mbopt" submit "$STUDY" --server "$address")
+    "$B/client/mbopt" watch "$job" --server "$address" > /dev/null || true
+  done
+  cpu_ticks=$(awk '{print $14 + $15}' "/proc/$server/stat")
+  pkill -f "mbopt-worker serve --server $address" || true
+  kill "$server"
+  wait "$server" 2> /dev/null || true
+  # One line per job: wall, cycles, analyses, work, variables.
+  sqlite3 -separator ' ' "$DIR/jobs.db" \
+    "SELECT j.wall_seconds, j.cycles, count(a.request_id), sum(a.wall_seconds), max(length(a.x_scaled)) / 8
+       FROM jobs j JOIN analyses a ON a.job_id = j.id GROUP BY j.id" > "$DIR/jobs.txt"
+  total_analyses=$(awk '{n += $3} END {print n}' "$DIR/jobs.txt")
+  awk -v W="$W" '{
+      wall = $1; cycles = $2; n_an = $3; work = $4; n = $5
+      mean = work / n_an; per_cycle = 1 + int((n + W - 1) / W)
+      critical = cycles * per_cycle * mean
+      print wall, n_an, work, n_an / wall, work / (W * wall), critical, 1000 * (wall - critical) / cycles
+    }' "$DIR/jobs.txt" > "$DIR/derived.txt"
+  cols=()
+  for c in 1 2 3 4 5 6 7; do cols+=("$(awk -v c=$c '{print $c}' "$DIR/derived.txt" | median)"); done
+  printf '%-3s %8.3f %9.0f %8.3f %7.0f %10.2f %9.3f %9.1f %11.3f\n' "$W" "${cols[@]}" \
+    "$(awk -v t="$cpu_ticks" -v hz="$TICKS" -v n="$total_analyses" 'BEGIN {print 1000 * t / hz / n}')"
+done
