@@ -16,7 +16,8 @@
 #               whole run of that W (start and stop included)
 #
 #   bash bench/service/service_bench.sh [STUDY] [JOBS] [W...]
-# Defaults: the vehicle, 7 jobs, W = 1 2 4.
+# Defaults: the vehicle, 7 jobs, W = 1 2 4. SERVER_ARGS (environment) is
+# passed to mbopt-server, e.g. SERVER_ARGS="--durability normal".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 STUDY=${1:-examples/vehicle/vehicle.study.textproto}
@@ -35,7 +36,8 @@ median() { sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a
 printf '%-3s %8s %9s %8s %7s %10s %9s %9s %11s\n' W wall_s analyses work_s per_s efficiency critical_s overhead_ms server_cpu_ms
 for W in "${WORKER_COUNTS[@]}"; do
   rm -f "$DIR"/jobs.db* "$DIR/port"
-  "$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" \
+  # shellcheck disable=SC2086  # SERVER_ARGS is a list of words
+  "$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" ${SERVER_ARGS:-} \
     > /dev/null 2> "$DIR/server.log" &
   server=$!
   while [ ! -s "$DIR/port" ]; do sleep 0.05; done

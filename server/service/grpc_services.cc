@@ -104,23 +104,28 @@ grpc::Status WorkerServiceImpl::Register(grpc::ServerContext*, const v1::Registe
   return grpc::Status::OK;
 }
 
+void WorkerServiceImpl::AddTasks(const std::vector<scheduler::Task>& tasks,
+                                 google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const {
+  const std::int64_t unix_now = NowUnixMs();
+  const std::int64_t clock_now = clock_->NowMs();
+  for (const scheduler::Task& t : tasks) {
+    v1::AnalysisTask* task = out->Add();
+    task->set_task_id(t.task_id);
+    task->set_job_id(t.job_id);
+    task->set_request_id(t.request_id);
+    task->mutable_x_scaled()->Add(t.x_scaled.begin(), t.x_scaled.end());
+    task->set_lease_deadline_unix_ms(unix_now + (t.lease_deadline_ms - clock_now));
+    task->set_want_gradients(t.want_gradients);
+  }
+}
+
 grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext*, const v1::AcquireTasksRequest* request,
                                              v1::AcquireTasksResponse* response) {
   const std::int64_t wait_ms = std::clamp<std::int64_t>(request->wait_ms(), 0, kMaxWaitMs);
   absl::StatusOr<std::vector<scheduler::Task>> tasks =
       scheduler_->AcquireWait(request->worker_id(), std::max(1, request->max_tasks()), wait_ms);
   if (!tasks.ok()) return ToGrpcStatus(tasks.status());
-  const std::int64_t unix_now = NowUnixMs();
-  const std::int64_t clock_now = clock_->NowMs();
-  for (const scheduler::Task& t : *tasks) {
-    v1::AnalysisTask* task = response->add_tasks();
-    task->set_task_id(t.task_id);
-    task->set_job_id(t.job_id);
-    task->set_request_id(t.request_id);
-    for (double x : t.x_scaled) task->add_x_scaled(x);
-    task->set_lease_deadline_unix_ms(unix_now + (t.lease_deadline_ms - clock_now));
-    task->set_want_gradients(t.want_gradients);
-  }
+  AddTasks(*tasks, response->mutable_tasks());
   return grpc::Status::OK;
 }
 
@@ -137,17 +142,26 @@ grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext*, const v1::GetStud
 
 grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::TaskResult* request,
                                              v1::ReportResultResponse* response) {
+  grpc::Status status = grpc::Status::OK;
   if (request->retry()) {
-    absl::Status status = manager_->ReportWorkerError(request->worker_id(), request->task_id(),
-                                                      request->failure_reason());
+    absl::Status reported = manager_->ReportWorkerError(request->worker_id(), request->task_id(),
+                                                        request->failure_reason());
     // A retry request for a task that is not outstanding is simply dropped.
-    response->set_accepted(status.ok());
-    return absl::IsNotFound(status) ? grpc::Status::OK : ToGrpcStatus(status);
+    response->set_accepted(reported.ok());
+    if (!reported.ok() && !absl::IsNotFound(reported)) status = ToGrpcStatus(reported);
+  } else {
+    absl::StatusOr<bool> accepted = manager_->ReportResult(WorkerReportFromProto(*request));
+    if (!accepted.ok()) return ToGrpcStatus(accepted.status());
+    response->set_accepted(*accepted);
   }
-  absl::StatusOr<bool> accepted = manager_->ReportResult(WorkerReportFromProto(*request));
-  if (!accepted.ok()) return ToGrpcStatus(accepted.status());
-  response->set_accepted(*accepted);
-  return grpc::Status::OK;
+  // The result may have made the next tasks (a cycle's trial point right
+  // after its last perturbation): they go back on the same call.
+  if (status.ok() && request->next_tasks() > 0) {
+    absl::StatusOr<std::vector<scheduler::Task>> tasks =
+        scheduler_->Acquire(request->worker_id(), std::min(request->next_tasks(), kMaxTasksPerCall));
+    if (tasks.ok()) AddTasks(*tasks, response->mutable_tasks());
+  }
+  return status;
 }
 
 grpc::Status WorkerServiceImpl::Attach(grpc::ServerContext* context, const v1::AttachRequest* request,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
@@ -53,12 +54,18 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
 
   // The longest a long poll waits, whatever the worker asks.
   static constexpr std::int64_t kMaxWaitMs = 30'000;
+  // The most tasks one ReportResult hands back (TaskResult.next_tasks).
+  static constexpr int kMaxTasksPerCall = 64;
   // How often an Attach stream checks whether its worker's connection closed.
   static constexpr std::int64_t kAttachPollMs = 20;
 
  private:
   JobManager* manager_;
   scheduler::Scheduler* scheduler_;
+  // Leased tasks into their wire form.
+  void AddTasks(const std::vector<scheduler::Task>& tasks,
+                google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const;
+
   const scheduler::Clock* clock_;
   std::int64_t max_message_bytes_;
 };

@@ -223,23 +223,27 @@ class Worker : public std::enable_shared_from_this<Worker> {
         continue;
       }
       backoff.Reset();
-      for (const auto& task : response.tasks()) {
-        ++tasks_received_;
-        if (options_.die_after_tasks > 0 && tasks_received_ == options_.die_after_tasks) {
-          Log(absl::StrCat("--die-after-tasks ", options_.die_after_tasks,
-                           ": killing this process with task ", task.task_id(), " in hand"));
-          std::fflush(stderr);
-          raise(SIGKILL);
-        }
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          queue_.push_back({task, worker_id});
-          cancelled_[task.task_id()] = false;
-          ++busy_;
-        }
-        cv_.notify_all();
-      }
+      for (const auto& task : response.tasks()) Take(task, worker_id);
     }
+  }
+
+  // A task leased to this worker (by AcquireTasks, or with the answer to a
+  // result): queued for a slot.
+  void Take(const v1::AnalysisTask& task, const std::string& worker_id) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++tasks_received_;
+      if (options_.die_after_tasks > 0 && tasks_received_ == options_.die_after_tasks) {
+        Log(absl::StrCat("--die-after-tasks ", options_.die_after_tasks, ": killing this process with task ",
+                         task.task_id(), " in hand"));
+        std::fflush(stderr);
+        raise(SIGKILL);
+      }
+      queue_.push_back({task, worker_id});
+      cancelled_[task.task_id()] = false;
+      ++busy_;
+    }
+    cv_.notify_all();
   }
 
   void SlotLoop() {
@@ -285,8 +289,13 @@ class Worker : public std::enable_shared_from_this<Worker> {
       {
         std::lock_guard<std::mutex> lock(mutex_);
         if (cancelled_[task.task_id()]) deliver = false;
+        // This slot is free once the result is in: ask for its next task
+        // with the result, unless another is already queued for it.
+        if (!stopping_ && queue_.empty()) result.set_next_tasks(1);
       }
-      if (deliver) Report(result);
+      if (deliver) {
+        for (const v1::AnalysisTask& next : Report(result)) Take(next, item.worker_id);
+      }
       {
         std::lock_guard<std::mutex> lock(mutex_);
         cancelled_.erase(task.task_id());
@@ -342,7 +351,8 @@ class Worker : public std::enable_shared_from_this<Worker> {
     return *prepared;
   }
 
-  void Report(const v1::TaskResult& result) {
+  // Delivers a result; returns the tasks the server leased with its answer.
+  std::vector<v1::AnalysisTask> Report(const v1::TaskResult& result) {
     Backoff backoff(options_.backoff, backoff_seed_ + 2);
     const auto give_up = Clock::now() + kReportRetryWindow;
     while (true) {
@@ -356,14 +366,14 @@ class Worker : public std::enable_shared_from_this<Worker> {
         if (!response.accepted() && options_.verbose) {
           Log(absl::StrCat("result of task ", result.task_id(), " was not accepted"));
         }
-        return;
+        return {response.tasks().begin(), response.tasks().end()};
       }
       if (!Retryable(status) || stop_.stopped() || Clock::now() > give_up) {
         Log(absl::StrCat("result of task ", result.task_id(),
                          " not delivered: ", status.error_message()));
-        return;
+        return {};
       }
-      if (stop_.WaitFor(backoff.Next())) return;
+      if (stop_.WaitFor(backoff.Next())) return {};
     }
   }
 
@@ -486,7 +496,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
   std::map<std::string, std::shared_ptr<const PreparedStudy>> studies_;
   std::map<std::string, std::string> study_errors_;
 
-  int tasks_received_ = 0;  // acquiring thread only
+  int tasks_received_ = 0;  // guarded by mutex_
   bool unreachable_logged_ = false;  // acquiring thread only
 };
 
