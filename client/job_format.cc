@@ -200,11 +200,12 @@ std::string ResultsCsv(const v1::GetJobResponse& job) {
   return out;
 }
 
-std::string ResultsJson(const v1::GetJobResponse& job) {
+std::string ResultsJson(const v1::GetJobResponse& job, const std::string& database) {
   const auto& s = job.summary();
   JsonWriter w;
   w.BeginObject();
   w.Field("job_id", s.job_id());
+  if (!database.empty()) w.Field("database", database);
   w.Field("study", s.study_name());
   w.Field("status", StateName(s.state()));
   w.Field("cycles", s.cycles());

@@ -37,6 +37,8 @@ std::string ListRow(const v1::JobSummary& summary);
 // entry per accepted cycle).
 std::string ResultsTable(const v1::GetJobResponse& job);
 std::string ResultsCsv(const v1::GetJobResponse& job);
-std::string ResultsJson(const v1::GetJobResponse& job);
+// `database`: where the job is kept (mbopt run), written as "database"
+// when not empty.
+std::string ResultsJson(const v1::GetJobResponse& job, const std::string& database = "");
 
 }  // namespace mbopt::client

@@ -161,7 +161,7 @@ int RunCommandMain(const Args& args) {
     }
     if (json && get_status.ok()) {
       job.mutable_summary()->set_state(v1::JOB_STATE_INTERRUPTED);
-      std::fputs(ResultsJson(job).c_str(), stdout);
+      std::fputs(ResultsJson(job, keep_db ? db_path : "").c_str(), stdout);
     }
     return kExitInterrupted;
   }
@@ -171,7 +171,7 @@ int RunCommandMain(const Args& args) {
     return Fail(f.message, f.exit_code);
   }
   if (json) {
-    std::fputs(ResultsJson(job).c_str(), stdout);
+    std::fputs(ResultsJson(job, keep_db ? db_path : "").c_str(), stdout);
   } else if (!quiet) {
     std::printf("\n%s", SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr).c_str());
     if (keep_db) {

@@ -105,7 +105,7 @@ std::string Comparable(const std::string& results_json) {
   std::istringstream in(results_json);
   std::string line, out;
   while (std::getline(in, line)) {
-    if (line.find("\"job_id\":") != std::string::npos ||
+    if (line.find("\"job_id\":") != std::string::npos || line.find("\"database\":") != std::string::npos ||
         line.find("\"wall_seconds\":") != std::string::npos) {
       continue;
     }

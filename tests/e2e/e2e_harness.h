@@ -63,7 +63,8 @@ client::Subprocess::Output Mbopt(const std::vector<std::string>& args,
                                  const std::vector<std::string>& extra_env = {});
 
 // `results --json` without the fields that legitimately differ between two
-// runs of one study (job id, wall time): what "the same result" means.
+// runs of one study (job id, database path, wall time): what "the same
+// result" means.
 std::string Comparable(const std::string& results_json);
 // The value of a top-level "key": value line of the CLI's JSON ("" if absent).
 std::string JsonField(const std::string& json, const std::string& key);

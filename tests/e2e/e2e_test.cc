@@ -316,6 +316,8 @@ TEST(EndToEnd, RunJsonStartsEverythingAndPrintsOneJsonObject) {
   EXPECT_EQ(json.back(), '}');
   EXPECT_EQ(json.find("\n}"), json.size() - 2) << "exactly one object on stdout";
   EXPECT_EQ(Comparable(run.stdout_text), reference);
+  const std::string database = JsonField(json, "database");
+  EXPECT_NE(database.find("/mbopt/runs/vehicle-"), std::string::npos) << "where the job is kept\n" << json;
 }
 
 // From `mbopt run` to the report page in two commands: run keeps its
