@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# How many analyses one server hands out per second when analyses cost
+# (almost) nothing (docs/benchmarks.md, "Service"): IN_FLIGHT jobs of STUDY
+# at once on one server, WORKERS workers of SLOTS slots each on 127.0.0.1,
+# ROUNDS rounds. Prints the analyses per second over the whole run and the
+# server's CPU time per analysis. The default study, the landing gear, has
+# analyses of about 0.06 ms, so the figure is the service's ceiling, not the
+# analyses' (a 2-core machine also runs the workers and the clients).
+#
+#   bash bench/service/dispatch_ceiling.sh [IN_FLIGHT] [WORKERS] [SLOTS] [ROUNDS] [STUDY]
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+IN_FLIGHT=${1:-16}
+WORKERS=${2:-4}
+SLOTS=${3:-8}
+ROUNDS=${4:-3}
+STUDY=${5:-examples/landing_gear/landing_gear.study.textproto}
+B=build
+DIR=$(mktemp -d)
+trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
+TICKS=$(getconf CLK_TCK)
+
+# shellcheck disable=SC2086  # SERVER_ARGS is a list of words
+"$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" ${SERVER_ARGS:-} \
+  > /dev/null 2> "$DIR/server.log" &
+server=$!
+while [ ! -s "$DIR/port" ]; do sleep 0.05; done
+address="127.0.0.1:$(cat "$DIR/port")"
+for i in $(seq "$WORKERS"); do
+  "$B/worker/main/mbopt-worker" serve --server "$address" --name "w$i" --slots "$SLOTS" 2> /dev/null &
+done
+sleep 0.5
+start=$(date +%s.%N)
+cpu_start=$(awk '{print $14 + $15}' "/proc/$server/stat")
+analyses=0
+for _ in $(seq "$ROUNDS"); do
+  jobs=()
+  for _ in $(seq "$IN_FLIGHT"); do jobs+=("$("$B/client/mbopt" submit "$STUDY" --server "$address")"); done
+  for job in "${jobs[@]}"; do
+    "$B/client/mbopt" watch "$job" --server "$address" > /dev/null || true
+    # results exits 1 for a job that did not converge: its analyses count all the same.
+    n=$({ "$B/client/mbopt" results "$job" --json --server "$address" || true; } |
+        sed -nE 's/^  "analyses": *([0-9]+).*/\1/p')
+    analyses=$((analyses + ${n:-0}))
+  done
+done
+cpu_end=$(awk '{print $14 + $15}' "/proc/$server/stat")
+awk -v a="$start" -v b="$(date +%s.%N)" -v n="$analyses" -v t=$((cpu_end - cpu_start)) -v hz="$TICKS" \
+  -v jobs=$((IN_FLIGHT * ROUNDS)) -v w="$WORKERS" -v s="$SLOTS" 'BEGIN {
+    printf "%d jobs, %d analyses in %.2f s on %d workers x %d slots: %.0f analyses/s; server CPU %.3f ms per analysis\n",
+      jobs, n, b - a, w, s, n / (b - a), 1000 * t / hz / n }'
