@@ -13,6 +13,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "server/jobs/job_state.h"
+#include "server/main/flag_value.h"
 #include "server/store/store.h"
 
 namespace mbopt::server_main {
@@ -52,14 +53,8 @@ bool ParseGcFlags(int argc, char** argv, GcFlags* flags) {
       flags->dry_run = true;
       continue;
     }
-    std::string name = arg, value;
-    const size_t eq = arg.find('=');
-    if (eq != std::string::npos) {
-      name = arg.substr(0, eq);
-      value = arg.substr(eq + 1);
-    } else if (i + 1 < argc) {
-      value = argv[++i];
-    } else {
+    std::string name, value;
+    if (!FlagValue(argc, argv, &i, &name, &value)) {
       std::cerr << "mbopt-server gc: " << arg << " needs a value\n" << kGcUsage;
       return false;
     }

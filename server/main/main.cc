@@ -15,6 +15,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
 #include "server/service/server.h"
 #include "server/store/store.h"
@@ -62,14 +63,8 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
       std::cout << kUsage;
       std::exit(0);
     }
-    std::string name = arg, value;
-    const size_t eq = arg.find('=');
-    if (eq != std::string::npos) {
-      name = arg.substr(0, eq);
-      value = arg.substr(eq + 1);
-    } else if (i + 1 < argc) {
-      value = argv[++i];
-    } else {
+    std::string name, value;
+    if (!mbopt::server_main::FlagValue(argc, argv, &i, &name, &value)) {
       std::cerr << "mbopt-server: " << arg << " needs a value\n" << kUsage;
       return false;
     }
