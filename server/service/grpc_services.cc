@@ -5,6 +5,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "server/service/proto_convert.h"
 #include "server/service/status_conversion.h"
 
@@ -27,6 +28,20 @@ std::int64_t NowUnixMs() {
 grpc::Status JobServiceImpl::Submit(grpc::ServerContext*, const v1::SubmitJobRequest* request,
                                     v1::SubmitJobResponse* response) {
   if (!request->has_study()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
+  // A study comes from files of at most kMaxInputFileBytes each (its own and
+  // its scene's); a larger message did not, and is refused before it is
+  // decoded, stored or sent to workers.
+  const std::size_t study_bytes = request->study().ByteSizeLong();
+  if (study_bytes > kMaxStudyMessageBytes) {
+    return ToGrpcStatus(absl::InvalidArgumentError(
+        absl::StrFormat("SubmitJobRequest.study is %.1f MB, more than the limit of %d MB", study_bytes / 1048576.0,
+                        static_cast<int>(kMaxStudyMessageBytes >> 20))));
+  }
+  if (request->source_name().size() > kMaxSourceNameBytes) {
+    return ToGrpcStatus(absl::InvalidArgumentError(absl::StrCat("SubmitJobRequest.source_name has ",
+                                                                request->source_name().size(),
+                                                                " bytes, more than the limit of ", kMaxSourceNameBytes)));
+  }
   const std::string source = request->source_name().empty()
                                  ? absl::StrCat("study '", request->study().name(), "'")
                                  : request->source_name();

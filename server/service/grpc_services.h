@@ -10,12 +10,18 @@
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
 #include "server/jobs/manager/job_manager.h"
+#include "spec/limits.h"
 
 namespace mbopt::service {
 
 class JobServiceImpl final : public v1::JobService::Service {
  public:
   explicit JobServiceImpl(JobManager* manager) : manager_(manager) {}
+
+  // What Submit takes: a study message no larger than its two files may be
+  // (spec/limits.h), and a source name of a path's length.
+  static constexpr std::size_t kMaxStudyMessageBytes = 2 * static_cast<std::size_t>(spec::kMaxInputFileBytes);
+  static constexpr std::size_t kMaxSourceNameBytes = 4096;
 
   grpc::Status Submit(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
                       v1::SubmitJobResponse* response) override;

@@ -499,6 +499,35 @@ TEST_F(ServerTest, SubmitWithoutStudyIsInvalidArgument) {
   EXPECT_THAT(status.error_message(), HasSubstr("study"));
 }
 
+TEST_F(ServerTest, OversizedStudyOrSourceNameIsRefusedNamingTheLimit) {
+  auto server = StartServer("a.db");
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  {
+    v1::SubmitJobRequest request;
+    *request.mutable_study() = OscillatorStudy();
+    request.mutable_study()->set_description(std::string(33 << 20, 'x'));
+    grpc::ClientContext context;
+    v1::SubmitJobResponse response;
+    grpc::Status status = stub->Submit(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("more than the limit of 32 MB"));
+  }
+  {
+    v1::SubmitJobRequest request;
+    *request.mutable_study() = OscillatorStudy();
+    request.set_source_name(std::string(5000, 'p'));
+    grpc::ClientContext context;
+    v1::SubmitJobResponse response;
+    grpc::Status status = stub->Submit(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("source_name has 5000 bytes"));
+  }
+  grpc::ClientContext context;
+  v1::ListJobsResponse jobs;
+  ASSERT_TRUE(stub->List(&context, v1::ListJobsRequest(), &jobs).ok());
+  EXPECT_EQ(jobs.jobs_size(), 0) << "nothing was stored";
+}
+
 TEST_F(ServerTest, BadStudyIsInvalidArgumentNamingTheField) {
   auto server = StartServer("a.db");
   v1::Study study = OscillatorStudy();
