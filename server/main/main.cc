@@ -17,18 +17,22 @@
 #include "absl/strings/str_cat.h"
 #include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
+#include "server/service/listen_address.h"
 #include "server/service/server.h"
 #include "server/store/store.h"
 
 namespace {
 
 constexpr const char* kUsage =
-    "usage: mbopt-server [--listen HOST:PORT] [--db PATH] [--port-file FILE]\n"
+    "usage: mbopt-server [--listen HOST:PORT [--insecure]] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
     "                    [--durability full|normal] [--crash-after-cycles N]\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
-    "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port)\n"
+    "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port);\n"
+    "                         only loopback addresses unless --insecure\n"
+    "  --insecure             allow an address other machines can reach, without TLS\n"
+    "                         or authentication (a warning at every start)\n"
     "  --db PATH              job database (default mbopt.db; created if missing)\n"
     "  --port-file FILE       write the port listened on to FILE once ready\n"
     "  --lease-ms N           lease of a task given to a worker (default 30000)\n"
@@ -62,6 +66,10 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       std::exit(0);
+    }
+    if (arg == "--insecure") {
+      flags->server.insecure = true;
+      continue;
     }
     std::string name, value;
     if (!mbopt::server_main::FlagValue(argc, argv, &i, &name, &value)) {
@@ -160,6 +168,11 @@ int main(int argc, char** argv) {
   if (!flags.port_file.empty() && !WritePortFile(flags.port_file, (*server)->port())) {
     (*server)->Shutdown();
     return 1;
+  }
+  if (flags.server.insecure && !mbopt::service::IsLoopbackAddress(flags.server.listen_address)) {
+    std::cerr << "mbopt-server: WARNING: listening on " << (*server)->address()
+              << " without TLS or authentication (--insecure): anyone who can reach this port can submit, read "
+                 "and cancel jobs and report results\n";
   }
   std::cout << "mbopt-server listening on " << (*server)->address() << std::endl;
 

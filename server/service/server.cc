@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
 #include "server/lp/make_clp_lp_solver.h"
+#include "server/service/listen_address.h"
 #include "server/service/proto_convert.h"
 
 namespace mbopt::service {
@@ -26,6 +27,13 @@ constexpr auto kTrimInterval = std::chrono::seconds(2);
 MboptServer::MboptServer(ServerOptions options) : options_(std::move(options)) {}
 
 absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions options) {
+  if (!options.insecure && !IsLoopbackAddress(options.listen_address)) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "refusing to listen on ", options.listen_address,
+        ": it is reachable from other machines, and connections have neither TLS nor authentication: anyone who "
+        "reaches the port could submit, read and cancel jobs and report results. Listen on 127.0.0.1 (and reach it "
+        "through an SSH tunnel or a VPN, deploy/README.md), or pass --insecure on a network you trust"));
+  }
   std::unique_ptr<MboptServer> server(new MboptServer(std::move(options)));
   MboptServer& s = *server;
   if (s.options_.clock == nullptr) {

@@ -31,6 +31,9 @@ namespace mbopt::service {
 
 struct ServerOptions {
   std::string listen_address = "127.0.0.1:50051";  // port 0: the OS picks
+  // Allows an address reachable from other machines although connections
+  // have no TLS or authentication (listen_address.h).
+  bool insecure = false;
   std::string db_path = "mbopt.db";
   std::int64_t lease_ms = 30'000;
   std::int64_t heartbeat_ms = 5'000;

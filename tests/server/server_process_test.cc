@@ -149,6 +149,16 @@ TEST_F(ServerProcessTest, PrintsReadinessWritesPortFileAndStopsCleanlyOnSigterm)
   EXPECT_EQ(job->state, "INTERRUPTED");
 }
 
+// Refused before anything is bound: the test opens no port off loopback.
+TEST_F(ServerProcessTest, RefusesAnAddressOffLoopbackWithoutInsecure) {
+  auto server = StartServer({"--listen", "0.0.0.0:0", "--db", db_});
+  EXPECT_EQ(server->ready_line, "");
+  const int status = server->Wait();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_FALSE(std::filesystem::exists(db_)) << "refused before the database is touched";
+}
+
 TEST_F(ServerProcessTest, RefusesAGarbageDatabaseWithAClearError) {
   { std::ofstream(db_) << std::string(4096, 'z'); }
   auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_});

@@ -21,6 +21,7 @@
 #include "absl/strings/str_cat.h"
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
+#include "server/service/listen_address.h"
 #include "server/store/store.h"
 #include "tests/server/fake_worker.h"
 #include "tests/server/test_study.h"
@@ -487,6 +488,29 @@ TEST_F(ServerTest, WorkerForgottenByARestartIsAskedToRegisterAgain) {
   request.set_worker_id(worker_id);
   v1::AcquireTasksResponse response;
   EXPECT_EQ(stub->AcquireTasks(&context, request, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST(ListenAddress, OnlyLoopbackAndLocalSocketsAreLoopback) {
+  for (const char* local : {"127.0.0.1:50051", "127.1.2.3:0", "localhost:50051", "[::1]:50051", "unix:/tmp/mbopt.sock"}) {
+    EXPECT_TRUE(IsLoopbackAddress(local)) << local;
+  }
+  for (const char* remote : {"0.0.0.0:50051", ":50051", "[::]:50051", "10.0.0.5:50051", "[fe80::1]:50051",
+                             "server.example.org:50051", "128.0.0.1:50051", "[::1:50051"}) {
+    EXPECT_FALSE(IsLoopbackAddress(remote)) << remote;
+  }
+}
+
+TEST_F(ServerTest, AddressOffLoopbackIsRefusedWithoutInsecureBeforeAnythingOpens) {
+  for (const char* address : {"0.0.0.0:0", "[::]:0", ":0"}) {
+    ServerOptions options;
+    options.listen_address = address;
+    options.db_path = (dir_ / "never.db").string();
+    absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
+    ASSERT_FALSE(server.ok()) << address;
+    EXPECT_EQ(server.status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_THAT(server.status().message(), HasSubstr("--insecure"));
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "never.db"));
+  }
 }
 
 TEST_F(ServerTest, SubmitWithoutStudyIsInvalidArgument) {
