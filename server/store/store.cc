@@ -365,8 +365,7 @@ absl::Status Store::SetJobState(const std::string& job_id, const std::string& st
   return absl::OkStatus();
 }
 
-absl::Status Store::AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& a) {
-  std::lock_guard<std::mutex> lock(mutex_);
+absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& a) {
   MBOPT_ASSIGN_OR_RETURN(
       Statement stmt,
       Statement::Prepare(db_,

@@ -3,15 +3,18 @@
 // version rule and what survives a crash are written down in docs/store.md.
 //
 // Durability: WAL journal with synchronous=FULL by default, so a call that
-// returned OK has reached the disk (Durability says what NORMAL changes). An analysis is committed on its own when it arrives;
-// a cycle's records are committed in one transaction with the job's progress,
-// so after a crash the database holds either all of a cycle or none of it.
+// returned OK has reached the disk (Durability says what NORMAL changes). An
+// analysis is committed when it arrives, together with any that arrive
+// meanwhile (group commit, AddAnalysis); a cycle's records are committed in
+// one transaction with the job's progress, so after a crash the database
+// holds either all of a cycle or none of it.
 //
 // Thread-safe: one connection, serialized by a mutex. Calls are short
 // (a handful of rows); the caller should still not hold its own locks across
 // them if it can avoid it.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -75,9 +78,16 @@ class Store {
   absl::Status SetJobState(const std::string& job_id, const std::string& state,
                            const std::string& message);
 
-  // Commits one analysis result (its own transaction). AlreadyExists if the
-  // job already has a result for that request id.
+  // Commits one analysis result. AlreadyExists if the job already has a
+  // result for that request id. Returns once the row is committed (and
+  // synced, at Durability::kFull). Group commit (store_group_commit.cc):
+  // results that arrive while another commit is under way are committed
+  // together in the next transaction, one sync for all; a caller never
+  // waits for more than the commit under way and its own.
   absl::Status AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& analysis);
+  // Transactions that committed analyses so far (for tests and benchmarks:
+  // fewer than the analyses when results arrived together).
+  std::int64_t AnalysisTransactions() const;
   absl::StatusOr<std::vector<jobs::AnalysisRecord>> LoadAnalyses(const std::string& job_id);  // by request id
 
   // Commits `records` (appended to the job's record log, indices assigned in
@@ -103,10 +113,27 @@ class Store {
 
  private:
   Store(std::string path, sqlite3* db);
+  // One INSERT into analyses; the caller holds mutex_ (and a transaction).
+  absl::Status InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& analysis);
+
+  // An analysis waiting for its group's commit.
+  struct PendingAnalysis {
+    const std::string* job_id;
+    const jobs::AnalysisRecord* record;
+    absl::Status status;
+    bool done = false;
+  };
+  void CommitAnalysisGroup(const std::vector<PendingAnalysis*>& group);
 
   std::string path_;
   std::mutex mutex_;
   sqlite3* db_;  // owned
+
+  mutable std::mutex group_mutex_;  // guards the three below
+  std::condition_variable group_done_;
+  std::vector<PendingAnalysis*> group_queue_;
+  bool group_committing_ = false;
+  std::int64_t analysis_transactions_ = 0;
 };
 
 }  // namespace mbopt::store

@@ -7,12 +7,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <string>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -498,6 +501,51 @@ TEST_F(StoreTest, DurabilityLevelsSetTheSyncModeAndNamesRoundTrip) {
     EXPECT_FALSE((*reopened)->ListJobs()->empty());
   }
   EXPECT_FALSE(ParseDurability("fast").has_value());
+}
+
+// Group commit: results from many threads at once are all committed (each
+// caller returns after its own row is in), a duplicate fails alone, and
+// they share transactions.
+TEST_F(StoreTest, ConcurrentAnalysesAreCommittedInGroups) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  std::vector<std::string> job_ids;
+  for (int j = 0; j < 4; ++j) {
+    auto job = (*store)->CreateJob(SampleJob());
+    ASSERT_TRUE(job.ok());
+    job_ids.push_back(job->id);
+  }
+  constexpr int kThreads = 8, kPerThread = 40;
+  std::atomic<int> failures{0}, duplicates{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < kPerThread; ++i) {
+        jobs::AnalysisRecord a;
+        a.request_id = t * kPerThread + i;
+        a.objective_terms = AwkwardDoubles();
+        const std::string& job = job_ids[static_cast<size_t>(t % 4)];
+        if (!(*store)->AddAnalysis(job, a).ok()) ++failures;
+        // The same request again must fail, and fail alone.
+        if (i % 10 == 0 && absl::IsAlreadyExists((*store)->AddAnalysis(job, a))) ++duplicates;
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(failures.load(), 0);
+  EXPECT_EQ(duplicates.load(), kThreads * kPerThread / 10);
+  std::size_t rows = 0;
+  for (const std::string& job : job_ids) {
+    auto analyses = (*store)->LoadAnalyses(job);
+    ASSERT_TRUE(analyses.ok());
+    for (const jobs::AnalysisRecord& a : *analyses) EXPECT_TRUE(BitIdentical(a.objective_terms, AwkwardDoubles()));
+    rows += analyses->size();
+  }
+  EXPECT_EQ(rows, static_cast<std::size_t>(kThreads * kPerThread));
+  const std::int64_t transactions = (*store)->AnalysisTransactions();
+  EXPECT_LT(transactions, kThreads * kPerThread) << "results that arrive together share a transaction";
+  std::cout << kThreads * kPerThread << " analyses (and " << kThreads * kPerThread / 10 << " duplicates) in "
+            << transactions << " transactions\n";
 }
 
 TEST_F(StoreTest, DatabaseUsesWalJournal) {
