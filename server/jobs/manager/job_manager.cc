@@ -140,13 +140,17 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
 void JobManager::EvictLocked(Entry& entry) {
   if (!entry.resident || Running(entry.state) || entry.job != nullptr) return;
   entry.stopped_summary = SummaryLocked(entry);
+  DropContentLocked(entry);
+  evictions_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void JobManager::DropContentLocked(Entry& entry) {
   std::vector<slp::CycleRecord>().swap(entry.records);
   entry.study = spec::Study{};
   entry.layout = spec::StudyLayout{};
   entry.layout_released = true;
   std::string().swap(entry.row.study);
   entry.resident = false;
-  evictions_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {
@@ -197,7 +201,7 @@ absl::Status JobManager::RestoreLocked(Entry& entry) {
   LoadContentLocked(entry, &cycles);
   entry.message = message;
   if (!cycles.ok()) {
-    EvictLocked(entry);
+    DropContentLocked(entry);  // the summary kept is the one from before
     return absl::DataLossError(absl::StrCat("job '", entry.row.id, "': cannot read the cycle log: ", cycles.message()));
   }
   return absl::OkStatus();

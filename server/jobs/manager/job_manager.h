@@ -192,6 +192,9 @@ class JobManager {
   // A stopped job gives up its study and records, keeping its summary; a
   // running one is left alone. RestoreLocked reads them back.
   void EvictLocked(Entry& entry);
+  // Frees the study, its bytes and the records (EvictLocked without a new
+  // summary).
+  void DropContentLocked(Entry& entry);
   absl::Status RestoreLocked(Entry& entry);
   // The view of a job whose records may have to be read from the database.
   absl::StatusOr<JobView> RestoredViewLocked(Entry& entry, std::size_t first_record);
