@@ -19,14 +19,11 @@ B=build
 DIR=$(mktemp -d)
 trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
 
-"$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" \
-  > /dev/null 2> "$DIR/server.log" &
-server=$!
-while [ ! -s "$DIR/port" ]; do sleep 0.05; done
-address="127.0.0.1:$(cat "$DIR/port")"
-for i in $(seq "$WORKERS"); do
-  "$B/worker/main/mbopt-worker" serve --server "$address" --name "w$i" 2> /dev/null &
-done
+# shellcheck source=bench/loopback.sh
+source bench/loopback.sh
+start_server
+server=$SERVER_PID address=$ADDRESS
+start_workers "$WORKERS"
 mbopt() { "$B/client/mbopt" "$@" --server "$address"; }
 rss_mb() { awk '/^VmRSS:/ {printf "%.1f", $2 / 1024}' "/proc/$server/status"; }
 db_mb() { du -cb "$DIR"/jobs.db* | awk 'END {printf "%.1f", $1 / 1e6}'; }

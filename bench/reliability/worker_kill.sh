@@ -16,15 +16,12 @@ KILL_AFTER=${3:-20}
 B=build
 DIR=$(mktemp -d)
 trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
+# shellcheck source=bench/loopback.sh
+source bench/loopback.sh
 
 one_run() {  # $1: normal | killed; prints the job's wall seconds
-  rm -f "$DIR"/jobs.db*
-  "$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" \
-    > /dev/null 2> "$DIR/server.log" &
-  local server=$!
-  while [ ! -s "$DIR/port" ]; do sleep 0.05; done
-  local address="127.0.0.1:$(cat "$DIR/port")"
-  rm -f "$DIR/port"
+  start_server
+  local server=$SERVER_PID address=$ADDRESS
   "$B/worker/main/mbopt-worker" serve --server "$address" --name steady 2> /dev/null &
   local pids=($!)
   if [ "$1" = killed ]; then

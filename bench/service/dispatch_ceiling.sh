@@ -20,15 +20,12 @@ DIR=$(mktemp -d)
 trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
 TICKS=$(getconf CLK_TCK)
 
+# shellcheck source=bench/loopback.sh
+source bench/loopback.sh
 # shellcheck disable=SC2086  # SERVER_ARGS is a list of words
-"$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" ${SERVER_ARGS:-} \
-  > /dev/null 2> "$DIR/server.log" &
-server=$!
-while [ ! -s "$DIR/port" ]; do sleep 0.05; done
-address="127.0.0.1:$(cat "$DIR/port")"
-for i in $(seq "$WORKERS"); do
-  "$B/worker/main/mbopt-worker" serve --server "$address" --name "w$i" --slots "$SLOTS" 2> /dev/null &
-done
+start_server ${SERVER_ARGS:-}
+server=$SERVER_PID address=$ADDRESS
+start_workers "$WORKERS" --slots "$SLOTS"
 sleep 0.5
 start=$(date +%s.%N)
 cpu_start=$(awk '{print $14 + $15}' "/proc/$server/stat")

@@ -30,28 +30,24 @@ command -v sqlite3 > /dev/null || { echo "service_bench: needs the sqlite3 shell
 DIR=$(mktemp -d)
 trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
 TICKS=$(getconf CLK_TCK)
+# shellcheck source=bench/loopback.sh
+source bench/loopback.sh
 
 median() { sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
 
 printf '%-3s %8s %9s %8s %7s %10s %9s %9s %11s\n' W wall_s analyses work_s per_s efficiency critical_s overhead_ms server_cpu_ms
 for W in "${WORKER_COUNTS[@]}"; do
-  rm -f "$DIR"/jobs.db* "$DIR/port"
   # shellcheck disable=SC2086  # SERVER_ARGS is a list of words
-  "$B/server/main/mbopt-server" --listen 127.0.0.1:0 --db "$DIR/jobs.db" --port-file "$DIR/port" ${SERVER_ARGS:-} \
-    > /dev/null 2> "$DIR/server.log" &
-  server=$!
-  while [ ! -s "$DIR/port" ]; do sleep 0.05; done
-  address="127.0.0.1:$(cat "$DIR/port")"
-  for i in $(seq "$W"); do "$B/worker/main/mbopt-worker" serve --server "$address" --name "w$i" 2> /dev/null & done
+  start_server ${SERVER_ARGS:-}
+  server=$SERVER_PID address=$ADDRESS
+  start_workers "$W"
   sleep 0.5  # the workers register
   for _ in $(seq "$JOBS"); do
     job=$("$B/client/mbopt" submit "$STUDY" --server "$address")
     "$B/client/mbopt" watch "$job" --server "$address" > /dev/null || true
   done
   cpu_ticks=$(awk '{print $14 + $15}' "/proc/$server/stat")
-  pkill -f "mbopt-worker serve --server $address" || true
-  kill "$server"
-  wait "$server" 2> /dev/null || true
+  stop_service
   # One line per job: wall, cycles, analyses, work, variables.
   sqlite3 -separator ' ' "$DIR/jobs.db" \
     "SELECT j.wall_seconds, j.cycles, count(a.request_id), sum(a.wall_seconds), max(length(a.x_scaled)) / 8

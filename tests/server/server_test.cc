@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -526,26 +527,21 @@ TEST_F(ServerTest, SubmitWithoutStudyIsInvalidArgument) {
 TEST_F(ServerTest, OversizedStudyOrSourceNameIsRefusedNamingTheLimit) {
   auto server = StartServer("a.db");
   auto stub = v1::JobService::NewStub(server->InProcessChannel());
-  {
+  // Submits the oscillator study changed by `edit`; expects a refusal naming `limit`.
+  auto expect_refused = [&](const std::function<void(v1::SubmitJobRequest&)>& edit, const std::string& limit) {
     v1::SubmitJobRequest request;
     *request.mutable_study() = OscillatorStudy();
-    request.mutable_study()->set_description(std::string(33 << 20, 'x'));
+    edit(request);
     grpc::ClientContext context;
     v1::SubmitJobResponse response;
     grpc::Status status = stub->Submit(&context, request, &response);
-    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_THAT(status.error_message(), HasSubstr("more than the limit of 32 MB"));
-  }
-  {
-    v1::SubmitJobRequest request;
-    *request.mutable_study() = OscillatorStudy();
-    request.set_source_name(std::string(5000, 'p'));
-    grpc::ClientContext context;
-    v1::SubmitJobResponse response;
-    grpc::Status status = stub->Submit(&context, request, &response);
-    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_THAT(status.error_message(), HasSubstr("source_name has 5000 bytes"));
-  }
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << limit;
+    EXPECT_THAT(status.error_message(), HasSubstr(limit));
+  };
+  expect_refused([](v1::SubmitJobRequest& r) { r.mutable_study()->set_description(std::string(33 << 20, 'x')); },
+                 "more than the limit of 32 MB");
+  expect_refused([](v1::SubmitJobRequest& r) { r.set_source_name(std::string(5000, 'p')); },
+                 "source_name has 5000 bytes");
   grpc::ClientContext context;
   v1::ListJobsResponse jobs;
   ASSERT_TRUE(stub->List(&context, v1::ListJobsRequest(), &jobs).ok());

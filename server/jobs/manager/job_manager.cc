@@ -25,8 +25,7 @@ struct JobManager::Entry {
 
   bool study_ok = false;
   spec::Study study;
-  spec::StudyLayout layout;  // empty once the job stopped (views recompute it)
-  bool layout_released = false;
+  spec::StudyLayout layout;  // while resident
   std::unique_ptr<jobs::Job> job;  // the optimizer of the current run; none once it stopped
   // Failed analyses by kind, kept when the optimizer is released.
   std::map<std::string, std::int64_t> failed_analyses_by_kind;
@@ -97,10 +96,11 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
     entry.timing = false;
     scheduler_->DropJob(id);
     if (!Running(to) && entry.job != nullptr) {
-      // A stopped job keeps what its summary and views need (records,
-      // counts, failures); the optimizer's state (linearization, LP,
-      // buffered results) is released, so a server's memory does not grow
-      // with every finished job. A resume rebuilds it from the log.
+      // A stopped job keeps its counts and failures for its summary; the
+      // optimizer's state (linearization, LP, buffered results) is released
+      // here and the study and records by EvictLocked below, so a server's
+      // memory does not grow with every finished job. A resume rebuilds
+      // them from the log.
       const slp::SlpOptimizer& optimizer = entry.job->optimizer();
       entry.row.cycles = optimizer.cycles_completed();
       entry.row.analyses = optimizer.analyses_used();
@@ -109,10 +109,6 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
         entry.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
       }
       entry.job.reset();
-    }
-    if (!Running(to) && entry.study_ok && !entry.layout_released) {
-      entry.layout = spec::StudyLayout{};  // its rows' names are most of a job's memory
-      entry.layout_released = true;
     }
   }
   entry.state = to;
@@ -147,8 +143,7 @@ void JobManager::EvictLocked(Entry& entry) {
 void JobManager::DropContentLocked(Entry& entry) {
   std::vector<slp::CycleRecord>().swap(entry.records);
   entry.study = spec::Study{};
-  entry.layout = spec::StudyLayout{};
-  entry.layout_released = true;
+  entry.layout = spec::StudyLayout{};  // its rows' names are most of a job's memory
   std::string().swap(entry.row.study);
   entry.resident = false;
 }
@@ -157,18 +152,13 @@ void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {
   entry.study_ok = false;
   absl::StatusOr<spec::Study> study = decoder_(entry.row.study, entry.row.source_name);
   if (study.ok()) {
-    // The layout is checked here so that a study this build cannot lay out
-    // is known before a resume is tried; it is kept only while running.
+    // A study this build cannot lay out is known before a resume is tried;
+    // the layout serves the views (row names) while the job is resident.
     absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
     if (layout.ok()) {
       entry.study = *std::move(study);
+      entry.layout = *std::move(layout);
       entry.study_ok = true;
-      if (Running(entry.state)) {
-        entry.layout = *std::move(layout);
-        entry.layout_released = false;
-      } else {
-        entry.layout_released = true;  // a stopped job's views recompute it
-      }
     } else {
       entry.message = std::string(layout.status().message());
     }
@@ -309,7 +299,6 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
     return unlogged.status();
   }
   entry.layout = (*job)->layout();
-  entry.layout_released = false;
   entry.job = *std::move(job);
   entry.records = std::move(decoded);
   absl::Status status = EnterStateLocked(
@@ -566,13 +555,7 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
   view.version = entry.version;
   view.ended = !Running(entry.state);
   if (entry.study_ok) {
-    std::optional<spec::StudyLayout> recomputed;
-    if (entry.layout_released) {
-      absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(entry.study);
-      if (layout.ok()) recomputed = *std::move(layout);
-    }
-    const spec::StudyLayout& layout = recomputed.has_value() ? *recomputed : entry.layout;
-    for (const spec::ConstraintRow& row : layout.rows) view.row_names.push_back(row.name);
+    for (const spec::ConstraintRow& row : entry.layout.rows) view.row_names.push_back(row.name);
     for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
   }
   view.study_bytes = entry.row.study;
