@@ -32,7 +32,11 @@ const ArgSpec kServerOrDb{{"--server", "--db"}, {}};
 // Parses `args`, requiring exactly `positional` positional arguments.
 absl::StatusOr<ParsedArgs> Parse(const Args& args, const ArgSpec& spec, size_t positional,
                                  const char* usage) {
-  auto parsed = ParseArgs(args, spec);
+  ArgSpec with_security = spec;
+  if (spec.value_options.count("--server") > 0) {
+    for (const char* option : secure_channel::kSecurityValueOptions) with_security.value_options.insert(option);
+  }
+  auto parsed = ParseArgs(args, with_security);
   if (!parsed.ok()) return parsed.status();
   if (parsed->positional.size() != positional) {
     return absl::InvalidArgumentError(std::string("usage: ") + usage);
@@ -46,6 +50,7 @@ struct Connection {
   std::unique_ptr<TempDir> temp_dir;
   std::unique_ptr<LocalCluster> local;
   std::string address;
+  secure_channel::ClientSecurity security;  // plaintext for the private server
   std::unique_ptr<v1::JobService::Stub> job_service;  // the gRPC client of the server's JobService
 };
 
@@ -61,7 +66,14 @@ std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int w
   const std::string db = parsed.Value("--db");
   if (db.empty()) {
     c.address = ResolveServerAddress(parsed.Value("--server"));
-    c.job_service = ConnectJobService(c.address);
+    secure_channel::ClientSecurityFlags flags;
+    for (const char* option : secure_channel::kSecurityValueOptions) {
+      secure_channel::SetSecurityFlag(option, parsed.Value(option), &flags);
+    }
+    absl::StatusOr<secure_channel::ClientSecurity> security = secure_channel::LoadClientSecurity(flags);
+    if (!security.ok()) return ConnectFailure{std::string(security.status().message())};
+    c.security = *std::move(security);
+    c.job_service = ConnectJobService(c.address, c.security);
     return c;
   }
   if (!parsed.Value("--server").empty()) return ConnectFailure{"--db and --server exclude each other"};
@@ -74,6 +86,9 @@ std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int w
   auto worker_binary = FindMboptBinary("mbopt-worker", "MBOPT_WORKER_BIN", "worker/main");
   if (!worker_binary.ok()) return ConnectFailure{std::string(worker_binary.status().message())};
   Interrupts::Install();  // before the cluster's and gRPC's threads
+  // The private server has neither TLS nor tokens; settings meant for
+  // another server must not reach its workers.
+  secure_channel::ClearSecurityEnvironment();
   c.temp_dir = std::make_unique<TempDir>();
   if (c.temp_dir->path().empty()) return ConnectFailure{"cannot create a temporary directory"};
   LocalClusterOptions options;
@@ -90,8 +105,9 @@ std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int w
   return c;
 }
 
-int FailRpc(const grpc::Status& status, const std::string& address) {
-  RpcFailure f = DescribeRpcFailure(status, address);
+int FailRpc(const grpc::Status& status, const std::string& address,
+            const secure_channel::ClientSecurity* security = nullptr) {
+  RpcFailure f = DescribeRpcFailure(status, address, security);
   return Fail(f.message, f.exit_code);
 }
 
@@ -155,7 +171,7 @@ int SubmitCommand(const Args& args) {
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
   grpc::Status status = c.job_service->Submit(&context, request, &response);
-  if (!status.ok()) return FailRpc(status, c.address);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
   std::printf("%s\n", response.job_id().c_str());
   std::fflush(stdout);
   if (!parsed->Has("--watch")) return kExitOk;
@@ -180,7 +196,7 @@ int StatusCommand(const Args& args) {
   Connection& c = std::get<Connection>(connected);
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, parsed->positional[0], &response);
-  if (!status.ok()) return FailRpc(status, c.address);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
   std::fputs(SummaryText(response.summary(), response.has_study() ? &response.study() : nullptr).c_str(), stdout);
   return kExitOk;
 }
@@ -195,7 +211,7 @@ int ListCommand(const Args& args) {
   grpc::ClientContext context;
   SetUnaryDeadline(&context);
   grpc::Status status = c.job_service->List(&context, v1::ListJobsRequest(), &response);
-  if (!status.ok()) return FailRpc(status, c.address);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
   std::printf("%s\n", ListHeader().c_str());
   for (const auto& job : response.jobs()) std::printf("%s\n", ListRow(job).c_str());
   return kExitOk;
@@ -215,7 +231,7 @@ int CancelOrResume(const ParsedArgs& parsed, bool cancel, int workers) {
   SetUnaryDeadline(&context);
   grpc::Status status = cancel ? c.job_service->Cancel(&context, ref, &summary)
                                : c.job_service->Resume(&context, ref, &summary);
-  if (!status.ok()) return FailRpc(status, c.address);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
   std::printf("%s: %s\n", summary.job_id().c_str(), StateName(summary.state()).c_str());
   std::fflush(stdout);
   // A private server stops with this command: stay until the job ends.
@@ -256,7 +272,7 @@ int ResultsCommand(const Args& args) {
   Connection& c = std::get<Connection>(connected);
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, parsed->positional[0], &response);
-  if (!status.ok()) return FailRpc(status, c.address);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
   if (parsed->Has("--json")) {
     std::fputs(ResultsJson(response).c_str(), stdout);
   } else if (parsed->Has("--csv")) {
@@ -284,7 +300,7 @@ int ReportCommand(const Args& args) {
   Connection& c = std::get<Connection>(connected);
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, job_id, &response);
-  if (!status.ok()) return FailRpc(status, c.address);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
   const std::string html = report::RenderJobReportHtml(report::ReportDataFromJob(response));
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << html;

@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "client/exit_codes.h"
+#include "common/secure_channel/connection_diagnosis.h"
 
 namespace mbopt::client {
 
@@ -14,19 +15,27 @@ std::string ResolveServerAddress(const std::string& flag_value) {
   return kDefaultServerAddress;
 }
 
-std::unique_ptr<v1::JobService::Stub> ConnectJobService(const std::string& address) {
+std::unique_ptr<v1::JobService::Stub> ConnectJobService(const std::string& address,
+                                                        const secure_channel::ClientSecurity& security) {
   grpc::ChannelArguments args;
   // Results of big studies (many cycles) exceed the 4 MB default.
   args.SetMaxReceiveMessageSize(256 * 1024 * 1024);
-  auto channel = grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args);
-  return v1::JobService::NewStub(channel);
+  return v1::JobService::NewStub(secure_channel::CreateChannel(address, security, args));
 }
 
-RpcFailure DescribeRpcFailure(const grpc::Status& status, const std::string& address) {
+RpcFailure DescribeRpcFailure(const grpc::Status& status, const std::string& address,
+                              const secure_channel::ClientSecurity* security) {
   const std::string detail = status.error_message();
   switch (status.error_code()) {
-    case grpc::StatusCode::UNAVAILABLE:
+    case grpc::StatusCode::UNAVAILABLE: {
+      const std::string cause =
+          security != nullptr ? secure_channel::DiagnoseConnectionFailure(address, *security) : "";
+      if (!cause.empty()) return {"cannot connect to server at " + address + ": " + cause, kExitUnreachable};
       return {"cannot reach server at " + address + ": " + detail, kExitUnreachable};
+    }
+    case grpc::StatusCode::UNAUTHENTICATED:
+    case grpc::StatusCode::PERMISSION_DENIED:
+      return {"server at " + address + " refused: " + detail, kExitDenied};
     case grpc::StatusCode::DEADLINE_EXCEEDED:
       return {"server at " + address + " did not answer in time: " + detail, kExitUnreachable};
     case grpc::StatusCode::NOT_FOUND:

@@ -11,6 +11,8 @@ enum ExitCode : int {
   kExitBadInput = 2,      // usage error, invalid study file, unknown job id
   kExitUnreachable = 3,   // no server at the address, or it failed mid-call
   kExitJobFailed = 4,     // the job failed (e.g. its first design cannot be analysed)
+  kExitDenied = 5,        // the server refused: no token, a wrong one, or
+                          // not the caller's job
   kExitInterrupted = 130, // Ctrl-C (128 + SIGINT), after cleaning up
 };
 

@@ -8,6 +8,7 @@
 
 #include "client/commands.h"
 #include "client/exit_codes.h"
+#include "common/secure_channel/client_security.h"
 
 namespace {
 
@@ -33,7 +34,9 @@ constexpr char kUsage[] =
     "\n"
     "every command but run and validate takes --server HOST:PORT (default $MBOPT_SERVER,\n"
     "else 127.0.0.1:50051); watch, status, list, results, report and resume take\n"
-    "--db PATH instead to read a database `mbopt run` kept. See docs/cli.md.\n";
+    "--db PATH instead to read a database `mbopt run` kept.\n"
+    "a server with TLS and tokens needs --tls-ca FILE and --token-file FILE (or\n"
+    "$MBOPT_TLS_CA and $MBOPT_TOKEN_FILE); see docs/cli.md, \"Connecting securely\".\n";
 
 }  // namespace
 
@@ -42,6 +45,7 @@ int main(int argc, char** argv) {
   // A closed output pipe (e.g. `mbopt run ... | head`) must not kill mbopt
   // before it has stopped its children and removed its temporary files.
   signal(SIGPIPE, SIG_IGN);
+  mbopt::secure_channel::QuietGrpcLogUnlessAsked();
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
       std::strcmp(argv[1], "help") == 0) {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);

@@ -73,6 +73,9 @@ function(mbopt_declare_modules)
   mbopt_module(common DIRS common PURE
     LIBS mbopt_common
     SUMMARY "status macros and checks (Abseil status only)")
+  mbopt_module(secure_channel DIRS common/secure_channel USES common
+    LIBS mbopt_secure_channel
+    SUMMARY "a client's connection to the server (CLI and worker): TLS and token from options or the environment, failures in words")
   mbopt_module(proto DIRS proto
     LIBS mbopt_proto
     SUMMARY "the file and wire schemas (generated `mbopt/v1/*.pb.h` belong here)")
@@ -122,16 +125,19 @@ function(mbopt_declare_modules)
   mbopt_module(job_manager DIRS server/jobs/manager USES jobs lp scheduler store spec common
     LIBS mbopt_job_manager
     SUMMARY "the server's jobs: jobs, scheduler and store meet (threads, an injected clock)")
-  mbopt_module(service DIRS server/service USES job_manager jobs lp scheduler store spec spec_io proto common
+  mbopt_module(auth DIRS server/auth USES common
+    LIBS mbopt_auth
+    SUMMARY "who may call the server: tokens and their hashed table, roles, TLS certificates (OpenSSL)")
+  mbopt_module(service DIRS server/service USES auth job_manager jobs lp scheduler store spec spec_io proto common
     LIBS mbopt_service
     SUMMARY "boundary: the gRPC services and the server object")
-  mbopt_module(server_main DIRS server/main USES service store jobs common
+  mbopt_module(server_main DIRS server/main USES service auth store jobs common
     LIBS mbopt-server
     SUMMARY "the `mbopt-server` program")
-  mbopt_module(worker_service DIRS worker/service USES engine spec spec_io proto common
+  mbopt_module(worker_service DIRS worker/service USES secure_channel engine spec spec_io proto common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(worker_main DIRS worker/main USES worker_service engine spec spec_io common
+  mbopt_module(worker_main DIRS worker/main USES worker_service secure_channel engine spec spec_io common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE
@@ -142,7 +148,7 @@ function(mbopt_declare_modules)
     USES report proto common
     LIBS mbopt_report_proto
     SUMMARY "boundary: `GetJobResponse` to `ReportData`")
-  mbopt_module(client DIRS client USES report report_proto spec_io spec proto common
+  mbopt_module(client DIRS client USES secure_channel report report_proto spec_io spec proto common
     LIBS mbopt_client mbopt
     SUMMARY "the `mbopt` CLI")
 

@@ -11,6 +11,7 @@ packages=(
   libeigen3-dev
   libsundials-dev
   libsqlite3-dev sqlite3
+  libssl-dev
   coinor-libclp-dev
   libgtest-dev libgmock-dev
   libbenchmark-dev

@@ -17,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
+#include "server/main/init_tls_command.h"
 #include "server/service/listen_address.h"
 #include "server/service/server.h"
 #include "server/store/store.h"
@@ -24,15 +25,26 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: mbopt-server [--listen HOST:PORT [--insecure]] [--db PATH] [--port-file FILE]\n"
+    "usage: mbopt-server [--listen HOST:PORT] [--tls-dir DIR | --tls-cert F --tls-key F --tokens F]\n"
+    "                    [--worker-ca F] [--insecure] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
     "                    [--durability full|normal] [--crash-after-cycles N]\n"
+    "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
+    "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
+    "       mbopt-server add-token --tokens F --role worker|user|admin --name N --out F\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
     "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port);\n"
-    "                         only loopback addresses unless --insecure\n"
-    "  --insecure             allow an address other machines can reach, without TLS\n"
-    "                         or authentication (a warning at every start)\n"
+    "                         an address other machines can reach needs TLS and tokens\n"
+    "  --tls-dir DIR          what `init-tls DIR` made: DIR/server.pem, DIR/server.key\n"
+    "                         and DIR/tokens (each overridden by its own option)\n"
+    "  --tls-cert F, --tls-key F  the server's certificate and key (PEM): TLS\n"
+    "  --tokens F             the token table; every call then needs a token\n"
+    "  --worker-ca F          workers must also present a client certificate\n"
+    "                         signed by this CA (mutual TLS)\n"
+    "  --insecure             allow an address other machines can reach without TLS\n"
+    "                         and tokens (a warning at every start)\n"
+    "  SIGHUP reads the token table again (to add or revoke tokens).\n"
     "  --db PATH              job database (default mbopt.db; created if missing)\n"
     "  --port-file FILE       write the port listened on to FILE once ready\n"
     "  --lease-ms N           lease of a task given to a worker (default 30000)\n"
@@ -47,6 +59,7 @@ constexpr const char* kUsage =
 
 struct Flags {
   mbopt::service::ServerOptions server;
+  std::string tls_dir;
   std::string port_file;
   std::int64_t crash_after_records = 0;
 };
@@ -79,6 +92,16 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     std::int64_t number = 0;
     if (name == "--listen") {
       flags->server.listen_address = value;
+    } else if (name == "--tls-dir") {
+      flags->tls_dir = value;
+    } else if (name == "--tls-cert") {
+      flags->server.tls_cert_file = value;
+    } else if (name == "--tls-key") {
+      flags->server.tls_key_file = value;
+    } else if (name == "--tokens") {
+      flags->server.tokens_file = value;
+    } else if (name == "--worker-ca") {
+      flags->server.worker_ca_file = value;
     } else if (name == "--db") {
       flags->server.db_path = value;
     } else if (name == "--port-file") {
@@ -111,6 +134,14 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
       return false;
     }
   }
+  if (!flags->tls_dir.empty()) {
+    auto fill = [&](std::string* field, const char* file) {
+      if (field->empty()) *field = flags->tls_dir + "/" + file;
+    };
+    fill(&flags->server.tls_cert_file, "server.pem");
+    fill(&flags->server.tls_key_file, "server.key");
+    fill(&flags->server.tokens_file, "tokens");
+  }
   return true;
 }
 
@@ -138,6 +169,12 @@ bool WritePortFile(const std::string& path, int port) {
 
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "gc") return mbopt::server_main::RunGcCommand(argc - 2, argv + 2);
+  if (argc >= 2 && std::string(argv[1]) == "init-tls") {
+    return mbopt::server_main::RunInitTlsCommand(argc - 2, argv + 2);
+  }
+  if (argc >= 2 && std::string(argv[1]) == "add-token") {
+    return mbopt::server_main::RunAddTokenCommand(argc - 2, argv + 2);
+  }
   Flags flags;
   if (!ParseFlags(argc, argv, &flags)) return 2;
   if (flags.server.heartbeat_ms >= flags.server.lease_ms) {
@@ -157,6 +194,7 @@ int main(int argc, char** argv) {
   sigemptyset(&stop_signals);
   sigaddset(&stop_signals, SIGTERM);
   sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   absl::StatusOr<std::unique_ptr<mbopt::service::MboptServer>> server =
@@ -169,15 +207,33 @@ int main(int argc, char** argv) {
     (*server)->Shutdown();
     return 1;
   }
-  if (flags.server.insecure && !mbopt::service::IsLoopbackAddress(flags.server.listen_address)) {
-    std::cerr << "mbopt-server: WARNING: listening on " << (*server)->address()
-              << " without TLS or authentication (--insecure): anyone who can reach this port can submit, read "
-                 "and cancel jobs and report results\n";
+  const bool tls = !flags.server.tls_cert_file.empty();
+  const bool tokens = !flags.server.tokens_file.empty();
+  if (flags.server.insecure && !mbopt::service::IsLoopbackAddress(flags.server.listen_address) && !(tls && tokens)) {
+    std::cerr << "mbopt-server: WARNING: listening on " << (*server)->address() << " without "
+              << (!tls && !tokens ? "TLS or tokens" : !tls ? "TLS" : "tokens")
+              << " (--insecure): anyone who can reach this port can submit, read and cancel jobs and report "
+                 "results\n";
   }
+  if (tls || tokens) {
+    std::cerr << "mbopt-server: " << (tls ? "TLS" : "no TLS") << ", "
+              << (tokens ? "every call needs a token" : "no tokens")
+              << (flags.server.worker_ca_file.empty() ? "" : ", workers need a certificate") << "\n";
+  }
+  // The ready line scripts and `mbopt run` read: keep its form.
   std::cout << "mbopt-server listening on " << (*server)->address() << std::endl;
 
   int signal_number = 0;
-  while (sigwait(&stop_signals, &signal_number) != 0) {
+  for (;;) {
+    if (sigwait(&stop_signals, &signal_number) != 0) continue;
+    if (signal_number != SIGHUP) break;
+    absl::StatusOr<std::size_t> reloaded = (*server)->ReloadTokens();
+    if (reloaded.ok()) {
+      std::cerr << "mbopt-server: SIGHUP: token table " << flags.server.tokens_file << " read again, " << *reloaded
+                << " tokens\n";
+    } else {
+      std::cerr << "mbopt-server: SIGHUP: " << reloaded.status().message() << "; the table in use stays\n";
+    }
   }
   std::cerr << "mbopt-server: " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM")
             << ": stopping; running jobs resume on the next start\n";

@@ -25,8 +25,19 @@ std::int64_t NowUnixMs() {
 
 // ------------------------------------------------------------------ jobs --
 
-grpc::Status JobServiceImpl::Submit(grpc::ServerContext*, const v1::SubmitJobRequest* request,
+absl::Status JobServiceImpl::CheckJobAccess(const grpc::ServerContext& context, const char* method,
+                                            const std::string& job_id) const {
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(context, method);
+  if (!caller.ok()) return caller.status();
+  absl::StatusOr<std::string> owner = manager_->OwnerOf(job_id);
+  if (!owner.ok()) return owner.status();
+  return CallAuthorizer::CheckMaySee(*caller, job_id, *owner);
+}
+
+grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
                                     v1::SubmitJobResponse* response) {
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "Submit");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
   if (!request->has_study()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
   // A study comes from files of at most kMaxInputFileBytes each (its own and
   // its scene's); a larger message did not, and is refused before it is
@@ -45,13 +56,17 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext*, const v1::SubmitJobReq
   const std::string source = request->source_name().empty()
                                  ? absl::StrCat("study '", request->study().name(), "'")
                                  : request->source_name();
-  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source);
+  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source, caller->name);
   if (!id.ok()) return ToGrpcStatus(id.status());
   response->set_job_id(*id);
   return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::Get(grpc::ServerContext*, const v1::JobRef* request, v1::GetJobResponse* response) {
+grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef* request,
+                                 v1::GetJobResponse* response) {
+  if (absl::Status access = CheckJobAccess(*context, "Get", request->job_id()); !access.ok()) {
+    return ToGrpcStatus(access);
+  }
   absl::StatusOr<JobView> view = manager_->Get(request->job_id());
   if (!view.ok()) return ToGrpcStatus(view.status());
   *response->mutable_summary() = ToProto(view->summary);
@@ -62,15 +77,23 @@ grpc::Status JobServiceImpl::Get(grpc::ServerContext*, const v1::JobRef* request
   return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::List(grpc::ServerContext*, const v1::ListJobsRequest*, v1::ListJobsResponse* response) {
+grpc::Status JobServiceImpl::List(grpc::ServerContext* context, const v1::ListJobsRequest*,
+                                  v1::ListJobsResponse* response) {
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "List");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
   absl::StatusOr<std::vector<JobSummaryData>> jobs = manager_->List();
   if (!jobs.ok()) return ToGrpcStatus(jobs.status());
-  for (const JobSummaryData& s : *jobs) *response->add_jobs() = ToProto(s);
+  for (const JobSummaryData& s : *jobs) {
+    if (CallAuthorizer::MaySee(*caller, s.owner)) *response->add_jobs() = ToProto(s);
+  }
   return grpc::Status::OK;
 }
 
 grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRef* request,
                                    grpc::ServerWriter<v1::JobEvent>* writer) {
+  if (absl::Status access = CheckJobAccess(*context, "Watch", request->job_id()); !access.ok()) {
+    return ToGrpcStatus(access);
+  }
   std::size_t next_record = 0;
   std::int64_t version = -1;
   while (!context->IsCancelled()) {
@@ -94,14 +117,22 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   return grpc::Status::CANCELLED;
 }
 
-grpc::Status JobServiceImpl::Cancel(grpc::ServerContext*, const v1::JobRef* request, v1::JobSummary* response) {
+grpc::Status JobServiceImpl::Cancel(grpc::ServerContext* context, const v1::JobRef* request,
+                                    v1::JobSummary* response) {
+  if (absl::Status access = CheckJobAccess(*context, "Cancel", request->job_id()); !access.ok()) {
+    return ToGrpcStatus(access);
+  }
   absl::StatusOr<JobSummaryData> summary = manager_->Cancel(request->job_id());
   if (!summary.ok()) return ToGrpcStatus(summary.status());
   *response = ToProto(*summary);
   return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::Resume(grpc::ServerContext*, const v1::JobRef* request, v1::JobSummary* response) {
+grpc::Status JobServiceImpl::Resume(grpc::ServerContext* context, const v1::JobRef* request,
+                                    v1::JobSummary* response) {
+  if (absl::Status access = CheckJobAccess(*context, "Resume", request->job_id()); !access.ok()) {
+    return ToGrpcStatus(access);
+  }
   absl::StatusOr<JobSummaryData> summary = manager_->Resume(request->job_id());
   if (!summary.ok()) return ToGrpcStatus(summary.status());
   *response = ToProto(*summary);
@@ -110,8 +141,11 @@ grpc::Status JobServiceImpl::Resume(grpc::ServerContext*, const v1::JobRef* requ
 
 // --------------------------------------------------------------- workers --
 
-grpc::Status WorkerServiceImpl::Register(grpc::ServerContext*, const v1::RegisterWorkerRequest* request,
+grpc::Status WorkerServiceImpl::Register(grpc::ServerContext* context, const v1::RegisterWorkerRequest* request,
                                          v1::RegisterWorkerResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Register"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
   response->set_worker_id(scheduler_->RegisterWorker(request->name(), request->slots()));
   response->set_heartbeat_interval_ms(static_cast<std::int32_t>(scheduler_->options().heartbeat_interval_ms));
   response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));
@@ -134,8 +168,11 @@ void WorkerServiceImpl::AddTasks(const std::vector<scheduler::Task>& tasks,
   }
 }
 
-grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext*, const v1::AcquireTasksRequest* request,
+grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext* context, const v1::AcquireTasksRequest* request,
                                              v1::AcquireTasksResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "AcquireTasks"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
   const std::int64_t wait_ms = std::clamp<std::int64_t>(request->wait_ms(), 0, kMaxWaitMs);
   absl::StatusOr<std::vector<scheduler::Task>> tasks =
       scheduler_->AcquireWait(request->worker_id(), std::max(1, request->max_tasks()), wait_ms);
@@ -144,8 +181,11 @@ grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext*, const v1::Acq
   return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext*, const v1::GetStudyRequest* request,
+grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext* context, const v1::GetStudyRequest* request,
                                          v1::GetStudyResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "GetStudy"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
   absl::StatusOr<std::string> bytes = manager_->StudyBytes(request->job_id());
   if (!bytes.ok()) return ToGrpcStatus(bytes.status());
   if (!response->mutable_study()->ParseFromString(*bytes)) {
@@ -155,8 +195,11 @@ grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext*, const v1::GetStud
   return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::TaskResult* request,
+grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext* context, const v1::TaskResult* request,
                                              v1::ReportResultResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResult"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
   grpc::Status status = grpc::Status::OK;
   if (request->retry()) {
     absl::Status reported = manager_->ReportWorkerError(request->worker_id(), request->task_id(),
@@ -181,6 +224,9 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext*, const v1::Tas
 
 grpc::Status WorkerServiceImpl::Attach(grpc::ServerContext* context, const v1::AttachRequest* request,
                                        grpc::ServerWriter<v1::AttachEvent>* writer) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Attach"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
   const std::string& worker_id = request->worker_id();
   if (!scheduler_->IsKnownWorker(worker_id)) {
     return ToGrpcStatus(absl::NotFoundError(absl::StrCat("no worker '", worker_id, "': register again")));
@@ -199,8 +245,11 @@ grpc::Status WorkerServiceImpl::Attach(grpc::ServerContext* context, const v1::A
   return grpc::Status::CANCELLED;
 }
 
-grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const v1::HeartbeatRequest* request,
+grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context, const v1::HeartbeatRequest* request,
                                           v1::HeartbeatResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Heartbeat"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
   std::vector<std::string> task_ids(request->task_ids().begin(), request->task_ids().end());
   scheduler::HeartbeatReply reply = scheduler_->Heartbeat(request->worker_id(), task_ids);
   response->set_known(reply.known);

@@ -8,6 +8,7 @@
 
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
+#include "server/service/call_authorizer.h"
 #include "server/scheduler/scheduler.h"
 #include "server/jobs/manager/job_manager.h"
 #include "spec/limits.h"
@@ -16,7 +17,8 @@ namespace mbopt::service {
 
 class JobServiceImpl final : public v1::JobService::Service {
  public:
-  explicit JobServiceImpl(JobManager* manager) : manager_(manager) {}
+  // `authorizer` is not owned and must outlive the service.
+  JobServiceImpl(JobManager* manager, const CallAuthorizer* authorizer) : manager_(manager), authorizer_(authorizer) {}
 
   // What Submit takes: a study message no larger than its two files may be
   // (spec/limits.h), and a source name of a path's length.
@@ -34,7 +36,11 @@ class JobServiceImpl final : public v1::JobService::Service {
   grpc::Status Resume(grpc::ServerContext* context, const v1::JobRef* request, v1::JobSummary* response) override;
 
  private:
+  // OK when the caller may see the job (which exists).
+  absl::Status CheckJobAccess(const grpc::ServerContext& context, const char* method, const std::string& job_id) const;
+
   JobManager* manager_;
+  const CallAuthorizer* authorizer_;
 };
 
 class WorkerServiceImpl final : public v1::WorkerService::Service {
@@ -42,8 +48,12 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   // The clock is the scheduler's (lease deadlines are on it).
   // `max_message_bytes` is what workers are told the server receives.
   WorkerServiceImpl(JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock,
-                    std::int64_t max_message_bytes)
-      : manager_(manager), scheduler_(scheduler), clock_(clock), max_message_bytes_(max_message_bytes) {}
+                    std::int64_t max_message_bytes, const CallAuthorizer* authorizer)
+      : manager_(manager),
+        scheduler_(scheduler),
+        clock_(clock),
+        max_message_bytes_(max_message_bytes),
+        authorizer_(authorizer) {}
 
   grpc::Status Register(grpc::ServerContext* context, const v1::RegisterWorkerRequest* request,
                         v1::RegisterWorkerResponse* response) override;
@@ -74,6 +84,7 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
 
   const scheduler::Clock* clock_;
   std::int64_t max_message_bytes_;
+  const CallAuthorizer* authorizer_;
 };
 
 }  // namespace mbopt::service

@@ -4,10 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <fstream>
+#include <optional>
+#include <sstream>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
+#include "server/auth/certificates.h"
+#include "server/auth/token_table.h"
 #include "server/lp/make_clp_lp_solver.h"
 #include "server/service/listen_address.h"
 #include "server/service/proto_convert.h"
@@ -22,20 +27,72 @@ constexpr auto kGrpcShutdownGrace = std::chrono::milliseconds(1000);
 // The least time between two returns of freed memory to the system.
 constexpr auto kTrimInterval = std::chrono::seconds(2);
 
+absl::StatusOr<std::string> ReadPemFile(const std::string& path, const char* option) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat(option, ": cannot read ", path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 }  // namespace
 
 MboptServer::MboptServer(ServerOptions options) : options_(std::move(options)) {}
 
-absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions options) {
-  if (!options.insecure && !IsLoopbackAddress(options.listen_address)) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "refusing to listen on ", options.listen_address,
-        ": it is reachable from other machines, and connections have neither TLS nor authentication: anyone who "
-        "reaches the port could submit, read and cancel jobs and report results. Listen on 127.0.0.1 (and reach it "
-        "through an SSH tunnel or a VPN, deploy/README.md), or pass --insecure on a network you trust"));
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecurity() {
+  std::optional<auth::TokenTable> tokens;
+  if (!options_.tokens_file.empty()) {
+    MBOPT_ASSIGN_OR_RETURN(tokens, auth::TokenTable::Load(options_.tokens_file));
+    if (tokens->size() == 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(options_.tokens_file, ": no tokens in the table: nobody could call the server"));
+    }
   }
+  const bool tls = !options_.tls_cert_file.empty() || !options_.tls_key_file.empty();
+  if (!IsLoopbackAddress(options_.listen_address) && !options_.insecure && (!tls || !tokens)) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "refusing to listen on ", options_.listen_address, ": it is reachable from other machines, and ",
+        !tls && !tokens ? "connections would have neither TLS nor tokens" : !tls ? "connections would have no TLS"
+                                                                              : "callers would need no token",
+        ": anyone who reaches the port could submit, read and cancel jobs and report results. Give --tls-dir DIR "
+        "(made by `mbopt-server init-tls DIR`), or listen on 127.0.0.1, or pass --insecure on a network you trust "
+        "(docs/server.md, \"Security\")"));
+  }
+  if (!options_.worker_ca_file.empty() && !tls) {
+    return absl::InvalidArgumentError("--worker-ca verifies workers' certificates over TLS: it needs --tls-cert and "
+                                      "--tls-key (or --tls-dir)");
+  }
+  authorizer_ = std::make_unique<CallAuthorizer>(std::move(tokens), !options_.worker_ca_file.empty());
+  if (!tls) return grpc::InsecureServerCredentials();
+  if (options_.tls_cert_file.empty() || options_.tls_key_file.empty()) {
+    return absl::InvalidArgumentError("TLS needs both the certificate (--tls-cert) and its key (--tls-key)");
+  }
+  MBOPT_ASSIGN_OR_RETURN(std::string certificate, ReadPemFile(options_.tls_cert_file, "--tls-cert"));
+  MBOPT_ASSIGN_OR_RETURN(std::string key, ReadPemFile(options_.tls_key_file, "--tls-key"));
+  MBOPT_RETURN_IF_ERROR(
+      auth::CheckKeyMatchesCertificate(certificate, key, options_.tls_cert_file, options_.tls_key_file));
+  MBOPT_ASSIGN_OR_RETURN(auth::CertificateInfo info, auth::InspectCertificate(certificate, options_.tls_cert_file));
+  if (info.expired) {
+    return absl::FailedPreconditionError(absl::StrCat("the server certificate ", options_.tls_cert_file,
+                                                      " expired on ", info.not_after,
+                                                      ": clients would refuse it. Make a new one (deploy/README.md)"));
+  }
+  grpc::SslServerCredentialsOptions ssl;
+  ssl.pem_key_cert_pairs.push_back({key, certificate});
+  if (!options_.worker_ca_file.empty()) {
+    MBOPT_ASSIGN_OR_RETURN(ssl.pem_root_certs, ReadPemFile(options_.worker_ca_file, "--worker-ca"));
+    MBOPT_RETURN_IF_ERROR(auth::InspectCertificate(ssl.pem_root_certs, options_.worker_ca_file).status());
+    // Verified when given, not required: users' clients have none; worker
+    // calls check for one (call_authorizer.h).
+    ssl.client_certificate_request = GRPC_SSL_REQUEST_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  return grpc::SslServerCredentials(ssl);
+}
+
+absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions options) {
   std::unique_ptr<MboptServer> server(new MboptServer(std::move(options)));
   MboptServer& s = *server;
+  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<grpc::ServerCredentials> credentials, s.LoadSecurity());
   if (s.options_.clock == nullptr) {
     s.own_clock_ = std::make_unique<scheduler::SteadyClock>();
     s.clock_ = s.own_clock_.get();
@@ -54,16 +111,16 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   s.manager_ = std::make_unique<JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, manager_options);
   MBOPT_RETURN_IF_ERROR(s.manager_->Start());
 
-  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get());
+  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get(), s.authorizer_.get());
   s.worker_service_ = std::make_unique<WorkerServiceImpl>(s.manager_.get(), s.scheduler_.get(), s.clock_,
-                                                         s.options_.max_message_bytes);
+                                                         s.options_.max_message_bytes, s.authorizer_.get());
   grpc::ServerBuilder builder;
   // Without this, gRPC on Linux binds with SO_REUSEPORT and a second server
   // on a port in use would silently share it instead of failing.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.SetMaxSendMessageSize(static_cast<int>(s.options_.max_message_bytes));
-  builder.AddListeningPort(s.options_.listen_address, grpc::InsecureServerCredentials(), &s.port_);
+  builder.AddListeningPort(s.options_.listen_address, credentials, &s.port_);
   builder.RegisterService(s.job_service_.get());
   builder.RegisterService(s.worker_service_.get());
   s.grpc_server_ = builder.BuildAndStart();
@@ -104,6 +161,19 @@ void MboptServer::ReaperLoop(std::int64_t interval_ms) {
     }
     lock.lock();
   }
+}
+
+absl::StatusOr<std::size_t> MboptServer::ReloadTokens() {
+  if (!authorizer_->needs_tokens()) {
+    return absl::FailedPreconditionError("the server was started without a token table (--tokens or --tls-dir)");
+  }
+  MBOPT_ASSIGN_OR_RETURN(auth::TokenTable tokens, auth::TokenTable::Load(options_.tokens_file));
+  if (tokens.size() == 0) {
+    return absl::InvalidArgumentError(absl::StrCat(options_.tokens_file, ": no tokens in the table"));
+  }
+  const std::size_t count = tokens.size();
+  authorizer_->ReplaceTokens(std::move(tokens));
+  return count;
 }
 
 std::shared_ptr<grpc::Channel> MboptServer::InProcessChannel() {

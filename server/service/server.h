@@ -31,8 +31,17 @@ namespace mbopt::service {
 
 struct ServerOptions {
   std::string listen_address = "127.0.0.1:50051";  // port 0: the OS picks
-  // Allows an address reachable from other machines although connections
-  // have no TLS or authentication (listen_address.h).
+  // TLS: the server's certificate and key (PEM files); both or neither.
+  std::string tls_cert_file;
+  std::string tls_key_file;
+  // With TLS: client certificates are verified against this CA, and worker
+  // calls must come with one (mutual TLS for workers).
+  std::string worker_ca_file;
+  // The table of accepted tokens (server/auth/token_table.h); empty: none,
+  // every caller may do everything.
+  std::string tokens_file;
+  // Allows an address reachable from other machines without TLS and
+  // tokens (listen_address.h).
   bool insecure = false;
   std::string db_path = "mbopt.db";
   std::int64_t lease_ms = 30'000;
@@ -63,11 +72,18 @@ class MboptServer {
   JobManager& manager() { return *manager_; }
   scheduler::Scheduler& scheduler() { return *scheduler_; }
 
+  // Reads the token table file again and uses it for the calls that start
+  // after (SIGHUP of mbopt-server). On error the table in use stays.
+  // Returns the number of tokens.
+  absl::StatusOr<std::size_t> ReloadTokens();
+
   // Graceful stop (see above). Idempotent.
   void Shutdown();
 
  private:
   explicit MboptServer(ServerOptions options);
+  // The listening credentials and the authorizer, from the options' files.
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> LoadSecurity();
   void ReaperLoop(std::int64_t interval_ms);
   void StopThreads();
 
@@ -77,6 +93,7 @@ class MboptServer {
   std::unique_ptr<store::Store> store_;
   std::unique_ptr<scheduler::Scheduler> scheduler_;
   std::unique_ptr<JobManager> manager_;
+  std::unique_ptr<CallAuthorizer> authorizer_;
   std::unique_ptr<JobServiceImpl> job_service_;
   std::unique_ptr<WorkerServiceImpl> worker_service_;
   std::unique_ptr<grpc::Server> grpc_server_;

@@ -28,6 +28,7 @@ struct JobRow {
   std::int32_t cycles = 0;      // cycles completed
   std::int64_t analyses = 0;    // analyses consumed by the optimizer
   double wall_seconds = 0;      // running time, not counting interruptions
+  std::string owner;            // who submitted it (a token's name); "" on a server without tokens
 };
 
 

@@ -113,6 +113,12 @@ CREATE TABLE job_sequence (
 INSERT INTO job_sequence(last_seq) SELECT coalesce(max(seq), 0) FROM jobs;
 UPDATE schema_version SET version = 4;
 )sql",
+    // 4 -> 5: who submitted each job (the name of the token's holder), so a
+    // user sees only their own jobs. Jobs of servers without tokens have none.
+    R"sql(
+ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';
+UPDATE schema_version SET version = 5;
+)sql",
 };
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kSchemaVersion - 1,
               "one migration step per schema version after the first");
@@ -213,12 +219,13 @@ JobRow ReadJob(const Statement& stmt) {
   job.cycles = static_cast<std::int32_t>(stmt.ColumnInt(10));
   job.analyses = stmt.ColumnInt(11);
   job.wall_seconds = stmt.ColumnDouble(12);
+  job.owner = stmt.ColumnText(13);
   return job;
 }
 
 constexpr const char* kJobColumns =
     "id, seq, study_name, source_name, study, state, message, created_unix_ms, "
-    "updated_unix_ms, records, cycles, analyses, wall_seconds";
+    "updated_unix_ms, records, cycles, analyses, wall_seconds, owner";
 
 }  // namespace
 
@@ -309,7 +316,7 @@ absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {
     stored.id = absl::StrCat("job-", stored.seq);
     MBOPT_ASSIGN_OR_RETURN(Statement stmt,
                            Statement::Prepare(db_, absl::StrCat("INSERT INTO jobs(", kJobColumns,
-                                                                ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)")));
+                                                                ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?)")));
     stmt.BindText(1, stored.id);
     stmt.BindInt(2, stored.seq);
     stmt.BindText(3, stored.study_name);
@@ -323,6 +330,7 @@ absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {
     stmt.BindInt(11, stored.cycles);
     stmt.BindInt(12, stored.analyses);
     stmt.BindDouble(13, stored.wall_seconds);
+    stmt.BindText(14, stored.owner);
     return stmt.Run();
   }));
   return stored;

@@ -293,6 +293,32 @@ std::int64_t SchemaVersionOf(const std::string& path) {
   return version;
 }
 
+// Who submitted a job is kept with it; a job from before owners (version 4)
+// reads as having none.
+TEST_F(StoreTest, JobOwnerIsKeptAndOlderJobsHaveNone) {
+  std::string job_id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    JobRow owned = SampleJob();
+    owned.owner = "alice";
+    job_id = (*store)->CreateJob(owned)->id;
+    EXPECT_EQ((*store)->GetJob(job_id)->owner, "alice");
+  }
+  // Exactly the version 4 layout.
+  RunSql(path_, "ALTER TABLE jobs DROP COLUMN owner; UPDATE schema_version SET version = 4;");
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  EXPECT_EQ((*store)->GetJob(job_id)->owner, "");
+  JobRow again = SampleJob();
+  again.owner = "bob";
+  const std::string bob_id = (*store)->CreateJob(again)->id;
+  EXPECT_EQ((*store)->GetJob(bob_id)->owner, "bob");
+  EXPECT_EQ((*store)->ListJobs()->size(), 2u);
+  store->reset();  // closes the database, which it holds locked
+  EXPECT_EQ(SchemaVersionOf(path_), kSchemaVersion);
+}
+
 // A database written by the first release (schema version 1: analyses
 // without gradient columns) opens, is migrated to the current version, keeps
 // its analyses bit for bit (without gradients) and takes new ones with them.
@@ -321,6 +347,7 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
          "ALTER TABLE analyses DROP COLUMN gradients_unavailable;"
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
          "DROP TABLE job_sequence;"
+         "ALTER TABLE jobs DROP COLUMN owner;"
          "UPDATE schema_version SET version = 1;");
   ASSERT_EQ(SchemaVersionOf(path_), 1);
 
@@ -371,6 +398,7 @@ TEST_F(StoreTest, VersionTwoFailuresBecomeUnclassified) {
   RunSql(path_,
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
          "DROP TABLE job_sequence;"
+         "ALTER TABLE jobs DROP COLUMN owner;"
          "UPDATE schema_version SET version = 2;");
   auto store = Store::Open(path_);
   ASSERT_TRUE(store.ok()) << store.status();

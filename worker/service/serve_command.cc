@@ -23,9 +23,20 @@ bool ParseInt(const std::string& text, int min, int* out) {
 
 const char* ServeUsage() {
   return "usage: mbopt-worker serve --server HOST:PORT [--slots N] [--name NAME]\n"
-         "       mbopt-worker --server HOST:PORT [--slots N] [--name NAME]\n"
+         "                          [--tls-ca FILE [--tls-cert FILE --tls-key FILE]] [--token-file FILE]\n"
+         "       mbopt-worker --server HOST:PORT ... (the same)\n"
          "  --slots N            analyses run at once (default 1)\n"
          "  --name NAME          name shown by the server (default host:pid)\n"
+         "  --tls-ca FILE        connect over TLS, trusting the server's certificate\n"
+         "                       if this CA signed it (env MBOPT_TLS_CA)\n"
+         "  --tls-cert FILE, --tls-key FILE  this worker's client certificate and key,\n"
+         "                       for a server with --worker-ca (env MBOPT_TLS_CERT, MBOPT_TLS_KEY)\n"
+         "  --tls-server-name N  the name the server's certificate must carry, when\n"
+         "                       --server is another (a tunnel; env MBOPT_TLS_SERVER_NAME)\n"
+         "  --token-file FILE    the worker token (env MBOPT_TOKEN_FILE, or MBOPT_TOKEN\n"
+         "                       holding the token); never on the command line\n"
+         "  Exit status: 0 stopped by a signal, 2 bad options, 3 the server refused the\n"
+         "  token or the first connection failed for a reason of this configuration.\n"
          "  --verbose            one line on stderr per task\n"
          "  --die-after-tasks N  testing only: SIGKILL this process on receiving the\n"
          "                       N-th task, before reporting it\n";
@@ -33,6 +44,7 @@ const char* ServeUsage() {
 
 int ServeMain(const std::vector<std::string>& args) {
   WorkerOptions options;
+  secure_channel::ClientSecurityFlags security_flags;
   for (size_t i = 0; i < args.size(); ++i) {
     std::string name = args[i], value;
     bool inline_value = false;
@@ -56,6 +68,9 @@ int ServeMain(const std::vector<std::string>& args) {
     } else if (name == "--name") {
       ok = need_value();
       options.name = value;
+    } else if (name == "--tls-ca" || name == "--tls-cert" || name == "--tls-key" || name == "--tls-server-name" ||
+               name == "--token-file") {
+      ok = need_value() && secure_channel::SetSecurityFlag(name, value, &security_flags);
     } else if (name == "--die-after-tasks") {
       ok = need_value() && ParseInt(value, 0, &options.die_after_tasks);
     } else if (name == "--verbose" && !inline_value) {
@@ -78,13 +93,20 @@ int ServeMain(const std::vector<std::string>& args) {
     std::fprintf(stderr, "mbopt-worker: --server HOST:PORT is required\n%s", ServeUsage());
     return 2;
   }
+  secure_channel::QuietGrpcLogUnlessAsked();
+  absl::StatusOr<secure_channel::ClientSecurity> security = secure_channel::LoadClientSecurity(security_flags);
+  if (!security.ok()) {
+    std::fprintf(stderr, "mbopt-worker: %s\n", std::string(security.status().message()).c_str());
+    return 2;
+  }
+  options.security = *std::move(security);
   // Leaked on purpose: the signal thread may outlive this function.
   auto* stop = new StopSignal();
   StopOnTerminationSignals(stop);
   absl::Status status = RunWorker(options, *stop);
   if (!status.ok()) {
     std::fprintf(stderr, "mbopt-worker: %s\n", std::string(status.message()).c_str());
-    return 2;
+    return absl::IsPermissionDenied(status) ? 3 : 2;
   }
   return 0;
 }

@@ -19,6 +19,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/strings/str_cat.h"
+#include "common/secure_channel/connection_diagnosis.h"
 #include "mbopt/v1/service.grpc.pb.h"
 #include "worker/service/result_size.h"
 #include "worker/service/task_evaluator.h"
@@ -102,8 +103,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
     if (options_.name.empty()) options_.name = DefaultName();
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(256 * 1024 * 1024);
-    stub_ = v1::WorkerService::NewStub(grpc::CreateCustomChannel(
-        options_.server_address, grpc::InsecureChannelCredentials(), args));
+    stub_ = v1::WorkerService::NewStub(secure_channel::CreateChannel(options_.server_address, options_.security, args));
   }
 
   void Run() {
@@ -121,7 +121,34 @@ class Worker : public std::enable_shared_from_this<Worker> {
     Log(absl::StrCat("stopped after ", tasks_received_, " tasks"));
   }
 
+  // Why the worker stopped on its own (Denied, Fatal); OK otherwise.
+  absl::Status fatal() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return fatal_;
+  }
+
  private:
+
+  // A refusal of the token (missing, wrong, revoked, not a worker's) stops
+  // the worker: retrying cannot help. Returns whether `status` is one.
+  bool Denied(const grpc::Status& status) {
+    if (status.error_code() != grpc::StatusCode::UNAUTHENTICATED &&
+        status.error_code() != grpc::StatusCode::PERMISSION_DENIED) {
+      return false;
+    }
+    Fatal(absl::StrCat("server at ", options_.server_address, " refused this worker: ", status.error_message()));
+    return true;
+  }
+
+  void Fatal(const std::string& message) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!fatal_.ok()) return;
+      fatal_ = absl::PermissionDeniedError(message);
+    }
+    stop_.Stop();
+  }
+
   void Log(const std::string& message) {
     std::fprintf(stderr, "mbopt-worker %s: %s\n", options_.name.c_str(), message.c_str());
   }
@@ -145,6 +172,14 @@ class Worker : public std::enable_shared_from_this<Worker> {
     ScopedCall scoped(calls_, &context);
     grpc::Status status = stub_->Register(&context, request, &response);
     if (!status.ok()) {
+      if (Denied(status)) return false;
+      if (!ever_registered_ && status.error_code() == grpc::StatusCode::UNAVAILABLE && !stop_.stopped()) {
+        const std::string cause = secure_channel::DiagnoseConnectionFailure(options_.server_address, options_.security);
+        if (!cause.empty()) {
+          Fatal(absl::StrCat("cannot connect to server at ", options_.server_address, ": ", cause));
+          return false;
+        }
+      }
       if (!unreachable_logged_ && !stop_.stopped()) {
         Log(absl::StrCat("cannot reach server at ", options_.server_address, ": ",
                          status.error_message(), "; retrying"));
@@ -153,6 +188,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
       return false;
     }
     unreachable_logged_ = false;
+    ever_registered_ = true;
     std::lock_guard<std::mutex> lock(mutex_);
     worker_id_ = response.worker_id();
     heartbeat_ms_ = response.heartbeat_interval_ms() > 0 ? response.heartbeat_interval_ms()
@@ -211,7 +247,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
         status = stub_->AcquireTasks(&context, request, &response);
       }
       if (!status.ok()) {
-        if (stop_.stopped()) break;
+        if (stop_.stopped() || Denied(status)) break;
         if (status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED) {
           // The server restarted, forgot us, or is gone: register again
           // (which waits for it to come back).
@@ -497,7 +533,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
   std::map<std::string, std::string> study_errors_;
 
   int tasks_received_ = 0;  // guarded by mutex_
+  absl::Status fatal_;      // guarded by mutex_
   bool unreachable_logged_ = false;  // acquiring thread only
+  bool ever_registered_ = false;     // acquiring thread only
 };
 
 }  // namespace
@@ -514,7 +552,7 @@ absl::Status RunWorker(const WorkerOptions& options, StopSignal& stop) {
   }
   auto worker = std::make_shared<Worker>(options, stop);
   worker->Run();
-  return absl::OkStatus();
+  return worker->fatal();
 }
 
 }  // namespace mbopt::worker

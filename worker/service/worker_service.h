@@ -14,6 +14,7 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "common/secure_channel/client_security.h"
 #include "worker/service/backoff.h"
 #include "worker/service/stop_signal.h"
 
@@ -21,6 +22,8 @@ namespace mbopt::worker {
 
 struct WorkerOptions {
   std::string server_address;  // host:port
+  // TLS and token (common/secure_channel/client_security.h).
+  secure_channel::ClientSecurity security;
   int slots = 1;               // analyses at once
   std::string name;            // shown on the server; empty: host:pid
   // Long-poll length of AcquireTasks.
@@ -35,7 +38,11 @@ struct WorkerOptions {
 
 // Runs until `stop` is requested; then lets running analyses finish, reports
 // their results if the server is there, and returns OK. InvalidArgument for
-// bad options.
+// bad options. PermissionDenied when the server refuses the worker's token
+// (at any time), or when the first connection fails for a reason that is
+// the worker's configuration (a certificate it does not trust, a port
+// without TLS, ...): a misconfigured worker stops at once instead of
+// retrying forever. Once registered, a lost server is waited for.
 absl::Status RunWorker(const WorkerOptions& options, StopSignal& stop);
 
 }  // namespace mbopt::worker

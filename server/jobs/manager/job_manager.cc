@@ -230,7 +230,8 @@ absl::Status JobManager::Start() {
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, const std::string& source_name) {
+absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, const std::string& source_name,
+                                               const std::string& owner) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
@@ -240,6 +241,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   store::JobRow row;
   row.study_name = study.name;
   row.source_name = source_name;
+  row.owner = owner;
   row.study = study_bytes;
   row.state = jobs::JobStateName(JobState::kRunning);
   MBOPT_ASSIGN_OR_RETURN(store::JobRow stored, store_->CreateJob(row));
@@ -490,6 +492,7 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   JobSummaryData s;
   s.job_id = entry.row.id;
   s.study_name = entry.row.study_name;
+  s.owner = entry.row.owner;
   s.state = entry.state;
   s.message = entry.message;
   s.created_unix_ms = entry.row.created_unix_ms;
@@ -591,6 +594,12 @@ absl::StatusOr<std::vector<JobSummaryData>> JobManager::List() {
   std::vector<JobSummaryData> summaries;
   for (auto& [seq, summary] : ordered) summaries.push_back(std::move(summary));
   return summaries;
+}
+
+absl::StatusOr<std::string> JobManager::OwnerOf(const std::string& job_id) {
+  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
+  std::lock_guard<std::mutex> lock(entry->mutex);
+  return entry->row.owner;
 }
 
 absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id) {

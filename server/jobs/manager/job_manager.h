@@ -62,6 +62,7 @@ struct JobManagerOptions {
 struct JobSummaryData {
   std::string job_id;
   std::string study_name;
+  std::string owner;  // who submitted it; "" on a server without tokens
   jobs::JobState state = jobs::JobState::kQueued;
   int cycles = 0;
   std::int64_t analyses = 0;
@@ -115,8 +116,12 @@ class JobManager {
   // fails is marked FAILED with the reason; the others go on.
   absl::Status Start();
 
-  // Validates and starts a study. InvalidArgument from the decoder.
-  absl::StatusOr<std::string> Submit(const std::string& study_bytes, const std::string& source_name);
+  // Validates and starts a study. InvalidArgument from the decoder. `owner`
+  // is the name of who submitted it ("" on a server without tokens).
+  absl::StatusOr<std::string> Submit(const std::string& study_bytes, const std::string& source_name,
+                                     const std::string& owner = "");
+  // Who submitted the job. NotFound naming the id for an unknown job.
+  absl::StatusOr<std::string> OwnerOf(const std::string& job_id);
 
   // NotFound naming the id for an unknown job.
   absl::StatusOr<JobView> Get(const std::string& job_id, std::size_t first_record = 0);

@@ -1,0 +1,91 @@
+#include "server/service/call_authorizer.h"
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+
+namespace mbopt::service {
+namespace {
+
+constexpr std::string_view kBearer = "Bearer ";
+
+}  // namespace
+
+CallAuthorizer::CallAuthorizer(std::optional<auth::TokenTable> tokens, bool workers_need_certificate)
+    : needs_tokens_(tokens.has_value()), workers_need_certificate_(workers_need_certificate) {
+  if (tokens) tokens_ = std::make_shared<const auth::TokenTable>(*std::move(tokens));
+}
+
+void CallAuthorizer::ReplaceTokens(auth::TokenTable tokens) {
+  auto table = std::make_shared<const auth::TokenTable>(std::move(tokens));
+  std::lock_guard<std::mutex> lock(mutex_);
+  tokens_ = std::move(table);
+}
+
+absl::StatusOr<auth::Principal> CallAuthorizer::Identify(const grpc::ServerContext& context) const {
+  if (!needs_tokens_) return auth::Principal{auth::Role::kAdmin, ""};
+  std::shared_ptr<const auth::TokenTable> tokens;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tokens = tokens_;
+  }
+  const auto& metadata = context.client_metadata();
+  const auto header = metadata.find("authorization");
+  if (header == metadata.end()) {
+    return absl::UnauthenticatedError(
+        "this server needs a token with every call: give it with --token-file FILE or MBOPT_TOKEN_FILE "
+        "(docs/server.md, \"Security\")");
+  }
+  const std::string_view value(header->second.data(), header->second.size());
+  if (value.substr(0, kBearer.size()) != kBearer) {
+    return absl::UnauthenticatedError("the authorization header is not `Bearer TOKEN`");
+  }
+  // The token itself is never put in a message: messages reach logs.
+  std::optional<auth::Principal> principal = tokens->Find(value.substr(kBearer.size()));
+  if (!principal) {
+    return absl::UnauthenticatedError(
+        "the token given is not one this server accepts (wrong token file, or the token was revoked)");
+  }
+  return *principal;
+}
+
+absl::StatusOr<auth::Principal> CallAuthorizer::ForJobs(const grpc::ServerContext& context,
+                                                        const char* method) const {
+  absl::StatusOr<auth::Principal> principal = Identify(context);
+  if (principal.ok() && principal->role == auth::Role::kWorker) {
+    return absl::PermissionDeniedError(absl::StrCat(
+        "a worker token may only acquire tasks and report results; ", method, " needs a user or admin token"));
+  }
+  return principal;
+}
+
+absl::StatusOr<auth::Principal> CallAuthorizer::ForWorkers(const grpc::ServerContext& context,
+                                                           const char* method) const {
+  absl::StatusOr<auth::Principal> principal = Identify(context);
+  if (!principal.ok()) return principal;
+  if (needs_tokens_ && principal->role != auth::Role::kWorker) {
+    return absl::PermissionDeniedError(absl::StrCat(
+        "a ", auth::RoleName(principal->role), " token cannot act as a worker; ", method, " needs a worker token"));
+  }
+  if (workers_need_certificate_) {
+    const std::shared_ptr<const grpc::AuthContext> auth = context.auth_context();
+    if (auth == nullptr || !auth->IsPeerAuthenticated()) {
+      return absl::UnauthenticatedError(absl::StrCat(
+          method, " needs a client certificate signed by the server's worker CA (mbopt-worker --tls-cert and "
+                  "--tls-key)"));
+    }
+  }
+  return principal;
+}
+
+bool CallAuthorizer::MaySee(const auth::Principal& principal, const std::string& owner) {
+  return principal.role == auth::Role::kAdmin || principal.name == owner;
+}
+
+absl::Status CallAuthorizer::CheckMaySee(const auth::Principal& principal, const std::string& job_id,
+                                         const std::string& owner) {
+  if (MaySee(principal, owner)) return absl::OkStatus();
+  return absl::PermissionDeniedError(absl::StrCat(
+      "job '", job_id, "' was submitted by another user; only its owner or an admin may see, cancel or resume it"));
+}
+
+}  // namespace mbopt::service

@@ -1,0 +1,156 @@
+// The secure set-up as deploy/README.md gives it, with real processes on
+// loopback: `mbopt-server init-tls`, a server with --tls-dir, a worker and
+// the CLI with the CA and their tokens. Also what each program says, and
+// which exit code it gives, when the CA or the token is missing or wrong.
+#include <sys/stat.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+#include "client/exit_codes.h"
+#include "client/subprocess.h"
+#include "tests/e2e/e2e_harness.h"
+
+namespace mbopt::e2e {
+namespace {
+
+using client::kExitBadInput;
+using client::kExitDenied;
+using client::kExitOk;
+using client::kExitUnreachable;
+using client::Subprocess;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+std::string Describe(const Subprocess::Output& out) {
+  return absl::StrCat("exit ", out.exit_code, "\nstdout:\n", out.stdout_text, "\nstderr:\n", out.stderr_text);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+unsigned Mode(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) return 0;
+  return info.st_mode & 0777;
+}
+
+int Lines(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
+
+// A worker run to its exit (it is expected to stop on its own).
+Subprocess::Output RunWorker(const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
+  std::vector<std::string> argv = {WorkerBinary(), "serve"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  absl::StatusOr<Subprocess::Output> out = client::RunCommand(argv, kGuard, env);
+  if (!out.ok()) return Subprocess::Output{-1, "", std::string(out.status().message())};
+  return *out;
+}
+
+TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
+  ScratchDir dir;
+  const std::string pki = dir.File("pki");
+  absl::StatusOr<Subprocess::Output> made = client::RunCommand(
+      {ServerBinary(), "init-tls", pki, "--host", "localhost", "--host", "127.0.0.1", "--user", "alice"}, kGuard);
+  ASSERT_TRUE(made.ok()) << made.status();
+  ASSERT_EQ(made->exit_code, 0) << Describe(*made);
+  EXPECT_THAT(made->stdout_text, HasSubstr("--tls-dir " ));
+  for (const char* secret : {"ca.key", "server.key", "worker.key", "worker.token", "admin.token", "alice.token", "tokens"}) {
+    EXPECT_EQ(Mode(pki + "/" + secret), 0600u) << secret;
+  }
+  EXPECT_EQ(Mode(pki), 0700u);
+  // Never over an existing installation.
+  absl::StatusOr<Subprocess::Output> again = client::RunCommand({ServerBinary(), "init-tls", pki}, kGuard);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->exit_code, 1);
+  EXPECT_THAT(again->stderr_text, HasSubstr("exists already; not overwritten"));
+
+  auto server = StartServer(dir.File("jobs.db"), {"--tls-dir", pki}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  const std::string addr = server->address;
+  Subprocess worker = StartWorker(addr, {"--tls-ca", pki + "/ca.pem", "--token-file", pki + "/worker.token"},
+                                  dir.File("worker.log"));
+  const std::vector<std::string> alice = {"MBOPT_TLS_CA=" + pki + "/ca.pem", "MBOPT_TOKEN_FILE=" + pki + "/alice.token"};
+
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--watch", "--server", addr}, alice);
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  auto secure = Mbopt({"results", "job-1", "--json", "--server", addr}, alice);
+  ASSERT_EQ(secure.exit_code, kExitOk) << Describe(secure);
+  // The same result as the private server of `mbopt run`, which has neither
+  // TLS nor tokens; the settings in the environment do not reach it.
+  auto plain = Mbopt({"run", VehicleStudy(), "--json", "--workers", "1", "--discard-db"}, alice);
+  ASSERT_EQ(plain.exit_code, kExitOk) << Describe(plain);
+  for (const char* key : {"status", "cycles", "analyses", "objective", "max_violation"}) {
+    EXPECT_EQ(JsonField(secure.stdout_text, key), JsonField(plain.stdout_text, key)) << key;
+  }
+  EXPECT_THAT(secure.stdout_text, HasSubstr("\"design\""));
+
+  // Options instead of the environment; the admin sees the job.
+  auto listed = Mbopt({"list", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file", pki + "/admin.token"});
+  EXPECT_EQ(listed.exit_code, kExitOk) << Describe(listed);
+  EXPECT_THAT(listed.stdout_text, HasSubstr("job-1"));
+
+  // Refusals: one line each, with the exit code that says which.
+  auto no_token = Mbopt({"list", "--server", addr, "--tls-ca", pki + "/ca.pem"});
+  EXPECT_EQ(no_token.exit_code, kExitDenied) << Describe(no_token);
+  EXPECT_THAT(no_token.stderr_text, HasSubstr("needs a token"));
+  EXPECT_EQ(Lines(no_token.stderr_text), 1) << no_token.stderr_text;
+  const std::string wrong_token_file = dir.Write("wrong.token", "mbopt_00000000\n");
+  auto wrong_token = Mbopt({"status", "job-1", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
+                            wrong_token_file});
+  EXPECT_EQ(wrong_token.exit_code, kExitDenied) << Describe(wrong_token);
+  EXPECT_THAT(wrong_token.stderr_text, HasSubstr("not one this server accepts"));
+  auto worker_as_user = Mbopt({"list", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
+                               pki + "/worker.token"});
+  EXPECT_EQ(worker_as_user.exit_code, kExitDenied) << Describe(worker_as_user);
+  auto no_ca = Mbopt({"list", "--server", addr, "--token-file", pki + "/admin.token"});
+  EXPECT_EQ(no_ca.exit_code, kExitUnreachable) << Describe(no_ca);
+  EXPECT_THAT(no_ca.stderr_text, HasSubstr("speaks TLS: give its CA certificate with --tls-ca"));
+  EXPECT_EQ(Lines(no_ca.stderr_text), 1) << no_ca.stderr_text;
+  auto missing_ca = Mbopt({"list", "--server", addr, "--tls-ca", dir.File("none.pem")});
+  EXPECT_EQ(missing_ca.exit_code, kExitBadInput) << Describe(missing_ca);
+  EXPECT_THAT(missing_ca.stderr_text, HasSubstr("--tls-ca: cannot read"));
+
+  // Workers with a user's token, or without the CA, stop at once and say why.
+  auto user_worker = RunWorker({"--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file", pki + "/alice.token"});
+  EXPECT_EQ(user_worker.exit_code, 3) << Describe(user_worker);
+  EXPECT_THAT(user_worker.stderr_text, HasSubstr("refused this worker: a user token cannot act as a worker"));
+  auto plaintext_worker = RunWorker({"--server", addr}, {"MBOPT_TOKEN_FILE=" + pki + "/worker.token"});
+  EXPECT_EQ(plaintext_worker.exit_code, 3) << Describe(plaintext_worker);
+  EXPECT_THAT(plaintext_worker.stderr_text, HasSubstr("speaks TLS"));
+
+  EXPECT_EQ(worker.Stop(kGuard), 0);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+  // No token ever reaches a log or an output.
+  const std::string logs = ReadFile(dir.File("server.log")) + ReadFile(dir.File("worker.log")) +
+                           submitted.stdout_text + submitted.stderr_text + user_worker.stderr_text;
+  for (const char* file : {"alice.token", "admin.token", "worker.token"}) {
+    std::string token = ReadFile(pki + "/" + file);
+    token.pop_back();
+    EXPECT_THAT(logs, Not(HasSubstr(token))) << file;
+  }
+}
+
+TEST(Secure, ServerRefusesAnAddressOtherMachinesReachWithoutTlsAndTokens) {
+  ScratchDir dir;
+  // Refused before it listens: nothing is opened off loopback.
+  absl::StatusOr<Subprocess::Output> refused = client::RunCommand(
+      {ServerBinary(), "--listen", "0.0.0.0:0", "--db", dir.File("jobs.db")}, kGuard);
+  ASSERT_TRUE(refused.ok());
+  EXPECT_EQ(refused->exit_code, 1);
+  EXPECT_THAT(refused->stderr_text, HasSubstr("neither TLS nor tokens"));
+  EXPECT_THAT(refused->stderr_text, HasSubstr("--tls-dir DIR"));
+  EXPECT_EQ(Lines(refused->stderr_text), 1) << refused->stderr_text;
+}
+
+}  // namespace
+}  // namespace mbopt::e2e

@@ -1,0 +1,378 @@
+// The server with TLS and tokens, on loopback, in process: who may call
+// what, whose jobs each user sees, and what a client that lacks the CA, the
+// token or the right certificate gets (and is told).
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "common/secure_channel/client_security.h"
+#include "common/secure_channel/connection_diagnosis.h"
+#include "mbopt/v1/service.grpc.pb.h"
+#include "server/auth/certificates.h"
+#include "server/auth/token.h"
+#include "server/auth/token_table.h"
+#include "server/service/server.h"
+#include "tests/server/fake_worker.h"
+#include "tests/server/test_study.h"
+
+namespace mbopt::service {
+namespace {
+
+using ::mbopt::testing::FakeWorker;
+using ::mbopt::testing::OscillatorStudy;
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+
+// A deadline for calls expected to fail at the connection: long enough for
+// a handshake on a loaded machine, short enough to keep the test quick.
+constexpr auto kConnectDeadline = std::chrono::seconds(10);
+
+class SecureServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           (std::string("mbopt_secure_") + info->name() + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    ca_ = Make({auth::CertificateKind::kAuthority, "test CA", {}, -3600, 86400}, nullptr);
+    server_certificate_ = Make({auth::CertificateKind::kServer, "server", {"localhost", "127.0.0.1"}, -3600, 86400}, &ca_);
+    worker_certificate_ = Make({auth::CertificateKind::kClient, "worker", {}, -3600, 86400}, &ca_);
+    alice_ = *auth::NewToken();
+    bob_ = *auth::NewToken();
+    admin_ = *auth::NewToken();
+    worker_ = *auth::NewToken();
+    Write("tokens", auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_) +
+                        auth::TokenTable::Line({auth::Role::kUser, "bob"}, bob_) +
+                        auth::TokenTable::Line({auth::Role::kAdmin, "ops"}, admin_) +
+                        auth::TokenTable::Line({auth::Role::kWorker, "workers"}, worker_));
+  }
+  void TearDown() override {
+    server_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  auth::KeyAndCertificate Make(const auth::CertificateRequest& request, const auth::KeyAndCertificate* issuer) {
+    absl::StatusOr<auth::KeyAndCertificate> made = auth::MakeCertificate(request, issuer);
+    EXPECT_TRUE(made.ok()) << made.status();
+    return made.ok() ? *made : auth::KeyAndCertificate{};
+  }
+  std::string Write(const std::string& name, const std::string& content) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path) << content;
+    return path;
+  }
+
+  ServerOptions SecureOptions(const auth::KeyAndCertificate& certificate) {
+    ServerOptions options;
+    options.listen_address = "127.0.0.1:0";
+    options.db_path = (dir_ / "jobs.db").string();
+    options.tls_cert_file = Write("server.pem", certificate.certificate_pem);
+    options.tls_key_file = Write("server.key", certificate.key_pem);
+    options.tokens_file = (dir_ / "tokens").string();
+    return options;
+  }
+  void StartServer(ServerOptions options) {
+    absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(std::move(options));
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+  }
+  void StartSecureServer() { StartServer(SecureOptions(server_certificate_)); }
+
+  // What a client with this CA (empty: plaintext), token and certificate has.
+  secure_channel::ClientSecurity Client(const std::string& token, const std::string& ca_pem,
+                                        const auth::KeyAndCertificate* certificate = nullptr) {
+    secure_channel::ClientSecurity security;
+    security.tls = !ca_pem.empty();
+    security.ca_pem = ca_pem;
+    security.ca_file = "ca.pem";
+    security.token = token;
+    if (certificate != nullptr) {
+      security.cert_pem = certificate->certificate_pem;
+      security.key_pem = certificate->key_pem;
+    }
+    return security;
+  }
+  std::shared_ptr<grpc::Channel> Channel(const secure_channel::ClientSecurity& security) {
+    return secure_channel::CreateChannel(server_->address(), security, grpc::ChannelArguments());
+  }
+  std::unique_ptr<v1::JobService::Stub> Jobs(const std::string& token) {
+    return v1::JobService::NewStub(Channel(Client(token, ca_.certificate_pem)));
+  }
+
+  static grpc::Status Submit(v1::JobService::Stub& jobs, std::string* job_id) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kConnectDeadline);
+    v1::SubmitJobRequest request;
+    *request.mutable_study() = OscillatorStudy();
+    v1::SubmitJobResponse response;
+    grpc::Status status = jobs.Submit(&context, request, &response);
+    *job_id = response.job_id();
+    return status;
+  }
+  static grpc::Status Get(v1::JobService::Stub& jobs, const std::string& job_id, v1::GetJobResponse* response) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kConnectDeadline);
+    v1::JobRef ref;
+    ref.set_job_id(job_id);
+    return jobs.Get(&context, ref, response);
+  }
+  static grpc::Status Cancel(v1::JobService::Stub& jobs, const std::string& job_id) {
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(job_id);
+    v1::JobSummary response;
+    return jobs.Cancel(&context, ref, &response);
+  }
+  static v1::ListJobsResponse List(v1::JobService::Stub& jobs) {
+    grpc::ClientContext context;
+    v1::ListJobsResponse response;
+    grpc::Status status = jobs.List(&context, v1::ListJobsRequest(), &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response;
+  }
+
+  std::filesystem::path dir_;
+  auth::KeyAndCertificate ca_, server_certificate_, worker_certificate_;
+  std::string alice_, bob_, admin_, worker_;
+  std::unique_ptr<MboptServer> server_;
+};
+
+TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
+  StartSecureServer();
+  auto alice = Jobs(alice_);
+  auto bob = Jobs(bob_);
+  auto admin = Jobs(admin_);
+  std::string alices_job, bobs_job;
+  ASSERT_TRUE(Submit(*alice, &alices_job).ok());
+  ASSERT_TRUE(Submit(*bob, &bobs_job).ok());
+
+  // A worker over TLS with the worker token runs both to the end.
+  FakeWorker worker(Channel(Client(worker_, ca_.certificate_pem)), 1);
+  worker.Run();
+  v1::GetJobResponse job;
+  ASSERT_TRUE(Get(*alice, alices_job, &job).ok());
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
+  EXPECT_EQ(job.summary().owner(), "alice");
+
+  // Bob can neither read nor cancel nor resume Alice's job, nor list it.
+  grpc::Status status = Get(*bob, alices_job, &job);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_THAT(status.error_message(), HasSubstr("submitted by another user"));
+  EXPECT_EQ(Cancel(*bob, alices_job).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  {
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(alices_job);
+    v1::JobSummary summary;
+    EXPECT_EQ(bob->Resume(&context, ref, &summary).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  }
+  {
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(alices_job);
+    auto stream = bob->Watch(&context, ref);
+    v1::JobEvent event;
+    EXPECT_FALSE(stream->Read(&event));
+    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  }
+  const v1::ListJobsResponse bobs_list = List(*bob);
+  ASSERT_EQ(bobs_list.jobs_size(), 1);
+  EXPECT_EQ(bobs_list.jobs(0).job_id(), bobs_job);
+  // The admin sees both.
+  EXPECT_EQ(List(*admin).jobs_size(), 2);
+  EXPECT_TRUE(Get(*admin, alices_job, &job).ok());
+}
+
+TEST_F(SecureServerTest, OnlyWorkerTokensActAsWorkersAndWorkerTokensCannotSubmit) {
+  StartSecureServer();
+  std::string job_id;
+  ASSERT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  for (const std::string* token : {&alice_, &admin_}) {
+    auto as_worker = v1::WorkerService::NewStub(Channel(Client(*token, ca_.certificate_pem)));
+    {
+      grpc::ClientContext context;
+      v1::RegisterWorkerRequest request;
+      request.set_name("impostor");
+      request.set_slots(1);
+      v1::RegisterWorkerResponse response;
+      grpc::Status status = as_worker->Register(&context, request, &response);
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+      EXPECT_THAT(status.error_message(), HasSubstr("cannot act as a worker; Register needs a worker token"));
+    }
+    {
+      grpc::ClientContext context;
+      v1::TaskResult result;
+      result.set_job_id(job_id);
+      result.set_task_id(job_id + "/0/1");
+      v1::ReportResultResponse response;
+      grpc::Status status = as_worker->ReportResult(&context, result, &response);
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+      EXPECT_THAT(status.error_message(), HasSubstr("ReportResult needs a worker token"));
+    }
+  }
+  std::string ignored;
+  grpc::Status status = Submit(*Jobs(worker_), &ignored);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_THAT(status.error_message(), HasSubstr("a worker token may only acquire tasks and report results"));
+}
+
+TEST_F(SecureServerTest, MissingOrWrongTokensAreRefusedAndReloadingTheTableRevokes) {
+  StartSecureServer();
+  std::string job_id;
+  grpc::Status status = Submit(*Jobs(""), &job_id);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_THAT(status.error_message(), HasSubstr("needs a token"));
+  status = Submit(*Jobs(*auth::NewToken()), &job_id);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_THAT(status.error_message(), HasSubstr("not one this server accepts"));
+
+  // A new table: Bob revoked, Carol added; calls that start after see it.
+  const std::string carol = *auth::NewToken();
+  Write("tokens", auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_) +
+                      auth::TokenTable::Line({auth::Role::kUser, "carol"}, carol));
+  absl::StatusOr<std::size_t> reloaded = server_->ReloadTokens();
+  ASSERT_TRUE(reloaded.ok()) << reloaded.status();
+  EXPECT_EQ(*reloaded, 2u);
+  EXPECT_EQ(Submit(*Jobs(bob_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_TRUE(Submit(*Jobs(carol), &job_id).ok());
+  // A broken table is refused and the one in use stays.
+  Write("tokens", "user carol not-a-hash\n");
+  EXPECT_THAT(std::string(server_->ReloadTokens().status().message()), HasSubstr("tokens:1:"));
+  EXPECT_TRUE(Submit(*Jobs(carol), &job_id).ok());
+}
+
+TEST_F(SecureServerTest, ClientsWithoutTheCaOrWithPlaintextCannotConnectAndAreToldWhy) {
+  StartSecureServer();
+  // Plaintext, with a valid token: refused at the connection.
+  std::string job_id;
+  auto plaintext = v1::JobService::NewStub(Channel(Client(alice_, "")));
+  EXPECT_EQ(Submit(*plaintext, &job_id).error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_THAT(secure_channel::DiagnoseConnectionFailure(server_->address(), Client(alice_, "")),
+              HasSubstr("speaks TLS: give its CA certificate with --tls-ca"));
+  // TLS trusting another installation's CA.
+  const auth::KeyAndCertificate other_ca = Make({auth::CertificateKind::kAuthority, "other", {}, -60, 86400}, nullptr);
+  auto wrong_ca = v1::JobService::NewStub(Channel(Client(alice_, other_ca.certificate_pem)));
+  EXPECT_EQ(Submit(*wrong_ca, &job_id).error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_THAT(secure_channel::DiagnoseConnectionFailure(server_->address(), Client(alice_, other_ca.certificate_pem)),
+              HasSubstr("is not signed by the CA in ca.pem"));
+  // The right CA: nothing to diagnose.
+  EXPECT_THAT(secure_channel::DiagnoseConnectionFailure(server_->address(), Client(alice_, ca_.certificate_pem)),
+              IsEmpty());
+  EXPECT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+}
+
+TEST_F(SecureServerTest, NoPlaintextHttp2IsAnsweredOnTheTlsPort) {
+  StartSecureServer();
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  timeval timeout{5, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+  // An HTTP/2 client's preface and an empty SETTINGS frame, in the clear.
+  const std::string preface = std::string("PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n") + std::string("\0\0\0\4\0\0\0\0\0", 9);
+  ASSERT_EQ(::send(fd, preface.data(), preface.size(), MSG_NOSIGNAL), static_cast<ssize_t>(preface.size()));
+  char reply[64] = {};
+  const ssize_t got = ::recv(fd, reply, sizeof reply, 0);
+  ::close(fd);
+  // A plaintext HTTP/2 server answers with its SETTINGS frame (type 4 in the
+  // fourth byte); a TLS server closes, or sends a TLS alert (record type 21).
+  if (got >= 4) {
+    EXPECT_NE(reply[3], 4) << "the TLS port answered plaintext HTTP/2";
+    EXPECT_EQ(static_cast<unsigned char>(reply[0]), 21u) << "neither closed nor a TLS alert";
+  } else {
+    EXPECT_LE(got, 0);
+  }
+}
+
+TEST_F(SecureServerTest, ACertificateForOtherHostsOrExpiredIsNamed) {
+  const auth::KeyAndCertificate elsewhere =
+      Make({auth::CertificateKind::kServer, "elsewhere", {"build7.example"}, -3600, 86400}, &ca_);
+  StartServer(SecureOptions(elsewhere));
+  EXPECT_THAT(secure_channel::DiagnoseConnectionFailure(server_->address(), Client(alice_, ca_.certificate_pem)),
+              HasSubstr("the server's certificate (for build7.example) is not made for '127.0.0.1'"));
+  // Through a tunnel, the name the certificate carries is given explicitly.
+  secure_channel::ClientSecurity tunnel = Client(alice_, ca_.certificate_pem);
+  tunnel.server_name = "build7.example";
+  std::string job_id;
+  EXPECT_TRUE(Submit(*v1::JobService::NewStub(Channel(tunnel)), &job_id).ok());
+  server_.reset();
+
+  const auth::KeyAndCertificate expired =
+      Make({auth::CertificateKind::kServer, "old", {"127.0.0.1"}, -7200, -3600}, &ca_);
+  absl::StatusOr<std::unique_ptr<MboptServer>> refused = MboptServer::Start(SecureOptions(expired));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(std::string(refused.status().message()), HasSubstr("server.pem expired on"));
+
+  ServerOptions mismatched = SecureOptions(server_certificate_);
+  mismatched.tls_key_file = Write("other.key", worker_certificate_.key_pem);
+  refused = MboptServer::Start(mismatched);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(std::string(refused.status().message()), HasSubstr("other.key is not the private key of the certificate"));
+}
+
+TEST_F(SecureServerTest, WithAWorkerCaWorkersNeedACertificateAndUsersDoNot) {
+  ServerOptions options = SecureOptions(server_certificate_);
+  options.worker_ca_file = Write("ca.pem", ca_.certificate_pem);
+  StartServer(options);
+  auto register_worker = [&](const secure_channel::ClientSecurity& security) {
+    auto stub = v1::WorkerService::NewStub(Channel(security));
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kConnectDeadline);
+    v1::RegisterWorkerRequest request;
+    request.set_name("w");
+    request.set_slots(1);
+    v1::RegisterWorkerResponse response;
+    return stub->Register(&context, request, &response);
+  };
+  grpc::Status status = register_worker(Client(worker_, ca_.certificate_pem));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_THAT(status.error_message(), HasSubstr("needs a client certificate signed by the server's worker CA"));
+  EXPECT_TRUE(register_worker(Client(worker_, ca_.certificate_pem, &worker_certificate_)).ok());
+  // A certificate from another CA does not get through the handshake.
+  const auth::KeyAndCertificate other_ca = Make({auth::CertificateKind::kAuthority, "other", {}, -60, 86400}, nullptr);
+  const auth::KeyAndCertificate foreign = Make({auth::CertificateKind::kClient, "foreign", {}, -60, 86400}, &other_ca);
+  EXPECT_EQ(register_worker(Client(worker_, ca_.certificate_pem, &foreign)).error_code(),
+            grpc::StatusCode::UNAVAILABLE);
+  // Users' clients have no certificate and need none.
+  std::string job_id;
+  EXPECT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+}
+
+TEST_F(SecureServerTest, AnAddressOtherMachinesReachNeedsTlsAndTokens) {
+  // Refused before anything listens: no socket is opened off loopback.
+  ServerOptions options;
+  options.listen_address = "0.0.0.0:0";
+  options.db_path = (dir_ / "jobs.db").string();
+  absl::StatusOr<std::unique_ptr<MboptServer>> refused = MboptServer::Start(options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(std::string(refused.status().message()), HasSubstr("neither TLS nor tokens"));
+  options.tokens_file = (dir_ / "tokens").string();
+  refused = MboptServer::Start(options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(std::string(refused.status().message()), HasSubstr("connections would have no TLS"));
+  options = SecureOptions(server_certificate_);
+  options.listen_address = "0.0.0.0:0";
+  options.tokens_file.clear();
+  refused = MboptServer::Start(options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(std::string(refused.status().message()), HasSubstr("callers would need no token"));
+}
+
+}  // namespace
+}  // namespace mbopt::service
