@@ -12,6 +12,7 @@ packages=(
   libsundials-dev
   libsqlite3-dev sqlite3
   libssl-dev
+  iproute2
   coinor-libclp-dev
   libgtest-dev libgmock-dev
   libbenchmark-dev

@@ -38,6 +38,7 @@ const char* ServeUsage() {
          "  Exit status: 0 stopped by a signal, 2 bad options, 3 the server refused the\n"
          "  token or the first connection failed for a reason of this configuration.\n"
          "  --verbose            one line on stderr per task\n"
+         "  --task-delay-ms N    testing only: hold each result N ms before reporting it\n"
          "  --die-after-tasks N  testing only: SIGKILL this process on receiving the\n"
          "                       N-th task, before reporting it\n";
 }
@@ -71,6 +72,8 @@ int ServeMain(const std::vector<std::string>& args) {
     } else if (name == "--tls-ca" || name == "--tls-cert" || name == "--tls-key" || name == "--tls-server-name" ||
                name == "--token-file") {
       ok = need_value() && secure_channel::SetSecurityFlag(name, value, &security_flags);
+    } else if (name == "--task-delay-ms") {
+      ok = need_value() && ParseInt(value, 0, &options.task_delay_ms);
     } else if (name == "--die-after-tasks") {
       ok = need_value() && ParseInt(value, 0, &options.die_after_tasks);
     } else if (name == "--verbose" && !inline_value) {

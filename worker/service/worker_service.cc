@@ -322,6 +322,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
         Log(absl::StrCat("task ", task.task_id(), result.ok() ? " ok" : " failed: ",
                          result.ok() ? "" : result.failure_reason()));
       }
+      // After the line above, so that a test reading it knows the worker
+      // holds the result for this long. A stop ends the hold early.
+      if (options_.task_delay_ms > 0 && deliver) stop_.WaitFor(std::chrono::milliseconds(options_.task_delay_ms));
       {
         std::lock_guard<std::mutex> lock(mutex_);
         if (cancelled_[task.task_id()]) deliver = false;

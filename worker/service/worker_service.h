@@ -33,6 +33,10 @@ struct WorkerOptions {
   // N-th task, before evaluating or reporting it (0: never). Recovery tests
   // use it to lose a worker in the middle of a cycle.
   int die_after_tasks = 0;
+  // Testing and benchmarks only: hold each result this long (ms) before
+  // reporting it, as a slower analysis would; the values are unchanged.
+  // The multi-host test uses it to cut links in the middle of a job.
+  int task_delay_ms = 0;
   bool verbose = false;  // a line on stderr per task
 };
 
