@@ -20,6 +20,7 @@ packages=(
   libsimbody-dev
   chromium zlib1g-dev
   clang libclang-rt-14-dev
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()
@@ -37,4 +38,21 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 echo "install-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
+# Slurm's packages would start their daemons, which have no configuration
+# here: the Slurm test runs a private cluster with its own (tests/slurm).
+# So no service is started during this install, and on a machine run by
+# systemd the two Slurm daemons are not enabled at boot.
+policy=/usr/sbin/policy-rc.d
+made_policy=0
+if [ ! -e "$policy" ]; then
+  printf '#!/bin/sh\n# mbopt install-deps: no service starts during its install\nexit 101\n' | $SUDO tee "$policy" > /dev/null
+  $SUDO chmod 755 "$policy"
+  made_policy=1
+  trap '$SUDO rm -f "$policy"' EXIT
+fi
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+if [[ " ${missing[*]} " == *" slurmd "* || " ${missing[*]} " == *" slurmctld "* ]] && [ -d /run/systemd/system ]; then
+  $SUDO systemctl disable slurmctld slurmd > /dev/null 2>&1 || true
+fi
+[ "$made_policy" = 1 ] && $SUDO rm -f "$policy" && trap - EXIT
+exit 0
