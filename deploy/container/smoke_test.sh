@@ -14,8 +14,11 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 IMAGE=${1:-localhost/mbopt:latest}
 STUDY=examples/vehicle/vehicle.study.textproto
-PORT=$((30000 + $$ % 20000))
-fail() { echo "container smoke test: FAIL: $*" >&2; exit 1; }
+PORT=$((20000 + $$ % 12000))  # below the ephemeral range (32768 and up)
+GUARD_S=60
+TEST_NAME="container smoke test"
+# shellcheck source=tests/shell/helpers.sh
+source tests/shell/helpers.sh
 command -v podman > /dev/null || fail "needs podman"
 DIR=$(mktemp -d)
 name="mbopt-smoke-$$"
@@ -35,8 +38,8 @@ chown -R "$uid" "$DIR/pki" "$DIR/data"
 run -d --read-only --name "$name-server" -v "$DIR/pki:/etc/mbopt/pki:ro" -v "$DIR/data:/var/lib/mbopt" "$IMAGE" \
   mbopt-server --listen "127.0.0.1:$PORT" --tls-dir /etc/mbopt/pki --db /var/lib/mbopt/mbopt.db > /dev/null
 server_log() { podman logs "$name-server" 2>&1 || true; }
-for _ in $(seq 100); do [[ "$(server_log)" == *"listening on"* ]] && break; sleep 0.1; done
-[[ "$(server_log)" == *"listening on 127.0.0.1:$PORT"* ]] || fail "the server did not start: $(server_log)"
+listening() { [[ "$(server_log)" == *"listening on 127.0.0.1:$PORT"* ]]; }
+wait_for "the server container to listen" listening
 for w in w1 w2; do
   run -d --read-only --name "$name-$w" -v "$DIR/pki:/pki:ro" -e MBOPT_TLS_CA=/pki/ca.pem -e MBOPT_TOKEN_FILE=/pki/worker.token \
     "$IMAGE" mbopt-worker serve --server "127.0.0.1:$PORT" --name "$w" > /dev/null
@@ -47,10 +50,8 @@ client() {
 }
 job=$(client submit "/$STUDY")
 client watch "$job" > /dev/null || fail "$job did not converge"
-comparable() { grep -v -e '"job_id":' -e '"database":' -e '"wall_seconds":'; }
-got=$(client results "$job" --json | comparable)
 reference=$(build/client/mbopt run "$STUDY" --json --workers 2 --discard-db | comparable)
-[ "$got" = "$reference" ] || { diff <(echo "$reference") <(echo "$got") >&2 || true; fail "$job differs from mbopt run on the host"; }
+expect_same_result "$job" "$(client results "$job" --json | comparable)" "$reference"
 podman stop -t 30 "$name-server" > /dev/null
 status=$(podman inspect -f '{{.State.ExitCode}}' "$name-server")
 [ "$status" = 0 ] || fail "the server exited with $status on SIGTERM"

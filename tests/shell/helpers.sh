@@ -1,0 +1,36 @@
+# Helpers shared by the tests written as shell scripts (tests/multihost,
+# tests/slurm, deploy/container/smoke_test.sh). Source it after setting
+# TEST_NAME (the prefix of every message) and GUARD_S (the longest any one
+# wait may take, in seconds: a failure guard, not a pace).
+
+fail() {
+  echo "$TEST_NAME: FAIL: $*" >&2
+  exit 1
+}
+
+# Waits until the command "$@" succeeds; $1 says what is awaited.
+wait_for() {
+  local what=$1
+  shift
+  local deadline=$((SECONDS + GUARD_S))
+  until "$@"; do
+    [ $SECONDS -lt $deadline ] || fail "timed out waiting for $what"
+    sleep 0.05
+  done
+}
+
+# `mbopt results --json` (or `mbopt run --json`) on stdin, without the fields
+# that differ between two runs of one study: what "the same result" means.
+# Every double is printed with 17 significant digits, so equal text is equal
+# bits.
+comparable() { grep -v -e '"job_id":' -e '"database":' -e '"wall_seconds":'; }
+
+# Fails, showing the difference, unless the comparable results $2 of the job
+# named $1 equal the reference $3.
+expect_same_result() {
+  [ -n "$3" ] || fail "the reference run printed nothing"
+  if [ "$2" != "$3" ]; then
+    diff <(echo "$3") <(echo "$2") >&2 || true
+    fail "$1 differs from the uninterrupted run"
+  fi
+}
