@@ -183,6 +183,10 @@ absl::StatusOr<CertificateInfo> InspectCertificate(const std::string& pem, const
   info.not_after = TimeText(X509_get0_notAfter(certificate.get()));
   info.expired = X509_cmp_current_time(X509_get0_notAfter(certificate.get())) < 0;
   info.not_yet_valid = X509_cmp_current_time(X509_get0_notBefore(certificate.get())) > 0;
+  int days = 0, seconds = 0;
+  if (ASN1_TIME_diff(&days, &seconds, nullptr, X509_get0_notAfter(certificate.get())) == 1) {
+    info.seconds_left = std::int64_t{days} * 86400 + seconds;
+  }
   Owned<GENERAL_NAMES> names(static_cast<GENERAL_NAMES*>(
       X509_get_ext_d2i(certificate.get(), NID_subject_alt_name, nullptr, nullptr)));
   for (int i = 0; names != nullptr && i < sk_GENERAL_NAME_num(names.get()); ++i) {

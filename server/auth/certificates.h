@@ -42,6 +42,7 @@ struct CertificateInfo {
   std::string not_after;  // e.g. "Mar  1 12:00:00 2029 GMT"
   bool expired = false;
   bool not_yet_valid = false;
+  std::int64_t seconds_left = 0;  // until not_after; negative once expired
   std::vector<std::string> hosts;  // its DNS and IP subject alternative names
 };
 

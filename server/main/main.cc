@@ -11,13 +11,16 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "server/auth/certificates.h"
 #include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
 #include "server/main/init_tls_command.h"
+#include "server/main/renew_cert_command.h"
 #include "server/service/listen_address.h"
 #include "server/service/server.h"
 #include "server/store/store.h"
@@ -32,6 +35,7 @@ constexpr const char* kUsage =
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
     "       mbopt-server add-token --tokens F --role worker|user|admin --name N --out F\n"
+    "       mbopt-server renew-cert DIR [--host NAME]... [--days N]\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
     "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port);\n"
@@ -56,6 +60,9 @@ constexpr const char* kUsage =
     "                         (default 256, at most 2047)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n";
+
+// A certificate this close to expiring is warned about at every start.
+constexpr std::int64_t kCertificateWarningSeconds = std::int64_t{30} * 86400;
 
 struct Flags {
   mbopt::service::ServerOptions server;
@@ -172,6 +179,9 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "init-tls") {
     return mbopt::server_main::RunInitTlsCommand(argc - 2, argv + 2);
   }
+  if (argc >= 2 && std::string(argv[1]) == "renew-cert") {
+    return mbopt::server_main::RunRenewCertCommand(argc - 2, argv + 2);
+  }
   if (argc >= 2 && std::string(argv[1]) == "add-token") {
     return mbopt::server_main::RunAddTokenCommand(argc - 2, argv + 2);
   }
@@ -219,6 +229,18 @@ int main(int argc, char** argv) {
     std::cerr << "mbopt-server: " << (tls ? "TLS" : "no TLS") << ", "
               << (tokens ? "every call needs a token" : "no tokens")
               << (flags.server.worker_ca_file.empty() ? "" : ", workers need a certificate") << "\n";
+  }
+  if (tls) {
+    // Started, so readable and not expired; say so well before it expires.
+    std::ifstream in(flags.server.tls_cert_file);
+    std::ostringstream pem;
+    pem << in.rdbuf();
+    absl::StatusOr<mbopt::auth::CertificateInfo> info =
+        mbopt::auth::InspectCertificate(pem.str(), flags.server.tls_cert_file);
+    if (info.ok() && info->seconds_left < kCertificateWarningSeconds) {
+      std::cerr << "mbopt-server: WARNING: the server certificate " << flags.server.tls_cert_file << " expires on "
+                << info->not_after << "; `mbopt-server renew-cert DIR` makes a new one from the same CA\n";
+    }
   }
   // The ready line scripts and `mbopt run` read: keep its form.
   std::cout << "mbopt-server listening on " << (*server)->address() << std::endl;

@@ -75,6 +75,7 @@ TEST(Certificates, ServerAndClientCertificatesVerifyAgainstTheirAuthorityOnly) {
   EXPECT_THAT(info->subject, HasSubstr("CN=server"));
   EXPECT_FALSE(info->expired);
   EXPECT_FALSE(info->not_yet_valid);
+  EXPECT_NEAR(static_cast<double>(info->seconds_left), 86400.0, 60.0);
 
   EXPECT_TRUE(CheckKeyMatchesCertificate(server->certificate_pem, server->key_pem, "s.pem", "s.key").ok());
   absl::Status mismatch = CheckKeyMatchesCertificate(server->certificate_pem, client->key_pem, "s.pem", "c.key");
@@ -90,6 +91,7 @@ TEST(Certificates, ValidityIsReportedAndEnforcedByVerification) {
   absl::StatusOr<CertificateInfo> info = InspectCertificate(expired->certificate_pem, "old.pem");
   ASSERT_TRUE(info.ok());
   EXPECT_TRUE(info->expired);
+  EXPECT_NEAR(static_cast<double>(info->seconds_left), -3600.0, 60.0);
   EXPECT_EQ(Verify(ca.certificate_pem, expired->certificate_pem, X509_PURPOSE_SSL_SERVER),
             X509_V_ERR_CERT_HAS_EXPIRED);
 

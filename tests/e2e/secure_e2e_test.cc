@@ -2,8 +2,11 @@
 // loopback: `mbopt-server init-tls`, a server with --tls-dir, a worker and
 // the CLI with the CA and their tokens. Also what each program says, and
 // which exit code it gives, when the CA or the token is missing or wrong.
+#include <signal.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -128,8 +131,47 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   EXPECT_EQ(plaintext_worker.exit_code, 3) << Describe(plaintext_worker);
   EXPECT_THAT(plaintext_worker.stderr_text, HasSubstr("speaks TLS"));
 
+  // A token added to the table works once the server has read it again
+  // (SIGHUP); until then it is refused.
+  absl::StatusOr<Subprocess::Output> added = client::RunCommand(
+      {ServerBinary(), "add-token", "--tokens", pki + "/tokens", "--role", "user", "--name", "bob", "--out",
+       pki + "/bob.token"},
+      kGuard);
+  ASSERT_TRUE(added.ok());
+  ASSERT_EQ(added->exit_code, 0) << Describe(*added);
+  EXPECT_EQ(Mode(pki + "/bob.token"), 0600u);
+  const std::vector<std::string> bob = {"MBOPT_TLS_CA=" + pki + "/ca.pem", "MBOPT_TOKEN_FILE=" + pki + "/bob.token"};
+  EXPECT_EQ(Mbopt({"list", "--server", addr}, bob).exit_code, kExitDenied);
+  server->process->Signal(SIGHUP);
+  Subprocess::Output bobs_list;
+  const auto deadline = std::chrono::steady_clock::now() + kGuard;
+  do {
+    bobs_list = Mbopt({"list", "--server", addr}, bob);
+  } while (bobs_list.exit_code == kExitDenied && std::chrono::steady_clock::now() < deadline);
+  EXPECT_EQ(bobs_list.exit_code, kExitOk) << Describe(bobs_list);
+  EXPECT_THAT(bobs_list.stdout_text, Not(HasSubstr("job-1"))) << "Bob sees only his own jobs";
+  auto bob_reads_alices = Mbopt({"status", "job-1", "--server", addr}, bob);
+  EXPECT_EQ(bob_reads_alices.exit_code, kExitDenied) << Describe(bob_reads_alices);
+  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("submitted by another user"));
+
   EXPECT_EQ(worker.Stop(kGuard), 0);
   EXPECT_EQ(server->process->Stop(kGuard), 0);
+
+  // A renewed certificate, from the same CA: clients keep their ca.pem.
+  absl::StatusOr<Subprocess::Output> renewed =
+      client::RunCommand({ServerBinary(), "renew-cert", pki, "--days", "10"}, kGuard);
+  ASSERT_TRUE(renewed.ok());
+  ASSERT_EQ(renewed->exit_code, 0) << Describe(*renewed);
+  EXPECT_THAT(renewed->stdout_text, HasSubstr("for localhost, 127.0.0.1"));
+  EXPECT_NE(ReadFile(pki + "/server.pem"), ReadFile(pki + "/server.pem.old"));
+  EXPECT_EQ(Mode(pki + "/server.key"), 0600u);
+  auto restarted = StartServer(dir.File("jobs.db"), {"--tls-dir", pki}, "127.0.0.1:0", dir.File("server2.log"));
+  ASSERT_TRUE(restarted.ok()) << restarted.status();
+  auto after_renewal = Mbopt({"status", "job-1", "--server", restarted->address}, alice);
+  EXPECT_EQ(after_renewal.exit_code, kExitOk) << Describe(after_renewal);
+  EXPECT_EQ(restarted->process->Stop(kGuard), 0);
+  // It expires within 30 days: the server says so at every start.
+  EXPECT_THAT(ReadFile(dir.File("server2.log")), HasSubstr("WARNING: the server certificate"));
   // No token ever reaches a log or an output.
   const std::string logs = ReadFile(dir.File("server.log")) + ReadFile(dir.File("worker.log")) +
                            submitted.stdout_text + submitted.stderr_text + user_worker.stderr_text;
