@@ -201,7 +201,8 @@ int RunInitTlsCommand(int argc, char** argv) {
   std::cout << "made " << dir << ": a CA, a server certificate for " << absl::StrJoin(flags.hosts, ", ")
             << " (valid " << flags.days << " days), a worker certificate, and tokens for the workers, an admin"
             << (flags.users.empty() ? "" : " and " + absl::StrJoin(flags.users, ", ")) << ".\n"
-            << "Keep ca.key offline once you no longer need to make certificates with it.\n\n"
+            << "Keep ca.key where only you can read it: renew-cert needs it, and whoever has it can make\n"
+            << "certificates this installation trusts.\n\n"
             << "server:  mbopt-server --listen 0.0.0.0:50051 --tls-dir " << dir << "\n"
             << "           (add --worker-ca " << dir << "/ca.pem to require worker certificates)\n"
             << "worker:  mbopt-worker --server " << host << ":50051 --tls-ca " << dir << "/ca.pem --token-file "
