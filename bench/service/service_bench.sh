@@ -14,6 +14,10 @@
 #   overhead    (wall - critical) / cycles: what the service adds per cycle
 #   server_cpu  the server's CPU time (user + system) per analysis, over the
 #               whole run of that W (start and stop included)
+#   latency     p50 and p99 over every analysis of that W of the time from its
+#               task's queueing on the server to its result's arrival there
+#               (analyses.latency_seconds): the analysis itself, the round
+#               trips and the wait for a free worker
 #
 #   bash bench/service/service_bench.sh [STUDY] [JOBS] [W...]
 # Defaults: the vehicle, 7 jobs, W = 1 2 4. SERVER_ARGS (environment) is
@@ -35,7 +39,8 @@ source bench/loopback.sh
 
 median() { sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
 
-printf '%-3s %8s %9s %8s %7s %10s %9s %9s %11s\n' W wall_s analyses work_s per_s efficiency critical_s overhead_ms server_cpu_ms
+printf '%-3s %8s %9s %8s %7s %10s %9s %9s %11s %8s %8s\n' W wall_s analyses work_s per_s efficiency critical_s overhead_ms \
+  server_cpu_ms lat50_ms lat99_ms
 for W in "${WORKER_COUNTS[@]}"; do
   # shellcheck disable=SC2086  # SERVER_ARGS is a list of words
   start_server ${SERVER_ARGS:-}
@@ -61,6 +66,9 @@ for W in "${WORKER_COUNTS[@]}"; do
     }' "$DIR/jobs.txt" > "$DIR/derived.txt"
   cols=()
   for c in 1 2 3 4 5 6 7; do cols+=("$(awk -v c=$c '{print $c}' "$DIR/derived.txt" | median)"); done
-  printf '%-3s %8.3f %9.0f %8.3f %7.0f %10.2f %9.3f %9.1f %11.3f\n' "$W" "${cols[@]}" \
-    "$(awk -v t="$cpu_ticks" -v hz="$TICKS" -v n="$total_analyses" 'BEGIN {print 1000 * t / hz / n}')"
+  sqlite3 "$DIR/jobs.db" "SELECT latency_seconds FROM analyses ORDER BY latency_seconds" > "$DIR/latency.txt"
+  percentile() { awk -v p="$1" '{a[NR]=$1} END {i = int(p * NR + 0.999999); if (i < 1) i = 1; print 1000 * a[i]}' "$DIR/latency.txt"; }
+  printf '%-3s %8.3f %9.0f %8.3f %7.0f %10.2f %9.3f %9.1f %11.3f %8.2f %8.2f\n' "$W" "${cols[@]}" \
+    "$(awk -v t="$cpu_ticks" -v hz="$TICKS" -v n="$total_analyses" 'BEGIN {print 1000 * t / hz / n}')" \
+    "$(percentile 0.50)" "$(percentile 0.99)"
 done

@@ -31,6 +31,9 @@ struct AnalysisRecord {
   std::string gradients_unavailable;
   std::string worker;              // worker id; "" for the server or an in-process run
   std::int32_t attempts = 1;       // attempts it took (leases given out)
+  // From the task's queueing on the server to its result's arrival there
+  // (real time, s); 0 where nothing was measured (in-process runs).
+  double latency_seconds = 0;
   spec::AnalysisCounters counters; // wall_seconds: the analysis' own running time
 
   bool ok() const { return failure.ok(); }

@@ -42,6 +42,7 @@ bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std:
     entry.request_id = request_id;
     entry.x_scaled = std::move(x_scaled);
     entry.want_gradients = want_gradients;
+    entry.queued_at = std::chrono::steady_clock::now();
     queues_[job_id].push_back(request_id);
   }
   task_available_.notify_all();
@@ -156,6 +157,8 @@ absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, c
   }
   FinishedTask done{entry->second.job_id, entry->second.request_id, std::move(entry->second.x_scaled),
                     entry->second.attempts, worker_id, ""};
+  done.latency_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - entry->second.queued_at).count();
   if (entry->second.leased) {
     leases_.erase(entry->second.task_id);
   } else {

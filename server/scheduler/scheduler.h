@@ -21,6 +21,7 @@
 // thread-safe; AcquireWait blocks (real time) for the long poll of workers.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -74,6 +75,10 @@ struct FinishedTask {
   int attempts = 0;           // leases handed out for it
   std::string worker_id;      // Complete: who delivered
   std::string failure_reason; // given up: the last attempt's failure
+  // Complete: real time from the request's queueing to its result, retries
+  // included (a measurement for benchmarks; the injected clock has no part
+  // in it).
+  double latency_seconds = 0;
 };
 
 struct HeartbeatReply {
@@ -158,6 +163,7 @@ class Scheduler {
     std::string worker_id;             // while leased
     std::string task_id;               // current attempt's id, while leased
     std::int64_t lease_deadline_ms = 0;
+    std::chrono::steady_clock::time_point queued_at;  // first queued (real time)
   };
   using Key = std::pair<std::string, std::int64_t>;  // job id, request id
   struct Worker {

@@ -119,6 +119,13 @@ UPDATE schema_version SET version = 4;
 ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';
 UPDATE schema_version SET version = 5;
 )sql",
+    // 5 -> 6: each analysis' latency, from its task's queueing to its result
+    // reaching the server (bench/service reads its percentiles). Rows of
+    // version 5 were not measured: 0.
+    R"sql(
+ALTER TABLE analyses ADD COLUMN latency_seconds REAL NOT NULL DEFAULT 0;
+UPDATE schema_version SET version = 6;
+)sql",
 };
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kSchemaVersion - 1,
               "one migration step per schema version after the first");
@@ -380,8 +387,9 @@ absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::
                          "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
                          "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
                          "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
-                         "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind) "
-                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
+                         "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind, "
+                         "latency_seconds) "
+                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
   stmt.BindText(1, job_id);
   stmt.BindInt(2, a.request_id);
   stmt.BindBlob(3, EncodeDoubles(a.x_scaled));
@@ -402,6 +410,7 @@ absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::
   stmt.BindBlob(18, EncodeDoubles(a.constraint_gradients));
   stmt.BindText(19, a.gradients_unavailable);
   stmt.BindText(20, spec::FailureKindName(a.failure.kind));
+  stmt.BindDouble(21, a.latency_seconds);
   absl::Status status = stmt.Run();
   if (absl::IsAlreadyExists(status)) {
     return absl::AlreadyExistsError(absl::StrCat("job '", job_id, "' already has a result for request ",
@@ -418,7 +427,7 @@ absl::StatusOr<std::vector<jobs::AnalysisRecord>> Store::LoadAnalyses(const std:
                          "SELECT request_id, x_scaled, ok, failure_reason, objective_terms, constraint_values, "
                          "worker, wall_seconds, attempts, time_steps, rhs_evaluations, jacobian_evaluations, "
                          "newton_iterations, position_solves, committed_unix_ms, objective_gradients, "
-                         "constraint_gradients, gradients_unavailable, failure_kind "
+                         "constraint_gradients, gradients_unavailable, failure_kind, latency_seconds "
                          "FROM analyses WHERE job_id = ? ORDER BY request_id"));
   stmt.BindText(1, job_id);
   std::vector<jobs::AnalysisRecord> rows;
@@ -448,6 +457,7 @@ absl::StatusOr<std::vector<jobs::AnalysisRecord>> Store::LoadAnalyses(const std:
     MBOPT_ASSIGN_OR_RETURN(a.objective_gradients, DecodeDoubles(stmt.ColumnBlob(15)));
     MBOPT_ASSIGN_OR_RETURN(a.constraint_gradients, DecodeDoubles(stmt.ColumnBlob(16)));
     a.gradients_unavailable = stmt.ColumnText(17);
+    a.latency_seconds = stmt.ColumnDouble(19);
     rows.push_back(std::move(a));
   }
   return rows;

@@ -83,6 +83,29 @@ TEST(Scheduler, EnqueueIgnoresRequestsAlreadyQueuedLeasedOrFinished) {
   EXPECT_EQ(scheduler.QueuedCount(), 0);
 }
 
+// Latency is real time from the first queueing to the result, whatever the
+// injected clock says and however many attempts it took.
+TEST(Scheduler, LatencyRunsFromTheFirstQueueingToTheResult) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  const auto before = std::chrono::steady_clock::now();
+  ASSERT_TRUE(scheduler.Enqueue("job-1", 0, {0.5}));
+  const std::string first = scheduler.RegisterWorker("first", 1);
+  const std::string second = scheduler.RegisterWorker("second", 1);
+  auto attempt = scheduler.Acquire(first, 1);
+  ASSERT_TRUE(attempt.ok() && attempt->size() == 1u);
+  ASSERT_TRUE(scheduler.Fail(first, attempt->front().task_id, "worker could not run it").ok());
+  clock.Advance(3'600'000);  // the injected clock has no part in it
+  auto retry = scheduler.Acquire(second, 1);
+  ASSERT_TRUE(retry.ok() && retry->size() == 1u);
+  absl::StatusOr<FinishedTask> done = scheduler.Complete(second, retry->front().task_id);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
+  ASSERT_TRUE(done.ok()) << done.status();
+  EXPECT_EQ(done->attempts, 2);
+  EXPECT_GT(done->latency_seconds, 0.0);
+  EXPECT_LE(done->latency_seconds, elapsed);
+}
+
 TEST(Scheduler, ExpiredLeaseRequeuesTheTaskForAnotherWorker) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());

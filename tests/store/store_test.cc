@@ -100,11 +100,13 @@ TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
   a.constraint_gradients = {nan, -0.0, std::nextafter(0.0, 1.0), 1.0 / 49.0};
   a.worker = "w-1";
   a.counters.time_steps = 1234;
+  a.latency_seconds = 0.000123;
   ASSERT_TRUE((*store)->AddAnalysis(a_job, a).ok());
   auto rows = (*store)->LoadAnalyses(job->id);
   ASSERT_TRUE(rows.ok()) << rows.status();
   ASSERT_EQ(rows->size(), 1u);
   EXPECT_EQ((*rows)[0].request_id, 7);
+  EXPECT_EQ((*rows)[0].latency_seconds, 0.000123);
   EXPECT_TRUE(BitIdentical((*rows)[0].x_scaled, a.x_scaled));
   EXPECT_TRUE(BitIdentical((*rows)[0].objective_terms, a.objective_terms));
   EXPECT_TRUE(BitIdentical((*rows)[0].constraint_values, a.constraint_values));
@@ -306,7 +308,9 @@ TEST_F(StoreTest, JobOwnerIsKeptAndOlderJobsHaveNone) {
     EXPECT_EQ((*store)->GetJob(job_id)->owner, "alice");
   }
   // Exactly the version 4 layout.
-  RunSql(path_, "ALTER TABLE jobs DROP COLUMN owner; UPDATE schema_version SET version = 4;");
+  RunSql(path_,
+         "ALTER TABLE jobs DROP COLUMN owner; ALTER TABLE analyses DROP COLUMN latency_seconds;"
+         "UPDATE schema_version SET version = 4;");
   auto store = Store::Open(path_);
   ASSERT_TRUE(store.ok()) << store.status();
   EXPECT_EQ((*store)->GetJob(job_id)->owner, "");
@@ -348,6 +352,7 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
          "DROP TABLE job_sequence;"
          "ALTER TABLE jobs DROP COLUMN owner;"
+         "ALTER TABLE analyses DROP COLUMN latency_seconds;"
          "UPDATE schema_version SET version = 1;");
   ASSERT_EQ(SchemaVersionOf(path_), 1);
 
@@ -399,6 +404,7 @@ TEST_F(StoreTest, VersionTwoFailuresBecomeUnclassified) {
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
          "DROP TABLE job_sequence;"
          "ALTER TABLE jobs DROP COLUMN owner;"
+         "ALTER TABLE analyses DROP COLUMN latency_seconds;"
          "UPDATE schema_version SET version = 2;");
   auto store = Store::Open(path_);
   ASSERT_TRUE(store.ok()) << store.status();

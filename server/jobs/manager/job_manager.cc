@@ -454,6 +454,7 @@ absl::StatusOr<bool> JobManager::ReportResult(WorkerReport report) {
   absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(report.worker_id, report.task_id);
   if (!finished.ok()) return false;
   record->attempts = finished->attempts;
+  record->latency_seconds = finished->latency_seconds;
   MBOPT_RETURN_IF_ERROR(DeliverLocked(*entry, *record));
   return true;
 }
