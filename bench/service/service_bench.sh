@@ -21,7 +21,10 @@
 #
 #   bash bench/service/service_bench.sh [STUDY] [JOBS] [W...]
 # Defaults: the vehicle, 7 jobs, W = 1 2 4. SERVER_ARGS (environment) is
-# passed to mbopt-server, e.g. SERVER_ARGS="--durability normal".
+# passed to mbopt-server, e.g. SERVER_ARGS="--durability normal", and
+# WORKER_ARGS to each mbopt-worker. Over TLS with tokens (an init-tls
+# directory D): SERVER_ARGS="--tls-dir D" WORKER_ARGS="--token-file
+# D/worker.token" MBOPT_TLS_CA=D/ca.pem MBOPT_TOKEN_FILE=D/admin.token.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 STUDY=${1:-examples/vehicle/vehicle.study.textproto}
@@ -45,7 +48,8 @@ for W in "${WORKER_COUNTS[@]}"; do
   # shellcheck disable=SC2086  # SERVER_ARGS is a list of words
   start_server ${SERVER_ARGS:-}
   server=$SERVER_PID address=$ADDRESS
-  start_workers "$W"
+  # shellcheck disable=SC2086  # WORKER_ARGS is a list of words
+  start_workers "$W" ${WORKER_ARGS:-}
   sleep 0.5  # the workers register
   for _ in $(seq "$JOBS"); do
     job=$("$B/client/mbopt" submit "$STUDY" --server "$address")
