@@ -128,6 +128,7 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   std::string out;
   out += "job:           " + s.job_id() + "\n";
   out += "study:         " + s.study_name() + "\n";
+  if (!s.owner().empty()) out += "submitted by:  " + s.owner() + "\n";
   out += "status:        " + StateName(s.state()) + "\n";
   out += "cycles:        " + std::to_string(s.cycles()) +
          (s.max_cycles() > 0 ? " (of at most " + std::to_string(s.max_cycles()) + ")" : "") + "\n";
@@ -148,17 +149,19 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
 
 std::string ListHeader() {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6s %9s %14s", "JOB", "STUDY", "STATUS",
-                "CYCLES", "ANALYSES", "OBJECTIVE");
+  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6s %9s %14s  %s", "JOB", "STUDY", "STATUS",
+                "CYCLES", "ANALYSES", "OBJECTIVE", "OWNER");
   return buf;
 }
 
 std::string ListRow(const v1::JobSummary& s) {
   char buf[512];
   const std::string objective = std::isfinite(s.objective()) ? Format("%.7g", s.objective()) : "-";
-  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6d %9lld %14s", s.job_id().c_str(),
+  // OWNER: who submitted it, "-" on a server without tokens.
+  std::snprintf(buf, sizeof buf, "%-24s %-24s %-12s %6d %9lld %14s  %s", s.job_id().c_str(),
                 s.study_name().c_str(), StateName(s.state()).c_str(), s.cycles(),
-                static_cast<long long>(s.analyses()), objective.c_str());
+                static_cast<long long>(s.analyses()), objective.c_str(),
+                s.owner().empty() ? "-" : s.owner().c_str());
   return buf;
 }
 

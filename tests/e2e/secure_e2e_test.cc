@@ -101,6 +101,7 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   auto listed = Mbopt({"list", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file", pki + "/admin.token"});
   EXPECT_EQ(listed.exit_code, kExitOk) << Describe(listed);
   EXPECT_THAT(listed.stdout_text, HasSubstr("job-1"));
+  EXPECT_THAT(listed.stdout_text, HasSubstr(" alice\n")) << "the OWNER column";
 
   // Refusals: one line each, with the exit code that says which.
   auto no_token = Mbopt({"list", "--server", addr, "--tls-ca", pki + "/ca.pem"});
