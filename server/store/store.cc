@@ -303,6 +303,7 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path, Dura
 Store::Store(std::string path, sqlite3* db) : path_(std::move(path)), db_(db) {}
 
 Store::~Store() {
+  insert_analysis_.reset();
   // Closing checkpoints the WAL into the main file; nothing is lost if it
   // fails (the WAL is replayed on the next open).
   sqlite3_close_v2(db_);
@@ -381,15 +382,19 @@ absl::Status Store::SetJobState(const std::string& job_id, const std::string& st
 }
 
 absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& a) {
-  MBOPT_ASSIGN_OR_RETURN(
-      Statement stmt,
-      Statement::Prepare(db_,
+  if (!insert_analysis_.has_value()) {
+    MBOPT_ASSIGN_OR_RETURN(
+        Statement prepared,
+        Statement::Prepare(db_,
                          "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
                          "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
                          "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
                          "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind, "
                          "latency_seconds) "
                          "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
+    insert_analysis_.emplace(std::move(prepared));
+  }
+  Statement& stmt = *insert_analysis_;
   stmt.BindText(1, job_id);
   stmt.BindInt(2, a.request_id);
   stmt.BindBlob(3, EncodeDoubles(a.x_scaled));
@@ -412,6 +417,9 @@ absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::
   stmt.BindText(20, spec::FailureKindName(a.failure.kind));
   stmt.BindDouble(21, a.latency_seconds);
   absl::Status status = stmt.Run();
+  // Ready for the next analysis, and holding nothing of this one (its blobs
+  // were copied in) while it waits.
+  stmt.Reset();
   if (absl::IsAlreadyExists(status)) {
     return absl::AlreadyExistsError(absl::StrCat("job '", job_id, "' already has a result for request ",
                                                  a.request_id, " (or the job does not exist)"));

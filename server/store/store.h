@@ -26,6 +26,7 @@
 #include "absl/status/statusor.h"
 #include "server/jobs/analysis_record.h"
 #include "server/store/records.h"
+#include "server/store/sqlite_statement.h"
 
 struct sqlite3;
 
@@ -128,6 +129,10 @@ class Store {
   std::string path_;
   std::mutex mutex_;
   sqlite3* db_;  // owned
+  // The INSERT of InsertAnalysisLocked, prepared once: preparing it for every
+  // analysis was a third of the server's CPU (docs/benchmarks.md). Guarded
+  // by mutex_; finalized before db_ is closed.
+  std::optional<Statement> insert_analysis_;
 
   mutable std::mutex group_mutex_;  // guards the three below
   std::condition_variable group_done_;
