@@ -86,9 +86,6 @@ std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int w
   auto worker_binary = FindMboptBinary("mbopt-worker", "MBOPT_WORKER_BIN", "worker/main");
   if (!worker_binary.ok()) return ConnectFailure{std::string(worker_binary.status().message())};
   Interrupts::Install();  // before the cluster's and gRPC's threads
-  // The private server has neither TLS nor tokens; settings meant for
-  // another server must not reach its workers.
-  secure_channel::ClearSecurityEnvironment();
   c.temp_dir = std::make_unique<TempDir>();
   if (c.temp_dir->path().empty()) return ConnectFailure{"cannot create a temporary directory"};
   LocalClusterOptions options;

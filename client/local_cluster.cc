@@ -5,11 +5,11 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "common/read_file.h"
+#include "common/secure_channel/client_security.h"
 
 namespace mbopt::client {
 namespace {
@@ -59,6 +59,10 @@ absl::StatusOr<std::string> ParseListeningLine(const std::string& line) {
 
 absl::StatusOr<std::unique_ptr<LocalCluster>> LocalCluster::Start(
     const LocalClusterOptions& options) {
+  // The private server has neither TLS nor tokens: settings in this
+  // process's environment meant for another server must not reach the
+  // workers started below (nor this process's own connection to it).
+  secure_channel::ClearSecurityEnvironment();
   std::unique_ptr<LocalCluster> cluster(new LocalCluster());
   cluster->options_ = options;
   SpawnOptions server_spawn;
@@ -111,10 +115,7 @@ void LocalCluster::Stop() {
 }
 
 std::string LocalCluster::ServerLogTail() const {
-  std::ifstream in(options_.log_dir + "/server.log");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string s = text.str();
+  std::string s = ReadWholeFile(options_.log_dir + "/server.log").value_or("");
   constexpr size_t kTail = 4000;
   if (s.size() > kTail) s = "..." + s.substr(s.size() - kTail);
   return s.empty() ? "" : "server log:\n" + s;

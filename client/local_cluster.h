@@ -36,6 +36,8 @@ struct LocalClusterOptions {
 
 class LocalCluster {
  public:
+  // Also clears this process's MBOPT_TLS_* and MBOPT_TOKEN* variables
+  // (common/secure_channel): the private server has neither TLS nor tokens.
   static absl::StatusOr<std::unique_ptr<LocalCluster>> Start(const LocalClusterOptions& options);
   ~LocalCluster();
 

@@ -17,7 +17,6 @@
 #include "client/args.h"
 #include "client/commands.h"
 #include "client/connection.h"
-#include "common/secure_channel/client_security.h"
 #include "client/exit_codes.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
@@ -108,9 +107,6 @@ int RunCommandMain(const Args& args) {
   cluster_options.db_path = db_path;
   cluster_options.log_dir = temp.path();
   cluster_options.workers = num_workers;
-  // The private server has neither TLS nor tokens; settings meant for
-  // another server must not reach its workers.
-  secure_channel::ClearSecurityEnvironment();
   auto cluster = LocalCluster::Start(cluster_options);
   if (!cluster.ok()) return Fail(std::string(cluster.status().message()), kExitUnreachable);
   const std::string address = (*cluster)->address();

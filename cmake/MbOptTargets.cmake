@@ -43,3 +43,20 @@ function(mbopt_test name)
     PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
     DISCOVERY_TIMEOUT 60)
 endfunction()
+
+# mbopt_programs_script_test(NAME SCRIPT LABELS ... [TIMEOUT s]): a test
+# written as a bash script that runs the three programs, given their paths
+# as `SCRIPT MBOPT_SERVER MBOPT_WORKER MBOPT` (tests/multihost, tests/slurm).
+# Registered only once all three are part of the build.
+function(mbopt_programs_script_test name script)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "LABELS" ${ARGN})
+  if(NOT (TARGET mbopt AND TARGET mbopt-server AND TARGET mbopt-worker))
+    return()
+  endif()
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 600)
+  endif()
+  add_test(NAME ${name}
+    COMMAND bash ${script} $<TARGET_FILE:mbopt-server> $<TARGET_FILE:mbopt-worker> $<TARGET_FILE:mbopt>)
+  set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT})
+endfunction()

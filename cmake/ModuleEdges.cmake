@@ -73,7 +73,10 @@ function(mbopt_declare_modules)
   mbopt_module(common DIRS common PURE
     LIBS mbopt_common
     SUMMARY "status macros and checks (Abseil status only)")
-  mbopt_module(secure_channel DIRS common/secure_channel USES common
+  mbopt_module(x509 DIRS common/x509 USES common
+    LIBS mbopt_x509
+    SUMMARY "X.509 certificates read and shown (OpenSSL): owned pointers, PEM, host names, dates")
+  mbopt_module(secure_channel DIRS common/secure_channel USES x509 common
     LIBS mbopt_secure_channel
     SUMMARY "a client's connection to the server (CLI and worker): TLS and token from options or the environment, failures in words")
   mbopt_module(proto DIRS proto
@@ -125,7 +128,7 @@ function(mbopt_declare_modules)
   mbopt_module(job_manager DIRS server/jobs/manager USES jobs lp scheduler store spec common
     LIBS mbopt_job_manager
     SUMMARY "the server's jobs: jobs, scheduler and store meet (threads, an injected clock)")
-  mbopt_module(auth DIRS server/auth USES common
+  mbopt_module(auth DIRS server/auth USES x509 common
     LIBS mbopt_auth
     SUMMARY "who may call the server: tokens and their hashed table, roles, TLS certificates (OpenSSL)")
   mbopt_module(service DIRS server/service USES auth job_manager jobs lp scheduler store spec spec_io proto common
@@ -137,7 +140,7 @@ function(mbopt_declare_modules)
   mbopt_module(worker_service DIRS worker/service USES secure_channel engine spec spec_io proto common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(worker_main DIRS worker/main USES worker_service secure_channel engine spec spec_io common
+  mbopt_module(worker_main DIRS worker/main USES worker_service engine spec spec_io common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE

@@ -1,8 +1,6 @@
 #include "common/secure_channel/client_security.h"
 
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -13,6 +11,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "common/read_file.h"
 
 namespace mbopt::secure_channel {
 namespace {
@@ -35,11 +34,9 @@ std::string Setting(const std::string& flag_value, const char* option, const cha
 }
 
 absl::StatusOr<std::string> ReadFile(const std::string& path, const std::string& source) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::InvalidArgumentError(absl::StrCat(source, ": cannot read ", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  absl::StatusOr<std::string> text = ReadWholeFile(path);
+  if (!text.ok()) return absl::InvalidArgumentError(absl::StrCat(source, ": ", text.status().message()));
+  return text;
 }
 
 class TokenInterceptor final : public grpc::experimental::Interceptor {
@@ -68,6 +65,11 @@ class TokenInterceptorFactory final : public grpc::experimental::ClientIntercept
 };
 
 }  // namespace
+
+bool IsSecurityOption(const std::string& option) {
+  ClientSecurityFlags ignored;
+  return SetSecurityFlag(option, "", &ignored);
+}
 
 bool SetSecurityFlag(const std::string& option, const std::string& value, ClientSecurityFlags* flags) {
   if (option == "--tls-ca") {

@@ -47,6 +47,9 @@ struct ClientSecurity {
 inline constexpr const char* kSecurityValueOptions[] = {"--tls-ca", "--tls-cert", "--tls-key", "--tls-server-name",
                                                         "--token-file"};
 
+// Whether `option` is one of kSecurityValueOptions.
+bool IsSecurityOption(const std::string& option);
+
 // Sets the field of `flags` that `option` (one of kSecurityValueOptions)
 // names. Returns false for another option.
 bool SetSecurityFlag(const std::string& option, const std::string& value, ClientSecurityFlags* flags);

@@ -12,24 +12,22 @@
 
 #include <cerrno>
 #include <memory>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "common/x509/x509_text.h"
 
 namespace mbopt::secure_channel {
 namespace {
 
 constexpr int kTimeoutMs = 3000;
 
-struct Free {
-  void operator()(SSL_CTX* p) const { SSL_CTX_free(p); }
-  void operator()(SSL* p) const { SSL_free(p); }
-  void operator()(BIO* p) const { BIO_free(p); }
-  void operator()(X509* p) const { X509_free(p); }
-  void operator()(EVP_PKEY* p) const { EVP_PKEY_free(p); }
-};
-template <typename T>
-using Owned = std::unique_ptr<T, Free>;
+using x509::Owned;
+
+// The TLS objects of one connection attempt.
+using SslContext = std::unique_ptr<SSL_CTX, decltype(&SSL_CTX_free)>;
+using Ssl = std::unique_ptr<SSL, decltype(&SSL_free)>;
 
 class Socket {
  public:
@@ -107,30 +105,9 @@ bool AddCaCertificates(SSL_CTX* context, const std::string& pem) {
   return added > 0;
 }
 
-std::string CertificateHosts(X509* certificate) {
-  std::vector<std::string> hosts;
-  auto* names = static_cast<GENERAL_NAMES*>(X509_get_ext_d2i(certificate, NID_subject_alt_name, nullptr, nullptr));
-  for (int i = 0; names != nullptr && i < sk_GENERAL_NAME_num(names); ++i) {
-    const GENERAL_NAME* name = sk_GENERAL_NAME_value(names, i);
-    if (name->type == GEN_DNS) {
-      hosts.emplace_back(reinterpret_cast<const char*>(ASN1_STRING_get0_data(name->d.dNSName)),
-                         ASN1_STRING_length(name->d.dNSName));
-    } else if (name->type == GEN_IPADD) {
-      char text[INET6_ADDRSTRLEN] = {};
-      const int family = ASN1_STRING_length(name->d.iPAddress) == 4 ? AF_INET : AF_INET6;
-      if (inet_ntop(family, ASN1_STRING_get0_data(name->d.iPAddress), text, sizeof text)) hosts.emplace_back(text);
-    }
-  }
-  GENERAL_NAMES_free(names);
+std::string CertificateHosts(const X509* certificate) {
+  const std::vector<std::string> hosts = x509::CertificateHosts(certificate);
   return hosts.empty() ? "no host names" : absl::StrJoin(hosts, ", ");
-}
-
-std::string TimeText(const ASN1_TIME* time) {
-  Owned<BIO> bio(BIO_new(BIO_s_mem()));
-  ASN1_TIME_print(bio.get(), time);
-  char* data = nullptr;
-  const long size = BIO_get_mem_data(bio.get(), &data);
-  return std::string(data, static_cast<std::size_t>(size));
 }
 
 // What the peer said about the handshake when it refused it.
@@ -150,24 +127,22 @@ std::string DiagnoseConnectionFailure(const std::string& address, const ClientSe
   Socket socket(Dial(host, port));
   if (socket.fd() < 0) return "";  // nothing listens there: gRPC's message says so
 
-  Owned<SSL_CTX> context(SSL_CTX_new(TLS_client_method()));
+  SslContext context(SSL_CTX_new(TLS_client_method()), &SSL_CTX_free);
   if (context == nullptr) return "";
   SSL_CTX_set_verify(context.get(), SSL_VERIFY_NONE, nullptr);  // judged below, with the reason
   if (security.tls && !AddCaCertificates(context.get(), security.ca_pem)) {
     return absl::StrCat(security.ca_file, " holds no PEM certificate (--tls-ca names the CA certificate, ca.pem)");
   }
   if (!security.cert_pem.empty()) {
-    Owned<BIO> cert_bio(BIO_new_mem_buf(security.cert_pem.data(), static_cast<int>(security.cert_pem.size())));
-    Owned<X509> certificate(PEM_read_bio_X509(cert_bio.get(), nullptr, nullptr, nullptr));
-    Owned<BIO> key_bio(BIO_new_mem_buf(security.key_pem.data(), static_cast<int>(security.key_pem.size())));
-    Owned<EVP_PKEY> key(PEM_read_bio_PrivateKey(key_bio.get(), nullptr, nullptr, nullptr));
+    Owned<X509> certificate = x509::ReadCertificate(security.cert_pem);
+    Owned<EVP_PKEY> key = x509::ReadPrivateKey(security.key_pem);
     if (certificate == nullptr || key == nullptr || SSL_CTX_use_certificate(context.get(), certificate.get()) != 1 ||
         SSL_CTX_use_PrivateKey(context.get(), key.get()) != 1) {
       ERR_clear_error();
       return "the client certificate (--tls-cert) or its key (--tls-key) cannot be read as PEM, or they do not match";
     }
   }
-  Owned<SSL> ssl(SSL_new(context.get()));
+  Ssl ssl(SSL_new(context.get()), &SSL_free);
   SSL_set_fd(ssl.get(), socket.fd());
   static const unsigned char kAlpn[] = {2, 'h', '2'};
   SSL_set_alpn_protos(ssl.get(), kAlpn, sizeof kAlpn);
@@ -213,10 +188,10 @@ std::string DiagnoseConnectionFailure(const std::string& address, const ClientSe
   const std::string what = absl::StrCat("the server's certificate (for ", CertificateHosts(peer), ")");
   switch (verdict) {
     case X509_V_ERR_CERT_HAS_EXPIRED:
-      return absl::StrCat(what, " expired on ", TimeText(X509_get0_notAfter(peer)),
+      return absl::StrCat(what, " expired on ", x509::TimeText(X509_get0_notAfter(peer)),
                           "; make a new one (deploy/README.md, \"Security\")");
     case X509_V_ERR_CERT_NOT_YET_VALID:
-      return absl::StrCat(what, " is not valid before ", TimeText(X509_get0_notBefore(peer)),
+      return absl::StrCat(what, " is not valid before ", x509::TimeText(X509_get0_notBefore(peer)),
                           ": is this machine's clock right?");
     case X509_V_ERR_HOSTNAME_MISMATCH:
     case X509_V_ERR_IP_ADDRESS_MISMATCH:

@@ -10,24 +10,16 @@
 #include <openssl/x509.h>
 #include <openssl/x509v3.h>
 
-#include <memory>
-
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "common/x509/x509_text.h"
 
 namespace mbopt::auth {
 namespace {
 
-struct Free {
-  void operator()(EVP_PKEY* p) const { EVP_PKEY_free(p); }
-  void operator()(X509* p) const { X509_free(p); }
-  void operator()(BIO* p) const { BIO_free(p); }
-  void operator()(BIGNUM* p) const { BN_free(p); }
-  void operator()(X509_EXTENSION* p) const { X509_EXTENSION_free(p); }
-  void operator()(GENERAL_NAMES* p) const { GENERAL_NAMES_free(p); }
-};
-template <typename T>
-using Owned = std::unique_ptr<T, Free>;
+using x509::BioText;
+using x509::Owned;
+using x509::ReadCertificate;
 
 // The last OpenSSL error as text, and the queue cleared.
 std::string OpenSslError() {
@@ -41,22 +33,6 @@ std::string OpenSslError() {
 
 absl::Status Failed(const std::string& what) {
   return absl::InternalError(absl::StrCat(what, ": ", OpenSslError()));
-}
-
-std::string BioText(BIO* bio) {
-  char* data = nullptr;
-  const long size = BIO_get_mem_data(bio, &data);
-  return std::string(data, static_cast<std::size_t>(size));
-}
-
-Owned<X509> ReadCertificate(const std::string& pem) {
-  Owned<BIO> bio(BIO_new_mem_buf(pem.data(), static_cast<int>(pem.size())));
-  return Owned<X509>(PEM_read_bio_X509(bio.get(), nullptr, nullptr, nullptr));
-}
-
-Owned<EVP_PKEY> ReadKey(const std::string& pem) {
-  Owned<BIO> bio(BIO_new_mem_buf(pem.data(), static_cast<int>(pem.size())));
-  return Owned<EVP_PKEY>(PEM_read_bio_PrivateKey(bio.get(), nullptr, nullptr, nullptr));
 }
 
 absl::Status AddExtension(X509* certificate, X509* issuer, int nid, const std::string& value) {
@@ -81,12 +57,6 @@ std::string AltNames(const std::vector<std::string>& hosts) {
   return absl::StrJoin(names, ",");
 }
 
-std::string TimeText(const ASN1_TIME* time) {
-  Owned<BIO> bio(BIO_new(BIO_s_mem()));
-  ASN1_TIME_print(bio.get(), time);
-  return BioText(bio.get());
-}
-
 }  // namespace
 
 absl::StatusOr<KeyAndCertificate> MakeCertificate(const CertificateRequest& request,
@@ -103,7 +73,7 @@ absl::StatusOr<KeyAndCertificate> MakeCertificate(const CertificateRequest& requ
   Owned<EVP_PKEY> issuer_key;
   if (issuer != nullptr) {
     issuer_certificate = ReadCertificate(issuer->certificate_pem);
-    issuer_key = ReadKey(issuer->key_pem);
+    issuer_key = x509::ReadPrivateKey(issuer->key_pem);
     if (issuer_certificate == nullptr || issuer_key == nullptr) {
       return absl::InvalidArgumentError("the issuer's certificate or key is not PEM");
     }
@@ -180,27 +150,14 @@ absl::StatusOr<CertificateInfo> InspectCertificate(const std::string& pem, const
   char subject[512];
   X509_NAME_oneline(X509_get_subject_name(certificate.get()), subject, sizeof subject);
   info.subject = subject;
-  info.not_after = TimeText(X509_get0_notAfter(certificate.get()));
+  info.not_after = x509::TimeText(X509_get0_notAfter(certificate.get()));
   info.expired = X509_cmp_current_time(X509_get0_notAfter(certificate.get())) < 0;
   info.not_yet_valid = X509_cmp_current_time(X509_get0_notBefore(certificate.get())) > 0;
   int days = 0, seconds = 0;
   if (ASN1_TIME_diff(&days, &seconds, nullptr, X509_get0_notAfter(certificate.get())) == 1) {
     info.seconds_left = std::int64_t{days} * 86400 + seconds;
   }
-  Owned<GENERAL_NAMES> names(static_cast<GENERAL_NAMES*>(
-      X509_get_ext_d2i(certificate.get(), NID_subject_alt_name, nullptr, nullptr)));
-  for (int i = 0; names != nullptr && i < sk_GENERAL_NAME_num(names.get()); ++i) {
-    const GENERAL_NAME* name = sk_GENERAL_NAME_value(names.get(), i);
-    if (name->type == GEN_DNS) {
-      const ASN1_STRING* dns = name->d.dNSName;
-      info.hosts.emplace_back(reinterpret_cast<const char*>(ASN1_STRING_get0_data(dns)), ASN1_STRING_length(dns));
-    } else if (name->type == GEN_IPADD) {
-      const ASN1_OCTET_STRING* ip = name->d.iPAddress;
-      char text[INET6_ADDRSTRLEN] = {};
-      const int family = ASN1_STRING_length(ip) == 4 ? AF_INET : AF_INET6;
-      if (inet_ntop(family, ASN1_STRING_get0_data(ip), text, sizeof text) != nullptr) info.hosts.emplace_back(text);
-    }
-  }
+  info.hosts = x509::CertificateHosts(certificate.get());
   return info;
 }
 
@@ -211,7 +168,7 @@ absl::Status CheckKeyMatchesCertificate(const std::string& certificate_pem, cons
     ERR_clear_error();
     return absl::InvalidArgumentError(absl::StrCat(certificate_name, ": no PEM certificate"));
   }
-  Owned<EVP_PKEY> key = ReadKey(key_pem);
+  Owned<EVP_PKEY> key = x509::ReadPrivateKey(key_pem);
   if (key == nullptr) {
     ERR_clear_error();
     return absl::InvalidArgumentError(absl::StrCat(key_name, ": no PEM private key"));

@@ -1,13 +1,12 @@
 #include "server/auth/token_table.h"
 
-#include <fstream>
-#include <sstream>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "common/read_file.h"
 #include "server/auth/token.h"
 
 namespace mbopt::auth {
@@ -66,11 +65,9 @@ absl::StatusOr<TokenTable> TokenTable::Parse(std::string_view text_view, const s
 }
 
 absl::StatusOr<TokenTable> TokenTable::Load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrCat("cannot read the token table ", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return Parse(text.str(), path);
+  absl::StatusOr<std::string> text = ReadWholeFile(path);
+  if (!text.ok()) return absl::NotFoundError(absl::StrCat("cannot read the token table ", path));
+  return Parse(*text, path);
 }
 
 std::optional<Principal> TokenTable::Find(std::string_view token) const {

@@ -11,11 +11,11 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <string>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "common/read_file.h"
 #include "server/auth/certificates.h"
 #include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
@@ -232,11 +232,9 @@ int main(int argc, char** argv) {
   }
   if (tls) {
     // Started, so readable and not expired; say so well before it expires.
-    std::ifstream in(flags.server.tls_cert_file);
-    std::ostringstream pem;
-    pem << in.rdbuf();
+    absl::StatusOr<std::string> pem = mbopt::ReadWholeFile(flags.server.tls_cert_file);
     absl::StatusOr<mbopt::auth::CertificateInfo> info =
-        mbopt::auth::InspectCertificate(pem.str(), flags.server.tls_cert_file);
+        pem.ok() ? mbopt::auth::InspectCertificate(*pem, flags.server.tls_cert_file) : pem.status();
     if (info.ok() && info->seconds_left < kCertificateWarningSeconds) {
       std::cerr << "mbopt-server: WARNING: the server certificate " << flags.server.tls_cert_file << " expires on "
                 << info->not_after << "; `mbopt-server renew-cert DIR` makes a new one from the same CA\n";

@@ -3,15 +3,14 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "common/read_file.h"
 #include "server/auth/certificates.h"
 #include "server/main/flag_value.h"
 #include "server/main/secret_file.h"
@@ -30,11 +29,9 @@ constexpr const char* kUsage =
     "  --days N     validity (default 825)\n";
 
 bool ReadFile(const std::string& path, std::string* out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream text;
-  text << in.rdbuf();
-  *out = text.str();
+  absl::StatusOr<std::string> text = ReadWholeFile(path);
+  if (!text.ok()) return false;
+  *out = *std::move(text);
   return true;
 }
 

@@ -4,12 +4,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/read_file.h"
 #include "common/status_macros.h"
 #include "server/auth/certificates.h"
 #include "server/auth/token_table.h"
@@ -28,11 +27,9 @@ constexpr auto kGrpcShutdownGrace = std::chrono::milliseconds(1000);
 constexpr auto kTrimInterval = std::chrono::seconds(2);
 
 absl::StatusOr<std::string> ReadPemFile(const std::string& path, const char* option) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::InvalidArgumentError(absl::StrCat(option, ": cannot read ", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  absl::StatusOr<std::string> text = ReadWholeFile(path);
+  if (!text.ok()) return absl::InvalidArgumentError(absl::StrCat(option, ": ", text.status().message()));
+  return text;
 }
 
 }  // namespace

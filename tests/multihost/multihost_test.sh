@@ -28,11 +28,7 @@ GUARD_S=120
 TEST_NAME=multihost
 # shellcheck source=tests/shell/helpers.sh
 source tests/shell/helpers.sh
-if [ "$(id -u)" -ne 0 ]; then
-  # As the README's set-up allows: a user with sudo.
-  sudo -n true 2> /dev/null || fail "network namespaces need root: run the tests as root or as a user with sudo"
-  exec sudo -n bash "$0" "$@"
-fi
+run_as_root "making network namespaces" "$@"
 command -v ip > /dev/null || fail "needs ip from iproute2 (deploy/install-deps.sh installs it)"
 command -v sqlite3 > /dev/null || fail "needs the sqlite3 shell (deploy/install-deps.sh installs it)"
 

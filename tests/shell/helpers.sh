@@ -8,6 +8,17 @@ fail() {
   exit 1
 }
 
+# Re-runs the calling script ("$@" are its arguments) as root through sudo
+# when it is not root and sudo needs no password (a user the README's set-up
+# allows); fails naming `why` root is needed otherwise.
+run_as_root() {
+  local why=$1
+  shift
+  [ "$(id -u)" -eq 0 ] && return 0
+  sudo -n true 2> /dev/null || fail "$why needs root: run the tests as root or as a user with sudo"
+  exec sudo -n bash "$0" "$@"
+}
+
 # Waits until the command "$@" succeeds; $1 says what is awaited.
 wait_for() {
   local what=$1

@@ -25,11 +25,7 @@ GUARD_S=120
 TEST_NAME=slurm
 # shellcheck source=tests/shell/helpers.sh
 source tests/shell/helpers.sh
-if [ "$(id -u)" -ne 0 ]; then
-  # As the README's set-up allows: a user with sudo.
-  sudo -n true 2> /dev/null || fail "a private Slurm cluster needs root: run the tests as root or as a user with sudo"
-  exec sudo -n bash "$0" "$@"
-fi
+run_as_root "a private Slurm cluster" "$@"
 for tool in slurmctld slurmd sbatch squeue scancel sinfo munged mungekey; do
   command -v "$tool" > /dev/null || fail "needs $tool (slurmctld, slurmd, slurm-client and munge: deploy/install-deps.sh)"
 done

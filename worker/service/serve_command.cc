@@ -69,8 +69,7 @@ int ServeMain(const std::vector<std::string>& args) {
     } else if (name == "--name") {
       ok = need_value();
       options.name = value;
-    } else if (name == "--tls-ca" || name == "--tls-cert" || name == "--tls-key" || name == "--tls-server-name" ||
-               name == "--token-file") {
+    } else if (secure_channel::IsSecurityOption(name)) {
       ok = need_value() && secure_channel::SetSecurityFlag(name, value, &security_flags);
     } else if (name == "--task-delay-ms") {
       ok = need_value() && ParseInt(value, 0, &options.task_delay_ms);
