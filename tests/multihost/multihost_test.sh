@@ -41,7 +41,7 @@ cleanup() {
   for pid in "${PIDS[@]}"; do kill -9 "$pid" 2> /dev/null || true; done
   wait 2> /dev/null || true
   for ns in "$SRV" "${WORKER_NS[@]}"; do ip netns del "$ns" 2> /dev/null || true; done
-  if [ "${KEEP_LOGS:-0}" = 1 ]; then echo "multihost: logs in $DIR" >&2; else rm -rf "$DIR"; fi
+  remove_test_dir "$DIR"
 }
 trap cleanup EXIT
 

@@ -45,3 +45,35 @@ expect_same_result() {
     fail "$1 differs from the uninterrupted run"
   fi
 }
+
+# Sends TERM to the processes whose pid files are given and waits (at most
+# 10 s) until they are gone. Daemons (slurmctld, slurmd, munged) are not
+# this shell's children, so `wait` does not wait for them, and they write
+# their state while shutting down: removing their directories before they
+# are gone races with those writes.
+stop_daemons() {
+  local pidfile pid pids=()
+  for pidfile in "$@"; do
+    [ -f "$pidfile" ] || continue
+    pid=$(cat "$pidfile" 2> /dev/null) || continue
+    [ -n "$pid" ] && kill -TERM "$pid" 2> /dev/null && pids+=("$pid")
+  done
+  local deadline=$((SECONDS + 10))
+  for pid in "${pids[@]}"; do
+    while kill -0 "$pid" 2> /dev/null && [ $SECONDS -lt $deadline ]; do sleep 0.05; done
+    kill -KILL "$pid" 2> /dev/null || true
+  done
+}
+
+# Removes the test's directory $1 unless KEEP_LOGS=1. A directory that will
+# not go (a straggler still writing) is reported, not turned into a failure
+# of a test whose checks all passed.
+remove_test_dir() {
+  if [ "${KEEP_LOGS:-0}" = 1 ]; then
+    echo "$TEST_NAME: logs in $1" >&2
+    return 0
+  fi
+  rm -rf "$1" 2> /dev/null || { sleep 1; rm -rf "$1" 2> /dev/null; } \
+    || echo "$TEST_NAME: note: could not remove $1" >&2
+  return 0
+}

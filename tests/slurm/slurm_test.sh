@@ -33,13 +33,17 @@ done
 DIR=$(mktemp -d)
 chmod 755 "$DIR"
 cleanup() {
-  [ -n "${SLURM_CONF:-}" ] && scancel --quiet --name=mbopt-workers 2> /dev/null || true
-  for pidfile in "$DIR"/run/*.pid; do
-    [ -f "$pidfile" ] && kill -TERM "$(cat "$pidfile")" 2> /dev/null || true
-  done
+  if [ -n "${SLURM_CONF:-}" ]; then
+    scancel --quiet --name=mbopt-workers 2> /dev/null || true
+    # Job steps write their output into $DIR until they end.
+    local deadline=$((SECONDS + 10))
+    while [ -n "$(squeue -h --name=mbopt-workers 2> /dev/null)" ] && [ $SECONDS -lt $deadline ]; do sleep 0.1; done
+  fi
   [ -n "${SERVER_PID:-}" ] && kill -TERM "$SERVER_PID" 2> /dev/null || true
+  stop_daemons "$DIR"/run/slurmd.pid "$DIR"/run/slurmctld.pid
+  stop_daemons "$DIR"/run/munged.pid
   wait 2> /dev/null || true
-  if [ "${KEEP_LOGS:-0}" = 1 ]; then echo "slurm: logs in $DIR" >&2; else rm -rf "$DIR"; fi
+  remove_test_dir "$DIR"
 }
 trap cleanup EXIT
 
