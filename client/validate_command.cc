@@ -38,9 +38,7 @@ const char* ReductionName(spec::Reduction r) {
 }
 
 std::string OutputName(const spec::Study& study, int output) {
-  return output >= 0 && static_cast<size_t>(output) < study.scene.outputs.size()
-             ? study.scene.outputs[static_cast<size_t>(output)].name
-             : "?";
+  return output >= 0 && output < study.num_signals() ? study.SignalName(output) : "?";
 }
 
 std::string WindowText(const spec::TimeWindow& w) {
@@ -67,6 +65,16 @@ std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& lay
                                 t.unit);
       }
       return text;
+    }
+    case spec::Objective::Form::kMaxOver: {
+      std::string text = "minimize the largest of:";
+      for (const spec::WeightedTerm& t : o.sum_terms) {
+        text += absl::StrFormat(" %s%s of %s%s%s%s;", t.weight != 1.0 ? absl::StrFormat("%g x ", t.weight) : "",
+                                ReductionName(t.reduction), OutputName(study, t.output), WindowText(t.window),
+                                t.unit.empty() ? "" : " in ", t.unit);
+      }
+      text.pop_back();
+      return text + absl::StrFormat(" (%d terms, min-max form)", layout.num_objective_terms());
     }
     case spec::Objective::Form::kTargetDistance: {
       std::string text = "distance to targets:";
@@ -109,6 +117,30 @@ int ValidateCommand(const Args& args) {
     for (int also : v.also_sets) sets += "," + scene.parameters[static_cast<size_t>(also)].name;
     std::printf("  %-12s sets %-20s initial %-12g in [%g, %g]%s\n", v.name.c_str(), sets.c_str(),
                 v.scale * v.initial, v.scale * v.lower, v.scale * v.upper, unit.c_str());
+  }
+  if (!study->cases.empty()) {
+    std::printf("load cases:  %zu, each analysed at every design point\n", study->cases.size());
+    for (const spec::LoadCase& c : study->cases) {
+      std::string sets;
+      for (const auto& [parameter, value_si] : c.parameter_values_si) {
+        const spec::Parameter& p = scene.parameters[static_cast<size_t>(parameter)];
+        sets += absl::StrFormat("%s%s = %g%s%s", sets.empty() ? "" : ", ", p.name, value_si / p.si_per_unit,
+                                p.unit.empty() ? "" : " ", p.unit);
+      }
+      std::printf("  %-12s %s\n", c.name.c_str(), sets.empty() ? "(the scene as it is)" : sets.c_str());
+    }
+  }
+  if (!study->responses.empty()) {
+    std::printf("responses:   %zu\n", study->responses.size());
+    for (size_t r = 0; r < study->responses.size(); ++r) {
+      const spec::Response& response = study->responses[r];
+      const spec::OutputShape& shape = layout->outputs[static_cast<size_t>(study->num_case_signals()) + r];
+      std::printf("  %-12s = %s%s%s (%s)\n", response.name.c_str(), response.expression->text().c_str(),
+                  response.dimension == spec::Dimension::kAny ? "" : ", a ",
+                  response.dimension == spec::Dimension::kAny ? "" : spec::DimensionName(response.dimension),
+                  shape.scalar ? "one value" : absl::StrFormat("%d series of %d instants", shape.series,
+                                                               shape.instants).c_str());
+    }
   }
   std::printf("objective:   %s\n", ObjectiveText(*study, *layout).c_str());
   std::map<int, int> rows_per_constraint;

@@ -13,6 +13,10 @@
 namespace mbopt::spec {
 namespace {
 
+// Expressions in files are short; a fixed evaluation stack avoids
+// allocation, and Parse refuses what would not fit.
+constexpr int kMaxEvaluationStack = 64;
+
 struct Function {
   const char* name;
   int arity;
@@ -68,6 +72,11 @@ class ExpressionParser {
     if (pos_ < text_.size()) return Error("an operator or the end of the expression");
     std::sort(e->parameters_.begin(), e->parameters_.end());
     e->parameters_.erase(std::unique(e->parameters_.begin(), e->parameters_.end()), e->parameters_.end());
+    if (max_depth_ > kMaxEvaluationStack) {
+      return absl::InvalidArgumentError(absl::StrCat("\"", text_, "\" is nested too deeply to evaluate (",
+                                                     max_depth_, " pending values, at most ", kMaxEvaluationStack,
+                                                     ")"));
+    }
     e->max_stack_ = max_depth_;
     return std::shared_ptr<const Expression>(std::move(e));
   }
@@ -105,7 +114,16 @@ class ExpressionParser {
       Emit(op == '*' ? Expression::Op::kMultiply : Expression::Op::kDivide, 0, 0, -1);
     }
   }
+  // Every nesting (parentheses, signs, powers, arguments) passes here: the
+  // parser's recursion is bounded before the machine's stack is.
   absl::Status Unary() {
+    if (nesting_ >= 4 * kMaxEvaluationStack) return Error("less nesting (parentheses, signs or powers)");
+    ++nesting_;
+    absl::Status s = UnaryBody();
+    --nesting_;
+    return s;
+  }
+  absl::Status UnaryBody() {
     Skip();
     if (pos_ < text_.size() && (text_[pos_] == '-' || text_[pos_] == '+')) {
       const char op = text_[pos_++];
@@ -127,7 +145,7 @@ class ExpressionParser {
   }
   absl::Status Primary() {
     Skip();
-    if (pos_ >= text_.size()) return Error("a number, a parameter name, a function or '('");
+    if (pos_ >= text_.size()) return Error(absl::StrCat("a number, a name (", names_.kind, "), a function or '('"));
     const char c = text_[pos_];
     if (c == '(') {
       ++pos_;
@@ -148,7 +166,14 @@ class ExpressionParser {
     }
     if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       const size_t start = pos_;
-      while (pos_ < text_.size() && (std::isalnum(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '_')) ++pos_;
+      // A dot followed by a letter continues a name: "<case>.<output>".
+      auto name_char = [&](size_t at) {
+        const unsigned char ch = static_cast<unsigned char>(text_[at]);
+        if (std::isalnum(ch) || ch == '_') return true;
+        return ch == '.' && at + 1 < text_.size() &&
+               (std::isalpha(static_cast<unsigned char>(text_[at + 1])) || text_[at + 1] == '_');
+      };
+      while (pos_ < text_.size() && name_char(pos_)) ++pos_;
       const std::string name = text_.substr(start, pos_ - start);
       Skip();
       if (pos_ < text_.size() && text_[pos_] == '(') return Call(name, start);
@@ -166,10 +191,10 @@ class ExpressionParser {
         if (Distance(known, name) <= 2) near.push_back(known);
       }
       return absl::InvalidArgumentError(absl::StrCat(
-          "column ", start + 1, " of \"", text_, "\": unknown parameter \"", name, "\"",
+          "column ", start + 1, " of \"", text_, "\": unknown ", names_.kind, " \"", name, "\"",
           near.empty() ? "" : absl::StrCat(" (did you mean ", absl::StrJoin(near, ", "), "?)")));
     }
-    return Error("a number, a parameter name, a function or '('");
+    return Error(absl::StrCat("a number, a name (", names_.kind, "), a function or '('"));
   }
   absl::Status Call(const std::string& name, size_t start) {
     int function = -1;
@@ -202,6 +227,7 @@ class ExpressionParser {
   Expression* out_ = nullptr;
   size_t pos_ = 0;
   int depth_ = 0, max_depth_ = 0;
+  int nesting_ = 0;
 };
 
 absl::StatusOr<std::shared_ptr<const Expression>> Expression::Parse(const std::string& text, const Names& names) {
@@ -209,8 +235,7 @@ absl::StatusOr<std::shared_ptr<const Expression>> Expression::Parse(const std::s
 }
 
 double Expression::Evaluate(const std::vector<double>& p) const {
-  // Expressions in scene files are short; a fixed stack avoids allocation.
-  constexpr int kMaxStack = 64;
+  constexpr int kMaxStack = kMaxEvaluationStack;
   double stack[kMaxStack];
   if (max_stack_ > kMaxStack) return NAN;
   int top = -1;
@@ -232,6 +257,142 @@ double Expression::Evaluate(const std::vector<double>& p) const {
     }
   }
   return top == 0 ? stack[0] : NAN;
+}
+
+namespace {
+
+// d f(a) / d a for the one-argument functions, in kFunctions' order.
+double Derivative1(int function, double a) {
+  switch (function) {
+    case 0: return 0.5 / std::sqrt(a);
+    case 1: return std::cos(a);
+    case 2: return -std::sin(a);
+    case 3: return 1.0 / (std::cos(a) * std::cos(a));
+    case 4: return 1.0 / std::sqrt(1.0 - a * a);
+    case 5: return -1.0 / std::sqrt(1.0 - a * a);
+    case 6: return 1.0 / (1.0 + a * a);
+    case 7: return std::exp(a);
+    case 8: return 1.0 / a;
+    case 9: return a > 0.0 ? 1.0 : a < 0.0 ? -1.0 : 0.0;
+    default: return NAN;
+  }
+}
+
+// d f(a, b) / d a and d f(a, b) / d b for the two-argument functions.
+std::pair<double, double> Derivative2(int function, double a, double b, double value) {
+  switch (function) {
+    case 10: {  // atan2(y = a, x = b)
+      const double r2 = a * a + b * b;
+      return {b / r2, -a / r2};
+    }
+    case 11: return a <= b ? std::pair{1.0, 0.0} : std::pair{0.0, 1.0};
+    case 12: return a >= b ? std::pair{1.0, 0.0} : std::pair{0.0, 1.0};
+    case 13: return {b * std::pow(a, b - 1.0), a > 0.0 ? value * std::log(a) : 0.0};
+    default: return {NAN, NAN};
+  }
+}
+
+}  // namespace
+
+double Expression::EvaluateWithPartials(const std::vector<double>& p, std::vector<double>* partials) const {
+  const size_t m = parameters_.size();
+  partials->assign(m, 0.0);
+  constexpr int kMaxStack = kMaxEvaluationStack;
+  if (max_stack_ > kMaxStack) {
+    partials->assign(m, NAN);
+    return NAN;
+  }
+  // Each stack entry carries its value and its m partials.
+  double value[kMaxStack];
+  std::vector<double> grad(static_cast<size_t>(max_stack_ + 1) * std::max<size_t>(m, 1), 0.0);
+  auto g = [&](int slot) { return grad.data() + static_cast<size_t>(slot) * m; };
+  // a := ca * a + cb * b, for the partials of two stack entries.
+  auto combine = [&](int a, double ca, int b, double cb) {
+    double* ga = g(a);
+    const double* gb = g(b);
+    // A partial that is exactly 0 stays out: 0 * inf (sqrt'(0) of a
+    // subexpression that does not depend on parameter k) is no NaN.
+    for (size_t k = 0; k < m; ++k) ga[k] = (ga[k] != 0.0 ? ca * ga[k] : 0.0) + (gb[k] != 0.0 ? cb * gb[k] : 0.0);
+  };
+  auto scale = [&](int a, double c) {
+    double* ga = g(a);
+    for (size_t k = 0; k < m; ++k) ga[k] = ga[k] != 0.0 ? c * ga[k] : 0.0;
+  };
+  int top = -1;
+  for (const Instruction& in : code_) {
+    switch (in.op) {
+      case Op::kConstant:
+        value[++top] = in.value;
+        std::fill(g(top), g(top) + m, 0.0);
+        break;
+      case Op::kParameter: {
+        value[++top] = p[static_cast<size_t>(in.index)];
+        std::fill(g(top), g(top) + m, 0.0);
+        const size_t k = static_cast<size_t>(
+            std::lower_bound(parameters_.begin(), parameters_.end(), in.index) - parameters_.begin());
+        g(top)[k] = 1.0;
+        break;
+      }
+      case Op::kNegate:
+        value[top] = -value[top];
+        scale(top, -1.0);
+        break;
+      case Op::kAdd:
+        --top;
+        value[top] += value[top + 1];
+        combine(top, 1.0, top + 1, 1.0);
+        break;
+      case Op::kSubtract:
+        --top;
+        value[top] -= value[top + 1];
+        combine(top, 1.0, top + 1, -1.0);
+        break;
+      case Op::kMultiply: {
+        --top;
+        const double a = value[top], b = value[top + 1];
+        value[top] = a * b;
+        combine(top, b, top + 1, a);
+        break;
+      }
+      case Op::kDivide: {
+        --top;
+        const double a = value[top], b = value[top + 1];
+        value[top] = a / b;
+        combine(top, 1.0 / b, top + 1, -a / (b * b));
+        break;
+      }
+      case Op::kPower: {
+        --top;
+        const double a = value[top], b = value[top + 1];
+        value[top] = std::pow(a, b);
+        const auto [da, db] = Derivative2(13, a, b, value[top]);
+        // An exponent that depends on nothing contributes nothing, even
+        // where log(a) is not defined.
+        combine(top, da, top + 1, db);
+        break;
+      }
+      case Op::kFunction1: {
+        const double a = value[top];
+        value[top] = kFunctions[static_cast<size_t>(in.index)].one(a);
+        scale(top, Derivative1(in.index, a));
+        break;
+      }
+      case Op::kFunction2: {
+        --top;
+        const double a = value[top], b = value[top + 1];
+        value[top] = kFunctions[static_cast<size_t>(in.index)].two(a, b);
+        const auto [da, db] = Derivative2(in.index, a, b, value[top]);
+        combine(top, da, top + 1, db);
+        break;
+      }
+    }
+  }
+  if (top != 0) {
+    partials->assign(m, NAN);
+    return NAN;
+  }
+  std::copy(g(0), g(0) + m, partials->begin());
+  return value[0];
 }
 
 }  // namespace mbopt::spec

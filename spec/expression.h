@@ -27,12 +27,18 @@ class Expression {
   struct Names {
     std::function<std::optional<int>(const std::string&)> find;
     std::vector<std::string> all;
+    std::string kind = "parameter";  // what a name is, for messages
   };
   // InvalidArgument "column N: <what was expected>" (1-based), or naming the
   // unknown parameter with the nearest known names.
   static absl::StatusOr<std::shared_ptr<const Expression>> Parse(const std::string& text, const Names& names);
 
   double Evaluate(const std::vector<double>& parameter_values_si) const;
+  // The value, and in `partials` (resized to parameters().size()) its
+  // derivatives with respect to each parameter read, in parameters()'s
+  // order: forward-mode differentiation of the code, exact up to rounding.
+  // abs, min and max take the derivative of the branch taken (abs: 0 at 0).
+  double EvaluateWithPartials(const std::vector<double>& parameter_values_si, std::vector<double>* partials) const;
   // Indices of the parameters it reads (sorted, unique).
   const std::vector<int>& parameters() const { return parameters_; }
   const std::string& text() const { return text_; }

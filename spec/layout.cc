@@ -8,6 +8,7 @@
 #include "absl/strings/str_format.h"
 #include "common/status_macros.h"
 #include "spec/limits.h"
+#include "spec/responses.h"
 
 namespace mbopt::spec {
 namespace {
@@ -43,9 +44,6 @@ std::string RowName(const std::string& constraint, const OutputShape& shape, int
   return name;
 }
 
-bool IsScalarOutput(const Scene& scene, int output) {
-  return std::holds_alternative<MassOutput>(scene.outputs[static_cast<size_t>(output)].kind);
-}
 
 ValueRef At(int output, int series, int instant, double sign) {
   return ValueRef{output, series, instant, sign, Over::kInstant, instant, instant};
@@ -163,9 +161,8 @@ double RefValue(const ValueRef& ref, const std::vector<double>& f, const std::ve
 OutputShape OutputShapeOf(const Scene& scene, int output) {
   OutputShape shape;
   const Output& out = scene.outputs[static_cast<size_t>(output)];
-  shape.instants = std::holds_alternative<MassOutput>(out.kind)
-                       ? 1
-                       : static_cast<int>(scene.time_grid.Instants().size());
+  shape.scalar = std::holds_alternative<MassOutput>(out.kind);
+  shape.instants = shape.scalar ? 1 : static_cast<int>(scene.time_grid.Instants().size());
   if (const auto* stress = std::get_if<BendingStressOutput>(&out.kind)) {
     // A flexible link of a multibody model: every node, 0 (end a) to n (end b).
     const auto* multibody = std::get_if<MultibodyModel>(&scene.model);
@@ -231,12 +228,36 @@ Dimension OutputDimension(const Output& output) {
                     output.kind);
 }
 
-StudyFootprint EstimateStudyFootprint(const Study& study) {
+namespace {
+
+// The shapes of every signal; a response whose reads disagree gets the shape
+// of the last one (MakeStudyLayout refuses it).
+std::vector<OutputShape> SignalShapes(const Study& study, std::vector<std::string>* errors) {
   const Scene& scene = study.scene;
-  const int num_outputs = static_cast<int>(scene.outputs.size());
+  std::vector<OutputShape> shapes;
+  for (int c = 0; c < study.num_cases(); ++c) {
+    for (size_t o = 0; o < scene.outputs.size(); ++o) shapes.push_back(OutputShapeOf(scene, static_cast<int>(o)));
+  }
+  const int instants = static_cast<int>(scene.time_grid.Instants().size());
+  for (size_t r = 0; r < study.responses.size(); ++r) {
+    absl::StatusOr<OutputShape> shape = ResponseShape(study, static_cast<int>(r), shapes, instants);
+    if (!shape.ok()) {
+      if (errors != nullptr) errors->push_back(std::string(shape.status().message()));
+      shape = OutputShape{1, instants, {study.responses[r].name}, false};
+    }
+    shapes.push_back(*std::move(shape));
+  }
+  return shapes;
+}
+
+}  // namespace
+
+StudyFootprint EstimateStudyFootprint(const Study& study) {
+  const std::vector<OutputShape> shapes = SignalShapes(study, nullptr);
+  const int num_signals = static_cast<int>(shapes.size());
   auto values = [&](int output) -> std::int64_t {
-    if (output < 0 || output >= num_outputs) return 0;
-    const OutputShape shape = OutputShapeOf(scene, output);
+    if (output < 0 || output >= num_signals) return 0;
+    const OutputShape& shape = shapes[static_cast<size_t>(output)];
     return static_cast<std::int64_t>(shape.series) * shape.instants;
   };
   StudyFootprint f;
@@ -244,9 +265,17 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
   f.objective_terms = objective.form == Objective::Form::kMinimizeMaxOf
                           ? values(objective.output) * (objective.reduction == Reduction::kMaxAbs ? 2 : 1)
                           : 1;
+  if (objective.form == Objective::Form::kMaxOver) {
+    f.objective_terms = 0;
+    for (const WeightedTerm& term : objective.sum_terms) {
+      f.objective_terms += IsWholeSeriesReduction(term.reduction)
+                               ? 1
+                               : values(term.output) * (term.reduction == Reduction::kMaxAbs ? 2 : 1);
+    }
+  }
   for (const Constraint& c : study.constraints) {
     const std::int64_t all = values(c.output);
-    const std::int64_t series = c.output >= 0 && c.output < num_outputs ? OutputShapeOf(scene, c.output).series : 0;
+    const std::int64_t series = c.output >= 0 && c.output < num_signals ? shapes[static_cast<size_t>(c.output)].series : 0;
     if (IsWholeSeriesReduction(c.reduction)) {
       f.constraint_rows += series * std::max(1, (c.upper ? 1 : 0) + (c.lower ? 1 : 0));
     } else {
@@ -275,17 +304,18 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
   }
   StudyLayout layout;
   layout.instants_s = scene.time_grid.Instants();
-  for (size_t o = 0; o < scene.outputs.size(); ++o) {
-    layout.outputs.push_back(OutputShapeOf(scene, static_cast<int>(o)));
-  }
-  const int num_outputs = static_cast<int>(scene.outputs.size());
-  auto valid_output = [&](int o) { return o >= 0 && o < num_outputs; };
+  std::vector<std::string> shape_errors;
+  layout.outputs = SignalShapes(study, &shape_errors);
+  if (!shape_errors.empty()) return LayoutError(study, "responses", shape_errors.front());
+  const int num_signals = study.num_signals();
+  auto valid_output = [&](int o) { return o >= 0 && o < num_signals; };
+  auto scalar = [&](int o) { return layout.outputs[static_cast<size_t>(o)].scalar; };
 
   const Objective& objective = study.objective;
   switch (objective.form) {
     case Objective::Form::kMinimizeMaxOf: {
       if (!valid_output(objective.output)) {
-        return LayoutError(study, "objective.minimize_max_of", "names no scene output");
+        return LayoutError(study, "objective.minimize_max_of", "names no scene output or response");
       }
       if (objective.reduction != Reduction::kMax && objective.reduction != Reduction::kMaxAbs) {
         return LayoutError(study, "objective.reduction",
@@ -295,7 +325,7 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       const OutputShape& shape = layout.outputs[static_cast<size_t>(objective.output)];
       MBOPT_ASSIGN_OR_RETURN(const auto window,
                              WindowInstants(study, "objective", objective.window, layout.instants_s,
-                                            IsScalarOutput(scene, objective.output), false));
+                                            scalar(objective.output), false));
       for (int i = window.first; i <= window.second; ++i) {
         for (int s = 0; s < shape.series; ++s) {
           layout.objective_terms.push_back(At(objective.output, s, i, 1.0));
@@ -308,20 +338,20 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
     }
     case Objective::Form::kMinimize: {
       if (!valid_output(objective.output)) {
-        return LayoutError(study, "objective.minimize", "names no scene output");
+        return LayoutError(study, "objective.minimize", "names no scene output or response");
       }
       const OutputShape& shape = layout.outputs[static_cast<size_t>(objective.output)];
       if (shape.series != 1) {
         return LayoutError(
             study, "objective.minimize",
-            absl::StrCat("output \"", scene.outputs[objective.output].name, "\" has ", shape.series,
+            absl::StrCat("output \"", study.SignalName(objective.output), "\" has ", shape.series,
                          " series; minimize needs a single value"));
       }
       layout.objective_form = ObjectiveForm::kScalar;
       const bool reduced = objective.reduction != Reduction::kFinal;
       MBOPT_ASSIGN_OR_RETURN(const auto window,
                              WindowInstants(study, "objective", objective.window, layout.instants_s,
-                                            IsScalarOutput(scene, objective.output), reduced));
+                                            scalar(objective.output), reduced));
       layout.objective_terms.push_back(SeriesRef(objective.output, 0, objective.reduction, window));
       break;
     }
@@ -332,16 +362,49 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
         const WeightedTerm& term = objective.sum_terms[k];
         const std::string field = absl::StrCat("objective.minimize_sum.terms[", k, "]");
-        if (!valid_output(term.output)) return LayoutError(study, field, "names no scene output");
+        if (!valid_output(term.output)) return LayoutError(study, field, "names no scene output or response");
         if (layout.outputs[static_cast<size_t>(term.output)].series != 1) {
           return LayoutError(study, field, "a term needs a single-series output");
         }
         const bool reduced = term.reduction != Reduction::kFinal;
         MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, term.window, layout.instants_s,
-                                                                 IsScalarOutput(scene, term.output), reduced));
+                                                                 scalar(term.output), reduced));
         layout.sum_refs.push_back(SeriesRef(term.output, 0, term.reduction, window));
       }
       layout.objective_form = ObjectiveForm::kScalar;
+      break;
+    }
+    case Objective::Form::kMaxOver: {
+      if (objective.sum_terms.empty()) {
+        return LayoutError(study, "objective.minimize_max_over.terms", "needs at least one term");
+      }
+      for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
+        const WeightedTerm& term = objective.sum_terms[k];
+        const std::string field = absl::StrCat("objective.minimize_max_over.terms[", k, "]");
+        if (!valid_output(term.output)) return LayoutError(study, field, "names no scene output or response");
+        const OutputShape& shape = layout.outputs[static_cast<size_t>(term.output)];
+        const double factor = term.weight / term.si_per_unit;
+        const bool whole = IsWholeSeriesReduction(term.reduction);
+        MBOPT_ASSIGN_OR_RETURN(
+            const auto window, WindowInstants(study, field, term.window, layout.instants_s, scalar(term.output),
+                                              whole && term.reduction != Reduction::kFinal));
+        for (int s = 0; s < shape.series; ++s) {
+          if (whole) {
+            layout.objective_terms.push_back(SeriesRef(term.output, s, term.reduction, window));
+            layout.objective_term_factors.push_back(factor);
+            continue;
+          }
+          for (int i = window.first; i <= window.second; ++i) {
+            layout.objective_terms.push_back(At(term.output, s, i, 1.0));
+            layout.objective_term_factors.push_back(factor);
+            if (term.reduction == Reduction::kMaxAbs) {
+              layout.objective_terms.push_back(At(term.output, s, i, -1.0));
+              layout.objective_term_factors.push_back(factor);
+            }
+          }
+        }
+      }
+      layout.objective_form = ObjectiveForm::kMinMax;
       break;
     }
     case Objective::Form::kTargetDistance: {
@@ -352,7 +415,7 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
         const TargetTerm& term = objective.terms[k];
         if (!valid_output(term.output)) {
           return LayoutError(study, absl::StrCat("objective.target_distance.terms[", k, "]"),
-                             "names no scene output");
+                             "names no scene output or response");
         }
         if (layout.outputs[static_cast<size_t>(term.output)].series != 1) {
           return LayoutError(study, absl::StrCat("objective.target_distance.terms[", k, "]"),
@@ -364,15 +427,19 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
     }
   }
 
+  if (objective.form == Objective::Form::kMinimizeMaxOf || objective.form == Objective::Form::kMinimize) {
+    layout.objective_term_factors.assign(layout.objective_terms.size(), 1.0 / objective.si_per_unit);
+  }
+
   const int decimals = TimeDecimals(layout.instants_s);
   for (size_t k = 0; k < study.constraints.size(); ++k) {
     const Constraint& constraint = study.constraints[k];
     if (!valid_output(constraint.output)) {
       return LayoutError(study, absl::StrCat("constraints[", k, "].output"),
-                         "names no scene output");
+                         "names no scene output or response");
     }
     const OutputShape& shape = layout.outputs[static_cast<size_t>(constraint.output)];
-    const bool scalar_output = IsScalarOutput(scene, constraint.output);
+    const bool scalar_output = scalar(constraint.output);
     const std::string field = absl::StrCat("constraints[", k, "]");
     const bool reduced = IsWholeSeriesReduction(constraint.reduction) && constraint.reduction != Reduction::kFinal;
     MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, constraint.window, layout.instants_s,
@@ -455,7 +522,7 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
     }
     if (!ok) {
       return absl::InvalidArgumentError(absl::StrCat(
-          "output \"", study.scene.outputs[o].name, "\" does not have the layout's shape (",
+          "output \"", study.SignalName(static_cast<int>(o)), "\" does not have the layout's shape (",
           shape.series, " series of ", shape.instants, " values)"));
     }
   }
@@ -485,8 +552,8 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
     values.objective_terms = {sum};
   } else {
     values.objective_terms.reserve(layout.objective_terms.size());
-    for (const ValueRef& ref : layout.objective_terms) {
-      values.objective_terms.push_back(value(ref) / objective.si_per_unit);
+    for (size_t k = 0; k < layout.objective_terms.size(); ++k) {
+      values.objective_terms.push_back(value(layout.objective_terms[k]) * layout.objective_term_factors[k]);
     }
     values.objective = -std::numeric_limits<double>::infinity();
     for (double term : values.objective_terms) {

@@ -39,6 +39,7 @@ struct OutputShape {
   int series = 1;
   int instants = 1;
   std::vector<std::string> series_labels;  // one per series
+  bool scalar = false;  // one value per analysis (mass), not a time series
 };
 
 // What the engine produces for scene output `output`. Bending stress: the
@@ -91,10 +92,14 @@ struct StudyLayout {
   // kMinMax: one per term. kScalar with minimize: the one value. kScalar
   // with target_distance: empty (the term combines several outputs).
   std::vector<ValueRef> objective_terms;
+  // kMinMax and minimize: one per objective term, the factor from its SI
+  // value to the term (1 / unit, and a kMaxOver term's weight).
+  std::vector<double> objective_term_factors;
   // kScalar with minimize_sum: one per term of study.objective.sum_terms.
   std::vector<ValueRef> sum_refs;
   std::vector<ConstraintRow> rows;
-  std::vector<OutputShape> outputs;  // one per scene output
+  // One per signal: the scene's outputs, then the study's responses.
+  std::vector<OutputShape> outputs;
   std::vector<double> instants_s;    // the grid
 
   int num_objective_terms() const {
@@ -129,8 +134,9 @@ struct StudyValues {
   int worst_row = -1;                     // row of max_violation; -1 if no rows
 };
 
-// `outputs_si[o]` points at output o's series, [series][instant], SI (as
-// spec::OutputValues::series). InvalidArgument if a shape differs from the
+// `outputs_si[o]` points at signal o's series, [series][instant], SI (as
+// spec::OutputValues::series): the scene's outputs and then the responses
+// (spec/responses.h). InvalidArgument if a shape differs from the
 // layout's; a non-finite value is passed through (the optimizer rejects it).
 absl::StatusOr<StudyValues> ComputeStudyValues(
     const Study& study, const StudyLayout& layout,

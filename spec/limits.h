@@ -18,6 +18,8 @@ inline constexpr int kMaxLinkageFlexibleElements = 200;  // per linkage link
 inline constexpr int kMaxDesignVariables = 10'000;
 inline constexpr std::int64_t kMaxIntegratorSteps = 100'000'000;  // per analysis
 inline constexpr int kMaxOptimizerCycles = 100'000;
+inline constexpr int kMaxResponses = 10'000;
+inline constexpr int kMaxLoadCases = 100;
 
 // Wall time of one analysis (integrator.max_wall_seconds): the default when
 // a scene does not say, and the most it may say. Over it, the analysis ends

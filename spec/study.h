@@ -2,11 +2,15 @@
 // meanings are documented in proto/mbopt/v1/study.proto.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "spec/expression.h"
 #include "spec/scene.h"
+#include "spec/units.h"
 
 namespace mbopt::spec {
 
@@ -46,7 +50,7 @@ struct TargetTerm {
 
 // A term of a weighted-sum objective: weight * (reduced output / unit).
 struct WeightedTerm {
-  int output = -1;
+  int output = -1;  // a signal: a scene output or a response (Study::SignalName)
   Reduction reduction = Reduction::kFinal;
   TimeWindow window;
   double weight = 1.0;
@@ -55,8 +59,12 @@ struct WeightedTerm {
 };
 
 struct Objective {
-  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance, kWeightedSum } form = Form::kMinimize;
-  std::vector<WeightedTerm> sum_terms;  // kWeightedSum
+  // kMaxOver: F = the largest of several terms (min-max over responses).
+  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance, kWeightedSum, kMaxOver } form = Form::kMinimize;
+  // kWeightedSum: the terms summed. kMaxOver: the terms whose largest value
+  // is F; MAX and MAX_ABS give a term per instant of the window, the
+  // whole-series reductions one; weights are positive.
+  std::vector<WeightedTerm> sum_terms;
   int output = -1;                 // kMinimizeMaxOf, kMinimize
   Reduction reduction = Reduction::kMax;
   std::vector<TargetTerm> terms;   // kTargetDistance
@@ -104,11 +112,34 @@ struct AnalysisOverrides {
   bool rigid_links = false;
 };
 
+// A named response: a series computed at every instant from the scene's
+// outputs, the responses before it, the scene's parameters and the time t
+// (SI throughout). Objectives and constraints name it like an output.
+//
+// Its expression's names are numbered as Study::ResponseNameIndex says:
+// signals (the scene's outputs, then the responses), then parameters, then t.
+struct Response {
+  std::string name;
+  std::shared_ptr<const Expression> expression;
+  Dimension dimension = Dimension::kAny;  // from the study's `unit`, for unit checks
+  std::string unit;                       // as written
+};
+
+// A load case: the scene analysed with some of its parameters set otherwise
+// (another road, another payload), at every design point. A study with
+// cases analyses each; its outputs are named "<case>.<output>".
+struct LoadCase {
+  std::string name;
+  std::vector<std::pair<int, double>> parameter_values_si;  // parameter index, SI value
+};
+
 struct Study {
   std::string name;
   std::string source_file;
   Scene scene;  // with the study's AnalysisOverrides already applied
   std::vector<DesignVariable> variables;
+  std::vector<LoadCase> cases;  // empty: one analysis of the scene as it is
+  std::vector<Response> responses;
   Objective objective;
   std::vector<Constraint> constraints;
   OptimizerSettings optimizer;
@@ -116,6 +147,24 @@ struct Study {
 
   // SI parameter values of the scene at scaled design x (others at default).
   std::vector<double> ParameterValuesAt(const std::vector<double>& x_scaled) const;
+
+  // The SI parameter values of load case `c` given the design's
+  // (`parameter_values_si`, from ParameterValuesAt); without cases, those.
+  std::vector<double> CaseParameterValues(int c, std::vector<double> parameter_values_si) const;
+  int num_cases() const { return cases.empty() ? 1 : static_cast<int>(cases.size()); }
+
+  // Signals are what objectives and constraints name: the scene's outputs
+  // (once per load case, case by case), then the responses.
+  int num_case_signals() const { return num_cases() * static_cast<int>(scene.outputs.size()); }
+  int num_signals() const { return num_case_signals() + static_cast<int>(responses.size()); }
+  // "<output>", "<case>.<output>" with load cases, or the response's name.
+  std::string SignalName(int signal) const;
+  // -1 if no output or response has this name.
+  int FindSignal(const std::string& name) const;
+  // A response expression's index of signal k is k; of parameter p,
+  // num_signals() + p; of the time t, num_signals() + parameters.
+  int ParameterNameIndex(int parameter) const { return num_signals() + parameter; }
+  int TimeNameIndex() const { return num_signals() + static_cast<int>(scene.parameters.size()); }
 };
 
 }  // namespace mbopt::spec

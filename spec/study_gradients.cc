@@ -3,11 +3,11 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "spec/responses.h"
 
 namespace mbopt::spec {
 namespace {
 
-using Series = std::vector<std::vector<double>>;
 
 absl::Status CheckShapes(const Study& study, const StudyLayout& layout,
                          const std::vector<const Series*>& outputs, const char* what) {
@@ -24,7 +24,7 @@ absl::Status CheckShapes(const Study& study, const StudyLayout& layout,
     }
     if (!ok) {
       return absl::InvalidArgumentError(absl::StrCat(
-          what, ": output \"", study.scene.outputs[o].name, "\" does not have the layout's shape (",
+          what, ": output \"", study.SignalName(static_cast<int>(o)), "\" does not have the layout's shape (",
           shape.series, " series of ", shape.instants, " values)"));
     }
   }
@@ -115,9 +115,9 @@ absl::StatusOr<StudyGradients> ComputeStudyGradients(
     }
     out.objective_terms.push_back(std::move(row));
   } else {
-    for (const ValueRef& ref : layout.objective_terms) {
-      std::vector<double> row = RefGradient(outputs_si, derivatives_si, layout.instants_s, ref);
-      for (size_t i = 0; i < n; ++i) row[i] = row[i] / objective.si_per_unit * factor[i];
+    for (size_t k = 0; k < layout.objective_terms.size(); ++k) {
+      std::vector<double> row = RefGradient(outputs_si, derivatives_si, layout.instants_s, layout.objective_terms[k]);
+      for (size_t i = 0; i < n; ++i) row[i] = row[i] * layout.objective_term_factors[k] * factor[i];
       out.objective_terms.push_back(std::move(row));
     }
   }

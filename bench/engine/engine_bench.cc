@@ -59,7 +59,7 @@ void BM_VehicleAnalysisAndValues_Rtol1e8(benchmark::State& state) {
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   for (auto _ : state) {
     mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
-    auto values = mbopt::engine::ComputeStudyValues(study, *layout, report);
+    auto values = mbopt::engine::ComputeStudyValues(study, *layout, report, p);
     if (!values.ok()) {
       state.SkipWithError(std::string(values.status().message()).c_str());
       break;

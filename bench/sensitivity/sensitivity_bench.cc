@@ -214,7 +214,7 @@ void BM_VehicleStudyValues(benchmark::State& state) {
   mbopt::spec::AnalysisCounters counters;
   for (auto _ : state) {
     mbopt::spec::AnalysisReport report = mbopt::engine::Analyze(study.scene, p);
-    auto values = mbopt::engine::ComputeStudyValues(study, *layout, report);
+    auto values = mbopt::engine::ComputeStudyValues(study, *layout, report, p);
     if (!values.ok()) {
       state.SkipWithError(std::string(values.status().message()).c_str());
       return;

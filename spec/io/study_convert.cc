@@ -1,5 +1,6 @@
 #include "spec/io/study_convert.h"
 
+#include <cctype>
 #include <cmath>
 #include <optional>
 #include <set>
@@ -12,6 +13,7 @@
 #include "spec/layout.h"
 #include "spec/limits.h"
 #include "spec/units.h"
+#include "spec/expression.h"
 
 namespace mbopt::spec::io {
 namespace {
@@ -32,18 +34,192 @@ double UnitFactor(const Where& w, const std::string& field, const std::string& n
   return unit->si_per_unit;
 }
 
-int FindOutput(const Scene& scene, const Where& w, const std::string& field,
-               const std::string& name, Errors* errors) {
-  const int index = scene.FindOutput(name);
+// A signal (a scene output, per load case, or a response) by name, or -1
+// with an error listing what there is.
+int FindOutput(const Study& study, const Where& w, const std::string& field, const std::string& name,
+               Errors* errors) {
+  const int index = study.FindSignal(name);
   if (index < 0) {
     std::string known;
-    for (const Output& o : scene.outputs)
-      absl::StrAppend(&known, known.empty() ? "" : ", ", "\"", o.name, "\"");
+    for (int s = 0; s < study.num_case_signals(); ++s) {
+      absl::StrAppend(&known, known.empty() ? "" : ", ", "\"", study.SignalName(s), "\"");
+    }
+    std::string responses_known;
+    for (const Response& r : study.responses)
+      absl::StrAppend(&responses_known, responses_known.empty() ? "" : ", ", "\"", r.name, "\"");
     errors->Add(w, field,
-                absl::StrCat("unknown output \"", name,
-                             "\"; the scene's outputs: ", known.empty() ? "(none)" : known));
+                absl::StrCat("unknown output \"", name, "\"; the scene's outputs",
+                             study.cases.empty() ? "" : " in each load case", ": ", known.empty() ? "(none)" : known,
+                             responses_known.empty() ? "" : absl::StrCat("; the study's responses: ", responses_known)));
   }
   return index;
+}
+
+Dimension SignalDimension(const Study& study, int signal) {
+  if (signal < 0 || signal >= study.num_signals()) return Dimension::kAny;
+  if (signal >= study.num_case_signals()) {
+    return study.responses[static_cast<size_t>(signal - study.num_case_signals())].dimension;
+  }
+  return OutputDimension(study.scene.outputs[static_cast<size_t>(signal) % study.scene.outputs.size()]);
+}
+
+// A name usable in expressions: a letter or '_', then letters, digits, '_'.
+bool IsIdentifier(const std::string& name) {
+  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+  for (char c : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  }
+  return true;
+}
+
+// The study's load cases. Each sets scene parameters that no design
+// variable sets, in the parameter's own unit unless it names another.
+std::vector<LoadCase> ConvertCases(const v1::Study& m, const Study& study, const Where& where, Errors* errors) {
+  std::vector<LoadCase> cases;
+  if (m.cases_size() > kMaxLoadCases) {
+    errors->Add(where, "cases", absl::StrFormat("%d load cases, more than the limit of %d", m.cases_size(),
+                                                kMaxLoadCases));
+    return cases;
+  }
+  std::set<int> set_by_variables;
+  for (const DesignVariable& v : study.variables) {
+    set_by_variables.insert(v.parameter);
+    set_by_variables.insert(v.also_sets.begin(), v.also_sets.end());
+  }
+  std::set<std::string> names;
+  for (int k = 0; k < m.cases_size(); ++k) {
+    const v1::LoadCase& c = m.cases(k);
+    const Where w = where.Child("cases", k);
+    LoadCase out;
+    out.name = c.name();
+    if (!IsIdentifier(c.name())) {
+      errors->Add(w, "name", absl::StrCat("\"", c.name(), "\" is not a name: letters, digits and '_', not starting "
+                                          "with a digit (outputs are named \"<case>.<output>\")"));
+    } else if (!names.insert(c.name()).second) {
+      errors->Add(w, "name", absl::StrCat("duplicate load case \"", c.name(), "\""));
+    }
+    std::set<int> set_here;
+    for (int p = 0; p < c.set_size(); ++p) {
+      const v1::ParameterValue& value = c.set(p);
+      const Where pw = w.Child("set", p);
+      const int parameter = study.scene.FindParameter(value.parameter());
+      if (parameter < 0) {
+        errors->Add(pw, "parameter", absl::StrCat("unknown scene parameter \"", value.parameter(), "\""));
+        continue;
+      }
+      if (set_by_variables.count(parameter) > 0) {
+        errors->Add(pw, "parameter", absl::StrCat("parameter \"", value.parameter(),
+                                                  "\" is set by a design variable; a load case sets the others"));
+        continue;
+      }
+      if (!set_here.insert(parameter).second) {
+        errors->Add(pw, "parameter", absl::StrCat("parameter \"", value.parameter(), "\" is set twice in this case"));
+        continue;
+      }
+      if (!std::isfinite(value.value())) errors->Add(pw, "value", "must be a finite number");
+      const Parameter& target = study.scene.parameters[static_cast<size_t>(parameter)];
+      double si_per_unit = target.si_per_unit;
+      if (!value.unit().empty()) {
+        absl::StatusOr<Unit> unit = FindUnit(value.unit());
+        absl::StatusOr<Unit> own = FindUnit(target.unit);
+        if (!unit.ok()) {
+          errors->Add(pw, "unit", std::string(unit.status().message()));
+        } else if (own.ok() && !UnitFits(*unit, own->dimension)) {
+          errors->Add(pw, "unit", absl::StrFormat("unit \"%s\" is a %s but parameter \"%s\" is a %s", value.unit(),
+                                                  DimensionName(unit->dimension), target.name,
+                                                  DimensionName(own->dimension)));
+        } else {
+          si_per_unit = unit->si_per_unit;
+        }
+      }
+      out.parameter_values_si.emplace_back(parameter, value.value() * si_per_unit);
+    }
+    cases.push_back(std::move(out));
+  }
+  return cases;
+}
+
+// The study's responses, in order. A response may read the signals (the
+// scene's outputs per load case, the responses before it), the scene's
+// parameters and t.
+std::vector<Response> ConvertResponses(const v1::Study& m, const Study& study, const Where& where, Errors* errors) {
+  const Scene& scene = study.scene;
+  std::vector<Response> responses;
+  if (m.responses_size() > kMaxResponses) {
+    errors->Add(where, "responses",
+                absl::StrFormat("%d responses, more than the limit of %d", m.responses_size(), kMaxResponses));
+    return responses;
+  }
+  const int num_case_signals = study.num_case_signals();
+  const int num_signals = num_case_signals + m.responses_size();
+  const int time_index = num_signals + static_cast<int>(scene.parameters.size());
+  for (int k = 0; k < m.responses_size(); ++k) {
+    const v1::Response& r = m.responses(k);
+    const Where w = where.Child("responses", k);
+    Response out;
+    out.name = r.name();
+    int clash = -1;
+    for (int s = 0; s < num_case_signals && clash < 0; ++s) {
+      if (study.SignalName(s) == r.name()) clash = s;
+    }
+    if (r.name().empty()) {
+      errors->Add(w, "name", "a response needs a name");
+    } else if (clash >= 0) {
+      errors->Add(w, "name", absl::StrCat("\"", r.name(), "\" is already an output of the scene"));
+    } else if (scene.FindParameter(r.name()) >= 0) {
+      errors->Add(w, "name", absl::StrCat("\"", r.name(), "\" is already a parameter of the scene"));
+    } else if (r.name() == "t" || r.name() == "pi") {
+      errors->Add(w, "name", absl::StrCat("\"", r.name(), "\" is reserved in expressions"));
+    } else {
+      for (const Response& earlier : responses) {
+        if (earlier.name == r.name()) errors->Add(w, "name", absl::StrCat("duplicate response \"", r.name(), "\""));
+      }
+    }
+    Expression::Names names;
+    names.kind = "output, response or parameter";
+    names.find = [&](const std::string& name) -> std::optional<int> {
+      for (int s = 0; s < num_case_signals; ++s) {
+        if (study.SignalName(s) == name) return s;
+      }
+      for (size_t e = 0; e < responses.size(); ++e) {
+        if (responses[e].name == name) return num_case_signals + static_cast<int>(e);
+      }
+      if (const int p = scene.FindParameter(name); p >= 0) return num_signals + p;
+      if (name == "t") return time_index;
+      return std::nullopt;
+    };
+    for (int s = 0; s < num_case_signals; ++s) names.all.push_back(study.SignalName(s));
+    for (const Response& e : responses) names.all.push_back(e.name);
+    for (const Parameter& p : scene.parameters) names.all.push_back(p.name);
+    names.all.push_back("t");
+    if (r.expr().empty()) {
+      errors->Add(w, "expr", "a response needs an expression, e.g. \"seat_position - body_position\"");
+    } else if (absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(r.expr(), names);
+               !parsed.ok()) {
+      std::string message(parsed.status().message());
+      // A later response is a name the parser did not know yet.
+      for (int later = k + 1; later < m.responses_size(); ++later) {
+        if (message.find(absl::StrCat("\"", m.responses(later).name(), "\"")) != std::string::npos) {
+          message += absl::StrCat(" (response \"", m.responses(later).name(),
+                                  "\" is defined later: a response reads only those before it)");
+          break;
+        }
+      }
+      errors->Add(w, "expr", message);
+    } else {
+      out.expression = *std::move(parsed);
+    }
+    out.unit = r.unit();
+    if (!r.unit().empty()) {
+      if (absl::StatusOr<Unit> unit = FindUnit(r.unit()); unit.ok()) {
+        out.dimension = unit->dimension;
+      } else {
+        errors->Add(w, "unit", std::string(unit.status().message()));
+      }
+    }
+    responses.push_back(std::move(out));
+  }
+  return responses;
 }
 
 std::optional<Reduction> ToReduction(v1::Reduction r) {
@@ -88,10 +264,12 @@ TimeWindow ConvertWindow(const Where& w, const v1::TimeWindow& m, Errors* errors
 
 }  // namespace
 
-Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* errors) {
+Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Errors* errors) {
   Study study;
   study.name = m.name();
   study.source_file = where.file();
+  study.scene = std::move(scene_in);
+  Scene& scene = study.scene;
 
   // Overrides first: the layout (grid size) depends on them.
   if (m.has_analysis()) {
@@ -198,6 +376,9 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
   if (m.variables_size() == 0)
     errors->Add(where, "variables", "a study needs at least one design variable");
 
+  study.cases = ConvertCases(m, study, where, errors);
+  study.responses = ConvertResponses(m, study, where, errors);
+
   // Objective.
   const Where ow = where.Child("objective");
   const v1::Objective& o = m.objective();
@@ -206,7 +387,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
   switch (o.form_case()) {
     case v1::Objective::kMinimizeMaxOf: {
       obj.form = Objective::Form::kMinimizeMaxOf;
-      obj.output = FindOutput(scene, ow, "minimize_max_of", o.minimize_max_of(), errors);
+      obj.output = FindOutput(study, ow, "minimize_max_of", o.minimize_max_of(), errors);
       if (o.reduction() == v1::REDUCTION_MAX) {
         obj.reduction = Reduction::kMax;
       } else if (o.reduction() == v1::REDUCTION_MAX_ABS) {
@@ -218,7 +399,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     }
     case v1::Objective::kMinimize: {
       obj.form = Objective::Form::kMinimize;
-      obj.output = FindOutput(scene, ow, "minimize", o.minimize(), errors);
+      obj.output = FindOutput(study, ow, "minimize", o.minimize(), errors);
       const std::optional<Reduction> r =
           o.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(o.reduction());
       if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
@@ -240,7 +421,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
         const v1::TargetTerm& t = o.target_distance().terms(k);
         const Where kw = tw.Child("terms", k);
         TargetTerm term;
-        term.output = FindOutput(scene, kw, "output", t.output(), errors);
+        term.output = FindOutput(study, kw, "output", t.output(), errors);
         term.target = t.target();
         term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
         if (!(term.weight > 0.0) || !std::isfinite(term.weight)) {
@@ -250,62 +431,75 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
         term.unit = t.unit();
         term.si_per_unit = UnitFactor(
             kw, "unit", t.unit(),
-            term.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(term.output)])
-                             : Dimension::kAny,
+            SignalDimension(study, term.output),
             errors);
         obj.terms.push_back(std::move(term));
       }
       break;
     }
-    case v1::Objective::kMinimizeSum: {
-      obj.form = Objective::Form::kWeightedSum;
-      const Where sw = ow.Child("minimize_sum");
-      if (o.minimize_sum().terms_size() == 0) errors->Add(sw, "terms", "minimize_sum needs at least one term");
+    case v1::Objective::kMinimizeSum:
+    case v1::Objective::kMinimizeMaxOver: {
+      const bool sum = o.form_case() == v1::Objective::kMinimizeSum;
+      obj.form = sum ? Objective::Form::kWeightedSum : Objective::Form::kMaxOver;
+      const char* form = sum ? "minimize_sum" : "minimize_max_over";
+      const Where sw = ow.Child(form);
+      const auto& terms = sum ? o.minimize_sum().terms() : o.minimize_max_over().terms();
+      if (terms.empty()) errors->Add(sw, "terms", absl::StrCat(form, " needs at least one term"));
       if (!o.unit().empty()) {
-        errors->Add(ow, "unit", "a weighted sum has no unit of its own: each term's `unit` says how it is taken");
+        errors->Add(ow, "unit", absl::StrCat(sum ? "a weighted sum" : "the largest of several terms",
+                                             " has no unit of its own: each term's `unit` says how it is taken"));
       }
-      for (int k = 0; k < o.minimize_sum().terms_size(); ++k) {
-        const v1::WeightedTerm& t = o.minimize_sum().terms(k);
+      for (int k = 0; k < terms.size(); ++k) {
+        const v1::WeightedTerm& t = terms[k];
         const Where kw = sw.Child("terms", k);
         WeightedTerm term;
-        term.output = FindOutput(scene, kw, "output", t.output(), errors);
+        term.output = FindOutput(study, kw, "output", t.output(), errors);
         const std::optional<Reduction> r =
             t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
-        if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
+        if (sum && (!r.has_value() || !IsWholeSeriesReduction(*r))) {
           errors->Add(kw, "reduction",
                       "a term takes one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
                       "REDUCTION_RANGE or REDUCTION_MEAN");
+        }
+        if (!sum && (!r.has_value() || *r == Reduction::kMin)) {
+          errors->Add(kw, "reduction",
+                      "a term of minimize_max_over is REDUCTION_MAX or REDUCTION_MAX_ABS (a term per instant), or "
+                      "one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, REDUCTION_RANGE "
+                      "or REDUCTION_MEAN");
         }
         term.reduction = r.value_or(Reduction::kFinal);
         if (t.has_window()) term.window = ConvertWindow(kw.Child("window"), t.window(), errors);
         term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
         if (!std::isfinite(term.weight)) errors->Add(kw, "weight", "must be a finite number");
+        if (!sum && !(term.weight > 0.0)) {
+          errors->Add(kw, "weight", absl::StrFormat("a term of the largest must weigh more than 0, got %g",
+                                                    term.weight));
+        }
         term.unit = t.unit();
-        term.si_per_unit = UnitFactor(
-            kw, "unit", t.unit(),
-            term.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(term.output)]) : Dimension::kAny,
-            errors);
+        term.si_per_unit = UnitFactor(kw, "unit", t.unit(), SignalDimension(study, term.output),
+                                      errors);
         obj.sum_terms.push_back(std::move(term));
       }
       break;
     }
     case v1::Objective::FORM_NOT_SET:
       errors->Add(where, "objective",
-                  "missing: expected `minimize_max_of`, `minimize`, `minimize_sum` or "
+                  "missing: expected `minimize_max_of`, `minimize`, `minimize_sum`, `minimize_max_over` or "
                   "`target_distance`");
       break;
   }
+  const bool termwise = obj.form == Objective::Form::kWeightedSum || obj.form == Objective::Form::kMaxOver;
   if (o.has_window()) {
     if (obj.form == Objective::Form::kTargetDistance) {
       errors->Add(ow, "window", "target_distance takes final values; it has no window");
     }
+    if (termwise) errors->Add(ow, "window", "each term has a window of its own (terms[k].window)");
     obj.window = ConvertWindow(ow.Child("window"), o.window(), errors);
   }
-  if (obj.form != Objective::Form::kTargetDistance && obj.form != Objective::Form::kWeightedSum) {
+  if (obj.form != Objective::Form::kTargetDistance && !termwise) {
     obj.si_per_unit =
         UnitFactor(ow, "unit", o.unit(),
-                   obj.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(obj.output)])
-                                   : Dimension::kAny,
+                   SignalDimension(study, obj.output),
                    errors);
   }
 
@@ -320,7 +514,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     if (!constraint_names.insert(c.name()).second) {
       errors->Add(w, "name", absl::StrCat("duplicate constraint name \"", c.name(), "\""));
     }
-    out.output = FindOutput(scene, w, "output", c.output(), errors);
+    out.output = FindOutput(study, w, "output", c.output(), errors);
     if (std::optional<Reduction> r = ToReduction(c.reduction())) {
       out.reduction = *r;
     } else {
@@ -381,8 +575,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     out.unit = c.unit();
     out.si_per_unit =
         UnitFactor(w, "unit", c.unit(),
-                   out.output >= 0 ? OutputDimension(scene.outputs[static_cast<size_t>(out.output)])
-                                   : Dimension::kAny,
+                   SignalDimension(study, out.output),
                    errors);
     study.constraints.push_back(std::move(out));
   }
@@ -439,16 +632,6 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
     s.central_differences = p.finite_difference() == v1::FINITE_DIFFERENCE_CENTRAL;
     s.simulator_sensitivities = p.sensitivity() == v1::SENSITIVITY_METHOD_SIMULATOR;
-    if (s.simulator_sensitivities) {
-      for (const DesignVariable& v : study.variables) {
-        if (!v.also_sets.empty()) {
-          errors->Add(w, "sensitivity",
-                      absl::StrCat("SENSITIVITY_METHOD_SIMULATOR is not available yet for a variable that sets several "
-                                   "parameters (\"", v.name, "\" has also_sets); use finite differences"));
-          break;
-        }
-      }
-    }
     if (s.simulator_sensitivities && std::holds_alternative<LinkageModel>(scene.model)) {
       errors->Add(w, "sensitivity",
                   "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: linkage scenes have no "
@@ -463,7 +646,6 @@ Study ConvertStudy(const v1::Study& m, Scene scene, const Where& where, Errors* 
     }
   }
 
-  study.scene = std::move(scene);
   if (errors->empty()) {
     // Catch what only the layout sees (e.g. minimize on a multi-series output).
     absl::StatusOr<StudyLayout> layout = MakeStudyLayout(study);

@@ -70,7 +70,7 @@ TEST(StudyValuesOfReport, FailedAnalysisIsFailedPreconditionWithItsReason) {
   ASSERT_TRUE(layout.ok());
   AnalysisReport failed;
   failed.Fail(spec::FailureKind::kIntegrator, "integrator failed near t = 1");
-  auto values = ComputeStudyValues(study, *layout, failed);
+  auto values = ComputeStudyValues(study, *layout, failed, study.scene.DefaultParameterValues());
   EXPECT_EQ(values.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(values.status().message()), HasSubstr("integrator failed near t = 1"));
 }
@@ -80,7 +80,7 @@ TEST(StudyValuesOfReport, VehicleInitialDesignViolatesTheSeatTravelLimitAboutFou
   auto layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok());
   const AnalysisReport r = Analyze(study.scene, study.scene.DefaultParameterValues());
-  auto values = ComputeStudyValues(study, *layout, r);
+  auto values = ComputeStudyValues(study, *layout, r, study.scene.DefaultParameterValues());
   ASSERT_TRUE(values.ok()) << values.status();
   ASSERT_GE(values->worst_row, 0);
   EXPECT_THAT(layout->rows[static_cast<size_t>(values->worst_row)].name, HasSubstr("s1@"));
@@ -120,14 +120,52 @@ TEST(StudyValuesOfReport, ExtraSeriesArePickedByLabel) {
     v.series.push_back({1.0 * node, 10.0 * node});
   }
   r.outputs = {v};
-  auto values = ComputeStudyValues(study, *layout, r);
+  auto values = ComputeStudyValues(study, *layout, r, study.scene.DefaultParameterValues());
   ASSERT_TRUE(values.ok()) << values.status();
   ASSERT_EQ(values->objective_terms.size(), 10u);
   EXPECT_DOUBLE_EQ(values->objective_terms[0], 1.0);  // node 1 at t = 0
   EXPECT_DOUBLE_EQ(values->objective, 50.0);          // node 5 at t = 1, not node 6
   r.outputs[0].series_labels[3] = "node x";
-  EXPECT_EQ(ComputeStudyValues(study, *layout, r).status().code(),
+  EXPECT_EQ(ComputeStudyValues(study, *layout, r, study.scene.DefaultParameterValues()).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+// Load cases: one report holding every case's outputs in signal order,
+// each case's outputs bit for bit those of an analysis at its parameters,
+// counters summed; a failing case fails the report and is named.
+TEST(Engine, LoadCasesAreAnalysedOneAfterTheOther) {
+  auto study = spec::io::LoadStudyFile("examples/vehicle/vehicle_two_roads.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_EQ(study->num_cases(), 2);
+  std::vector<double> x;
+  for (const spec::DesignVariable& v : study->variables) x.push_back(v.initial);
+  const std::vector<double> design = study->ParameterValuesAt(x);
+  const AnalysisReport combined = AnalyzeCases(*study, design);
+  ASSERT_TRUE(combined.ok()) << combined.failure.reason;
+  const size_t outputs = study->scene.outputs.size();
+  ASSERT_EQ(combined.outputs.size(), 2 * outputs);
+  spec::AnalysisCounters sum;
+  for (int c = 0; c < 2; ++c) {
+    const AnalysisReport alone = Analyze(study->scene, study->CaseParameterValues(c, design));
+    ASSERT_TRUE(alone.ok());
+    sum += alone.counters;
+    for (size_t o = 0; o < outputs; ++o) {
+      const OutputValues& got = combined.outputs[static_cast<size_t>(c) * outputs + o];
+      EXPECT_EQ(got.name, study->SignalName(static_cast<int>(static_cast<size_t>(c) * outputs + o)));
+      EXPECT_EQ(got.series, alone.outputs[o].series) << got.name;
+    }
+  }
+  EXPECT_EQ(combined.counters.time_steps, sum.time_steps);
+  EXPECT_EQ(combined.counters.rhs_evaluations, sum.rhs_evaluations);
+  // The two roads differ.
+  EXPECT_NE(combined.outputs[0].series, combined.outputs[outputs].series);
+
+  spec::Study failing = *study;
+  failing.cases[1].parameter_values_si.emplace_back(failing.scene.FindParameter("m1"), -1.0);
+  const AnalysisReport failed = AnalyzeCases(failing, design);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_THAT(failed.failure.reason, HasSubstr("load case fast: "));
+  EXPECT_TRUE(failed.outputs.empty());
 }
 
 }  // namespace

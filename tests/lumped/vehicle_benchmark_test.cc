@@ -60,7 +60,7 @@ TEST_P(VehicleCheckValues, MaxSeatAccelerationOnTheGridMatchesTheBenchmark) {
   // The study's objective is the same peak, reported in m/s^2.
   auto layout = spec::MakeStudyLayout(study);
   ASSERT_TRUE(layout.ok());
-  auto values = engine::ComputeStudyValues(study, *layout, r);
+  auto values = engine::ComputeStudyValues(study, *layout, r, study.ParameterValuesAt(GetParam().x));
   ASSERT_TRUE(values.ok()) << values.status();
   EXPECT_NEAR(values->objective, expected * kInch, kCheckValueRelativeTolerance * expected * kInch);
 }

@@ -147,6 +147,40 @@ TEST(SimulatorSensitivities, WeightedSumMatchesCentralDifferences) {
   ExpectGradientsMatchCentralDifferences(study);
 }
 
+// The chain rule through named responses (of two outputs, of parameters
+// only) and a min-max objective over several terms: the example
+// vehicle_worst_case.study.textproto at tight tolerances.
+TEST(SimulatorSensitivities, ResponsesAndMaxOverTermsMatchCentralDifferences) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_worst_case.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_EQ(study->responses.size(), 2u);
+  study->scene.integrator.relative_tolerance = kTightRelativeTolerance;
+  study->scene.integrator.absolute_tolerance = kTightAbsoluteTolerance;
+  study->scene.integrator.max_steps = 1'000'000;
+  ExpectGradientsMatchCentralDifferences(*study);
+}
+
+// One variable for both tyre stiffnesses (also_sets): its derivative is the
+// sum of the two parameters' derivatives.
+TEST(SimulatorSensitivities, VariableSettingTwoParametersMatchesCentralDifferences) {
+  spec::Study study = TightVehicle();
+  const int k3 = study.scene.FindParameter("k3");
+  ASSERT_EQ(study.variables[2].parameter, k3);
+  study.variables[1].also_sets = {k3};
+  study.variables.erase(study.variables.begin() + 2);
+  ExpectGradientsMatchCentralDifferences(study);
+}
+
+// Two load cases: each case's sensitivities, in signal order.
+TEST(SimulatorSensitivities, LoadCasesMatchCentralDifferences) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_two_roads.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  study->scene.integrator.relative_tolerance = kTightRelativeTolerance;
+  study->scene.integrator.absolute_tolerance = kTightAbsoluteTolerance;
+  study->scene.integrator.max_steps = 1'000'000;
+  ExpectGradientsMatchCentralDifferences(*study);
+}
+
 TEST(SimulatorSensitivities, GradientsComeWithTheValuesOfAPlainAnalysis) {
   // The values of the sensitivity analysis are the plain analysis' values
   // up to the integration tolerance.

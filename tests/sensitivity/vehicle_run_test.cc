@@ -42,5 +42,46 @@ TEST(SimulatorSensitivityRun, VehicleReachesTheFiniteDifferenceOptimumWithFewerA
   EXPECT_LT(sim->analyses_run, fd->analyses_run);
 }
 
+// The same comparison for the studies that name their responses and take
+// the worst of two terms (examples/vehicle/vehicle_worst_case), and for a
+// variable that sets both tyre stiffnesses.
+void ExpectSameOptimumWithFewerAnalyses(const spec::Study& fd_study) {
+  spec::Study sim_study = fd_study;
+  sim_study.optimizer.simulator_sensitivities = true;
+  absl::StatusOr<LocalRunResult> fd = RunStudyLocally(fd_study);
+  ASSERT_TRUE(fd.ok()) << fd.status();
+  absl::StatusOr<LocalRunResult> sim = RunStudyLocally(sim_study);
+  ASSERT_TRUE(sim.ok()) << sim.status();
+  std::cout << fd_study.name << ": finite differences F = " << fd->outcome.objective << " in " << fd->analyses_run
+            << " analyses; simulator F = " << sim->outcome.objective << " in " << sim->analyses_run << "\n";
+  EXPECT_EQ(sim->outcome.state, slp::RunState::kConverged) << sim->end_reason;
+  EXPECT_LT(sim->outcome.max_violation, kFeasible);
+  EXPECT_LT(std::abs(sim->outcome.objective - fd->outcome.objective) / std::abs(fd->outcome.objective),
+            kSameOptimum);
+  EXPECT_LT(sim->analyses_run, fd->analyses_run);
+  // Every gradient came from the simulator: one analysis per cycle.
+  EXPECT_EQ(sim->analyses_run, sim->outcome.cycles + 1);
+}
+
+TEST(SimulatorSensitivityRun, ResponsesAndWorstCaseObjective) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_worst_case.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ExpectSameOptimumWithFewerAnalyses(*study);
+}
+
+TEST(SimulatorSensitivityRun, TwoLoadCases) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_two_roads.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ExpectSameOptimumWithFewerAnalyses(*study);
+}
+
+TEST(SimulatorSensitivityRun, VariableSettingBothTyreStiffnesses) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(kVehicleStudy);
+  ASSERT_TRUE(study.ok()) << study.status();
+  study->variables[1].also_sets = {study->scene.FindParameter("k3")};
+  study->variables.erase(study->variables.begin() + 2);
+  ExpectSameOptimumWithFewerAnalyses(*study);
+}
+
 }  // namespace
 }  // namespace mbopt::local_run

@@ -12,6 +12,7 @@
 
 #include "spec/layout.h"
 #include "spec/limits.h"
+#include "tests/spec/oscillator_scene.h"
 
 namespace mbopt::spec::io {
 namespace {
@@ -19,34 +20,7 @@ namespace {
 using ::testing::HasSubstr;
 
 // A one-body scene; tests replace pieces of it to break one thing at a time.
-const char kScene[] = R"pb(name: "oscillator"
-parameters { name: "k" value: 100 unit: "N/m" }
-parameters { name: "mass" value: 2 unit: "kg" }
-lumped {
-  bodies { name: "body" mass_kg { param: "mass" } dofs: DOF_Y }
-  elements {
-    name: "spring"
-    a { body: "body" }
-    b { input: "road" }
-    direction { y { value: 1 } }
-    stiffness_n_per_m { param: "k" }
-    damping_n_s_per_m { value: 0.5 }
-  }
-  inputs {
-    name: "road"
-    cosine_bump {
-      height_m { value: 0.01 }
-      length_m { value: 1 }
-      speed_m_per_s { value: 2 }
-      start_time_s { value: 0.1 }
-    }
-    direction { y { value: 1 } }
-  }
-}
-outputs { name: "x" element_deflection { element: "spring" } }
-outputs { name: "acc" body_acceleration { body: "body" axis: AXIS_Y } }
-time_grid { start_s: 0 end_s: 1 points: 11 }
-)pb";
+const char* const kScene = ::mbopt::testing::kOscillatorScene;
 
 const char kStudy[] = R"pb(name: "oscillator study"
 scene_file: "oscillator.scene.textproto"
@@ -455,8 +429,11 @@ TEST_F(StudyFiles, VariableThatSetsSeveralParametersGivesThemTheSameSiValue) {
               HasSubstr("variables[0].also_sets[0]: unknown scene parameter \"nope\""));
   EXPECT_THAT(LoadError(scene, Replace(kStudy, "parameter: \"k\"", "parameter: \"k\" also_sets: \"k\"")),
               HasSubstr("already set by a variable"));
-  EXPECT_THAT(LoadError(scene, study + "optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }\n"),
-              HasSubstr("optimizer.sensitivity: SENSITIVITY_METHOD_SIMULATOR is not available yet"));
+  // Simulator sensitivities sum the derivatives of the parameters set
+  // (tests/sensitivity): the option loads.
+  EXPECT_TRUE(
+      LoadStudyFile(Write("oscillator.study.textproto", study + "optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }\n"))
+          .ok());
 }
 
 TEST_F(StudyFiles, WeightedSumTermsCarryTheirOwnUnitsAndReductions) {

@@ -95,10 +95,11 @@ absl::StatusOr<StudyEvaluation> EvaluateStudy(const spec::Study& study, const sp
   // Whether gradients are computed is fixed by the request, so an
   // evaluation stays a pure function of (study, x, want_gradients).
   StudyAnalysisWithGradients analysis;
+  const std::vector<double> parameters_si = study.ParameterValuesAt(x_scaled);
   if (want_gradients) {
     analysis = AnalyzeStudyWithGradients(study, layout, x_scaled);
   } else {
-    analysis.report = Analyze(study.scene, study.ParameterValuesAt(x_scaled));
+    analysis.report = AnalyzeCases(study, parameters_si);
   }
   const spec::AnalysisReport& report = analysis.report;
   StudyEvaluation evaluation;
@@ -109,7 +110,7 @@ absl::StatusOr<StudyEvaluation> EvaluateStudy(const spec::Study& study, const sp
     if (evaluation.failure.reason.empty()) evaluation.failure.reason = "the analysis failed (no reason given)";
     return evaluation;
   }
-  MBOPT_ASSIGN_OR_RETURN(spec::StudyValues values, ComputeStudyValues(study, layout, report));
+  MBOPT_ASSIGN_OR_RETURN(spec::StudyValues values, ComputeStudyValues(study, layout, report, parameters_si));
   if (const std::string non_finite = FirstNonFinite(layout, values); !non_finite.empty()) {
     evaluation.failure =
         spec::AnalysisFailure::Of(spec::FailureKind::kNonFiniteValue, absl::StrCat("non-finite result: ", non_finite));

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <variant>
 
+#include "spec/responses.h"
 #include "worker/multibody/scene_analysis.h"
 #include "worker/solve/lumped_sensitivity.h"
 
@@ -14,27 +15,55 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
   const auto start = std::chrono::steady_clock::now();
   StudyAnalysisWithGradients out;
   const std::vector<double> parameters_si = study.ParameterValuesAt(x_scaled);
+  // Every parameter a variable sets (its own, then also_sets): the engine
+  // differentiates with respect to each, and a variable's derivative is the
+  // sum over the parameters it sets, which all take its value.
   std::vector<int> parameters;
-  for (const spec::DesignVariable& v : study.variables) parameters.push_back(v.parameter);
+  std::vector<size_t> variable_of;
+  for (size_t i = 0; i < study.variables.size(); ++i) {
+    const spec::DesignVariable& v = study.variables[i];
+    parameters.push_back(v.parameter);
+    variable_of.push_back(i);
+    for (int also : v.also_sets) {
+      parameters.push_back(also);
+      variable_of.push_back(i);
+    }
+  }
   const bool multibody = std::holds_alternative<spec::MultibodyModel>(study.scene.model);
   out.gradients_unavailable = multibody ? multibody::MultibodySensitivityUnavailable(study.scene)
                                         : solve::LumpedSensitivityUnavailable(study.scene, parameters);
   if (!out.gradients_unavailable.empty()) {
-    out.report = Analyze(study.scene, parameters_si);
+    out.report = AnalyzeCases(study, parameters_si);
     return out;
   }
-  std::vector<std::vector<std::vector<double>>> output_derivatives;
-  if (multibody) {
-    multibody::MultibodySensitivityResult result =
-        multibody::AnalyzeMultibodySceneWithSensitivities(study.scene, parameters_si, parameters);
-    out.report = std::move(result.report);
-    out.gradients_unavailable = std::move(result.unavailable);
-    output_derivatives = std::move(result.output_derivatives);
-  } else {
-    solve::LumpedSensitivityResult result =
-        solve::SimulateLumpedWithSensitivities(study.scene, parameters_si, parameters);
-    out.report = std::move(result.report);
-    output_derivatives = std::move(result.output_derivatives);
+  // [parameter][signal]: every case's outputs in turn, as AnalyzeCases
+  // orders them.
+  std::vector<std::vector<std::vector<double>>> output_derivatives(parameters.size());
+  for (int c = 0; c < study.num_cases(); ++c) {
+    const std::vector<double> case_si = study.CaseParameterValues(c, parameters_si);
+    spec::AnalysisReport report;
+    std::vector<std::vector<std::vector<double>>> derivatives;
+    if (multibody) {
+      multibody::MultibodySensitivityResult result =
+          multibody::AnalyzeMultibodySceneWithSensitivities(study.scene, case_si, parameters);
+      report = std::move(result.report);
+      if (out.gradients_unavailable.empty()) out.gradients_unavailable = std::move(result.unavailable);
+      derivatives = std::move(result.output_derivatives);
+    } else {
+      solve::LumpedSensitivityResult result = solve::SimulateLumpedWithSensitivities(study.scene, case_si, parameters);
+      report = std::move(result.report);
+      derivatives = std::move(result.output_derivatives);
+    }
+    const bool ok = report.ok();
+    if (study.cases.empty()) {
+      out.report = std::move(report);
+    } else if (!AppendCaseReport(study, c, std::move(report), &out.report)) {
+      break;
+    }
+    if (!ok) break;
+    for (size_t k = 0; k < parameters.size() && k < derivatives.size(); ++k) {
+      for (auto& series : derivatives[k]) output_derivatives[k].push_back(std::move(series));
+    }
   }
   out.report.counters.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -43,20 +72,40 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
     return out;
   }
   if (!out.gradients_unavailable.empty()) return out;
-  // One series per lumped output: wrap each derivative series.
-  const size_t n = parameters.size();
+  for (const auto& per_parameter : output_derivatives) {
+    if (per_parameter.size() != out.report.outputs.size()) {
+      out.gradients_unavailable = "the engine's sensitivities do not cover every output";
+      return out;
+    }
+  }
+  // One series per output: wrap each derivative series, summed over the
+  // parameters of each variable.
+  const size_t n = study.variables.size();
   const size_t num_outputs = out.report.outputs.size();
   std::vector<std::vector<std::vector<std::vector<double>>>> wrapped(n);
   std::vector<std::vector<const std::vector<std::vector<double>>*>> derivatives(n);
   std::vector<const std::vector<std::vector<double>>*> values(num_outputs);
   for (size_t o = 0; o < num_outputs; ++o) values[o] = &out.report.outputs[o].series;
-  for (size_t i = 0; i < n; ++i) {
-    wrapped[i].resize(num_outputs);
+  for (size_t i = 0; i < n; ++i) wrapped[i].resize(num_outputs);
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    const size_t i = variable_of[k];
     for (size_t o = 0; o < num_outputs; ++o) {
-      wrapped[i][o] = {output_derivatives[i][o]};
-      derivatives[i].push_back(&wrapped[i][o]);
+      const std::vector<double>& d = output_derivatives[k][o];
+      if (wrapped[i][o].empty()) {
+        wrapped[i][o] = {d};
+      } else {
+        std::vector<double>& sum = wrapped[i][o][0];
+        for (size_t t = 0; t < sum.size() && t < d.size(); ++t) sum[t] += d[t];
+      }
     }
   }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t o = 0; o < num_outputs; ++o) derivatives[i].push_back(&wrapped[i][o]);
+  }
+  std::vector<spec::Series> response_values;
+  std::vector<std::vector<spec::Series>> response_derivatives;
+  spec::AppendResponses(study, layout, parameters_si, &response_values, &values);
+  spec::AppendResponseDerivatives(study, layout, parameters_si, values, &response_derivatives, &derivatives);
   absl::StatusOr<spec::StudyGradients> gradients =
       spec::ComputeStudyGradients(study, layout, values, derivatives);
   if (!gradients.ok()) {

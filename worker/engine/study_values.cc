@@ -1,19 +1,20 @@
 #include "worker/engine/study_values.h"
 
 #include "absl/strings/str_cat.h"
+#include "spec/responses.h"
 
 namespace mbopt::engine {
 
 absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
-                                                     const spec::AnalysisReport& report) {
+                                                     const spec::AnalysisReport& report,
+                                                     const std::vector<double>& parameter_values_si) {
   if (!report.ok()) {
     return absl::FailedPreconditionError(absl::StrCat("analysis failed: ", report.failure.reason));
   }
-  if (report.outputs.size() != layout.outputs.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("analysis has ", report.outputs.size(),
-                                                   " outputs, the layout expects ",
-                                                   layout.outputs.size()));
+  if (report.outputs.size() != static_cast<size_t>(study.num_case_signals())) {
+    return absl::InvalidArgumentError(absl::StrCat("analysis has ", report.outputs.size(), " outputs, the study ",
+                                                   study.num_case_signals(), " (its scene's for each load case)"));
   }
   std::vector<const std::vector<std::vector<double>>*> series(report.outputs.size());
   std::vector<std::vector<std::vector<double>>> selected(report.outputs.size());
@@ -40,6 +41,8 @@ absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
     }
     series[o] = &selected[o];
   }
+  std::vector<spec::Series> responses;
+  spec::AppendResponses(study, layout, parameter_values_si, &responses, &series);
   return spec::ComputeStudyValues(study, layout, series);
 }
 

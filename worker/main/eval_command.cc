@@ -193,10 +193,10 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
   }
 
-  const spec::AnalysisReport report = engine::Analyze(study.scene, parameters);
+  const spec::AnalysisReport report = engine::AnalyzeCases(study, parameters);
   const bool ok = report.ok();
   absl::StatusOr<spec::StudyValues> values =
-      ok ? engine::ComputeStudyValues(study, *layout, report)
+      ok ? engine::ComputeStudyValues(study, *layout, report, parameters)
          : absl::StatusOr<spec::StudyValues>(absl::FailedPreconditionError(report.failure.reason));
   if (ok && !values.ok()) {
     err << "mbopt-worker eval: " << values.status().message() << "\n";
@@ -204,7 +204,8 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   }
   const std::string objective_unit =
       study.objective.form == spec::Objective::Form::kTargetDistance ||
-              study.objective.form == spec::Objective::Form::kWeightedSum
+              study.objective.form == spec::Objective::Form::kWeightedSum ||
+              study.objective.form == spec::Objective::Form::kMaxOver
           ? ""
           : (study.objective.unit.empty() ? "SI" : study.objective.unit);
 
