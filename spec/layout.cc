@@ -287,7 +287,10 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
                                       + n                // the linearization's gradient
                                       + 5 * (n + 2) / 2) // the dense LP row and the solver's copy
                                  + 120;                  // the row's layout entry and name
-  f.memory_bytes = (f.objective_terms + f.constraint_rows) * per_value;
+  std::int64_t series_values = 0;
+  for (int signal = 0; signal < num_signals; ++signal) series_values += values(signal);
+  f.series_bytes = 8 * series_values * (study.optimizer.simulator_sensitivities ? n + 1 : 1);
+  f.memory_bytes = (f.objective_terms + f.constraint_rows) * per_value + f.series_bytes;
   return f;
 }
 
@@ -297,10 +300,12 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
     return LayoutError(
         study, "constraints",
         absl::StrFormat("the study needs about %.1f GB of memory for its %d objective terms and %d constraint rows "
-                        "with %d variables, more than the limit of %.0f GB; use fewer time points "
-                        "(analysis.time_grid_points) or fewer constraints on time series",
+                        "with %d variables and %.1f GB of series (outputs of every load case, responses), more "
+                        "than the limit of %.0f GB; use fewer time points (analysis.time_grid_points), fewer "
+                        "constraints on time series, or fewer load cases and responses",
                         static_cast<double>(f.memory_bytes) / 1e9, f.objective_terms, f.constraint_rows,
-                        study.variables.size(), static_cast<double>(kMaxStudyMemoryBytes) / (1 << 30)));
+                        study.variables.size(), static_cast<double>(f.series_bytes) / 1e9,
+                        static_cast<double>(kMaxStudyMemoryBytes) / (1 << 30)));
   }
   StudyLayout layout;
   layout.instants_s = scene.time_grid.Instants();

@@ -109,13 +109,16 @@ struct StudyLayout {
 };
 
 // What laying a study out will cost, counted from its shapes before any row
-// exists: objective terms, constraint rows, and the optimizer's memory for
-// them (values, gradients, a batch of finite-difference results, the LP and
-// the solver's copy of it, the rows' names).
+// exists: objective terms, constraint rows, and the memory for them (values,
+// gradients, a batch of finite-difference results, the LP and the solver's
+// copy of it, the rows' names) and for the series of one analysis.
 struct StudyFootprint {
   std::int64_t objective_terms = 0;
   std::int64_t constraint_rows = 0;
-  std::int64_t memory_bytes = 0;
+  // The series one analysis holds: every output of every load case and
+  // every response (and their derivatives with simulator sensitivities).
+  std::int64_t series_bytes = 0;
+  std::int64_t memory_bytes = 0;  // all of it, series included
 };
 StudyFootprint EstimateStudyFootprint(const Study& study);
 

@@ -40,13 +40,18 @@ int FindOutput(const Study& study, const Where& w, const std::string& field, con
                Errors* errors) {
   const int index = study.FindSignal(name);
   if (index < 0) {
-    std::string known;
-    for (int s = 0; s < study.num_case_signals(); ++s) {
-      absl::StrAppend(&known, known.empty() ? "" : ", ", "\"", study.SignalName(s), "\"");
-    }
-    std::string responses_known;
-    for (const Response& r : study.responses)
-      absl::StrAppend(&responses_known, responses_known.empty() ? "" : ", ", "\"", r.name, "\"");
+    // Named in full up to a point: a message is read, not scrolled.
+    constexpr int kListed = 20;
+    auto list = [&](int first, int end) {
+      std::string text;
+      for (int s = first; s < end && s < first + kListed; ++s) {
+        absl::StrAppend(&text, text.empty() ? "" : ", ", "\"", study.SignalName(s), "\"");
+      }
+      if (end - first > kListed) absl::StrAppend(&text, " and ", end - first - kListed, " more");
+      return text;
+    };
+    const std::string known = list(0, study.num_case_signals());
+    const std::string responses_known = list(study.num_case_signals(), study.num_signals());
     errors->Add(w, field,
                 absl::StrCat("unknown output \"", name, "\"; the scene's outputs",
                              study.cases.empty() ? "" : " in each load case", ": ", known.empty() ? "(none)" : known,

@@ -412,6 +412,13 @@ TEST_F(StudyFiles, StudyTooLargeForMemoryIsRefusedWithItsEstimate) {
   const std::string error = LoadError(kScene, study);
   EXPECT_THAT(error, HasSubstr("GB of memory"));
   EXPECT_THAT(error, HasSubstr("more than the limit of 2 GB"));
+  // Series count too: 200 responses of 1e6 instants in each of two load
+  // cases need 3.2 GB before any row exists.
+  std::string series = Replace(kStudy, "minimize_max_of: \"acc\"", "minimize_max_of: \"a.acc\"");
+  series = Replace(series, "output: \"x\"", "output: \"a.x\"") +
+           "analysis { time_grid_points: 1000000 }\ncases { name: \"a\" }\ncases { name: \"b\" }\n";
+  for (int k = 0; k < 200; ++k) series += "responses { name: \"r" + std::to_string(k) + "\" expr: \"a.x * t\" }\n";
+  EXPECT_THAT(LoadError(kScene, series), AllOf(HasSubstr("GB of series"), HasSubstr("fewer load cases and responses")));
 }
 
 TEST_F(StudyFiles, VariableThatSetsSeveralParametersGivesThemTheSameSiValue) {
