@@ -18,6 +18,7 @@
 #include "client/local_cluster.h"
 #include "client/report/job_report_html.h"
 #include "client/report/report_from_proto.h"
+#include "client/report_responses.h"
 #include "client/study_file.h"
 #include "client/temp_dir.h"
 #include "client/watch.h"
@@ -286,8 +287,8 @@ int ReportCommand(const Args& args) {
   for (std::string& a : spelled) {
     if (a == "-o") a = "--output";
   }
-  auto parsed = Parse(spelled, {{"--server", "--db", "--output"}, {}}, 1,
-                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH]");
+  auto parsed = Parse(spelled, {{"--server", "--db", "--output"}, {"--no-responses"}}, 1,
+                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH] [--no-responses]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   const std::string job_id = parsed->positional[0];
   std::string path = parsed->Value("--output");
@@ -298,7 +299,13 @@ int ReportCommand(const Args& args) {
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, job_id, &response);
   if (!status.ok()) return FailRpc(status, c.address, &c.security);
-  const std::string html = report::RenderJobReportHtml(report::ReportDataFromJob(response));
+  report::ReportData data = report::ReportDataFromJob(response);
+  if (parsed->Has("--no-responses")) {
+    data.responses_note = "Not analysed (mbopt report --no-responses).";
+  } else {
+    AddResponsePlots(response, &data);
+  }
+  const std::string html = report::RenderJobReportHtml(data);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << html;
   out.close();

@@ -140,7 +140,7 @@ function(mbopt_declare_modules)
   mbopt_module(worker_service DIRS worker/service USES secure_channel engine spec spec_io proto common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(worker_main DIRS worker/main USES worker_service engine spec spec_io common
+  mbopt_module(worker_main DIRS worker/main USES worker_service engine spec spec_io proto common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE

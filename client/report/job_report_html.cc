@@ -7,6 +7,7 @@
 #include "client/report/html_escape.h"
 #include "client/report/number_format.h"
 #include "client/report/report_tables.h"
+#include "client/report/response_plots.h"
 #include "client/report/svg_line_plot.h"
 
 namespace mbopt::report {
@@ -122,6 +123,23 @@ std::string RenderJobReportHtml(const ReportData& data) {
     out += Figure(ApproximationErrorPlot(data));
     out += Figure(MoveLimitPlot(data));
     out += Figure(DesignVariablePlot(data));
+  }
+
+  out += "<h2>Responses at the initial and final designs</h2>\n";
+  if (data.responses.empty()) {
+    out += "<p class=\"empty\">" +
+           EscapeHtml(data.responses_note.empty() ? std::string("No responses to show.") : data.responses_note) +
+           "</p>\n";
+  } else {
+    out += "<p class=\"note\">Each objective and constraint's output over time, analysed again at the initial "
+           "design (grey, dashed) and at the final design (blue), with the constraint's limits. For a "
+           "multi-series output (stress at every node) the series that comes closest to its limit at the "
+           "final design is shown.</p>\n";
+    for (const ResponsePlot& plot : data.responses) {
+      out += Figure(ResponsePlotSpec(plot));
+      if (!plot.note.empty()) out += "<p class=\"note\">" + EscapeHtml(plot.note) + "</p>\n";
+    }
+    if (!data.responses_note.empty()) out += "<p class=\"note\">" + EscapeHtml(data.responses_note) + "</p>\n";
   }
 
   out += "<h2>Final design</h2>\n";

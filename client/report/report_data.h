@@ -68,6 +68,23 @@ enum class ScaleChoice {
   kLog,
 };
 
+// A response over time at the initial and at the final design, with the
+// limits a constraint puts on it: what the page's "Responses" section plots.
+// Values are in `unit`.
+struct ResponsePlot {
+  std::string title;        // e.g. "s1: max_abs <= 0.456 in"
+  std::string unit;         // empty: SI
+  std::string note;         // e.g. the reduced values, or the window
+  std::vector<double> times_s;
+  std::vector<double> initial;  // same length as times_s
+  std::vector<double> final;
+  struct Limit {
+    double value = 0.0;
+    std::string label;
+  };
+  std::vector<Limit> limits;
+};
+
 struct ReportData {
   std::string job_id;
   std::string study_name;
@@ -92,6 +109,10 @@ struct ReportData {
   std::vector<ActiveConstraint> active_constraints;
 
   std::vector<ReportCycle> records;  // in the order the optimizer emitted them
+  // The responses at the initial and final designs; when there are none,
+  // `responses_note` says why (e.g. the analyses could not be run).
+  std::vector<ResponsePlot> responses;
+  std::string responses_note;
 
   // kAuto for the objective: logarithmic only when every value is > 0.
   ScaleChoice objective_scale = ScaleChoice::kAuto;

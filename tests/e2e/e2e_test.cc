@@ -345,6 +345,15 @@ TEST(EndToEnd, RunKeepsItsDatabaseForReportAndResults) {
   std::stringstream text;
   text << html.rdbuf();
   EXPECT_NE(text.str().find("6.389"), std::string::npos) << "the page shows the optimum";
+  // And the responses there: the seat acceleration and every travel limit,
+  // analysed again at the initial and the final design.
+  for (const char* expected : {"Responses at the initial and final designs", "objective: max_abs of seat_acceleration",
+                               "s1: max_abs of s1 &lt;= 0.456 in", "s5: max_abs of s5 &lt;= 1 in", "final design"}) {
+    EXPECT_NE(text.str().find(expected), std::string::npos) << expected;
+  }
+  int plots = 0;
+  for (size_t at = text.str().find("<svg"); at != std::string::npos; at = text.str().find("<svg", at + 1)) ++plots;
+  EXPECT_EQ(plots, 5 + 6) << "five history plots, the objective's output and five constraints";
   auto results = Mbopt({"results", "job-1", "--json", "--db", db}, env);
   ASSERT_EQ(results.exit_code, kExitOk) << Describe(results);
   EXPECT_EQ(Comparable(results.stdout_text), Comparable(ReferenceResult(2)));

@@ -287,3 +287,40 @@ TEST(JobReportHtml, SurvivesExtremeAndMissingValues) {
 
 }  // namespace
 }  // namespace mbopt::report
+
+namespace mbopt::report {
+namespace {
+
+// The responses section: a plot per response with both designs and the
+// limits as labelled lines, the note under it; without responses, the
+// reason.
+TEST(JobReportHtml, ShowsResponsesAtTheInitialAndFinalDesignsWithTheirLimits) {
+  ReportData data = testing::SyntheticVehicleReport();
+  ResponsePlot plot;
+  plot.title = "s1: max_abs of s1 <= 0.456 in";
+  plot.unit = "in";
+  plot.note = "rms: 0.2 in at the initial design";
+  plot.times_s = {0.0, 0.5, 1.0};
+  plot.initial = {0.0, 0.6, -0.1};
+  plot.final = {0.0, 0.4, std::nan("")};
+  plot.limits = {{0.456, "limit"}, {-0.456, "-limit"}};
+  data.responses = {plot};
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  EXPECT_EQ(testing::SvgFragments(html).size(), 6u);
+  EXPECT_THAT(html, HasSubstr("Responses at the initial and final designs"));
+  EXPECT_THAT(html, HasSubstr("s1: max_abs of s1 &lt;= 0.456 in"));
+  EXPECT_THAT(html, HasSubstr("initial design"));
+  EXPECT_THAT(html, HasSubstr("final design"));
+  EXPECT_THAT(html, HasSubstr("-limit"));
+  EXPECT_THAT(html, HasSubstr("rms: 0.2 in at the initial design"));
+
+  data.responses.clear();
+  data.responses_note = "The job has no analysed design yet.";
+  const std::string none = RenderJobReportHtml(data);
+  EXPECT_EQ(testing::SvgFragments(none).size(), 5u);
+  EXPECT_THAT(none, HasSubstr("The job has no analysed design yet."));
+}
+
+}  // namespace
+}  // namespace mbopt::report

@@ -1,14 +1,12 @@
 #include "worker/engine/study_values.h"
 
 #include "absl/strings/str_cat.h"
-#include "spec/responses.h"
 
 namespace mbopt::engine {
 
-absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
-                                                     const spec::StudyLayout& layout,
-                                                     const spec::AnalysisReport& report,
-                                                     const std::vector<double>& parameter_values_si) {
+absl::Status BuildStudySignals(const spec::Study& study, const spec::StudyLayout& layout,
+                               const spec::AnalysisReport& report, const std::vector<double>& parameter_values_si,
+                               StudySignals* out) {
   if (!report.ok()) {
     return absl::FailedPreconditionError(absl::StrCat("analysis failed: ", report.failure.reason));
   }
@@ -16,13 +14,13 @@ absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
     return absl::InvalidArgumentError(absl::StrCat("analysis has ", report.outputs.size(), " outputs, the study ",
                                                    study.num_case_signals(), " (its scene's for each load case)"));
   }
-  std::vector<const std::vector<std::vector<double>>*> series(report.outputs.size());
-  std::vector<std::vector<std::vector<double>>> selected(report.outputs.size());
+  out->signals.assign(report.outputs.size(), nullptr);
+  out->selected.assign(report.outputs.size(), {});
   for (size_t o = 0; o < report.outputs.size(); ++o) {
     const spec::OutputValues& output = report.outputs[o];
     const spec::OutputShape& shape = layout.outputs[o];
     if (static_cast<int>(output.series.size()) == shape.series) {
-      series[o] = &output.series;
+      out->signals[o] = &output.series;
       continue;
     }
     // More series than the layout uses (e.g. stress at pinned nodes, zero
@@ -37,13 +35,21 @@ absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
             "output \"", output.name, "\" has ", output.series.size(),
             " series and none labelled \"", label, "\", which the study's layout needs"));
       }
-      selected[o].push_back(output.series[found]);
+      out->selected[o].push_back(output.series[found]);
     }
-    series[o] = &selected[o];
+    out->signals[o] = &out->selected[o];
   }
-  std::vector<spec::Series> responses;
-  spec::AppendResponses(study, layout, parameter_values_si, &responses, &series);
-  return spec::ComputeStudyValues(study, layout, series);
+  spec::AppendResponses(study, layout, parameter_values_si, &out->responses, &out->signals);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
+                                                     const spec::StudyLayout& layout,
+                                                     const spec::AnalysisReport& report,
+                                                     const std::vector<double>& parameter_values_si) {
+  StudySignals signals;
+  if (absl::Status s = BuildStudySignals(study, layout, report, parameter_values_si, &signals); !s.ok()) return s;
+  return spec::ComputeStudyValues(study, layout, signals.signals);
 }
 
 }  // namespace mbopt::engine

@@ -9,6 +9,7 @@
 #include "spec/layout.h"
 #include "spec/study.h"
 #include "spec/analysis_report.h"
+#include "spec/responses.h"
 
 namespace mbopt::engine {
 
@@ -19,6 +20,19 @@ namespace mbopt::engine {
 // labels (spec::OutputShapeOf). The study's responses are computed from the
 // outputs and `parameter_values_si`, the analysis' SI parameter values
 // (Study::ParameterValuesAt).
+// Every signal of one analysis, SI: the outputs of every load case (the
+// layout's series, picked by label where the engine reports more), then the
+// study's responses. `signals` points into the report and into this object,
+// which is filled in place and not moved.
+struct StudySignals {
+  std::vector<const spec::Series*> signals;
+  std::vector<spec::Series> selected;   // per output, when picked by label
+  std::vector<spec::Series> responses;
+};
+absl::Status BuildStudySignals(const spec::Study& study, const spec::StudyLayout& layout,
+                               const spec::AnalysisReport& report, const std::vector<double>& parameter_values_si,
+                               StudySignals* out);
+
 absl::StatusOr<spec::StudyValues> ComputeStudyValues(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
                                                      const spec::AnalysisReport& report,

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <ostream>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "mbopt/v1/series.pb.h"
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
 #include "worker/engine/analysis.h"
@@ -17,7 +19,7 @@ namespace mbopt::worker {
 namespace {
 
 const char kUsage[] =
-    "usage: mbopt-worker eval STUDY [--set NAME=VALUE ...] [--json]\n"
+    "usage: mbopt-worker eval STUDY [--set NAME=VALUE ...] [--json] [--series-out FILE]\n"
     "  Runs one analysis of STUDY (a .study.textproto) at its initial design and\n"
     "  prints the objective, the worst constraint row, per-output summaries,\n"
     "  the formulation and the counters.\n"
@@ -25,6 +27,9 @@ const char kUsage[] =
     "                    bounds) or a scene parameter (VALUE in the parameter's own\n"
     "                    unit); repeatable\n"
     "  --json            print one JSON object instead of text\n"
+    "  --series-out FILE also write every output (per load case) and response\n"
+    "                    series, SI, to FILE (binary mbopt.v1.AnalysisSeries,\n"
+    "                    proto/mbopt/v1/series.proto): what `mbopt report` plots\n"
     "  exit status: 0 ok, 1 analysis failed, 2 bad input\n";
 
 std::string JsonString(const std::string& s) {
@@ -58,6 +63,38 @@ std::string JsonString(const std::string& s) {
 }
 
 std::string JsonNumber(double v) { return std::isfinite(v) ? absl::StrFormat("%.17g", v) : "null"; }
+
+// Every signal's series (outputs per load case, then responses) in a binary
+// mbopt.v1.AnalysisSeries; a failed analysis writes its reason instead.
+absl::Status WriteSeries(const spec::Study& study, const spec::StudyLayout& layout,
+                         const spec::AnalysisReport& report, const std::vector<double>& parameters_si,
+                         const std::string& path) {
+  v1::AnalysisSeries message;
+  message.mutable_times_s()->Assign(report.times_s.begin(), report.times_s.end());
+  engine::StudySignals signals;
+  absl::Status built = report.ok()
+                           ? engine::BuildStudySignals(study, layout, report, parameters_si, &signals)
+                           : absl::FailedPreconditionError(report.failure.reason);
+  if (!built.ok()) {
+    message.set_failure(std::string(built.message()));
+  } else {
+    for (size_t k = 0; k < signals.signals.size(); ++k) {
+      v1::SignalSeries* signal = message.add_signals();
+      signal->set_name(study.SignalName(static_cast<int>(k)));
+      const spec::OutputShape& shape = layout.outputs[k];
+      for (size_t s = 0; s < signals.signals[k]->size(); ++s) {
+        signal->add_labels(s < shape.series_labels.size() ? shape.series_labels[s] : absl::StrCat(s));
+        const std::vector<double>& values = (*signals.signals[k])[s];
+        signal->add_series()->mutable_values_si()->Assign(values.begin(), values.end());
+      }
+    }
+  }
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  if (!file || !message.SerializeToOstream(&file)) return absl::InvalidArgumentError("cannot write " + path);
+  file.close();
+  if (!file) return absl::InvalidArgumentError("cannot write " + path);
+  return absl::OkStatus();
+}
 
 struct SeriesSummary {
   std::string label;
@@ -130,6 +167,7 @@ const char* EvalUsage() { return kUsage; }
 int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   std::string study_path;
   std::vector<std::string> sets;
+  std::string series_out;
   bool json = false;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -143,6 +181,12 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       sets.push_back(args[++i]);
     } else if (a.rfind("--set=", 0) == 0) {
       sets.push_back(a.substr(6));
+    } else if (a == "--series-out") {
+      if (i + 1 >= args.size()) {
+        err << "mbopt-worker eval: --series-out needs a file\n" << kUsage;
+        return kExitBadInput;
+      }
+      series_out = args[++i];
     } else if (a == "--help" || a == "-h") {
       out << kUsage;
       return kExitOk;
@@ -195,6 +239,12 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 
   const spec::AnalysisReport report = engine::AnalyzeCases(study, parameters);
   const bool ok = report.ok();
+  if (!series_out.empty()) {
+    if (absl::Status written = WriteSeries(study, *layout, report, parameters, series_out); !written.ok()) {
+      err << "mbopt-worker eval: " << written.message() << "\n";
+      return kExitBadInput;
+    }
+  }
   absl::StatusOr<spec::StudyValues> values =
       ok ? engine::ComputeStudyValues(study, *layout, report, parameters)
          : absl::StatusOr<spec::StudyValues>(absl::FailedPreconditionError(report.failure.reason));
