@@ -1,6 +1,8 @@
 // `mbopt-worker eval`: output, --set semantics and exit codes.
 #include "worker/main/eval_command.h"
 
+#include "mbopt/v1/series.pb.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -96,6 +98,54 @@ TEST(EvalCommand, FailedAnalysisIsExitCodeOneWithTheReason) {
   EXPECT_THAT(r.out, HasSubstr("\"status\": \"failed\""));
   EXPECT_THAT(r.out, HasSubstr("step budget"));
   EXPECT_THAT(r.out, HasSubstr("\"objective\": null"));
+}
+
+}  // namespace
+}  // namespace mbopt::worker
+
+namespace mbopt::worker {
+namespace {
+
+v1::AnalysisSeries ReadSeries(const std::string& path) {
+  v1::AnalysisSeries series;
+  std::ifstream file(path, std::ios::binary);
+  EXPECT_TRUE(file && series.ParseFromIstream(&file)) << path;
+  return series;
+}
+
+// --series-out: every output of every load case, then every response, in
+// signal order with the grid's instants; a response is its expression of
+// the outputs at every instant; a failed analysis writes its reason.
+TEST(EvalCommand, SeriesOutHoldsEveryOutputAndResponse) {
+  const std::string path = (std::filesystem::path(::testing::TempDir()) / "eval_series.pb").string();
+  EvalRun r = Eval({"examples/vehicle/vehicle_worst_case.study.textproto", "--series-out", path});
+  ASSERT_EQ(r.code, kExitOk) << r.err;
+  v1::AnalysisSeries series = ReadSeries(path);
+  EXPECT_TRUE(series.failure().empty());
+  ASSERT_EQ(series.signals_size(), 8);
+  EXPECT_EQ(series.times_s_size(), 101);
+  EXPECT_EQ(series.signals(0).name(), "seat_acceleration");
+  EXPECT_EQ(series.signals(6).name(), "pitch_travel");
+  const auto& s2 = series.signals(2).series(0).values_si();
+  const auto& s3 = series.signals(3).series(0).values_si();
+  const auto& pitch = series.signals(6).series(0).values_si();
+  ASSERT_EQ(pitch.size(), 101);
+  for (int i = 0; i < pitch.size(); ++i) EXPECT_EQ(pitch[i], s2[i] - s3[i]) << i;
+  ASSERT_EQ(series.signals(7).series(0).values_si_size(), 1);  // k2 + k3: one value
+  EXPECT_NEAR(series.signals(7).series(0).values_si(0), 600 * 175.126835, 1e-3);  // 600 lbf/in in N/m
+
+  r = Eval({"examples/vehicle/vehicle_two_roads.study.textproto", "--series-out", path});
+  ASSERT_EQ(r.code, kExitOk) << r.err;
+  series = ReadSeries(path);
+  ASSERT_EQ(series.signals_size(), 12);
+  EXPECT_EQ(series.signals(6).name(), "fast.seat_acceleration");
+  EXPECT_THAT(r.out, HasSubstr("fast.s1"));
+
+  r = Eval({"examples/vehicle/vehicle_two_roads.study.textproto", "--set", "m1=-1", "--series-out", path});
+  EXPECT_EQ(r.code, kExitAnalysisFailed);
+  series = ReadSeries(path);
+  EXPECT_THAT(series.failure(), HasSubstr("load case report: "));
+  EXPECT_EQ(series.signals_size(), 0);
 }
 
 }  // namespace
