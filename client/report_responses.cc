@@ -159,7 +159,8 @@ void AddResponsePlots(const v1::GetJobResponse& job, report::ReportData* data) {
                             double si_per_unit, const std::string& unit) {
     if (signal < 0 || !shown.insert(signal).second) return;
     data->responses.push_back(SignalPlot(*initial, *final, signal, si_per_unit, unit,
-                                         absl::StrCat("objective: ", ReductionName(reduction), " of ",
+                                         absl::StrCat(objective.maximize ? "objective (maximized): " : "objective: ",
+                                                      ReductionName(reduction), " of ",
                                                       study.SignalName(signal), WindowText(window))));
   };
   switch (objective.form) {

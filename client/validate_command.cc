@@ -55,7 +55,8 @@ std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& lay
                              ReductionName(o.reduction), OutputName(study, o.output),
                              layout.num_objective_terms());
     case spec::Objective::Form::kMinimize:
-      return absl::StrFormat("minimize the %s of %s%s", ReductionName(o.reduction), OutputName(study, o.output),
+      return absl::StrFormat("%s the %s of %s%s", o.maximize ? "maximize" : "minimize", ReductionName(o.reduction),
+                             OutputName(study, o.output),
                              WindowText(o.window));
     case spec::Objective::Form::kWeightedSum: {
       std::string text = "minimize the weighted sum:";

@@ -343,7 +343,8 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
     }
     case Objective::Form::kMinimize: {
       if (!valid_output(objective.output)) {
-        return LayoutError(study, "objective.minimize", "names no scene output or response");
+        return LayoutError(study, objective.maximize ? "objective.maximize" : "objective.minimize",
+                           "names no scene output or response");
       }
       const OutputShape& shape = layout.outputs[static_cast<size_t>(objective.output)];
       if (shape.series != 1) {
@@ -433,7 +434,8 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
   }
 
   if (objective.form == Objective::Form::kMinimizeMaxOf || objective.form == Objective::Form::kMinimize) {
-    layout.objective_term_factors.assign(layout.objective_terms.size(), 1.0 / objective.si_per_unit);
+    layout.objective_term_factors.assign(layout.objective_terms.size(),
+                                         objective.ReportedSign() / objective.si_per_unit);
   }
 
   const int decimals = TimeDecimals(layout.instants_s);

@@ -71,6 +71,10 @@ struct Objective {
   std::string unit;
   double si_per_unit = 1.0;
   TimeWindow window;
+  // kMinimize only: maximize the value instead. The optimizer minimizes
+  // F = -value; what the service reports is ReportedSign() * F, the value.
+  bool maximize = false;
+  double ReportedSign() const { return maximize ? -1.0 : 1.0; }
 };
 
 struct Constraint {

@@ -61,7 +61,7 @@ std::string RowName(int row, const std::vector<std::string>& row_names) {
 }  // namespace
 
 v1::CycleRecord ToProto(const slp::CycleRecord& r, const std::vector<std::string>& row_names,
-                        const std::vector<double>& variable_scales) {
+                        const std::vector<double>& variable_scales, double objective_sign) {
   v1::CycleRecord out;
   out.set_cycle(r.cycle);
   out.set_attempt(r.attempt);
@@ -73,9 +73,9 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const std::vector<std::string
     const double scale = static_cast<size_t>(i) < variable_scales.size() ? variable_scales[static_cast<size_t>(i)] : 1.0;
     out.add_x_trial_physical(scale * r.x_trial[i]);
   }
-  out.set_objective_x0(r.objective_x0);
-  out.set_objective_trial(r.objective_trial);
-  out.set_objective_predicted(r.objective_predicted);
+  out.set_objective_x0(objective_sign * r.objective_x0);
+  out.set_objective_trial(objective_sign * r.objective_trial);
+  out.set_objective_predicted(objective_sign * r.objective_predicted);
   out.set_max_violation_x0(r.max_violation_x0);
   out.set_max_violation_trial(r.max_violation_trial);
   out.set_worst_constraint(RowName(r.worst_constraint_trial, row_names));

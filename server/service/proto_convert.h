@@ -15,9 +15,10 @@ namespace mbopt::service {
 
 v1::JobState ToProto(jobs::JobState state);
 v1::JobSummary ToProto(const JobSummaryData& summary);
-// `row_names` and `variable_scales` as in JobView.
+// `row_names`, `variable_scales` and `objective_sign` as in JobView: the
+// objective values go out as reported (a maximized value as itself).
 v1::CycleRecord ToProto(const slp::CycleRecord& record, const std::vector<std::string>& row_names,
-                        const std::vector<double>& variable_scales);
+                        const std::vector<double>& variable_scales, double objective_sign);
 
 // A worker's result as the job manager takes it (the job's intake then
 // validates the record).

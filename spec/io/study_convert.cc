@@ -402,16 +402,20 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
       }
       break;
     }
-    case v1::Objective::kMinimize: {
+    case v1::Objective::kMinimize:
+    case v1::Objective::kMaximize: {
       obj.form = Objective::Form::kMinimize;
-      obj.output = FindOutput(study, ow, "minimize", o.minimize(), errors);
+      obj.maximize = o.form_case() == v1::Objective::kMaximize;
+      obj.output = obj.maximize ? FindOutput(study, ow, "maximize", o.maximize(), errors)
+                                : FindOutput(study, ow, "minimize", o.minimize(), errors);
       const std::optional<Reduction> r =
           o.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(o.reduction());
       if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
         errors->Add(ow, "reduction",
-                    "minimize takes one value per run: REDUCTION_FINAL (the default), REDUCTION_RMS, "
-                    "REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN (for a maximum over time use "
-                    "minimize_max_of)");
+                    absl::StrCat(obj.maximize ? "maximize" : "minimize",
+                                 " takes one value per run: REDUCTION_FINAL (the default), REDUCTION_RMS, "
+                                 "REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN (for a maximum over time "
+                                 "use minimize_max_of)"));
       }
       obj.reduction = r.value_or(Reduction::kFinal);
       break;
@@ -489,8 +493,8 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     }
     case v1::Objective::FORM_NOT_SET:
       errors->Add(where, "objective",
-                  "missing: expected `minimize_max_of`, `minimize`, `minimize_sum`, `minimize_max_over` or "
-                  "`target_distance`");
+                  "missing: expected `minimize_max_of`, `minimize`, `maximize`, `minimize_sum`, "
+                  "`minimize_max_over` or `target_distance`");
       break;
   }
   const bool termwise = obj.form == Objective::Form::kWeightedSum || obj.form == Objective::Form::kMaxOver;

@@ -22,6 +22,7 @@
 #include "spec/io/study_io.h"
 #include "tests/e2e/e2e_harness.h"
 #include "tests/fuzz/mutate.h"
+#include "tests/spec/oscillator_scene.h"
 
 namespace mbopt::e2e {
 namespace {
@@ -450,6 +451,43 @@ TEST(EndToEnd, ResponsesAndLoadCasesRunThroughTheService) {
   EXPECT_NE(validate.stdout_text.find("fast.s1"), std::string::npos) << validate.stdout_text;
   validate = Mbopt({"validate", examples + "vehicle_worst_case.study.textproto"});
   EXPECT_NE(validate.stdout_text.find("axle_springs = k2 + k3"), std::string::npos) << validate.stdout_text;
+}
+
+// A maximized objective is reported as the value itself everywhere a client
+// sees it (run's summary, every cycle of results, eval), while the optimizer
+// minimizes its negative: maximize 3 - (u - 1)^2 - (v + 2)^2, 3 at (1, -2).
+TEST(EndToEnd, MaximizedObjectiveIsReportedAsItself) {
+  ScratchDir dir;
+  std::string scene = ::mbopt::testing::kOscillatorScene;
+  const std::string after = "parameters { name: \"mass\" value: 2 unit: \"kg\" }\n";
+  scene.insert(scene.find(after) + after.size(), "parameters { name: \"u\" value: 0.5 }\nparameters { name: \"v\" value: 2 }\n");
+  dir.Write("carrier.scene.textproto", scene);
+  const std::string study = dir.Write("hill.study.textproto", R"pb(name: "hill"
+scene_file: "carrier.scene.textproto"
+variables { name: "u" parameter: "u" lower: -2 upper: 2 }
+variables { name: "v" parameter: "v" lower: -3 upper: 3 }
+responses { name: "hill" expr: "3 - (u - 1)^2 - (v + 2)^2" }
+objective { maximize: "hill" }
+optimizer { convergence_objective_tolerance: 1e-6 max_cycles: 200 }
+)pb");
+  const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()};
+  auto run = Mbopt({"run", study, "--workers", "2", "--json"}, env);
+  ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);
+  EXPECT_EQ(JsonField(run.stdout_text, "status"), "converged");
+  EXPECT_NEAR(std::stod(JsonField(run.stdout_text, "objective")), 3.0, 1e-6) << run.stdout_text;
+  // Every cycle's F is the value (from 3 - 0.25 - 16 = -13.25 at the start),
+  // rising to 3: the history's objectives go up, never the negatives down.
+  std::vector<double> history;
+  const std::string key = "\"objective\": ";
+  for (size_t at = run.stdout_text.find("\"history\""); at != std::string::npos;) {
+    at = run.stdout_text.find(key, at + 1);
+    if (at != std::string::npos) history.push_back(std::stod(run.stdout_text.substr(at + key.size())));
+  }
+  ASSERT_GE(history.size(), 3u) << run.stdout_text;
+  EXPECT_LT(history.front(), -1.0);
+  EXPECT_NEAR(history.back(), 3.0, 1e-6);
+  auto validate = Mbopt({"validate", study});
+  EXPECT_NE(validate.stdout_text.find("maximize the final of hill"), std::string::npos) << validate.stdout_text;
 }
 
 // ------------------------------------------------------------- bad input --

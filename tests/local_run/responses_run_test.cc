@@ -56,6 +56,17 @@ responses { name: "force" expr: "k * x" unit: "N" }
 objective { minimize_max_of: "force" reduction: REDUCTION_MAX_ABS unit: "N" }
 )pb";
 
+// maximize 3 - (u - 1)^2 - (v + 2)^2: the maximum 3 at u = 1, v = -2. The
+// optimizer minimizes the negative; the service reports the value itself.
+const char kMaximizeStudy[] = R"pb(name: "maximize a response"
+scene_file: "carrier.scene.textproto"
+variables { name: "u" parameter: "u" lower: -2 upper: 2 }
+variables { name: "v" parameter: "v" lower: -3 upper: 3 }
+responses { name: "hill" expr: "3 - (u - 1)^2 - (v + 2)^2" }
+objective { maximize: "hill" }
+optimizer { convergence_objective_tolerance: 1e-6 max_cycles: 200 }
+)pb";
+
 class ResponsesRun : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -85,6 +96,20 @@ TEST_F(ResponsesRun, MinMaxOfTwoResponsesUnderALinearDesignConstraintReachesTheC
   EXPECT_LT(run.max_violation, 1e-6);
   std::cout << "min-max: F " << run.objective << " at u = " << run.design[0] << ", v = " << run.design[1]
             << " after " << run.analyses << " analyses\n";
+}
+
+TEST_F(ResponsesRun, MaximizeReachesTheMaximum) {
+  absl::StatusOr<spec::Study> study = Load(kMaximizeStudy);
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_TRUE(study->objective.maximize);
+  absl::StatusOr<LocalRunResult> result = RunStudyLocally(*study, LocalRunOptions{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  const RunOutcome& run = result->outcome;
+  EXPECT_EQ(run.state, slp::RunState::kConverged) << result->end_reason;
+  // In-process runs give the optimizer's own F, the negative.
+  EXPECT_NEAR(study->objective.ReportedSign() * run.objective, 3.0, 1e-6);
+  EXPECT_NEAR(run.design[0], 1.0, 1e-3);
+  EXPECT_NEAR(run.design[1], -2.0, 1e-3);
 }
 
 TEST_F(ResponsesRun, ResponseOfAnOutputAndAParameterIsTheirProductAtEveryInstant) {

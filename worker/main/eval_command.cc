@@ -283,7 +283,7 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     out << "}";
     if (ok) {
-      out << ", \"objective\": " << JsonNumber(values->objective);
+      out << ", \"objective\": " << JsonNumber(study.objective.ReportedSign() * values->objective);
       out << ", \"objective_unit\": " << JsonString(objective_unit);
       out << ", \"objective_terms\": " << values->objective_terms.size();
       out << ", \"max_violation\": " << JsonNumber(values->max_violation);
@@ -342,7 +342,8 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     out << "status       FAILED: " << report.failure.reason << "\n";
   } else {
     out << "status       ok\n";
-    out << absl::StrFormat("objective    %.6g %s (%d term%s)\n", values->objective, objective_unit,
+    out << absl::StrFormat("objective    %.6g %s (%d term%s)\n", study.objective.ReportedSign() * values->objective,
+                           objective_unit,
                            values->objective_terms.size(),
                            values->objective_terms.size() == 1 ? "" : "s");
     if (values->worst_row >= 0) {

@@ -522,6 +522,8 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
     }
   }
   s.failed_analyses_by_kind = entry.failed_analyses_by_kind;
+  // The optimizer minimizes; a maximized value is reported as itself.
+  const double sign = entry.study_ok ? entry.study.objective.ReportedSign() : 1.0;
   if (entry.job != nullptr) {
     const slp::SlpOptimizer& optimizer = entry.job->optimizer();
     s.cycles = optimizer.cycles_completed();
@@ -532,14 +534,14 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
     if (!entry.records.empty()) {
       const slp::DesignPoint best = optimizer.best_design();
       design = best.x;
-      s.objective = best.objective;
+      s.objective = sign * best.objective;
       s.max_violation = best.max_violation;
     }
   } else if (!entry.records.empty() && options.has_value()) {
     // Not running in this process: the same choice from the logged records.
     if (std::optional<slp::DesignPoint> best = jobs::BestDesignOfRecords(entry.records, *options)) {
       design = best->x;
-      s.objective = best->objective;
+      s.objective = sign * best->objective;
       s.max_violation = best->max_violation;
     }
   }
@@ -561,6 +563,7 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
   if (entry.study_ok) {
     for (const spec::ConstraintRow& row : entry.layout.rows) view.row_names.push_back(row.name);
     for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
+    view.objective_sign = entry.study.objective.ReportedSign();
   }
   view.study_bytes = entry.row.study;
   return view;

@@ -66,7 +66,8 @@ struct JobSummaryData {
   jobs::JobState state = jobs::JobState::kQueued;
   int cycles = 0;
   std::int64_t analyses = 0;
-  // The result's F, in objective_unit, and maxg (normalized, > 0 violated);
+  // The result's F, in objective_unit (a maximized value as itself), and
+  // maxg (normalized, > 0 violated);
   // NaN while no design has been analysed (and for a job that failed there).
   double objective = std::numeric_limits<double>::quiet_NaN();
   std::string objective_unit;
@@ -91,6 +92,7 @@ struct JobView {
   bool ended = false;                     // the job is not running (nothing more will come)
   std::vector<std::string> row_names;     // constraint rows, for worst_* indices
   std::vector<double> variable_scales;    // physical = scale * x
+  double objective_sign = 1.0;            // reported F = sign * the records' F (-1: maximized)
   std::string study_bytes;
 };
 
