@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/local_cluster.h"
+#include "client/study_text.h"
 #include "client/subprocess.h"
 #include "client/temp_dir.h"
 #include "mbopt/v1/series.pb.h"
@@ -24,26 +25,6 @@ namespace {
 constexpr std::chrono::minutes kAnalysisGuard{30};
 // A page with more plots than this is not read: the rest are counted.
 constexpr int kMaxPlots = 24;
-
-const char* ReductionName(spec::Reduction r) {
-  switch (r) {
-    case spec::Reduction::kMax: return "max";
-    case spec::Reduction::kMaxAbs: return "max_abs";
-    case spec::Reduction::kMin: return "min";
-    case spec::Reduction::kFinal: return "final";
-    case spec::Reduction::kRms: return "rms";
-    case spec::Reduction::kIntegral: return "integral";
-    case spec::Reduction::kRange: return "range";
-    case spec::Reduction::kMean: return "mean";
-  }
-  return "?";
-}
-
-std::string WindowText(const spec::TimeWindow& w) {
-  if (w.whole_grid()) return "";
-  return absl::StrFormat(" from %s to %s", w.from_s ? absl::StrFormat("%g s", *w.from_s) : "the start",
-                         w.to_s ? absl::StrFormat("%g s", *w.to_s) : "the end");
-}
 
 // Runs the worker's eval at scaled design `x` and reads the series it writes.
 absl::StatusOr<v1::AnalysisSeries> Analyse(const std::string& worker, const std::string& study_path,

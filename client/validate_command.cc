@@ -10,6 +10,7 @@
 #include "client/args.h"
 #include "client/commands.h"
 #include "client/exit_codes.h"
+#include "client/study_text.h"
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
 #include "spec/study.h"
@@ -23,28 +24,8 @@ const char* ModelName(const spec::Scene& scene) {
   return "multibody";
 }
 
-const char* ReductionName(spec::Reduction r) {
-  switch (r) {
-    case spec::Reduction::kMax: return "max";
-    case spec::Reduction::kMaxAbs: return "max_abs";
-    case spec::Reduction::kMin: return "min";
-    case spec::Reduction::kFinal: return "final";
-    case spec::Reduction::kRms: return "rms";
-    case spec::Reduction::kIntegral: return "integral";
-    case spec::Reduction::kRange: return "range";
-    case spec::Reduction::kMean: return "mean";
-  }
-  return "?";
-}
-
 std::string OutputName(const spec::Study& study, int output) {
   return output >= 0 && output < study.num_signals() ? study.SignalName(output) : "?";
-}
-
-std::string WindowText(const spec::TimeWindow& w) {
-  if (w.whole_grid()) return "";
-  return absl::StrFormat(" from %s to %s", w.from_s ? absl::StrFormat("%g s", *w.from_s) : "the start",
-                         w.to_s ? absl::StrFormat("%g s", *w.to_s) : "the end");
 }
 
 std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& layout) {

@@ -458,18 +458,8 @@ TEST(EndToEnd, ResponsesAndLoadCasesRunThroughTheService) {
 // minimizes its negative: maximize 3 - (u - 1)^2 - (v + 2)^2, 3 at (1, -2).
 TEST(EndToEnd, MaximizedObjectiveIsReportedAsItself) {
   ScratchDir dir;
-  std::string scene = ::mbopt::testing::kOscillatorScene;
-  const std::string after = "parameters { name: \"mass\" value: 2 unit: \"kg\" }\n";
-  scene.insert(scene.find(after) + after.size(), "parameters { name: \"u\" value: 0.5 }\nparameters { name: \"v\" value: 2 }\n");
-  dir.Write("carrier.scene.textproto", scene);
-  const std::string study = dir.Write("hill.study.textproto", R"pb(name: "hill"
-scene_file: "carrier.scene.textproto"
-variables { name: "u" parameter: "u" lower: -2 upper: 2 }
-variables { name: "v" parameter: "v" lower: -3 upper: 3 }
-responses { name: "hill" expr: "3 - (u - 1)^2 - (v + 2)^2" }
-objective { maximize: "hill" }
-optimizer { convergence_objective_tolerance: 1e-6 max_cycles: 200 }
-)pb");
+  dir.Write("carrier.scene.textproto", ::mbopt::testing::CarrierScene());
+  const std::string study = dir.Write("hill.study.textproto", ::mbopt::testing::kHillStudy);
   const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()};
   auto run = Mbopt({"run", study, "--workers", "2", "--json"}, env);
   ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);

@@ -17,14 +17,8 @@
 namespace mbopt::local_run {
 namespace {
 
-// A cheap analysis (the oscillator of the spec tests) and two parameters, u
-// and v, that no element uses: the study's responses make them the problem.
-std::string CarrierScene() {
-  std::string scene = ::mbopt::testing::kOscillatorScene;
-  const std::string after = "parameters { name: \"mass\" value: 2 unit: \"kg\" }\n";
-  scene.insert(scene.find(after) + after.size(), "parameters { name: \"u\" value: 0.5 }\nparameters { name: \"v\" value: 2 }\n");
-  return scene;
-}
+// The oscillator with two free parameters u and v (tests/spec).
+using ::mbopt::testing::CarrierScene;
 
 // min max(f1, f2), f1 = (u - 1)^2 + v^2, f2 = (u + 1)^2 + v^2, subject to
 // u + v >= 1 (a linear constraint on the design variables): on the line
@@ -56,16 +50,9 @@ responses { name: "force" expr: "k * x" unit: "N" }
 objective { minimize_max_of: "force" reduction: REDUCTION_MAX_ABS unit: "N" }
 )pb";
 
-// maximize 3 - (u - 1)^2 - (v + 2)^2: the maximum 3 at u = 1, v = -2. The
-// optimizer minimizes the negative; the service reports the value itself.
-const char kMaximizeStudy[] = R"pb(name: "maximize a response"
-scene_file: "carrier.scene.textproto"
-variables { name: "u" parameter: "u" lower: -2 upper: 2 }
-variables { name: "v" parameter: "v" lower: -3 upper: 3 }
-responses { name: "hill" expr: "3 - (u - 1)^2 - (v + 2)^2" }
-objective { maximize: "hill" }
-optimizer { convergence_objective_tolerance: 1e-6 max_cycles: 200 }
-)pb";
+// The optimizer minimizes the negative; the service reports the value
+// itself.
+const char* const kMaximizeStudy = ::mbopt::testing::kHillStudy;
 
 class ResponsesRun : public ::testing::Test {
  protected:
