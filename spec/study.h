@@ -106,6 +106,9 @@ struct OptimizerSettings {
   // finite differences (lumped and multibody scenes; not linkage scenes
   // or static multibody analyses).
   bool simulator_sensitivities = false;
+  // Stop, converged, at a feasible design whose objective is this good (at
+  // or below it; at or above it when maximizing).
+  std::optional<double> objective_target;
 };
 
 struct AnalysisOverrides {

@@ -22,7 +22,8 @@ inline constexpr char kProtocol[] = R"(## Protocol
   upper bound, one retry after a failed perturbation); the objective divided by |F(x0)|; a
   min-max objective in the same bound formulation the SLP uses (an extra variable b in
   [-10, 10]: minimize b subject to f_i / |F(x0)| - b <= 0), so the peers see a smooth problem;
-  stopping at ftol_rel = xtol_rel = 1e-6 or when the next request would exceed the analysis cap;
+  stopping at ftol_rel = xtol_rel = 1e-6, at the study's `objective_target` if it has one (NLopt's
+  stopval, as the SLP stops there), or when the next request would exceed the analysis cap;
   constraint tolerance 1e-6 on the normalized rows (NLopt returns the best point it saw that
   meets every row within it; with 0, finite-difference noise of 1e-12 at an active row made
   SLSQP return an early, strictly feasible design far from the optimum).

@@ -194,7 +194,11 @@ absl::StatusOr<MethodRun> RunNloptPeer(const spec::Study& study, PeerAlgorithm a
                       (m == 0 || nlopt_add_inequality_mconstraint(opt, static_cast<unsigned>(m), Constraints,
                                                                   &c, tol.data()) == NLOPT_SUCCESS) &&
                       nlopt_set_ftol_rel(opt, options.ftol_rel) == NLOPT_SUCCESS &&
-                      nlopt_set_xtol_rel(opt, options.xtol_rel) == NLOPT_SUCCESS;
+                      nlopt_set_xtol_rel(opt, options.xtol_rel) == NLOPT_SUCCESS &&
+                      // The study's objective_target is NLopt's stopval: the
+                      // same "good enough" for every method.
+                      (!fd_options.objective_target.has_value() ||
+                       nlopt_set_stopval(opt, *fd_options.objective_target / c.objective_scale) == NLOPT_SUCCESS);
   if (!set_ok) {
     nlopt_destroy(opt);
     return absl::InternalError("configuring NLopt failed");

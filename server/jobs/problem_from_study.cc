@@ -60,6 +60,11 @@ absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study) {
   options.finite_difference_relative_step =
       s.finite_difference_relative_step.value_or(options.finite_difference_relative_step);
   options.analyses_provide_gradients = s.simulator_sensitivities;
+  // The study states the target in the reported sense (a maximized value as
+  // itself); the optimizer minimizes sign * value.
+  if (s.objective_target.has_value()) {
+    options.objective_target = study.objective.ReportedSign() * *s.objective_target;
+  }
   absl::Status valid = InStudy(study, options.Validate());
   if (!valid.ok()) return valid;
   return options;

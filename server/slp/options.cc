@@ -45,6 +45,9 @@ absl::Status SlpOptions::Validate() const {
       return Bad(p.name, p.value, "must be finite and > 0");
     }
   }
+  if (objective_target.has_value() && !std::isfinite(*objective_target)) {
+    return Bad("objective_target", *objective_target, "must be finite");
+  }
   if (min_move_limit > max_move_limit) {
     return absl::InvalidArgumentError(
         absl::StrCat("SlpOptions.min_move_limit = ", min_move_limit,

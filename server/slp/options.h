@@ -2,6 +2,8 @@
 // section 3 (Etman et al. 1994); every field is documented in docs/method.md.
 #pragma once
 
+#include <optional>
+
 #include "absl/status/status.h"
 
 namespace mbopt::slp {
@@ -67,6 +69,12 @@ struct SlpOptions {
   double convergence_objective_tolerance = 0.005;
   double convergence_violation_tolerance = 0.005;
   double convergence_optimality_tolerance = 0.005;
+  // A value of F the user calls good enough: an accepted design with F at
+  // or below it and maxg below violation_tolerance ends the run converged,
+  // whatever the tests above say. For objectives whose optimum is known,
+  // such as a distance to targets that can be met (F = 0), where the
+  // relative tests have no scale. Absent: no such stop.
+  std::optional<double> objective_target;
 
   // Penalty on the infeasibility variable s, relative to the objective's scale.
   double infeasibility_penalty = 1e3;

@@ -318,6 +318,11 @@ class SlpOptimizer::Impl {
     }
   }
 
+  // A feasible design at or below the user's objective target.
+  bool MeetsObjectiveTarget(const PointValues& v) const {
+    return options_.objective_target.has_value() && v.objective <= *options_.objective_target &&
+           v.max_violation < options_.convergence_violation_tolerance;
+  }
   bool AnyFrozen() const {
     return std::find(lin_.frozen.begin(), lin_.frozen.end(), true) != lin_.frozen.end();
   }
@@ -505,7 +510,14 @@ class SlpOptimizer::Impl {
       in.max_violation = trial.max_violation;
       in.objective_trial = trial.objective;
     }
-    const MoveLimitDecision decision = ApplyMoveLimitStrategy(options_, in);
+    MoveLimitDecision decision = ApplyMoveLimitStrategy(options_, in);
+    // A feasible trial that meets the user's objective target ends the run
+    // whatever the strategy thinks of its approximation: the run has what
+    // was asked for.
+    if (!in.trial_failed && MeetsObjectiveTarget(trial)) {
+      decision.accept = true;
+      decision.rejection_reason.clear();
+    }
     r.accepted = decision.accept;
     r.rejection_reason = decision.rejection_reason;
     if (in.trial_failed) {
@@ -525,10 +537,10 @@ class SlpOptimizer::Impl {
     // Accepted: x* becomes the next x0.
     const double relative_change = RelativeObjectiveChange(
         v0_.objective, trial.objective, options_.objective_magnitude_floor);
-    const bool converged = relative_change < options_.convergence_objective_tolerance &&
-                           trial.max_violation < options_.convergence_violation_tolerance &&
-                           r.optimality_residual < options_.convergence_optimality_tolerance &&
-                           !AnyFrozen();
+    const bool converged = MeetsObjectiveTarget(trial) ||
+                           (relative_change < options_.convergence_objective_tolerance &&
+                            trial.max_violation < options_.convergence_violation_tolerance &&
+                            r.optimality_residual < options_.convergence_optimality_tolerance && !AnyFrozen());
     dx_old_ = d;
     dF_old_ = trial.objective - v0_.objective;
     x0_ = x_trial_;

@@ -639,6 +639,13 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
       s.max_cycles = p.max_cycles();
     }
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
+    if (p.has_objective_target()) {
+      if (!std::isfinite(p.objective_target())) {
+        errors->Add(w, "objective_target", "must be a finite number");
+      } else {
+        s.objective_target = p.objective_target();
+      }
+    }
     s.central_differences = p.finite_difference() == v1::FINITE_DIFFERENCE_CENTRAL;
     s.simulator_sensitivities = p.sensitivity() == v1::SENSITIVITY_METHOD_SIMULATOR;
     if (s.simulator_sensitivities && std::holds_alternative<LinkageModel>(scene.model)) {
