@@ -203,7 +203,12 @@ Dimension OutputDimension(const Output& output) {
                         [](const PointPositionOutput&) { return Dimension::kLength; },
                         [](const LinkRotationOutput&) { return Dimension::kAngle; },
                         [](const ElementDeflectionOutput&) { return Dimension::kLength; },
-                        [](const BodyAccelerationOutput&) { return Dimension::kAcceleration; },
+                        [](const BodyAccelerationOutput& b) {
+                          using Q = BodyAccelerationOutput::Quantity;
+                          return b.quantity == Q::kDisplacement ? Dimension::kLength
+                                 : b.quantity == Q::kVelocity   ? Dimension::kVelocity
+                                                                : Dimension::kAcceleration;
+                        },
                         [](const BendingStressOutput&) { return Dimension::kPressure; },
                         [](const DriveTorqueOutput&) { return Dimension::kTorque; },
                         [](const MassOutput&) { return Dimension::kMass; },

@@ -213,7 +213,15 @@ enum class Axis { kX, kY };
 struct PointPositionOutput { int link = -1; int point = -1; int joint = -1; Axis axis = Axis::kX; };  // link point, or joint if joint >= 0
 struct LinkRotationOutput { int link = -1; };
 struct ElementDeflectionOutput { int element = -1; };
-struct BodyAccelerationOutput { int body = -1; Vec2 offset_m; Axis axis = Axis::kY; };
+// A lumped body point's motion: its acceleration, or (small motions about
+// the equilibrium) its displacement or velocity.
+struct BodyAccelerationOutput {
+  enum class Quantity { kAcceleration, kDisplacement, kVelocity };
+  int body = -1;
+  Vec2 offset_m;
+  Axis axis = Axis::kY;
+  Quantity quantity = Quantity::kAcceleration;
+};
 struct BendingStressOutput { int link = -1; };
 struct DriveTorqueOutput {};
 struct MassOutput {};

@@ -986,11 +986,19 @@ class SceneConverter {
           out.kind = k;
           break;
         }
-        case v1::Output::kBodyAcceleration: {
+        case v1::Output::kBodyAcceleration:
+        case v1::Output::kBodyDisplacement:
+        case v1::Output::kBodyVelocity: {
           needs = "lumped";
-          const Where kw = ow.Child("body_acceleration");
-          const v1::BodyAccelerationOutput& a = o.body_acceleration();
+          using Q = BodyAccelerationOutput::Quantity;
+          const bool displacement = o.kind_case() == v1::Output::kBodyDisplacement;
+          const bool velocity = o.kind_case() == v1::Output::kBodyVelocity;
+          const Where kw =
+              ow.Child(displacement ? "body_displacement" : velocity ? "body_velocity" : "body_acceleration");
+          const v1::BodyAccelerationOutput& a =
+              displacement ? o.body_displacement() : velocity ? o.body_velocity() : o.body_acceleration();
           BodyAccelerationOutput k;
+          k.quantity = displacement ? Q::kDisplacement : velocity ? Q::kVelocity : Q::kAcceleration;
           if (lumped) k.body = lookup(lumped_bodies_, kw, "body", a.body(), "body");
           k.offset_m = Vec(kw, "offset_m", a.has_offset_m(), a.offset_m(), Dimension::kLength);
           k.axis = axis(kw, a.axis());

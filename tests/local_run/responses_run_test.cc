@@ -126,7 +126,7 @@ namespace {
 // intermediate responses (P's coordinates, the gear's rotation) and compose
 // the objective from them exactly, here as the largest weighted residual
 // (examples/landing_gear/landing_gear_intermediate). Where the direct
-// formulation stops at F = 0.056 after 265 analyses (docs/results.md), this
+// formulation ends at F = 0.040 after 525 analyses (docs/results.md), this
 // one drives the residuals to its objective_target: the report's own
 // objective, evaluated at the result, is below 1e-5.
 TEST(LandingGearIntermediate, IntermediateResponsesMeetTheTargets) {

@@ -177,8 +177,8 @@ void LumpedModel::Acceleration(double t_s, const Eigen::VectorXd& q, const Eigen
   qddot->array() /= mass_diagonal_.array();
 }
 
-double LumpedModel::PointAcceleration(int body, double offset_x_m, double offset_y_m,
-                                      spec::Axis axis, const Eigen::VectorXd& qddot) const {
+double LumpedModel::PointMotion(int body, double offset_x_m, double offset_y_m, spec::Axis axis,
+                                const Eigen::Ref<const Eigen::VectorXd>& qddot) const {
   const int ix = CoordinateOf(body, spec::Dof::kX);
   const int iy = CoordinateOf(body, spec::Dof::kY);
   const int ir = CoordinateOf(body, spec::Dof::kRotation);

@@ -74,9 +74,10 @@ class LumpedModel {
   // Acceleration q'' from the equations of motion.
   void Acceleration(double t_s, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot,
                     Eigen::VectorXd* qddot) const;
-  // Acceleration of a point of a body along an axis, from q''.
-  double PointAcceleration(int body, double offset_x_m, double offset_y_m, spec::Axis axis,
-                           const Eigen::VectorXd& qddot) const;
+  // A body point's motion along an axis: its displacement from q, velocity
+  // from q', acceleration from q'' (small rotations: the same linear map).
+  double PointMotion(int body, double offset_x_m, double offset_y_m, spec::Axis axis,
+                     const Eigen::Ref<const Eigen::VectorXd>& coordinates) const;
   // Instants in (t_begin, t_end) where f(t) has a kink (a bump starts or
   // ends), ascending and without duplicates.
   std::vector<double> KinkTimes(double t_begin_s, double t_end_s) const;

@@ -26,7 +26,7 @@ spec::AnalysisReport Failed(spec::AnalysisReport report, const spec::AnalysisFai
 
 // What to evaluate for one requested output at each instant.
 struct OutputPlan {
-  enum class Kind { kDeflection, kAcceleration } kind = Kind::kDeflection;
+  enum class Kind { kDeflection, kAcceleration, kDisplacement, kVelocity } kind = Kind::kDeflection;
   int element = -1;
   int body = -1;
   double offset_x_m = 0, offset_y_m = 0;
@@ -135,16 +135,19 @@ spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
       plan.kind = OutputPlan::Kind::kDeflection;
       plan.element = d->element;
     } else if (const auto* a = std::get_if<spec::BodyAccelerationOutput>(&out.kind)) {
-      plan.kind = OutputPlan::Kind::kAcceleration;
+      using Q = spec::BodyAccelerationOutput::Quantity;
+      plan.kind = a->quantity == Q::kDisplacement ? OutputPlan::Kind::kDisplacement
+                  : a->quantity == Q::kVelocity   ? OutputPlan::Kind::kVelocity
+                                                  : OutputPlan::Kind::kAcceleration;
       plan.body = a->body;
       plan.offset_x_m = a->offset_m.x.Resolve(parameter_values_si);
       plan.offset_y_m = a->offset_m.y.Resolve(parameter_values_si);
       plan.axis = a->axis;
-      needs_acceleration = true;
+      needs_acceleration = needs_acceleration || plan.kind == OutputPlan::Kind::kAcceleration;
     } else {
       return Failed(report, spec::FailureKind::kInvalidModel, absl::StrCat("output \"", out.name,
                                          "\" is not available for a lumped scene (only "
-                                         "element_deflection and body_acceleration are)"));
+                                         "element_deflection and body_acceleration, _displacement and _velocity are)"));
     }
     plans.push_back(plan);
     spec::OutputValues values;
@@ -161,10 +164,15 @@ spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
     if (needs_acceleration) m.Acceleration(t, q, v, &a);
     for (size_t o = 0; o < plans.size(); ++o) {
       const OutputPlan& plan = plans[o];
+      // A body point's displacement, velocity and acceleration are the same
+      // linear map of q, q' and q''.
       const double value =
           plan.kind == OutputPlan::Kind::kDeflection
               ? m.Deflection(plan.element, q, t)
-              : m.PointAcceleration(plan.body, plan.offset_x_m, plan.offset_y_m, plan.axis, a);
+              : m.PointMotion(plan.body, plan.offset_x_m, plan.offset_y_m, plan.axis,
+                                    plan.kind == OutputPlan::Kind::kDisplacement ? q
+                                    : plan.kind == OutputPlan::Kind::kVelocity   ? v
+                                                                                 : a);
       if (!std::isfinite(value)) {
         return spec::AnalysisFailure::Of(
             spec::FailureKind::kNonFiniteValue,

@@ -165,6 +165,7 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   // Outputs to evaluate (as SimulateLumped).
   struct Plan {
     bool deflection = true;
+    spec::BodyAccelerationOutput::Quantity quantity = spec::BodyAccelerationOutput::Quantity::kAcceleration;
     int index = -1;
     double ox = 0, oy = 0;
     spec::Axis axis = spec::Axis::kY;
@@ -176,6 +177,7 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
       plan.index = d->element;
     } else if (const auto* a = std::get_if<spec::BodyAccelerationOutput>(&out.kind)) {
       plan.deflection = false;
+      plan.quantity = a->quantity;
       plan.index = a->body;
       plan.ox = a->offset_m.x.Resolve(parameter_values_si);
       plan.oy = a->offset_m.y.Resolve(parameter_values_si);
@@ -210,8 +212,11 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
 
   // Appends the outputs and their derivatives at instant t from the state
   // (q, q') and sensitivity(k) -> (s, s') of parameter k.
+  using Quantity = spec::BodyAccelerationOutput::Quantity;
   bool need_acceleration = false;
-  for (const Plan& plan : plans) need_acceleration = need_acceleration || !plan.deflection;
+  for (const Plan& plan : plans) {
+    need_acceleration = need_acceleration || (!plan.deflection && plan.quantity == Quantity::kAcceleration);
+  }
   Eigen::VectorXd q(n), v(n), qddot(n), dqddot(n);
   const SensitivityRecorder record = [&](double t, const Eigen::Ref<const Eigen::VectorXd>& state,
                                          const std::function<const double*(int)>& sensitivity) {
@@ -220,9 +225,14 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
     m.Acceleration(t, q, v, &qddot);
     for (size_t o = 0; o < plans.size(); ++o) {
       const Plan& plan = plans[o];
+      // A body point's displacement, velocity and acceleration: the same
+      // linear map of q, q' and q'' (and of their sensitivities below).
       const double value = plan.deflection
                                ? m.Deflection(plan.index, q, t)
-                               : m.PointAcceleration(plan.index, plan.ox, plan.oy, plan.axis, qddot);
+                               : m.PointMotion(plan.index, plan.ox, plan.oy, plan.axis,
+                                                     plan.quantity == Quantity::kDisplacement ? q
+                                                     : plan.quantity == Quantity::kVelocity   ? v
+                                                                                              : qddot);
       report.outputs[o].series[0].push_back(value);
     }
     for (int k = 0; k < ns; ++k) {
@@ -232,9 +242,12 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
       for (size_t o = 0; o < plans.size(); ++o) {
         const Plan& plan = plans[o];
         const double derivative =
-            plan.deflection
-                ? m.elements()[static_cast<size_t>(plan.index)].gradient.dot(sq)
-                : m.PointAcceleration(plan.index, plan.ox, plan.oy, plan.axis, dqddot);
+            plan.deflection ? m.elements()[static_cast<size_t>(plan.index)].gradient.dot(sq)
+            : plan.quantity == Quantity::kDisplacement
+                ? m.PointMotion(plan.index, plan.ox, plan.oy, plan.axis, sq)
+            : plan.quantity == Quantity::kVelocity
+                ? m.PointMotion(plan.index, plan.ox, plan.oy, plan.axis, sv)
+                : m.PointMotion(plan.index, plan.ox, plan.oy, plan.axis, dqddot);
         result.output_derivatives[static_cast<size_t>(k)][o].push_back(derivative);
       }
     }
