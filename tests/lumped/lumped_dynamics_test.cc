@@ -263,6 +263,38 @@ TEST(LumpedDynamics, ReportsOnlyTheRequestedOutputsInSceneOrder) {
   EXPECT_EQ(r.formulation, spec::Formulation::kDynamic);
 }
 
+// body_displacement and body_velocity of the free damped oscillator against
+// the closed form x(t), x'(t), to the same fraction of the amplitude as the
+// deflection and acceleration above.
+TEST(LumpedDynamics, BodyDisplacementAndVelocityMatchTheClosedForm) {
+  const OneDof p;
+  spec::Scene scene = OneDofScene(p, false);
+  spec::BodyAccelerationOutput displacement;
+  displacement.body = 0;
+  displacement.quantity = spec::BodyAccelerationOutput::Quantity::kDisplacement;
+  spec::BodyAccelerationOutput velocity = displacement;
+  velocity.quantity = spec::BodyAccelerationOutput::Quantity::kVelocity;
+  scene.outputs.push_back({"y", displacement});
+  scene.outputs.push_back({"v", velocity});
+  LumpedDynamicsOptions options;
+  const double x0 = 0.01;
+  options.initial_q = Eigen::VectorXd::Constant(1, x0);
+  const spec::AnalysisReport r = SimulateLumped(scene, {p.stiffness_n_per_m}, options);
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  ASSERT_EQ(r.outputs.size(), 4u);
+  const double wn = std::sqrt(p.stiffness_n_per_m / p.mass_kg);
+  const double zeta = p.damping_n_s_per_m / (2 * std::sqrt(p.stiffness_n_per_m * p.mass_kg));
+  const double wd = wn * std::sqrt(1 - zeta * zeta);
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double t = r.times_s[i];
+    const double e = std::exp(-zeta * wn * t);
+    const double x = x0 * e * (std::cos(wd * t) + zeta * wn / wd * std::sin(wd * t));
+    const double v = -x0 * e * wn * wn / wd * std::sin(wd * t);
+    EXPECT_NEAR(r.outputs[2].series[0][i], x, kRelativeToAmplitude * x0) << "t = " << t;
+    EXPECT_NEAR(r.outputs[3].series[0][i], v, kRelativeToAmplitude * x0 * wn) << "t = " << t;
+  }
+}
+
 TEST(LumpedModel, KinksAreTheBumpStartsAndEndsInsideTheInterval) {
   spec::Scene scene = OneDofScene(OneDof(), true);
   auto model = model::LumpedModel::Assemble(std::get<spec::LumpedModel>(scene.model), {800.0});

@@ -171,6 +171,38 @@ TEST(SimulatorSensitivities, VariableSettingTwoParametersMatchesCentralDifferenc
   ExpectGradientsMatchCentralDifferences(study);
 }
 
+// A seat's absolute displacement and velocity (body_displacement,
+// body_velocity) under constraints: their sensitivities are those of the
+// coordinates and their rates.
+TEST(SimulatorSensitivities, BodyDisplacementAndVelocityMatchCentralDifferences) {
+  spec::Study study = TightVehicle();
+  const auto& lumped = std::get<spec::LumpedModel>(study.scene.model);
+  int seat = -1;
+  for (size_t b = 0; b < lumped.bodies.size(); ++b) {
+    if (lumped.bodies[b].name == "seat") seat = static_cast<int>(b);
+  }
+  ASSERT_GE(seat, 0);
+  spec::BodyAccelerationOutput motion;
+  motion.body = seat;
+  motion.quantity = spec::BodyAccelerationOutput::Quantity::kDisplacement;
+  study.scene.outputs.push_back({"seat_y", motion});
+  motion.quantity = spec::BodyAccelerationOutput::Quantity::kVelocity;
+  study.scene.outputs.push_back({"seat_v", motion});
+  const int outputs = static_cast<int>(study.scene.outputs.size());
+  spec::Constraint y;
+  y.name = "seat_y";
+  y.output = outputs - 2;
+  y.reduction = spec::Reduction::kMaxAbs;
+  y.limit = 0.05;
+  spec::Constraint v = y;
+  v.name = "seat_v";
+  v.output = outputs - 1;
+  v.limit = 1.0;
+  study.constraints.push_back(y);
+  study.constraints.push_back(v);
+  ExpectGradientsMatchCentralDifferences(study);
+}
+
 // Two load cases: each case's sensitivities, in signal order.
 TEST(SimulatorSensitivities, LoadCasesMatchCentralDifferences) {
   absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_two_roads.study.textproto");
