@@ -132,6 +132,9 @@ TEST(EvalCommand, SeriesOutHoldsEveryOutputAndResponse) {
   ASSERT_EQ(pitch.size(), 101);
   for (int i = 0; i < pitch.size(); ++i) EXPECT_EQ(pitch[i], s2[i] - s3[i]) << i;
   ASSERT_EQ(series.signals(7).series(0).values_si_size(), 1);  // k2 + k3: one value
+  // The printed summary lists the responses after the outputs.
+  EXPECT_THAT(r.out, HasSubstr("pitch_travel"));
+  EXPECT_THAT(r.out, HasSubstr("axle_springs"));
   EXPECT_NEAR(series.signals(7).series(0).values_si(0), 600 * 175.126835, 1e-3);  // 600 lbf/in in N/m
 
   r = Eval({"examples/vehicle/vehicle_two_roads.study.textproto", "--series-out", path});

@@ -259,7 +259,10 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           ? ""
           : (study.objective.unit.empty() ? "SI" : study.objective.unit);
 
+  // Every output (per load case), then every response: what a user checks
+  // their response expressions against.
   std::vector<std::vector<SeriesSummary>> summaries;
+  std::vector<std::string> summary_names;
   for (const auto& o : report.outputs) {
     std::vector<SeriesSummary> per_series;
     for (size_t s = 0; s < o.series.size(); ++s) {
@@ -268,6 +271,21 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
                     report.times_s));
     }
     summaries.push_back(std::move(per_series));
+    summary_names.push_back(o.name);
+  }
+  engine::StudySignals signals;
+  if (ok && !study.responses.empty() &&
+      engine::BuildStudySignals(study, *layout, report, parameters, &signals).ok()) {
+    for (int k = study.num_case_signals(); k < study.num_signals(); ++k) {
+      const spec::OutputShape& shape = layout->outputs[static_cast<size_t>(k)];
+      std::vector<SeriesSummary> per_series;
+      for (size_t s = 0; s < signals.signals[static_cast<size_t>(k)]->size(); ++s) {
+        per_series.push_back(Summarize(s < shape.series_labels.size() ? shape.series_labels[s] : absl::StrCat(s),
+                                       (*signals.signals[static_cast<size_t>(k)])[s], report.times_s));
+      }
+      summaries.push_back(std::move(per_series));
+      summary_names.push_back(study.SignalName(k));
+    }
   }
   const auto& c = report.counters;
 
@@ -303,7 +321,7 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     out << ", \"outputs\": [";
     for (size_t o = 0; o < summaries.size(); ++o) {
-      out << (o ? ", " : "") << "{\"name\": " << JsonString(report.outputs[o].name)
+      out << (o ? ", " : "") << "{\"name\": " << JsonString(summary_names[o])
           << ", \"series\": [";
       for (size_t s = 0; s < summaries[o].size(); ++s) {
         const SeriesSummary& m = summaries[o][s];
@@ -357,12 +375,12 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       out << "worst row    (no constraints)\n";
     }
   }
-  out << "outputs      (SI; min and max over the grid)\n";
+  out << "outputs      (SI; min and max over the grid; responses after the outputs)\n";
   for (size_t o = 0; o < summaries.size(); ++o) {
     for (const SeriesSummary& m : summaries[o]) {
       const std::string label = summaries[o].size() > 1
-                                    ? absl::StrCat(report.outputs[o].name, "[", m.label, "]")
-                                    : report.outputs[o].name;
+                                    ? absl::StrCat(summary_names[o], "[", m.label, "]")
+                                    : summary_names[o];
       out << absl::StrFormat("  %-24s min %-13.6g at t=%-8.4g max %-13.6g at t=%.4g\n", label,
                              m.min, m.t_min, m.max, m.t_max);
     }
