@@ -31,7 +31,7 @@ constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--tls-dir DIR | --tls-cert F --tls-key F --tokens F]\n"
     "                    [--worker-ca F] [--insecure] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
-    "                    [--durability full|normal] [--crash-after-cycles N]\n"
+    "                    [--durability full|normal] [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
     "       mbopt-server add-token --tokens F --role worker|user|admin --name N --out F\n"
@@ -59,7 +59,9 @@ constexpr const char* kUsage =
     "  --max-message-mb N     largest message taken or sent, a result or a study\n"
     "                         (default 256, at most 2047)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
-    "                         commits its N-th cycle record\n";
+    "                         commits its N-th cycle record\n"
+    "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
+    "                         its N-th transaction of results, before COMMIT\n";
 
 // A certificate this close to expiring is warned about at every start.
 constexpr std::int64_t kCertificateWarningSeconds = std::int64_t{30} * 86400;
@@ -69,6 +71,7 @@ struct Flags {
   std::string tls_dir;
   std::string port_file;
   std::int64_t crash_after_records = 0;
+  std::int64_t crash_in_commit = 0;
 };
 
 bool ParseInt(const std::string& flag, const std::string& text, std::int64_t min, std::int64_t* out) {
@@ -136,6 +139,9 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;
+    } else if (name == "--crash-in-commit") {
+      if (!ParseInt(name, value, 1, &number)) return false;
+      flags->crash_in_commit = number;
     } else {
       std::cerr << "mbopt-server: unknown option '" << name << "'\n" << kUsage;
       return false;
@@ -195,6 +201,13 @@ int main(int argc, char** argv) {
     const std::int64_t crash_at = flags.crash_after_records;
     flags.server.manager.after_record_commit = [crash_at](std::int64_t committed) {
       if (committed == crash_at) ::raise(SIGKILL);
+    };
+  }
+
+  if (flags.crash_in_commit > 0) {
+    const std::int64_t crash_at = flags.crash_in_commit;
+    flags.server.before_result_commit = [crash_at](std::int64_t transaction) {
+      if (transaction == crash_at) ::raise(SIGKILL);
     };
   }
 

@@ -59,8 +59,24 @@ bool Scheduler::HasOtherLiveWorker(const std::string& worker_id, const std::set<
   return false;
 }
 
+int Scheduler::FairShareLocked(const std::string& worker_id) const {
+  std::int64_t total_slots = 0;
+  for (const auto& [id, worker] : workers_) total_slots += worker.slots;
+  std::int64_t queued = 0;
+  for (const auto& [job_id, queue] : queues_) queued += static_cast<std::int64_t>(queue.size());
+  std::int64_t leased_to_worker = 0;
+  for (const auto& [task_id, key] : leases_) {
+    if (entries_.at(key).worker_id == worker_id) ++leased_to_worker;
+  }
+  const std::int64_t slots = workers_.at(worker_id).slots;
+  const std::int64_t outstanding = queued + static_cast<std::int64_t>(leases_.size());
+  const std::int64_t share = (outstanding * slots + total_slots - 1) / std::max<std::int64_t>(1, total_slots);
+  return static_cast<int>(std::max(share, slots) - leased_to_worker);
+}
+
 std::vector<Task> Scheduler::AcquireLocked(const std::string& worker_id, int max_tasks) {
   std::vector<Task> tasks;
+  if (max_tasks > 1) max_tasks = std::min(max_tasks, FairShareLocked(worker_id));
   const std::int64_t now = clock_->NowMs();
   while (static_cast<int>(tasks.size()) < max_tasks && !queues_.empty()) {
     // Round robin: the first job after the last one served, wrapping around,

@@ -103,8 +103,12 @@ class Scheduler {
   bool Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled,
                bool want_gradients = false);
 
-  // Up to `max_tasks` tasks for `worker_id`, fairly across jobs. NotFound
-  // for an unknown worker (it must register again).
+  // Up to `max_tasks` tasks for `worker_id`, fairly across jobs. A worker
+  // may ask for more tasks than it has slots (to run them back to back and
+  // report their results together); it gets at most its share, by slots,
+  // of the work outstanding (queued and leased), less what it holds, and
+  // never fewer than its free slots: a batch does not leave other workers
+  // idle. NotFound for an unknown worker (it must register again).
   absl::StatusOr<std::vector<Task>> Acquire(const std::string& worker_id, int max_tasks);
   // As Acquire, but waits up to `wait_ms` (real time) for a task to appear
   // when none is available. Returns early (empty) on Shutdown().
@@ -173,6 +177,8 @@ class Scheduler {
   };
 
   std::vector<Task> AcquireLocked(const std::string& worker_id, int max_tasks);
+  // How many more tasks `worker_id` may hold now (Acquire); may be <= 0.
+  int FairShareLocked(const std::string& worker_id) const;
   bool HasOtherLiveWorker(const std::string& worker_id, const std::set<std::string>& excluded) const;
   // Records a failed attempt; returns the finished task if it is given up.
   std::optional<FinishedTask> FailLocked(const Key& key, const std::string& reason);

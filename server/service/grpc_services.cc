@@ -175,7 +175,7 @@ grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext* context, const
   }
   const std::int64_t wait_ms = std::clamp<std::int64_t>(request->wait_ms(), 0, kMaxWaitMs);
   absl::StatusOr<std::vector<scheduler::Task>> tasks =
-      scheduler_->AcquireWait(request->worker_id(), std::max(1, request->max_tasks()), wait_ms);
+      scheduler_->AcquireWait(request->worker_id(), std::clamp(request->max_tasks(), 1, kMaxTasksPerCall), wait_ms);
   if (!tasks.ok()) return ToGrpcStatus(tasks.status());
   AddTasks(*tasks, response->mutable_tasks());
   return grpc::Status::OK;
@@ -220,6 +220,47 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext* context, const
     if (tasks.ok()) AddTasks(*tasks, response->mutable_tasks());
   }
   return status;
+}
+
+grpc::Status WorkerServiceImpl::ReportResults(grpc::ServerContext* context, const v1::TaskResults* request,
+                                              v1::ReportResultsResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResults"); !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
+  std::vector<WorkerReport> reports;
+  std::vector<int> report_index;  // the answer of each report
+  // Each result names the registration its task was leased under (a worker
+  // that registered again may still report tasks of the old one).
+  for (int i = 0; i < request->results_size(); ++i) {
+    const v1::TaskResult& result = request->results(i);
+    v1::ResultAnswer* answer = response->add_answers();
+    if (result.retry()) {
+      const absl::Status reported =
+          manager_->ReportWorkerError(result.worker_id(), result.task_id(), result.failure_reason());
+      answer->set_accepted(reported.ok());
+      if (!reported.ok() && !absl::IsNotFound(reported)) answer->set_error(std::string(reported.message()));
+      continue;
+    }
+    reports.push_back(WorkerReportFromProto(result));
+    report_index.push_back(i);
+  }
+  const std::vector<absl::StatusOr<bool>> taken = manager_->ReportResults(std::move(reports));
+  for (size_t k = 0; k < taken.size(); ++k) {
+    v1::ResultAnswer* answer = response->mutable_answers(report_index[k]);
+    if (taken[k].ok()) {
+      answer->set_accepted(*taken[k]);
+    } else if (absl::IsUnavailable(taken[k].status())) {
+      return ToGrpcStatus(taken[k].status());  // the server is stopping: the worker retries the call
+    } else {
+      answer->set_error(std::string(taken[k].status().message()));
+    }
+  }
+  if (request->next_tasks() > 0) {
+    absl::StatusOr<std::vector<scheduler::Task>> tasks =
+        scheduler_->Acquire(request->worker_id(), std::min(request->next_tasks(), kMaxTasksPerCall));
+    if (tasks.ok()) AddTasks(*tasks, response->mutable_tasks());
+  }
+  return grpc::Status::OK;
 }
 
 grpc::Status WorkerServiceImpl::Attach(grpc::ServerContext* context, const v1::AttachRequest* request,

@@ -63,6 +63,8 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
                         v1::GetStudyResponse* response) override;
   grpc::Status ReportResult(grpc::ServerContext* context, const v1::TaskResult* request,
                             v1::ReportResultResponse* response) override;
+  grpc::Status ReportResults(grpc::ServerContext* context, const v1::TaskResults* request,
+                             v1::ReportResultsResponse* response) override;
   grpc::Status Heartbeat(grpc::ServerContext* context, const v1::HeartbeatRequest* request,
                          v1::HeartbeatResponse* response) override;
   grpc::Status Attach(grpc::ServerContext* context, const v1::AttachRequest* request,
@@ -70,7 +72,8 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
 
   // The longest a long poll waits, whatever the worker asks.
   static constexpr std::int64_t kMaxWaitMs = 30'000;
-  // The most tasks one ReportResult hands back (TaskResult.next_tasks).
+  // The most tasks one call hands out (AcquireTasks, and the next tasks
+  // with a result).
   static constexpr int kMaxTasksPerCall = 64;
   // How often an Attach stream checks whether its worker's connection closed.
   static constexpr std::int64_t kAttachPollMs = 20;

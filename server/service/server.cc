@@ -101,6 +101,7 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   scheduler_options.heartbeat_interval_ms = s.options_.heartbeat_ms;
   MBOPT_RETURN_IF_ERROR(scheduler_options.Validate());
   MBOPT_ASSIGN_OR_RETURN(s.store_, store::Store::Open(s.options_.db_path, s.options_.durability));
+  if (s.options_.before_result_commit) s.store_->SetBeforeCommitHook(s.options_.before_result_commit);
   s.scheduler_ = std::make_unique<scheduler::Scheduler>(s.clock_, scheduler_options);
   JobManagerOptions manager_options = s.options_.manager;
   if (manager_options.clock == nullptr) manager_options.clock = s.clock_;

@@ -56,6 +56,9 @@ struct ServerOptions {
   // What a machine crash may take from the job database (store.h).
   store::Durability durability = store::Durability::kFull;
   JobManagerOptions manager;
+  // Testing: called inside each transaction of results before its COMMIT
+  // (Store::SetBeforeCommitHook); empty: nothing.
+  std::function<void(std::int64_t transaction)> before_result_commit;
 };
 
 class MboptServer {

@@ -304,6 +304,9 @@ Store::Store(std::string path, sqlite3* db) : path_(std::move(path)), db_(db) {}
 
 Store::~Store() {
   insert_analysis_.reset();
+  select_records_.reset();
+  insert_cycle_.reset();
+  update_progress_.reset();
   // Closing checkpoints the WAL into the main file; nothing is lost if it
   // fails (the WAL is replayed on the next open).
   sqlite3_close_v2(db_);
@@ -473,40 +476,58 @@ absl::StatusOr<std::vector<jobs::AnalysisRecord>> Store::LoadAnalyses(const std:
 
 absl::Status Store::CommitCycle(const std::string& job_id, const std::vector<CycleRow>& records,
                                 const JobProgress& progress) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return InTransaction(db_, [&]() -> absl::Status {
-    MBOPT_ASSIGN_OR_RETURN(Statement count, Statement::Prepare(db_, "SELECT records FROM jobs WHERE id = ?"));
-    count.BindText(1, job_id);
-    MBOPT_ASSIGN_OR_RETURN(bool found, count.Step());
-    if (!found) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
-    std::int64_t next = count.ColumnInt(0);
-    MBOPT_ASSIGN_OR_RETURN(
-        Statement insert,
-        Statement::Prepare(db_, "INSERT INTO cycles(job_id, idx, cycle, attempt, record) VALUES (?,?,?,?,?)"));
-    for (const CycleRow& r : records) {
-      insert.BindText(1, job_id);
-      insert.BindInt(2, next++);
-      insert.BindInt(3, r.cycle);
-      insert.BindInt(4, r.attempt);
-      insert.BindBlob(5, r.record);
-      MBOPT_RETURN_IF_ERROR(insert.Run());
-      insert.Reset();
-    }
-    MBOPT_ASSIGN_OR_RETURN(
-        Statement update,
-        Statement::Prepare(db_,
-                           "UPDATE jobs SET records = ?, state = ?, message = ?, cycles = ?, analyses = ?, "
-                           "wall_seconds = ?, updated_unix_ms = ? WHERE id = ?"));
-    update.BindInt(1, next);
-    update.BindText(2, progress.state);
-    update.BindText(3, progress.message);
-    update.BindInt(4, progress.cycles);
-    update.BindInt(5, progress.analyses);
-    update.BindDouble(6, progress.wall_seconds);
-    update.BindInt(7, NowUnixMs());
-    update.BindText(8, job_id);
-    return update.Run();
-  });
+  JobWrite write;
+  write.job_id = job_id;
+  write.cycles = records;
+  write.progress = progress;
+  return Commit(write);
+}
+
+absl::Status Store::AppendCyclesLocked(const std::string& job_id, const std::vector<CycleRow>& records,
+                                       const JobProgress& progress) {
+  auto prepare = [this](std::optional<Statement>& slot, const char* sql) -> absl::Status {
+    if (slot.has_value()) return absl::OkStatus();
+    MBOPT_ASSIGN_OR_RETURN(Statement prepared, Statement::Prepare(db_, sql));
+    slot.emplace(std::move(prepared));
+    return absl::OkStatus();
+  };
+  MBOPT_RETURN_IF_ERROR(prepare(select_records_, "SELECT records FROM jobs WHERE id = ?"));
+  MBOPT_RETURN_IF_ERROR(
+      prepare(insert_cycle_, "INSERT INTO cycles(job_id, idx, cycle, attempt, record) VALUES (?,?,?,?,?)"));
+  MBOPT_RETURN_IF_ERROR(prepare(update_progress_,
+                                "UPDATE jobs SET records = ?, state = ?, message = ?, cycles = ?, analyses = ?, "
+                                "wall_seconds = ?, updated_unix_ms = ? WHERE id = ?"));
+  Statement& count = *select_records_;
+  count.BindText(1, job_id);
+  absl::StatusOr<bool> found = count.Step();
+  const std::int64_t first = found.ok() && *found ? count.ColumnInt(0) : 0;
+  count.Reset();
+  if (!found.ok()) return found.status();
+  if (!*found) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
+  std::int64_t next = first;
+  Statement& insert = *insert_cycle_;
+  for (const CycleRow& r : records) {
+    insert.BindText(1, job_id);
+    insert.BindInt(2, next++);
+    insert.BindInt(3, r.cycle);
+    insert.BindInt(4, r.attempt);
+    insert.BindBlob(5, r.record);
+    absl::Status inserted = insert.Run();
+    insert.Reset();
+    MBOPT_RETURN_IF_ERROR(inserted);
+  }
+  Statement& update = *update_progress_;
+  update.BindInt(1, next);
+  update.BindText(2, progress.state);
+  update.BindText(3, progress.message);
+  update.BindInt(4, progress.cycles);
+  update.BindInt(5, progress.analyses);
+  update.BindDouble(6, progress.wall_seconds);
+  update.BindInt(7, NowUnixMs());
+  update.BindText(8, job_id);
+  absl::Status updated = update.Run();
+  update.Reset();
+  return updated;
 }
 
 absl::StatusOr<std::vector<CycleRow>> Store::LoadCycles(const std::string& job_id) {

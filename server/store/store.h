@@ -3,11 +3,12 @@
 // version rule and what survives a crash are written down in docs/store.md.
 //
 // Durability: WAL journal with synchronous=FULL by default, so a call that
-// returned OK has reached the disk (Durability says what NORMAL changes). An
-// analysis is committed when it arrives, together with any that arrive
-// meanwhile (group commit, AddAnalysis); a cycle's records are committed in
-// one transaction with the job's progress, so after a crash the database
-// holds either all of a cycle or none of it.
+// returned OK has reached the disk (Durability says what NORMAL changes).
+// What a job's results change (their analysis rows, and the cycle records
+// they completed with the job's progress) is one JobWrite, committed
+// atomically, together with the writes of other callers that arrive
+// meanwhile (group commit), so after a crash the database holds either all
+// of a write or none of it.
 //
 // Thread-safe: one connection, serialized by a mutex. Calls are short
 // (a handful of rows); the caller should still not hold its own locks across
@@ -16,6 +17,7 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -57,6 +59,17 @@ enum class Durability {
 const char* DurabilityName(Durability durability);
 std::optional<Durability> ParseDurability(const std::string& name);
 
+// What one batch of a job's results changes, committed atomically
+// (Store::Commit): the analysis rows, and the cycle records they completed
+// with the job's progress. Pointers: the rows are not copied (a result may be
+// megabytes).
+struct JobWrite {
+  std::string job_id;
+  std::vector<const jobs::AnalysisRecord*> analyses;
+  std::vector<CycleRow> cycles;             // appended to the record log, indices in order
+  std::optional<JobProgress> progress;      // updates the job row when set
+};
+
 class Store {
  public:
   // Opens or creates the database at `path`. FailedPrecondition for a file
@@ -79,20 +92,29 @@ class Store {
   absl::Status SetJobState(const std::string& job_id, const std::string& state,
                            const std::string& message);
 
-  // Commits one analysis result. AlreadyExists if the job already has a
-  // result for that request id. Returns once the row is committed (and
-  // synced, at Durability::kFull). Group commit (store_group_commit.cc):
-  // results that arrive while another commit is under way are committed
-  // together in the next transaction, one sync for all; a caller never
-  // waits for more than the commit under way and its own.
+  // Commits `write` atomically: all of it or none (AlreadyExists if the job
+  // already has a result for one of the request ids, NotFound for an unknown
+  // job with cycle records). Returns once it is committed (and synced, at
+  // Durability::kFull). Group commit (store_group_commit.cc): writes that
+  // arrive while another commit is under way are committed together in the
+  // next transaction, one sync for all, each in a savepoint of its own so
+  // that one that fails fails alone; a caller never waits for more than the
+  // commit under way and its own.
+  absl::Status Commit(const JobWrite& write);
+  // Commits one analysis result (Commit of a write with that row only).
   absl::Status AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& analysis);
-  // Transactions that committed analyses so far (for tests and benchmarks:
-  // fewer than the analyses when results arrived together).
+  // Transactions that committed writes so far (for tests and benchmarks:
+  // fewer than the writes when they arrived together).
   std::int64_t AnalysisTransactions() const;
+  // Testing: called inside each group transaction after its rows are
+  // written and before COMMIT, with the transaction's number (1-based), so
+  // a test can kill the process in the middle of a group commit.
+  void SetBeforeCommitHook(std::function<void(std::int64_t transaction)> hook);
   absl::StatusOr<std::vector<jobs::AnalysisRecord>> LoadAnalyses(const std::string& job_id);  // by request id
 
   // Commits `records` (appended to the job's record log, indices assigned in
-  // order after the existing ones) and `progress` in ONE transaction.
+  // order after the existing ones) and `progress` in ONE transaction (Commit
+  // of a write without analyses).
   absl::Status CommitCycle(const std::string& job_id, const std::vector<CycleRow>& records,
                            const JobProgress& progress);
   absl::StatusOr<std::vector<CycleRow>> LoadCycles(const std::string& job_id);  // by index
@@ -117,14 +139,19 @@ class Store {
   // One INSERT into analyses; the caller holds mutex_ (and a transaction).
   absl::Status InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& analysis);
 
-  // An analysis waiting for its group's commit.
-  struct PendingAnalysis {
-    const std::string* job_id;
-    const jobs::AnalysisRecord* record;
+  // The rows of one write; the caller holds mutex_ and a transaction.
+  absl::Status WriteLocked(const JobWrite& write);
+  absl::Status AppendCyclesLocked(const std::string& job_id, const std::vector<CycleRow>& cycles,
+                                  const JobProgress& progress);
+
+  // A write waiting for its group's commit.
+  struct PendingWrite {
+    const JobWrite* write;
     absl::Status status;
     bool done = false;
   };
-  void CommitAnalysisGroup(const std::vector<PendingAnalysis*>& group);
+  void CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t transaction,
+                   const std::function<void(std::int64_t)>& before_commit);
 
   std::string path_;
   std::mutex mutex_;
@@ -133,12 +160,17 @@ class Store {
   // analysis was a third of the server's CPU (docs/benchmarks.md). Guarded
   // by mutex_; finalized before db_ is closed.
   std::optional<Statement> insert_analysis_;
+  // The statements of AppendCyclesLocked, prepared once like the INSERT.
+  std::optional<Statement> select_records_;
+  std::optional<Statement> insert_cycle_;
+  std::optional<Statement> update_progress_;
 
-  mutable std::mutex group_mutex_;  // guards the three below
+  mutable std::mutex group_mutex_;  // guards the members below
   std::condition_variable group_done_;
-  std::vector<PendingAnalysis*> group_queue_;
+  std::vector<PendingWrite*> group_queue_;
   bool group_committing_ = false;
   std::int64_t analysis_transactions_ = 0;
+  std::function<void(std::int64_t)> before_commit_;
 };
 
 }  // namespace mbopt::store

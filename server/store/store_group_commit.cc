@@ -1,12 +1,20 @@
-// Group commit of analysis results (store.h, AddAnalysis; docs/store.md).
+// Group commit of job writes (store.h, Commit; docs/store.md).
 #include "absl/status/status.h"
+#include "common/status_macros.h"
 #include "server/store/sqlite_statement.h"
 #include "server/store/store.h"
 
 namespace mbopt::store {
 
 absl::Status Store::AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& analysis) {
-  PendingAnalysis mine{&job_id, &analysis, absl::OkStatus()};
+  JobWrite write;
+  write.job_id = job_id;
+  write.analyses.push_back(&analysis);
+  return Commit(write);
+}
+
+absl::Status Store::Commit(const JobWrite& write) {
+  PendingWrite mine{&write, absl::OkStatus()};
   std::unique_lock<std::mutex> lock(group_mutex_);
   group_queue_.push_back(&mine);
   while (!mine.done) {
@@ -14,15 +22,17 @@ absl::Status Store::AddAnalysis(const std::string& job_id, const jobs::AnalysisR
       group_done_.wait(lock);
       continue;
     }
-    // This caller commits everything queued so far, its own row included;
-    // rows that arrive meanwhile wait for the next group.
+    // This caller commits everything queued so far, its own write included;
+    // writes that arrive meanwhile wait for the next group.
     group_committing_ = true;
-    std::vector<PendingAnalysis*> group;
+    std::vector<PendingWrite*> group;
     group.swap(group_queue_);
+    const std::int64_t transaction = analysis_transactions_ + 1;
+    const std::function<void(std::int64_t)> hook = before_commit_;
     lock.unlock();
-    CommitAnalysisGroup(group);
+    CommitGroup(group, transaction, hook);
     lock.lock();
-    for (PendingAnalysis* p : group) p->done = true;
+    for (PendingWrite* p : group) p->done = true;
     group_committing_ = false;
     ++analysis_transactions_;
     group_done_.notify_all();
@@ -30,23 +40,58 @@ absl::Status Store::AddAnalysis(const std::string& job_id, const jobs::AnalysisR
   return mine.status;
 }
 
-void Store::CommitAnalysisGroup(const std::vector<PendingAnalysis*>& group) {
+absl::Status Store::WriteLocked(const JobWrite& write) {
+  for (const jobs::AnalysisRecord* a : write.analyses) {
+    MBOPT_RETURN_IF_ERROR(InsertAnalysisLocked(write.job_id, *a));
+  }
+  if (write.progress.has_value()) {
+    MBOPT_RETURN_IF_ERROR(AppendCyclesLocked(write.job_id, write.cycles, *write.progress));
+  }
+  return absl::OkStatus();
+}
+
+void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t transaction,
+                        const std::function<void(std::int64_t)>& before_commit) {
   std::lock_guard<std::mutex> lock(mutex_);
   absl::Status begun = Exec(db_, "BEGIN IMMEDIATE");
   if (!begun.ok()) {
-    for (PendingAnalysis* p : group) p->status = begun;
+    for (PendingWrite* p : group) p->status = begun;
     return;
   }
-  // A row that fails (a duplicate request id) fails alone: SQLite undoes
-  // only that statement, and the others commit.
-  for (PendingAnalysis* p : group) p->status = InsertAnalysisLocked(*p->job_id, *p->record);
+  if (group.size() == 1) {
+    group[0]->status = WriteLocked(*group[0]->write);
+  } else {
+    // A write that fails (a second result for the same request) fails
+    // alone: its savepoint is rolled back, and the others commit.
+    for (PendingWrite* p : group) {
+      absl::Status status = Exec(db_, "SAVEPOINT job_write");
+      if (status.ok()) status = WriteLocked(*p->write);
+      if (status.ok()) {
+        status = Exec(db_, "RELEASE job_write");
+      } else {
+        (void)Exec(db_, "ROLLBACK TO job_write");
+        (void)Exec(db_, "RELEASE job_write");
+      }
+      p->status = status;
+    }
+  }
+  if (group.size() == 1 && !group[0]->status.ok()) {
+    (void)Exec(db_, "ROLLBACK");
+    return;
+  }
+  if (before_commit) before_commit(transaction);
   const absl::Status committed = Exec(db_, "COMMIT");
   if (!committed.ok()) {
     (void)Exec(db_, "ROLLBACK");
-    for (PendingAnalysis* p : group) {
+    for (PendingWrite* p : group) {
       if (p->status.ok()) p->status = committed;
     }
   }
+}
+
+void Store::SetBeforeCommitHook(std::function<void(std::int64_t transaction)> hook) {
+  std::lock_guard<std::mutex> lock(group_mutex_);
+  before_commit_ = std::move(hook);
 }
 
 std::int64_t Store::AnalysisTransactions() const {

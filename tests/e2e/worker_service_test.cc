@@ -231,6 +231,18 @@ class FakeWorkerService final : public v1::WorkerService::Service {
     return grpc::Status::OK;
   }
 
+  grpc::Status ReportResults(grpc::ServerContext*, const v1::TaskResults* request,
+                             v1::ReportResultsResponse* response) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    report_calls_.push_back(request->results_size());
+    for (const v1::TaskResult& result : request->results()) {
+      results_.push_back(result);
+      response->add_answers()->set_accepted(true);
+    }
+    cv_.notify_all();
+    return grpc::Status::OK;
+  }
+
   grpc::Status Heartbeat(grpc::ServerContext*, const v1::HeartbeatRequest*,
                          v1::HeartbeatResponse* response) override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -259,6 +271,7 @@ class FakeWorkerService final : public v1::WorkerService::Service {
   v1::Study study_;
   std::vector<v1::AnalysisTask> tasks_;
   std::vector<v1::TaskResult> results_;
+  std::vector<int> report_calls_;  // results per ReportResults call
   int registrations_ = 0;
   int heartbeats_ = 0;
   int study_fetches_ = 0;
@@ -310,6 +323,50 @@ TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgot
     EXPECT_EQ(r.job_id(), "job-1");
     // Identical inputs, identical outputs: bit identity is the point.
     EXPECT_EQ(r.objective_terms(0), fake.results_[0].objective_terms(0));
+  }
+}
+
+// Tasks handed out together run back to back and their results go back in
+// one call; with --batch 1 each goes back alone.
+TEST(WorkerService, TasksHandedOutTogetherAreReportedTogether) {
+  const v1::Study proto = VehicleStudyProto();
+  for (const int batch : {16, 1}) {
+    SCOPED_TRACE(batch);
+    FakeWorkerService fake(proto);
+    int port = 0;
+    grpc::ServerBuilder builder;
+    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+    builder.RegisterService(&fake);
+    std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+    ASSERT_NE(server, nullptr);
+    const std::vector<double> x0 = InitialDesign(proto);
+    for (int i = 0; i < 5; ++i) {
+      v1::AnalysisTask task = TaskAt(x0);
+      task.set_task_id("job-1/" + std::to_string(i) + "/1");
+      task.set_request_id(i);
+      fake.Queue(task);
+    }
+    WorkerOptions options;
+    options.server_address = "127.0.0.1:" + std::to_string(port);
+    options.slots = 1;
+    options.batch = batch;
+    options.acquire_wait_ms = 200;
+    StopSignal stop;
+    absl::Status run_status;
+    std::thread worker([&] { run_status = RunWorker(options, stop); });
+    EXPECT_TRUE(fake.WaitUntil([](FakeWorkerService& f) { return f.results_.size() == 5; }));
+    stop.Stop();
+    worker.join();
+    EXPECT_TRUE(run_status.ok()) << run_status;
+    server->Shutdown();
+    std::lock_guard<std::mutex> lock(fake.mutex_);
+    if (batch == 1) {
+      EXPECT_EQ(fake.report_calls_, std::vector<int>(5, 1));
+    } else {
+      EXPECT_EQ(fake.report_calls_, std::vector<int>{5});
+    }
+    ASSERT_EQ(fake.results_.size(), 5u);
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(fake.results_[static_cast<size_t>(i)].request_id(), i) << "in the order run";
   }
 }
 

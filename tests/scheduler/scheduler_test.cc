@@ -53,6 +53,32 @@ TEST(Scheduler, HandsOutTasksRoundRobinBetweenJobs) {
   }
 }
 
+// A worker that asks for a batch gets its share, by slots, of the work
+// outstanding, never fewer than its free slots: the others are not left idle.
+TEST(Scheduler, BatchesAreTheWorkersShareOfTheOutstandingTasks) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  for (int r = 0; r < 9; ++r) scheduler.Enqueue("job-1", r, {});
+  const std::string a = scheduler.RegisterWorker("a", 1);
+  const std::string b = scheduler.RegisterWorker("b", 1);
+  EXPECT_EQ(scheduler.Acquire(a, 64)->size(), 5u) << "ceil(9 / 2)";
+  EXPECT_EQ(scheduler.Acquire(a, 64)->size(), 0u) << "a holds its share";
+  EXPECT_EQ(scheduler.Acquire(b, 64)->size(), 4u);
+  // Alone (b's slots are gone with b), a worker takes everything.
+  scheduler.WorkerLost(b);
+  EXPECT_EQ(scheduler.Acquire(a, 64)->size(), 4u) << "b's tasks, queued again";
+
+  Scheduler weighted(&clock, Options());
+  for (int r = 0; r < 9; ++r) weighted.Enqueue("job-1", r, {});
+  const std::string big = weighted.RegisterWorker("big", 2);
+  const std::string small = weighted.RegisterWorker("small", 1);
+  EXPECT_EQ(weighted.Acquire(big, 64)->size(), 6u) << "ceil(9 * 2 / 3)";
+  EXPECT_EQ(weighted.Acquire(small, 64)->size(), 3u);
+  // A free slot always gets a task, whatever the shares.
+  weighted.Enqueue("job-1", 9, {});
+  EXPECT_EQ(weighted.Acquire(small, 1)->size(), 1u);
+}
+
 TEST(Scheduler, FairnessHoldsAcrossSeparateAcquireCalls) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());

@@ -732,22 +732,33 @@ std::set<std::int64_t> RequestIds(const std::vector<v1::AnalysisTask>& tasks) {
   return ids;
 }
 
+// Every task the worker can get, one per call: a call for many would give
+// it only its share of them (the other fake workers count as idle).
+std::vector<v1::AnalysisTask> AcquireOneByOne(FakeWorker& worker) {
+  std::vector<v1::AnalysisTask> all;
+  while (true) {
+    std::vector<v1::AnalysisTask> one = worker.Acquire(1);
+    if (one.empty()) return all;
+    all.insert(all.end(), one.begin(), one.end());
+  }
+}
+
 TEST_F(ServerTest, LostWorkersTasksAreRetriedElsewhereThenGivenUpAfterThreeAttempts) {
   auto server = StartServer("a.db");
   const std::string id = Submit(*server, OscillatorStudy());
   FakeWorker a(server->InProcessChannel(), 1, "a");
   FakeWorker b(server->InProcessChannel(), 2, "b");
   FakeWorker c(server->InProcessChannel(), 3, "c");
-  std::vector<v1::AnalysisTask> first = a.Acquire(100);
+  std::vector<v1::AnalysisTask> first = AcquireOneByOne(a);
   ASSERT_FALSE(first.empty());
   clock_.Advance(kLeaseMs);
   server->manager().ExpireLeases();
-  EXPECT_TRUE(a.Acquire(100).empty());  // b and c, who have not failed them, are preferred
-  std::vector<v1::AnalysisTask> second = b.Acquire(100);
+  EXPECT_TRUE(AcquireOneByOne(a).empty());  // b and c, who have not failed them, are preferred
+  std::vector<v1::AnalysisTask> second = AcquireOneByOne(b);
   EXPECT_EQ(RequestIds(second), RequestIds(first));
   clock_.Advance(kLeaseMs);
   server->manager().ExpireLeases();
-  std::vector<v1::AnalysisTask> third = c.Acquire(100);
+  std::vector<v1::AnalysisTask> third = AcquireOneByOne(c);
   EXPECT_EQ(RequestIds(third), RequestIds(first));
   EXPECT_EQ(Get(*server, id).summary().state(), v1::JOB_STATE_RUNNING);
   clock_.Advance(kLeaseMs);

@@ -27,6 +27,10 @@ const char* ServeUsage() {
          "       mbopt-worker --server HOST:PORT ... (the same)\n"
          "  --slots N            analyses run at once (default 1)\n"
          "  --name NAME          name shown by the server (default host:pid)\n"
+         "  --batch N            take up to N tasks at a time and report their results\n"
+         "                       together (default 16, at most 64; never fewer than\n"
+         "                       --slots); the server gives no worker more than its\n"
+         "                       share of the work outstanding. 1: one task per slot\n"
          "  --tls-ca FILE        connect over TLS, trusting the server's certificate\n"
          "                       if this CA signed it (env MBOPT_TLS_CA)\n"
          "  --tls-cert FILE, --tls-key FILE  this worker's client certificate and key,\n"
@@ -71,6 +75,8 @@ int ServeMain(const std::vector<std::string>& args) {
       options.name = value;
     } else if (secure_channel::IsSecurityOption(name)) {
       ok = need_value() && secure_channel::SetSecurityFlag(name, value, &security_flags);
+    } else if (name == "--batch") {
+      ok = need_value() && ParseInt(value, 1, &options.batch) && options.batch <= kMaxBatch;
     } else if (name == "--task-delay-ms") {
       ok = need_value() && ParseInt(value, 0, &options.task_delay_ms);
     } else if (name == "--die-after-tasks") {

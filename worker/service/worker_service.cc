@@ -37,6 +37,13 @@ constexpr auto kShortCallDeadline = std::chrono::seconds(10);
 // that its lease has long expired and the task runs elsewhere.
 constexpr auto kReportRetryWindow = std::chrono::seconds(60);
 constexpr size_t kMaxCachedStudies = 64;
+// The most bytes of results held for one call while the server's message
+// limit is not known.
+constexpr std::int64_t kDefaultBatchBytes = 2 * 1024 * 1024;
+// The longest a finished result waits for others: analyses that take longer
+// than this are reported one by one, so a result is never kept from the
+// job's log (and from a crash-safe place) for long.
+constexpr auto kMaxHold = std::chrono::seconds(1);
 
 std::string DefaultName() {
   char host[256] = {0};
@@ -120,6 +127,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
     for (auto& t : threads) t.join();
     Log(absl::StrCat("stopped after ", tasks_received_, " tasks"));
   }
+
+  // The most tasks in hand when asking for more (WorkerOptions::batch).
+  int Capacity() const { return std::max(options_.slots, std::min(options_.batch, kMaxBatch)); }
 
   // Why the worker stopped on its own (Denied, Fatal); OK otherwise.
   absl::Status fatal() {
@@ -230,7 +240,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
         std::unique_lock<std::mutex> lock(mutex_);
         cv_.wait(lock, [this] { return stopping_ || busy_ < options_.slots; });
         if (stopping_) break;
-        free_slots = options_.slots - busy_;
+        free_slots = Capacity() - busy_;
         worker_id = worker_id_;
       }
       v1::AcquireTasksRequest request;
@@ -288,8 +298,16 @@ class Worker : public std::enable_shared_from_this<Worker> {
       {
         std::unique_lock<std::mutex> lock(mutex_);
         cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
-        // On stop, tasks not yet started are left to their leases.
-        if (stopping_) return;
+        // On stop, tasks not yet started are left to their leases; results
+        // held for a batch are still delivered.
+        if (stopping_) {
+          std::vector<v1::TaskResult> held;
+          held.swap(held_);
+          held_bytes_ = 0;
+          lock.unlock();
+          if (!held.empty()) Deliver(std::move(held), 0, "");
+          return;
+        }
         item = std::move(queue_.front());
         queue_.pop_front();
       }
@@ -302,13 +320,13 @@ class Worker : public std::enable_shared_from_this<Worker> {
       std::string study_error;
       auto study = StudyFor(task.job_id(), &study_error);
       bool deliver = true;
+      std::int64_t max_message_bytes = 0;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        max_message_bytes = max_message_bytes_;
+      }
       if (study != nullptr) {
         EvaluateTask(*study, task, &result);
-        std::int64_t max_message_bytes = 0;
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          max_message_bytes = max_message_bytes_;
-        }
         FitResultToServerLimit(max_message_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
@@ -325,23 +343,59 @@ class Worker : public std::enable_shared_from_this<Worker> {
       // After the line above, so that a test reading it knows the worker
       // holds the result for this long. A stop ends the hold early.
       if (options_.task_delay_ms > 0 && deliver) stop_.WaitFor(std::chrono::milliseconds(options_.task_delay_ms));
+      // Results are held while more tasks of this worker wait to run, and go
+      // back together (one call, one commit on the server) once none does,
+      // when they approach the server's message limit, or after kMaxHold.
+      const std::int64_t budget = max_message_bytes > 0 ? max_message_bytes / 2 : kDefaultBatchBytes;
+      std::vector<std::vector<v1::TaskResult>> batches;
+      int next_tasks = 0;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         if (cancelled_[task.task_id()]) deliver = false;
-        // This slot is free once the result is in: ask for its next task
-        // with the result, unless another is already queued for it.
-        if (!stopping_ && queue_.empty()) result.set_next_tasks(1);
+        if (!deliver) {
+          cancelled_.erase(task.task_id());
+          --busy_;
+        } else {
+          const std::int64_t bytes = static_cast<std::int64_t>(result.ByteSizeLong());
+          if (!held_.empty() && held_bytes_ + bytes > budget) {
+            batches.emplace_back();
+            batches.back().swap(held_);
+            held_bytes_ = 0;
+          }
+          if (held_.empty()) held_since_ = std::chrono::steady_clock::now();
+          held_.push_back(std::move(result));
+          held_bytes_ += bytes;
+        }
+        if (!held_.empty() && (queue_.empty() || stopping_ || held_bytes_ > budget ||
+                               std::chrono::steady_clock::now() - held_since_ >= kMaxHold)) {
+          batches.emplace_back();
+          batches.back().swap(held_);
+          held_bytes_ = 0;
+          // The slots free once these are in: ask for their next tasks with
+          // them, unless tasks are already queued here.
+          if (!stopping_ && queue_.empty()) {
+            next_tasks = Capacity() - busy_ + static_cast<int>(batches.back().size());
+          }
+        }
       }
-      if (deliver) {
-        for (const v1::AnalysisTask& next : Report(result)) Take(next, item.worker_id);
-      }
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        cancelled_.erase(task.task_id());
-        --busy_;
+      for (size_t b = 0; b < batches.size(); ++b) {
+        Deliver(std::move(batches[b]), b + 1 == batches.size() ? next_tasks : 0, item.worker_id);
       }
       cv_.notify_all();
     }
+  }
+
+  // Reports a batch of results, frees their places, and queues the tasks
+  // the server handed out with its answer (leased under `worker_id`).
+  void Deliver(std::vector<v1::TaskResult> results, int next_tasks, const std::string& worker_id) {
+    const std::vector<v1::AnalysisTask> next = Report(results, next_tasks, worker_id);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const v1::TaskResult& r : results) cancelled_.erase(r.task_id());
+      busy_ -= static_cast<int>(results.size());
+    }
+    for (const v1::AnalysisTask& task : next) Take(task, worker_id);
+    cv_.notify_all();
   }
 
   // The job's prepared study, fetched once. nullptr with an empty `error`
@@ -390,25 +444,37 @@ class Worker : public std::enable_shared_from_this<Worker> {
     return *prepared;
   }
 
-  // Delivers a result; returns the tasks the server leased with its answer.
-  std::vector<v1::AnalysisTask> Report(const v1::TaskResult& result) {
+  // Delivers results; returns the tasks the server leased with its answer
+  // (`next_tasks` of them at most, for the registration `worker_id`).
+  std::vector<v1::AnalysisTask> Report(const std::vector<v1::TaskResult>& results, int next_tasks,
+                                       const std::string& worker_id) {
+    v1::TaskResults request;
+    request.set_worker_id(worker_id.empty() ? results.front().worker_id() : worker_id);
+    for (const v1::TaskResult& r : results) *request.add_results() = r;
+    request.set_next_tasks(next_tasks);
     Backoff backoff(options_.backoff, backoff_seed_ + 2);
     const auto give_up = Clock::now() + kReportRetryWindow;
     while (true) {
-      v1::ReportResultResponse response;
+      v1::ReportResultsResponse response;
       grpc::ClientContext context;
       context.set_deadline(Clock::now() + kShortCallDeadline);
       // Not registered for cancellation: a result finished while stopping is
       // still worth delivering.
-      grpc::Status status = stub_->ReportResult(&context, result, &response);
+      grpc::Status status = stub_->ReportResults(&context, request, &response);
       if (status.ok()) {
-        if (!response.accepted() && options_.verbose) {
-          Log(absl::StrCat("result of task ", result.task_id(), " was not accepted"));
+        for (int i = 0; i < response.answers_size() && i < request.results_size(); ++i) {
+          const v1::ResultAnswer& answer = response.answers(i);
+          if (!answer.error().empty()) {
+            Log(absl::StrCat("result of task ", request.results(i).task_id(), " refused: ", answer.error()));
+          } else if (!answer.accepted() && options_.verbose) {
+            Log(absl::StrCat("result of task ", request.results(i).task_id(), " was not accepted"));
+          }
         }
         return {response.tasks().begin(), response.tasks().end()};
       }
       if (!Retryable(status) || stop_.stopped() || Clock::now() > give_up) {
-        Log(absl::StrCat("result of task ", result.task_id(),
+        Log(absl::StrCat(results.size() == 1 ? "result of task " : "results of tasks ", results.front().task_id(),
+                         results.size() > 1 ? absl::StrCat(" and ", results.size() - 1, " more") : "",
                          " not delivered: ", status.error_message()));
         return {};
       }
@@ -525,7 +591,10 @@ class Worker : public std::enable_shared_from_this<Worker> {
   int heartbeat_ms_ = kDefaultHeartbeatMs;
   std::int64_t max_message_bytes_ = 0;  // the server's, from registration; 0: unknown
   std::deque<QueuedTask> queue_;
-  int busy_ = 0;                          // tasks queued or being evaluated
+  int busy_ = 0;                          // tasks queued, being evaluated or held as results
+  std::vector<v1::TaskResult> held_;      // results waiting to go back with others
+  std::int64_t held_bytes_ = 0;
+  std::chrono::steady_clock::time_point held_since_;  // when the oldest held result was held
   std::map<std::string, bool> cancelled_; // task id -> cancelled, for tasks in hand
   std::string attached_;        // the registration the presence thread holds (or tries)
   std::string attach_settled_;  // the registration whose Attach was answered

@@ -20,11 +20,20 @@
 
 namespace mbopt::worker {
 
+// The largest WorkerOptions::batch (the server hands out at most this many
+// tasks per call).
+inline constexpr int kMaxBatch = 64;
+
 struct WorkerOptions {
   std::string server_address;  // host:port
   // TLS and token (common/secure_channel/client_security.h).
   secure_channel::ClientSecurity security;
   int slots = 1;               // analyses at once
+  // The most tasks in hand (queued here or running) when asking for more,
+  // at least `slots`: tasks handed out together run back to back and their
+  // results go back in one call (one round trip and one commit for all).
+  // The server caps it at the worker's share of the work outstanding.
+  int batch = 16;
   std::string name;            // shown on the server; empty: host:pid
   // Long-poll length of AcquireTasks.
   int acquire_wait_ms = 5000;

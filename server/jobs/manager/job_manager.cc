@@ -333,7 +333,8 @@ void JobManager::FailJobLocked(Entry& entry, const std::string& message) {
 // Commits the records the optimizer emitted, with the job's progress, in one
 // transaction; when the optimizer has ended, that transaction also stores
 // the final state, and the job then enters it.
-absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records) {
+absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records,
+                                             const std::vector<const jobs::AnalysisRecord*>& analyses) {
   const slp::SlpOptimizer& optimizer = entry.job->optimizer();
   const JobState state = jobs::JobStateOf(optimizer.state());
   std::string message;
@@ -353,16 +354,21 @@ absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::Cycl
   progress.cycles = optimizer.cycles_completed();
   progress.analyses = optimizer.analyses_used();
   progress.wall_seconds = WallSecondsLocked(entry);
-  std::vector<store::CycleRow> rows;
-  rows.reserve(records.size());
+  store::JobWrite write;
+  write.job_id = entry.row.id;
+  write.analyses = analyses;
+  write.cycles.reserve(records.size());
   for (const slp::CycleRecord& r : records) {
-    rows.push_back(store::CycleRow{0, r.cycle, r.attempt, jobs::EncodeCycleRecord(r)});
+    write.cycles.push_back(store::CycleRow{0, r.cycle, r.attempt, jobs::EncodeCycleRecord(r)});
   }
-  absl::Status status = store_->CommitCycle(entry.row.id, rows, progress);
+  write.progress = progress;
+  absl::Status status = store_->Commit(write);
   if (!status.ok()) {
-    FailJobLocked(entry, absl::StrCat("cannot log cycle records: ", status.message()));
+    FailJobLocked(entry, absl::StrCat("cannot log ", analyses.empty() ? "" : "analyses and ",
+                                      "cycle records: ", status.message()));
     return status;
   }
+  const std::vector<store::CycleRow>& rows = write.cycles;
   for (slp::CycleRecord& r : records) entry.records.push_back(std::move(r));
   std::int64_t committed = 0;
   {
@@ -385,21 +391,45 @@ absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::Cycl
   return absl::OkStatus();
 }
 
-absl::Status JobManager::DeliverLocked(Entry& entry, const jobs::AnalysisRecord& record) {
+absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return absl::OkStatus();
-  absl::Status status = store_->AddAnalysis(entry.row.id, record);
-  if (!status.ok()) {
-    FailJobLocked(entry, absl::StrCat("cannot log analysis ", record.request_id, ": ", status.message()));
-    return status;
+  // The whole batch goes to the optimizer first and is then committed in one
+  // transaction with the records it completed: nothing is published, and no
+  // worker is told its result was taken, before that commit; a failed commit
+  // fails the job. Results the optimizer no longer waits for (the job ended,
+  // or an earlier result of the batch completed what it needed) are neither
+  // applied nor logged, so replay meets exactly the logged ones.
+  std::vector<const jobs::AnalysisRecord*> applied;
+  std::vector<slp::CycleRecord> emitted;
+  for (const jobs::AnalysisRecord& record : batch) {
+    if (!entry.job->running()) break;
+    const std::vector<slp::AnalysisRequest> pending = entry.job->PendingRequests();
+    if (std::none_of(pending.begin(), pending.end(),
+                     [&record](const slp::AnalysisRequest& r) { return r.id == record.request_id; })) {
+      continue;
+    }
+    absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Apply(record);
+    if (!records.ok()) {
+      FailJobLocked(entry, absl::StrCat("the optimizer refused analysis ", record.request_id, ": ",
+                                        records.status().message()));
+      return records.status();
+    }
+    applied.push_back(&record);
+    for (slp::CycleRecord& r : *records) emitted.push_back(std::move(r));
   }
-  absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Apply(record);
-  if (!records.ok()) {
-    FailJobLocked(entry, absl::StrCat("the optimizer refused analysis ", record.request_id, ": ",
-                                      records.status().message()));
-    return records.status();
-  }
-  if (!records->empty() || !entry.job->running()) {
-    MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, *std::move(records)));
+  if (applied.empty()) return absl::OkStatus();
+  if (!emitted.empty() || !entry.job->running()) {
+    MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, std::move(emitted), applied));
+  } else {
+    store::JobWrite write;
+    write.job_id = entry.row.id;
+    write.analyses = applied;
+    if (absl::Status status = store_->Commit(write); !status.ok()) {
+      FailJobLocked(entry, absl::StrCat("cannot log analysis ", applied.front()->request_id,
+                                        applied.size() > 1 ? absl::StrCat(" and ", applied.size() - 1, " more") : "",
+                                        ": ", status.message()));
+      return status;
+    }
   }
   ScheduleLocked(entry);
   Changed(entry);
@@ -417,46 +447,83 @@ void JobManager::DeliverGivenUpLocked(Entry& entry, const scheduler::FinishedTas
     LogError(entry.row.id, record.status());
     return;
   }
-  absl::Status delivered = DeliverLocked(entry, *record);
+  absl::Status delivered = DeliverLocked(entry, {*std::move(record)});
   if (!delivered.ok()) LogError(entry.row.id, delivered);
 }
 
 absl::StatusOr<bool> JobManager::ReportResult(WorkerReport report) {
+  std::vector<WorkerReport> one;
+  one.push_back(std::move(report));
+  return std::move(ReportResults(std::move(one)).front());
+}
+
+std::vector<absl::StatusOr<bool>> JobManager::ReportResults(std::vector<WorkerReport> reports) {
+  std::vector<absl::StatusOr<bool>> answers(reports.size(), false);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (shutdown_) return absl::UnavailableError("the server is shutting down");
+    if (shutdown_) {
+      answers.assign(reports.size(), absl::UnavailableError("the server is shutting down"));
+      return answers;
+    }
   }
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(report.job_id));
-  std::lock_guard<std::mutex> lock(entry->mutex);
+  // Each job's results in the order they came, under its lock once.
+  std::map<std::string, std::vector<size_t>> by_job;
+  for (size_t i = 0; i < reports.size(); ++i) by_job[reports[i].job_id].push_back(i);
+  for (const auto& [job_id, indices] : by_job) {
+    absl::StatusOr<std::shared_ptr<Entry>> entry = Find(job_id);
+    if (!entry.ok()) {
+      for (size_t i : indices) answers[i] = entry.status();
+      continue;
+    }
+    std::lock_guard<std::mutex> lock((*entry)->mutex);
+    std::vector<jobs::AnalysisRecord> batch;
+    std::vector<size_t> batch_indices;
+    for (size_t i : indices) {
+      absl::StatusOr<jobs::AnalysisRecord> record = TakeResultLocked(**entry, std::move(reports[i]));
+      if (!record.ok()) {
+        answers[i] = record.status();
+      } else if (record->request_id >= 0) {
+        batch.push_back(*std::move(record));
+        batch_indices.push_back(i);
+      }
+    }
+    const absl::Status delivered = DeliverLocked(**entry, batch);
+    for (size_t i : batch_indices) answers[i] = delivered.ok() ? absl::StatusOr<bool>(true) : delivered;
+  }
+  return answers;
+}
+
+absl::StatusOr<jobs::AnalysisRecord> JobManager::TakeResultLocked(Entry& entry, WorkerReport report) {
+  jobs::AnalysisRecord dropped;
+  dropped.request_id = -1;
   const std::int64_t request_id = report.record.request_id;
   const std::string expected_prefix = absl::StrCat(report.job_id, "/", request_id, "/");
   if (report.task_id.rfind(expected_prefix, 0) != 0) {
     return absl::InvalidArgumentError(absl::StrCat("task id '", report.task_id, "' does not belong to job '",
                                                    report.job_id, "' request ", request_id));
   }
-  if (entry->job == nullptr || entry->state != JobState::kRunning) return false;
-  const std::vector<slp::AnalysisRequest> pending = entry->job->PendingRequests();
+  if (entry.job == nullptr || entry.state != JobState::kRunning) return dropped;
+  const std::vector<slp::AnalysisRequest> pending = entry.job->PendingRequests();
   if (std::none_of(pending.begin(), pending.end(),
                    [request_id](const slp::AnalysisRequest& r) { return r.id == request_id; })) {
-    return false;  // answered already (another attempt won): dropped
+    return dropped;  // answered already (another attempt won)
   }
   report.record.worker = report.worker_id;
-  absl::StatusOr<jobs::AnalysisRecord> record = entry->job->Intake(std::move(report.record));
+  absl::StatusOr<jobs::AnalysisRecord> record = entry.job->Intake(std::move(report.record));
   if (!record.ok()) {
     // A result that does not fit its task counts as a failed attempt; the
     // worker is told why, and the task goes to another worker.
     const std::string reason = absl::StrCat("result of task ", report.task_id, ": ", record.status().message());
     absl::StatusOr<std::optional<scheduler::FinishedTask>> failed =
         scheduler_->Fail(report.worker_id, report.task_id, reason);
-    if (failed.ok() && failed->has_value()) DeliverGivenUpLocked(*entry, **failed);
+    if (failed.ok() && failed->has_value()) DeliverGivenUpLocked(entry, **failed);
     return absl::InvalidArgumentError(reason);
   }
   absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(report.worker_id, report.task_id);
-  if (!finished.ok()) return false;
+  if (!finished.ok()) return dropped;
   record->attempts = finished->attempts;
   record->latency_seconds = finished->latency_seconds;
-  MBOPT_RETURN_IF_ERROR(DeliverLocked(*entry, *record));
-  return true;
+  return record;
 }
 
 void JobManager::GiveUp(const scheduler::FinishedTask& task) {

@@ -4,11 +4,13 @@
 // place where the store, the scheduler and the optimizers meet; it speaks
 // domain types only (the gRPC services translate).
 //
-// Ordering, per job (under the job's mutex): a result is committed to the
-// store, then given to the optimizer; the records it emits are committed in
-// one transaction with the job's progress, then published to watchers, then
-// the optimizer's new requests are queued. So a record is durable before
-// anyone sees it, and a crash at any point is repaired by replay (job.h).
+// Ordering, per job (under the job's mutex): a batch of results (one or
+// more that a worker reported together) is given to the optimizer; the
+// results and the records they made it emit are committed in one
+// transaction with the job's progress; only then are the records published
+// to watchers, the worker told its results were taken, and the optimizer's
+// new requests queued. So a result or record is durable before anyone sees
+// it, and a crash at any point is repaired by replay (job.h).
 //
 // Every change of a job's state goes through one function (EnterStateLocked),
 // which persists it, logs the event and wakes watchers; a store error on the
@@ -148,6 +150,11 @@ class JobManager {
   // with the analysis) and the optimizer uses finite differences for that
   // cycle. NotFound for an unknown job. Unavailable after Shutdown.
   absl::StatusOr<bool> ReportResult(WorkerReport report);
+  // Several results (a worker's batch), one answer each, in order, as
+  // ReportResult would give it. The results of one job are applied to its
+  // optimizer together and committed in one transaction with the cycle
+  // records they complete (one commit, and one sync, per job and batch).
+  std::vector<absl::StatusOr<bool>> ReportResults(std::vector<WorkerReport> reports);
 
   // A worker could not run a task (not a failure of the analysis).
   absl::Status ReportWorkerError(const std::string& worker_id, const std::string& task_id,
@@ -205,8 +212,18 @@ class JobManager {
   absl::Status RestoreLocked(Entry& entry);
   // The view of a job whose records may have to be read from the database.
   absl::StatusOr<JobView> RestoredViewLocked(Entry& entry, std::size_t first_record);
-  absl::Status DeliverLocked(Entry& entry, const jobs::AnalysisRecord& record);
-  absl::Status CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records);
+  // Validates a worker's result for the job (the task, the request still
+  // pending, the job's intake) and completes its task: the record to
+  // deliver; request_id -1 when it is to be dropped (not outstanding any
+  // more); InvalidArgument for a result that does not fit its task.
+  absl::StatusOr<jobs::AnalysisRecord> TakeResultLocked(Entry& entry, WorkerReport report);
+  // Applies a batch of the job's results and logs them with what they
+  // completed (one transaction).
+  absl::Status DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch);
+  // Commits the optimizer's new records with the job's progress and
+  // `analyses` in one transaction.
+  absl::Status CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records,
+                                   const std::vector<const jobs::AnalysisRecord*>& analyses = {});
   void ScheduleLocked(Entry& entry);
   void FailJobLocked(Entry& entry, const std::string& message);
   JobSummaryData SummaryLocked(const Entry& entry) const;
