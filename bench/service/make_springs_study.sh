@@ -55,6 +55,6 @@ mkdir -p "$OUT"
   done
   echo "} }"
   for i in $(seq "$N"); do
-    echo "constraints { name: \"d$i\" output: \"d$i\" reduction: REDUCTION_MAX_ABS limit: 0.03 unit: \"m\" }"
+    echo "constraints { name: \"d$i\" output: \"d$i\" reduction: REDUCTION_RMS limit: 0.01 unit: \"m\" }"
   done
 } > "$OUT/springs.study.textproto"

@@ -31,7 +31,8 @@ constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--tls-dir DIR | --tls-cert F --tls-key F --tokens F]\n"
     "                    [--worker-ca F] [--insecure] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
-    "                    [--durability full|normal] [--crash-after-cycles N] [--crash-in-commit N]\n"
+    "                    [--durability full|cycles|normal]\n"
+    "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
     "       mbopt-server add-token --tokens F --role worker|user|admin --name N --out F\n"
@@ -53,9 +54,12 @@ constexpr const char* kUsage =
     "  --port-file FILE       write the port listened on to FILE once ready\n"
     "  --lease-ms N           lease of a task given to a worker (default 30000)\n"
     "  --heartbeat-ms N       heartbeat interval asked of workers (default 5000)\n"
-    "  --durability full|normal  full (default): every commit synced to disk;\n"
-    "                         normal: a machine crash may lose the last commits,\n"
-    "                         which a resume analyses again (docs/store.md)\n"
+    "  --durability full|cycles|normal  what a machine crash (power loss) may take\n"
+    "                         (a crash of the server alone loses nothing): full:\n"
+    "                         nothing, every commit synced; cycles (default): the\n"
+    "                         results of the cycle in progress; normal: the last\n"
+    "                         commits. A resume analyses again what was lost and\n"
+    "                         ends with the same result (docs/store.md)\n"
     "  --max-message-mb N     largest message taken or sent, a result or a study\n"
     "                         (default 256, at most 2047)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
@@ -125,7 +129,7 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     } else if (name == "--durability") {
       const std::optional<mbopt::store::Durability> durability = mbopt::store::ParseDurability(value);
       if (!durability) {
-        std::cerr << "mbopt-server: --durability is full or normal, got '" << value << "'\n";
+        std::cerr << "mbopt-server: --durability is full, cycles or normal, got '" << value << "'\n";
         return false;
       }
       flags->server.durability = *durability;

@@ -54,7 +54,7 @@ struct ServerOptions {
   // job's records); workers are told it when they register.
   std::int64_t max_message_bytes = std::int64_t{256} << 20;
   // What a machine crash may take from the job database (store.h).
-  store::Durability durability = store::Durability::kFull;
+  store::Durability durability = store::Durability::kCycles;
   JobManagerOptions manager;
   // Testing: called inside each transaction of results before its COMMIT
   // (Store::SetBeforeCommitHook); empty: nothing.

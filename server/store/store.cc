@@ -237,11 +237,20 @@ constexpr const char* kJobColumns =
 }  // namespace
 
 const char* DurabilityName(Durability durability) {
-  return durability == Durability::kFull ? "full" : "normal";
+  switch (durability) {
+    case Durability::kFull:
+      return "full";
+    case Durability::kCycles:
+      return "cycles";
+    case Durability::kNormal:
+      return "normal";
+  }
+  return "full";
 }
 
 std::optional<Durability> ParseDurability(const std::string& name) {
   if (name == "full") return Durability::kFull;
+  if (name == "cycles") return Durability::kCycles;
   if (name == "normal") return Durability::kNormal;
   return std::nullopt;
 }
@@ -269,7 +278,7 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path, Dura
     sqlite3_close(db);
     return NotUsable(path, status);
   }
-  std::unique_ptr<Store> store(new Store(path, db));
+  std::unique_ptr<Store> store(new Store(path, db, durability));
   sqlite3_extended_result_codes(db, 1);
   // One server per database: the exclusive lock, taken below and held until
   // close, makes a second process's open fail instead of both running the
@@ -288,7 +297,9 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path, Dura
     }
   }
   if (status.ok()) {
-    status = Exec(db, durability == Durability::kFull ? "PRAGMA synchronous = FULL" : "PRAGMA synchronous = NORMAL");
+    // kCycles runs FULL and drops to NORMAL only for commits of results
+    // alone (store_group_commit.cc).
+    status = Exec(db, durability == Durability::kNormal ? "PRAGMA synchronous = NORMAL" : "PRAGMA synchronous = FULL");
   }
   if (status.ok()) status = Exec(db, "PRAGMA foreign_keys = ON");
   if (status.ok()) status = Exec(db, "BEGIN EXCLUSIVE; COMMIT");
@@ -300,7 +311,8 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path, Dura
   return store;
 }
 
-Store::Store(std::string path, sqlite3* db) : path_(std::move(path)), db_(db) {}
+Store::Store(std::string path, sqlite3* db, Durability durability)
+    : path_(std::move(path)), durability_(durability), synchronous_full_(durability != Durability::kNormal), db_(db) {}
 
 Store::~Store() {
   insert_analysis_.reset();

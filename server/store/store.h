@@ -46,8 +46,15 @@ inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 // either level (docs/store.md, "Durability").
 enum class Durability {
   // Every commit is synced to disk (synchronous = FULL): one fdatasync per
-  // analysis and per cycle.
+  // transaction of results.
   kFull,
+  // The default. Commits with cycle records (and every other change: jobs,
+  // states, events) are synced; commits of results alone reach the
+  // operating system at once and the disk with the next synced commit. A
+  // machine crash may lose the results of the cycle in progress, never a
+  // cycle record anyone has seen: a resume analyses them again and ends with
+  // the same result, bit for bit.
+  kCycles,
   // Commits reach the operating system, which writes them soon
   // (synchronous = NORMAL): a machine crash may lose the last commits. A
   // job resumes from what is left, analyses again what was lost and ends
@@ -55,7 +62,7 @@ enum class Durability {
   kNormal,
 };
 
-// "full" / "normal".
+// "full" / "cycles" / "normal".
 const char* DurabilityName(Durability durability);
 std::optional<Durability> ParseDurability(const std::string& name);
 
@@ -77,7 +84,7 @@ class Store {
   // all) or one written by a newer mbopt; DataLoss when SQLite reports
   // corruption; Unavailable when the file cannot be opened.
   static absl::StatusOr<std::unique_ptr<Store>> Open(const std::string& path,
-                                                     Durability durability = Durability::kFull);
+                                                     Durability durability = Durability::kCycles);
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;
@@ -106,6 +113,9 @@ class Store {
   // Transactions that committed writes so far (for tests and benchmarks:
   // fewer than the writes when they arrived together).
   std::int64_t AnalysisTransactions() const;
+  // Of those, the ones committed with a sync (all at kFull, those with cycle
+  // records at kCycles, none at kNormal).
+  std::int64_t SyncedTransactions() const;
   // Testing: called inside each group transaction after its rows are
   // written and before COMMIT, with the transaction's number (1-based), so
   // a test can kill the process in the middle of a group commit.
@@ -135,7 +145,7 @@ class Store {
   absl::Status Compact();
 
  private:
-  Store(std::string path, sqlite3* db);
+  Store(std::string path, sqlite3* db, Durability durability);
   // One INSERT into analyses; the caller holds mutex_ (and a transaction).
   absl::Status InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& analysis);
 
@@ -152,9 +162,15 @@ class Store {
   };
   void CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t transaction,
                    const std::function<void(std::int64_t)>& before_commit);
+  // The transaction itself; the caller holds mutex_ and set the sync mode.
+  void CommitGroupLocked(const std::vector<PendingWrite*>& group, std::int64_t transaction,
+                         const std::function<void(std::int64_t)>& before_commit);
 
   std::string path_;
-  std::mutex mutex_;
+  const Durability durability_;
+  mutable std::mutex mutex_;
+  bool synchronous_full_ = true;  // the connection's mode now; guarded by mutex_
+  std::int64_t synced_transactions_ = 0;  // guarded by mutex_
   sqlite3* db_;  // owned
   // The INSERT of InsertAnalysisLocked, prepared once: preparing it for every
   // analysis was a third of the server's CPU (docs/benchmarks.md). Guarded
@@ -170,6 +186,7 @@ class Store {
   std::vector<PendingWrite*> group_queue_;
   bool group_committing_ = false;
   std::int64_t analysis_transactions_ = 0;
+
   std::function<void(std::int64_t)> before_commit_;
 };
 

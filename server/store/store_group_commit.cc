@@ -1,4 +1,6 @@
 // Group commit of job writes (store.h, Commit; docs/store.md).
+#include <algorithm>
+
 #include "absl/status/status.h"
 #include "common/status_macros.h"
 #include "server/store/sqlite_statement.h"
@@ -53,6 +55,40 @@ absl::Status Store::WriteLocked(const JobWrite& write) {
 void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t transaction,
                         const std::function<void(std::int64_t)>& before_commit) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // At kCycles a group of results alone is not synced: it reaches the disk
+  // with the next synced commit (the WAL is synced as a whole), and until
+  // then a machine crash can take only analyses, which replay asks for
+  // again. Every other transaction runs FULL.
+  bool sync = durability_ == Durability::kFull;
+  if (durability_ == Durability::kCycles) {
+    sync = std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->write->progress.has_value(); });
+    if (!sync) {
+      const absl::Status mode = Exec(db_, "PRAGMA synchronous = NORMAL");
+      if (!mode.ok()) {
+        for (PendingWrite* p : group) p->status = mode;
+        return;
+      }
+      synchronous_full_ = false;
+    }
+  }
+  CommitGroupLocked(group, transaction, before_commit);
+  if (!synchronous_full_) {
+    // Back to FULL for everything else; if that fails the next commit of
+    // the connection is merely not synced, so it is logged, not returned.
+    if (const absl::Status full = Exec(db_, "PRAGMA synchronous = FULL"); full.ok()) synchronous_full_ = true;
+  }
+  if (sync) {
+    for (const PendingWrite* p : group) {
+      if (p->status.ok()) {
+        ++synced_transactions_;
+        break;
+      }
+    }
+  }
+}
+
+void Store::CommitGroupLocked(const std::vector<PendingWrite*>& group, std::int64_t transaction,
+                              const std::function<void(std::int64_t)>& before_commit) {
   absl::Status begun = Exec(db_, "BEGIN IMMEDIATE");
   if (!begun.ok()) {
     for (PendingWrite* p : group) p->status = begun;
@@ -97,6 +133,11 @@ void Store::SetBeforeCommitHook(std::function<void(std::int64_t transaction)> ho
 std::int64_t Store::AnalysisTransactions() const {
   std::lock_guard<std::mutex> lock(group_mutex_);
   return analysis_transactions_;
+}
+
+std::int64_t Store::SyncedTransactions() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return synced_transactions_;
 }
 
 }  // namespace mbopt::store

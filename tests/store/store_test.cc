@@ -523,7 +523,7 @@ TEST_F(StoreTest, SecondOpenWhileTheFirstIsOpenIsRefused) {
 }
 
 TEST_F(StoreTest, DurabilityLevelsSetTheSyncModeAndNamesRoundTrip) {
-  for (const Durability d : {Durability::kFull, Durability::kNormal}) {
+  for (const Durability d : {Durability::kFull, Durability::kCycles, Durability::kNormal}) {
     EXPECT_EQ(ParseDurability(DurabilityName(d)), d);
     {
       auto store = Store::Open(path_, d);
@@ -537,11 +537,50 @@ TEST_F(StoreTest, DurabilityLevelsSetTheSyncModeAndNamesRoundTrip) {
   EXPECT_FALSE(ParseDurability("fast").has_value());
 }
 
+// Which commits are synced: at kCycles those with cycle records, not those
+// of results alone; all at kFull, none at kNormal. Either way every row is
+// there when the database is opened again.
+TEST_F(StoreTest, CommitsWithCycleRecordsAreSyncedAtTheCyclesLevel) {
+  for (const Durability d : {Durability::kFull, Durability::kCycles, Durability::kNormal}) {
+    SCOPED_TRACE(DurabilityName(d));
+    std::filesystem::remove(path_);
+    std::filesystem::remove(path_ + "-wal");
+    std::filesystem::remove(path_ + "-shm");
+    std::string job_id;
+    {
+      auto store = Store::Open(path_, d);
+      ASSERT_TRUE(store.ok()) << store.status();
+      auto job = (*store)->CreateJob(SampleJob());
+      ASSERT_TRUE(job.ok());
+      job_id = job->id;
+      jobs::AnalysisRecord first;
+      first.request_id = 0;
+      first.objective_terms = AwkwardDoubles();
+      ASSERT_TRUE((*store)->AddAnalysis(job_id, first).ok());
+      jobs::AnalysisRecord second = first;
+      second.request_id = 1;
+      JobWrite with_cycle;
+      with_cycle.job_id = job_id;
+      with_cycle.analyses.push_back(&second);
+      with_cycle.cycles.push_back(CycleRow{0, 1, 0, "record"});
+      with_cycle.progress = JobProgress{"RUNNING", "", 1, 2, 0.5};
+      ASSERT_TRUE((*store)->Commit(with_cycle).ok());
+      EXPECT_EQ((*store)->AnalysisTransactions(), 2);
+      EXPECT_EQ((*store)->SyncedTransactions(), d == Durability::kFull ? 2 : d == Durability::kCycles ? 1 : 0);
+    }
+    auto reopened = Store::Open(path_, d);
+    ASSERT_TRUE(reopened.ok()) << reopened.status();
+    EXPECT_EQ((*reopened)->LoadAnalyses(job_id)->size(), 2u);
+    EXPECT_EQ((*reopened)->LoadCycles(job_id)->size(), 1u);
+  }
+}
+
 // Group commit: results from many threads at once are all committed (each
 // caller returns after its own row is in), a duplicate fails alone, and
 // they share transactions.
 TEST_F(StoreTest, ConcurrentAnalysesAreCommittedInGroups) {
-  auto store = Store::Open(path_);
+  // Synced commits, so that commits take long enough for results to meet.
+  auto store = Store::Open(path_, Durability::kFull);
   ASSERT_TRUE(store.ok()) << store.status();
   std::vector<std::string> job_ids;
   for (int j = 0; j < 4; ++j) {
