@@ -7,6 +7,11 @@
 # analyses of about 0.06 ms, so the figure is the service's ceiling, not the
 # analyses' (a 2-core machine also runs the workers and the clients).
 #
+# SERVER_ARGS and WORKER_ARGS (environment) go to mbopt-server and to each
+# mbopt-worker. Many slots whose analyses sleep instead of compute (what
+# one server can dispatch when the workers are elsewhere):
+# WORKER_ARGS="--task-delay-ms 2" with, e.g., 8 workers of 8 slots.
+#
 #   bash bench/service/dispatch_ceiling.sh [IN_FLIGHT] [WORKERS] [SLOTS] [ROUNDS] [STUDY]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -25,7 +30,8 @@ source bench/loopback.sh
 # shellcheck disable=SC2086  # SERVER_ARGS is a list of words
 start_server ${SERVER_ARGS:-}
 server=$SERVER_PID address=$ADDRESS
-start_workers "$WORKERS" --slots "$SLOTS"
+# shellcheck disable=SC2086  # WORKER_ARGS is a list of words
+start_workers "$WORKERS" --slots "$SLOTS" ${WORKER_ARGS:-}
 sleep 0.5
 start=$(date +%s.%N)
 cpu_start=$(awk '{print $14 + $15}' "/proc/$server/stat")

@@ -33,20 +33,31 @@ std::string Scheduler::RegisterWorker(const std::string& name, int slots) {
 
 bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled,
                         bool want_gradients) {
+  std::vector<NewTask> one;
+  one.push_back(NewTask{request_id, std::move(x_scaled), want_gradients});
+  return EnqueueAll(job_id, std::move(one)) == 1;
+}
+
+int Scheduler::EnqueueAll(const std::string& job_id, std::vector<NewTask> tasks) {
+  int queued = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    const Key key{job_id, request_id};
-    if (entries_.count(key) != 0 || finished_.count(key) != 0) return false;
-    Entry& entry = entries_[key];
-    entry.job_id = job_id;
-    entry.request_id = request_id;
-    entry.x_scaled = std::move(x_scaled);
-    entry.want_gradients = want_gradients;
-    entry.queued_at = std::chrono::steady_clock::now();
-    queues_[job_id].push_back(request_id);
+    const auto now = std::chrono::steady_clock::now();
+    for (NewTask& task : tasks) {
+      const Key key{job_id, task.request_id};
+      if (entries_.count(key) != 0 || finished_.count(key) != 0) continue;
+      Entry& entry = entries_[key];
+      entry.job_id = job_id;
+      entry.request_id = task.request_id;
+      entry.x_scaled = std::move(task.x_scaled);
+      entry.want_gradients = task.want_gradients;
+      entry.queued_at = now;
+      queues_[job_id].push_back(task.request_id);
+      ++queued;
+    }
   }
-  task_available_.notify_all();
-  return true;
+  if (queued > 0) task_available_.notify_all();
+  return queued;
 }
 
 bool Scheduler::HasOtherLiveWorker(const std::string& worker_id, const std::set<std::string>& excluded) const {

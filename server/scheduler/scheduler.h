@@ -102,6 +102,15 @@ class Scheduler {
   // pending list each time.
   bool Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled,
                bool want_gradients = false);
+  // Queues several analyses of `job_id` at once, as Enqueue each, and wakes
+  // the waiting workers once all are queued (so that the first to wake sees
+  // them all and takes its share, not one). Returns how many were new.
+  struct NewTask {
+    std::int64_t request_id = 0;
+    std::vector<double> x_scaled;
+    bool want_gradients = false;
+  };
+  int EnqueueAll(const std::string& job_id, std::vector<NewTask> tasks);
 
   // Up to `max_tasks` tasks for `worker_id`, fairly across jobs. A worker
   // may ask for more tasks than it has slots (to run them back to back and

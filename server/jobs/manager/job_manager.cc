@@ -319,10 +319,12 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
 
 void JobManager::ScheduleLocked(Entry& entry) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
+  std::vector<scheduler::Scheduler::NewTask> tasks;
   for (const slp::AnalysisRequest& request : entry.job->PendingRequests()) {
-    scheduler_->Enqueue(entry.row.id, request.id, std::vector<double>(request.x.data(), request.x.data() + request.x.size()),
-                        request.want_gradients);
+    tasks.push_back({request.id, std::vector<double>(request.x.data(), request.x.data() + request.x.size()),
+                     request.want_gradients});
   }
+  scheduler_->EnqueueAll(entry.row.id, std::move(tasks));
 }
 
 void JobManager::FailJobLocked(Entry& entry, const std::string& message) {
