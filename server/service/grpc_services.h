@@ -75,8 +75,11 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   // The most tasks one call hands out (AcquireTasks, and the next tasks
   // with a result).
   static constexpr int kMaxTasksPerCall = 64;
-  // How often an Attach stream checks whether its worker's connection closed.
-  static constexpr std::int64_t kAttachPollMs = 20;
+  // How often an Attach stream checks whether its worker's connection
+  // closed: how late a dead worker's tasks are handed out again, against a
+  // wake-up per worker every period (20 ms cost the server 6 % of its CPU
+  // with four workers).
+  static constexpr std::int64_t kAttachPollMs = 100;
 
  private:
   JobManager* manager_;

@@ -278,16 +278,21 @@ class FakeWorkerService final : public v1::WorkerService::Service {
   int slots_ = 0;
 };
 
+// The fake on 127.0.0.1 (any free port, in *port); nullptr if it cannot start.
+std::unique_ptr<grpc::Server> ServeOnLoopback(FakeWorkerService& fake, int* port) {
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), port);
+  builder.RegisterService(&fake);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  return server != nullptr && *port > 0 ? std::move(server) : nullptr;
+}
+
 TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgotten) {
   const v1::Study proto = VehicleStudyProto();
   FakeWorkerService fake(proto);
   int port = 0;
-  grpc::ServerBuilder builder;
-  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
-  builder.RegisterService(&fake);
-  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  std::unique_ptr<grpc::Server> server = ServeOnLoopback(fake, &port);
   ASSERT_NE(server, nullptr);
-  ASSERT_GT(port, 0);
 
   WorkerOptions options;
   options.server_address = "127.0.0.1:" + std::to_string(port);
@@ -334,10 +339,7 @@ TEST(WorkerService, TasksHandedOutTogetherAreReportedTogether) {
     SCOPED_TRACE(batch);
     FakeWorkerService fake(proto);
     int port = 0;
-    grpc::ServerBuilder builder;
-    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
-    builder.RegisterService(&fake);
-    std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+    std::unique_ptr<grpc::Server> server = ServeOnLoopback(fake, &port);
     ASSERT_NE(server, nullptr);
     const std::vector<double> x0 = InitialDesign(proto);
     for (int i = 0; i < 5; ++i) {
