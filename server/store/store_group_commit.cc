@@ -59,10 +59,10 @@ void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t tr
   // with the next synced commit (the WAL is synced as a whole), and until
   // then a machine crash can take only analyses, which replay asks for
   // again. Every other transaction runs FULL.
-  bool sync = durability_ == Durability::kFull;
   if (durability_ == Durability::kCycles) {
-    sync = std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->write->progress.has_value(); });
-    if (!sync) {
+    const bool has_records =
+        std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->write->progress.has_value(); });
+    if (!has_records) {
       const absl::Status mode = Exec(db_, "PRAGMA synchronous = NORMAL");
       if (!mode.ok()) {
         for (PendingWrite* p : group) p->status = mode;
@@ -71,19 +71,15 @@ void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t tr
       synchronous_full_ = false;
     }
   }
+  const bool synced = synchronous_full_;
   CommitGroupLocked(group, transaction, before_commit);
-  if (!synchronous_full_) {
-    // Back to FULL for everything else; if that fails the next commit of
-    // the connection is merely not synced, so it is logged, not returned.
-    if (const absl::Status full = Exec(db_, "PRAGMA synchronous = FULL"); full.ok()) synchronous_full_ = true;
+  if (durability_ == Durability::kCycles && !synchronous_full_) {
+    // Back to FULL for everything else; should that fail, the next commit
+    // is merely not synced, and the one after tries again.
+    if (Exec(db_, "PRAGMA synchronous = FULL").ok()) synchronous_full_ = true;
   }
-  if (sync) {
-    for (const PendingWrite* p : group) {
-      if (p->status.ok()) {
-        ++synced_transactions_;
-        break;
-      }
-    }
+  if (synced && std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->status.ok(); })) {
+    ++synced_transactions_;
   }
 }
 
