@@ -332,11 +332,17 @@ TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgot
 }
 
 // Tasks handed out together run back to back and their results go back in
-// one call; with --batch 1 each goes back alone.
+// one call; with --batch 1, or when each analysis takes longer than a cheap
+// one (here held 150 ms), each goes back alone.
 TEST(WorkerService, TasksHandedOutTogetherAreReportedTogether) {
   const v1::Study proto = VehicleStudyProto();
-  for (const int batch : {16, 1}) {
-    SCOPED_TRACE(batch);
+  struct Case {
+    int batch;
+    int task_delay_ms;
+    std::vector<int> calls;  // results per ReportResults call
+  };
+  for (const Case& c : {Case{16, 0, {5}}, Case{1, 0, {1, 1, 1, 1, 1}}, Case{16, 150, {1, 1, 1, 1, 1}}}) {
+    SCOPED_TRACE(::testing::Message() << "batch " << c.batch << ", delay " << c.task_delay_ms << " ms");
     FakeWorkerService fake(proto);
     int port = 0;
     std::unique_ptr<grpc::Server> server = ServeOnLoopback(fake, &port);
@@ -351,7 +357,8 @@ TEST(WorkerService, TasksHandedOutTogetherAreReportedTogether) {
     WorkerOptions options;
     options.server_address = "127.0.0.1:" + std::to_string(port);
     options.slots = 1;
-    options.batch = batch;
+    options.batch = c.batch;
+    options.task_delay_ms = c.task_delay_ms;
     options.acquire_wait_ms = 200;
     StopSignal stop;
     absl::Status run_status;
@@ -362,11 +369,7 @@ TEST(WorkerService, TasksHandedOutTogetherAreReportedTogether) {
     EXPECT_TRUE(run_status.ok()) << run_status;
     server->Shutdown();
     std::lock_guard<std::mutex> lock(fake.mutex_);
-    if (batch == 1) {
-      EXPECT_EQ(fake.report_calls_, std::vector<int>(5, 1));
-    } else {
-      EXPECT_EQ(fake.report_calls_, std::vector<int>{5});
-    }
+    EXPECT_EQ(fake.report_calls_, c.calls);
     ASSERT_EQ(fake.results_.size(), 5u);
     for (int i = 0; i < 5; ++i) EXPECT_EQ(fake.results_[static_cast<size_t>(i)].request_id(), i) << "in the order run";
   }

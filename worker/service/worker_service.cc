@@ -40,10 +40,14 @@ constexpr size_t kMaxCachedStudies = 64;
 // The most bytes of results held for one call while the server's message
 // limit is not known.
 constexpr std::int64_t kDefaultBatchBytes = 2 * 1024 * 1024;
-// The longest a finished result waits for others: analyses that take longer
-// than this are reported one by one, so a result is never kept from the
-// job's log (and from a crash-safe place) for long.
+// How long finished results wait for others. Only the results of cheap
+// analyses (shorter than kCheapAnalysis) are held, and no longer than
+// kMaxHold (checked as each analysis ends), so a held result waits at most
+// about kMaxHold + kCheapAnalysis and a longer analysis is reported as soon
+// as it ends: no result is kept from the job's log (and from a crash-safe
+// place) for long.
 constexpr auto kMaxHold = std::chrono::seconds(1);
+constexpr auto kCheapAnalysis = std::chrono::milliseconds(100);
 
 std::string DefaultName() {
   char host[256] = {0};
@@ -325,6 +329,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
         std::lock_guard<std::mutex> lock(mutex_);
         max_message_bytes = max_message_bytes_;
       }
+      const auto started = std::chrono::steady_clock::now();
       if (study != nullptr) {
         EvaluateTask(*study, task, &result);
         FitResultToServerLimit(max_message_bytes, &result);
@@ -343,9 +348,10 @@ class Worker : public std::enable_shared_from_this<Worker> {
       // After the line above, so that a test reading it knows the worker
       // holds the result for this long. A stop ends the hold early.
       if (options_.task_delay_ms > 0 && deliver) stop_.WaitFor(std::chrono::milliseconds(options_.task_delay_ms));
-      // Results are held while more tasks of this worker wait to run, and go
-      // back together (one call, one commit on the server) once none does,
-      // when they approach the server's message limit, or after kMaxHold.
+      // Results of cheap analyses are held while more tasks of this worker
+      // wait to run, and go back together (one call, one commit on the
+      // server) once none does, when they approach the server's message
+      // limit, or after kMaxHold.
       const std::int64_t budget = max_message_bytes > 0 ? max_message_bytes / 2 : kDefaultBatchBytes;
       std::vector<std::vector<v1::TaskResult>> batches;
       int next_tasks = 0;
@@ -366,8 +372,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
           held_.push_back(std::move(result));
           held_bytes_ += bytes;
         }
-        if (!held_.empty() && (queue_.empty() || stopping_ || held_bytes_ > budget ||
-                               std::chrono::steady_clock::now() - held_since_ >= kMaxHold)) {
+        const auto now = std::chrono::steady_clock::now();
+        if (!held_.empty() && (queue_.empty() || stopping_ || held_bytes_ > budget || now - started >= kCheapAnalysis ||
+                               now - held_since_ >= kMaxHold)) {
           batches.emplace_back();
           batches.back().swap(held_);
           held_bytes_ = 0;
