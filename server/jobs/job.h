@@ -71,6 +71,7 @@ class Job {
   bool running() const { return optimizer_->state() == slp::RunState::kRunning; }
 
   std::vector<slp::AnalysisRequest> PendingRequests() const { return optimizer_->PendingRequests(); }
+  bool IsPending(std::int64_t request_id) const { return optimizer_->IsPending(request_id); }
 
   // Validates a candidate record for a pending request into the record to
   // log and apply: x_scaled is the request's; a failed record loses its

@@ -200,26 +200,31 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext* context, const
   if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResult"); !caller.ok()) {
     return ToGrpcStatus(caller.status());
   }
-  grpc::Status status = grpc::Status::OK;
-  if (request->retry()) {
-    absl::Status reported = manager_->ReportWorkerError(request->worker_id(), request->task_id(),
-                                                        request->failure_reason());
-    // A retry request for a task that is not outstanding is simply dropped.
-    response->set_accepted(reported.ok());
-    if (!reported.ok() && !absl::IsNotFound(reported)) status = ToGrpcStatus(reported);
-  } else {
-    absl::StatusOr<bool> accepted = manager_->ReportResult(WorkerReportFromProto(*request));
-    if (!accepted.ok()) return ToGrpcStatus(accepted.status());
-    response->set_accepted(*accepted);
-  }
-  // The result may have made the next tasks (a cycle's trial point right
+  const absl::StatusOr<bool> accepted = request->retry() ? ReportRetry(*request)
+                                                         : manager_->ReportResult(WorkerReportFromProto(*request));
+  if (!accepted.ok()) return ToGrpcStatus(accepted.status());
+  response->set_accepted(*accepted);
+  LeaseNextTasks(request->worker_id(), request->next_tasks(), response->mutable_tasks());
+  return grpc::Status::OK;
+}
+
+absl::StatusOr<bool> WorkerServiceImpl::ReportRetry(const v1::TaskResult& result) const {
+  const absl::Status reported =
+      manager_->ReportWorkerError(result.worker_id(), result.task_id(), result.failure_reason());
+  // A retry request for a task that is not outstanding is simply dropped.
+  if (absl::IsNotFound(reported)) return false;
+  if (!reported.ok()) return reported;
+  return true;
+}
+
+void WorkerServiceImpl::LeaseNextTasks(const std::string& worker_id, int next_tasks,
+                                       google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const {
+  // The results may have made the next tasks (a cycle's trial point right
   // after its last perturbation): they go back on the same call.
-  if (status.ok() && request->next_tasks() > 0) {
-    absl::StatusOr<std::vector<scheduler::Task>> tasks =
-        scheduler_->Acquire(request->worker_id(), std::min(request->next_tasks(), kMaxTasksPerCall));
-    if (tasks.ok()) AddTasks(*tasks, response->mutable_tasks());
-  }
-  return status;
+  if (next_tasks <= 0) return;
+  absl::StatusOr<std::vector<scheduler::Task>> tasks =
+      scheduler_->Acquire(worker_id, std::min(next_tasks, kMaxTasksPerCall));
+  if (tasks.ok()) AddTasks(*tasks, out);
 }
 
 grpc::Status WorkerServiceImpl::ReportResults(grpc::ServerContext* context, const v1::TaskResults* request,
@@ -235,10 +240,12 @@ grpc::Status WorkerServiceImpl::ReportResults(grpc::ServerContext* context, cons
     const v1::TaskResult& result = request->results(i);
     v1::ResultAnswer* answer = response->add_answers();
     if (result.retry()) {
-      const absl::Status reported =
-          manager_->ReportWorkerError(result.worker_id(), result.task_id(), result.failure_reason());
-      answer->set_accepted(reported.ok());
-      if (!reported.ok() && !absl::IsNotFound(reported)) answer->set_error(std::string(reported.message()));
+      const absl::StatusOr<bool> accepted = ReportRetry(result);
+      if (accepted.ok()) {
+        answer->set_accepted(*accepted);
+      } else {
+        answer->set_error(std::string(accepted.status().message()));
+      }
       continue;
     }
     reports.push_back(WorkerReportFromProto(result));
@@ -255,11 +262,7 @@ grpc::Status WorkerServiceImpl::ReportResults(grpc::ServerContext* context, cons
       answer->set_error(std::string(taken[k].status().message()));
     }
   }
-  if (request->next_tasks() > 0) {
-    absl::StatusOr<std::vector<scheduler::Task>> tasks =
-        scheduler_->Acquire(request->worker_id(), std::min(request->next_tasks(), kMaxTasksPerCall));
-    if (tasks.ok()) AddTasks(*tasks, response->mutable_tasks());
-  }
+  LeaseNextTasks(request->worker_id(), request->next_tasks(), response->mutable_tasks());
   return grpc::Status::OK;
 }
 

@@ -84,6 +84,12 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
  private:
   JobManager* manager_;
   scheduler::Scheduler* scheduler_;
+  // A worker could not run a task (TaskResult.retry): its attempt fails.
+  // Whether that was taken (false: the task was not outstanding any more).
+  absl::StatusOr<bool> ReportRetry(const v1::TaskResult& result) const;
+  // Leases up to `next_tasks` tasks to the worker into `out` (none for 0).
+  void LeaseNextTasks(const std::string& worker_id, int next_tasks,
+                      google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const;
   // Leased tasks into their wire form.
   void AddTasks(const std::vector<scheduler::Task>& tasks,
                 google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const;

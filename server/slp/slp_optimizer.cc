@@ -94,6 +94,7 @@ class SlpOptimizer::Impl {
     for (const auto& [id, req] : outstanding_) out.push_back(req);
     return out;
   }
+  bool IsPending(std::int64_t request_id) const { return outstanding_.count(request_id) != 0; }
 
   absl::Status SubmitResult(const AnalysisResult& result) {
     auto it = outstanding_.find(result.request_id);
@@ -612,6 +613,7 @@ SlpOptimizer::~SlpOptimizer() = default;
 std::vector<AnalysisRequest> SlpOptimizer::PendingRequests() const {
   return impl_->PendingRequests();
 }
+bool SlpOptimizer::IsPending(std::int64_t request_id) const { return impl_->IsPending(request_id); }
 absl::Status SlpOptimizer::SubmitResult(const AnalysisResult& result) {
   return impl_->SubmitResult(result);
 }

@@ -139,6 +139,8 @@ class SlpOptimizer {
 
   // Analyses requested and not yet answered, ordered by id.
   std::vector<AnalysisRequest> PendingRequests() const;
+  // Whether `request_id` is among them (without copying them).
+  bool IsPending(std::int64_t request_id) const;
 
   // Hands in one result. InvalidArgument for an unknown or already answered
   // id, or value vectors of the wrong size. NaN or infinite values are

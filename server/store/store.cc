@@ -315,10 +315,10 @@ Store::Store(std::string path, sqlite3* db, Durability durability)
     : path_(std::move(path)), durability_(durability), synchronous_full_(durability != Durability::kNormal), db_(db) {}
 
 Store::~Store() {
-  insert_analysis_.reset();
-  select_records_.reset();
-  insert_cycle_.reset();
-  update_progress_.reset();
+  for (std::optional<Statement>* prepared : {&insert_analysis_, &select_records_, &insert_cycle_, &update_progress_,
+                                             &pragma_sync_normal_, &pragma_sync_full_}) {
+    prepared->reset();
+  }
   // Closing checkpoints the WAL into the main file; nothing is lost if it
   // fails (the WAL is replayed on the next open).
   sqlite3_close_v2(db_);
@@ -397,19 +397,16 @@ absl::Status Store::SetJobState(const std::string& job_id, const std::string& st
 }
 
 absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& a) {
-  if (!insert_analysis_.has_value()) {
-    MBOPT_ASSIGN_OR_RETURN(
-        Statement prepared,
-        Statement::Prepare(db_,
-                         "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
-                         "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
-                         "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
-                         "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind, "
-                         "latency_seconds) "
-                         "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
-    insert_analysis_.emplace(std::move(prepared));
-  }
-  Statement& stmt = *insert_analysis_;
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement * insert,
+      PreparedLocked(insert_analysis_,
+                     "INSERT INTO analyses(job_id, request_id, x_scaled, ok, failure_reason, objective_terms, "
+                     "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
+                     "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
+                     "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind, "
+                     "latency_seconds) "
+                     "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
+  Statement& stmt = *insert;
   stmt.BindText(1, job_id);
   stmt.BindInt(2, a.request_id);
   stmt.BindBlob(3, EncodeDoubles(a.x_scaled));
@@ -495,21 +492,25 @@ absl::Status Store::CommitCycle(const std::string& job_id, const std::vector<Cyc
   return Commit(write);
 }
 
-absl::Status Store::AppendCyclesLocked(const std::string& job_id, const std::vector<CycleRow>& records,
-                                       const JobProgress& progress) {
-  auto prepare = [this](std::optional<Statement>& slot, const char* sql) -> absl::Status {
-    if (slot.has_value()) return absl::OkStatus();
+absl::StatusOr<Statement*> Store::PreparedLocked(std::optional<Statement>& slot, const char* sql) {
+  if (!slot.has_value()) {
     MBOPT_ASSIGN_OR_RETURN(Statement prepared, Statement::Prepare(db_, sql));
     slot.emplace(std::move(prepared));
-    return absl::OkStatus();
-  };
-  MBOPT_RETURN_IF_ERROR(prepare(select_records_, "SELECT records FROM jobs WHERE id = ?"));
-  MBOPT_RETURN_IF_ERROR(
-      prepare(insert_cycle_, "INSERT INTO cycles(job_id, idx, cycle, attempt, record) VALUES (?,?,?,?,?)"));
-  MBOPT_RETURN_IF_ERROR(prepare(update_progress_,
-                                "UPDATE jobs SET records = ?, state = ?, message = ?, cycles = ?, analyses = ?, "
-                                "wall_seconds = ?, updated_unix_ms = ? WHERE id = ?"));
-  Statement& count = *select_records_;
+  }
+  return &*slot;
+}
+
+absl::Status Store::AppendCyclesLocked(const std::string& job_id, const std::vector<CycleRow>& records,
+                                       const JobProgress& progress) {
+  MBOPT_ASSIGN_OR_RETURN(Statement * select, PreparedLocked(select_records_, "SELECT records FROM jobs WHERE id = ?"));
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement * insert_cycle,
+      PreparedLocked(insert_cycle_, "INSERT INTO cycles(job_id, idx, cycle, attempt, record) VALUES (?,?,?,?,?)"));
+  MBOPT_ASSIGN_OR_RETURN(Statement * update_progress,
+                         PreparedLocked(update_progress_,
+                                        "UPDATE jobs SET records = ?, state = ?, message = ?, cycles = ?, "
+                                        "analyses = ?, wall_seconds = ?, updated_unix_ms = ? WHERE id = ?"));
+  Statement& count = *select;
   count.BindText(1, job_id);
   absl::StatusOr<bool> found = count.Step();
   const std::int64_t first = found.ok() && *found ? count.ColumnInt(0) : 0;
@@ -517,7 +518,7 @@ absl::Status Store::AppendCyclesLocked(const std::string& job_id, const std::vec
   if (!found.ok()) return found.status();
   if (!*found) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
   std::int64_t next = first;
-  Statement& insert = *insert_cycle_;
+  Statement& insert = *insert_cycle;
   for (const CycleRow& r : records) {
     insert.BindText(1, job_id);
     insert.BindInt(2, next++);
@@ -528,7 +529,7 @@ absl::Status Store::AppendCyclesLocked(const std::string& job_id, const std::vec
     insert.Reset();
     MBOPT_RETURN_IF_ERROR(inserted);
   }
-  Statement& update = *update_progress_;
+  Statement& update = *update_progress;
   update.BindInt(1, next);
   update.BindText(2, progress.state);
   update.BindText(3, progress.message);

@@ -2,8 +2,9 @@
 // analysis result, every cycle record and an event log. The schema, the
 // version rule and what survives a crash are written down in docs/store.md.
 //
-// Durability: WAL journal with synchronous=FULL by default, so a call that
-// returned OK has reached the disk (Durability says what NORMAL changes).
+// Durability: WAL journal; which commits are synced to disk is the
+// Durability level (by default those that carry cycle records: a crash of
+// the machine may cost recomputing the cycle in progress, never a record).
 // What a job's results change (their analysis rows, and the cycle records
 // they completed with the job's progress) is one JobWrite, committed
 // atomically, together with the writes of other callers that arrive
@@ -74,7 +75,7 @@ struct JobWrite {
   std::string job_id;
   std::vector<const jobs::AnalysisRecord*> analyses;
   std::vector<CycleRow> cycles;             // appended to the record log, indices in order
-  std::optional<JobProgress> progress;      // updates the job row when set
+  std::optional<JobProgress> progress;      // updates the job row; required with cycles
 };
 
 class Store {
@@ -102,7 +103,7 @@ class Store {
   // Commits `write` atomically: all of it or none (AlreadyExists if the job
   // already has a result for one of the request ids, NotFound for an unknown
   // job with cycle records). Returns once it is committed (and synced, at
-  // Durability::kFull). Group commit (store_group_commit.cc): writes that
+  // Durability::kFull, and at kCycles when it carries cycle records). Group commit (store_group_commit.cc): writes that
   // arrive while another commit is under way are committed together in the
   // next transaction, one sync for all, each in a savepoint of its own so
   // that one that fails fails alone; a caller never waits for more than the
@@ -146,6 +147,9 @@ class Store {
 
  private:
   Store(std::string path, sqlite3* db, Durability durability);
+  // `slot`'s statement, prepared on first use (parsing a statement for every
+  // write was a third of the server's CPU); the caller holds mutex_.
+  absl::StatusOr<Statement*> PreparedLocked(std::optional<Statement>& slot, const char* sql);
   // One INSERT into analyses; the caller holds mutex_ (and a transaction).
   absl::Status InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& analysis);
 
@@ -162,6 +166,8 @@ class Store {
   };
   void CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t transaction,
                    const std::function<void(std::int64_t)>& before_commit);
+  // Switches the connection's sync mode (synchronous_full_ follows).
+  absl::Status SetSynchronousLocked(bool full);
   // The transaction itself; the caller holds mutex_ and set the sync mode.
   void CommitGroupLocked(const std::vector<PendingWrite*>& group, std::int64_t transaction,
                          const std::function<void(std::int64_t)>& before_commit);
@@ -176,10 +182,13 @@ class Store {
   // analysis was a third of the server's CPU (docs/benchmarks.md). Guarded
   // by mutex_; finalized before db_ is closed.
   std::optional<Statement> insert_analysis_;
-  // The statements of AppendCyclesLocked, prepared once like the INSERT.
+  // The statements of AppendCyclesLocked and of the sync-level switch
+  // (kCycles), prepared once like the INSERT.
   std::optional<Statement> select_records_;
   std::optional<Statement> insert_cycle_;
   std::optional<Statement> update_progress_;
+  std::optional<Statement> pragma_sync_normal_;
+  std::optional<Statement> pragma_sync_full_;
 
   mutable std::mutex group_mutex_;  // guards the members below
   std::condition_variable group_done_;

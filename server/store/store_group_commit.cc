@@ -2,6 +2,7 @@
 #include <algorithm>
 
 #include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
 #include "common/status_macros.h"
 #include "server/store/sqlite_statement.h"
 #include "server/store/store.h"
@@ -43,6 +44,9 @@ absl::Status Store::Commit(const JobWrite& write) {
 }
 
 absl::Status Store::WriteLocked(const JobWrite& write) {
+  if (!write.cycles.empty() && !write.progress.has_value()) {
+    return absl::InvalidArgumentError(absl::StrCat("cycle records of job '", write.job_id, "' without its progress"));
+  }
   for (const jobs::AnalysisRecord* a : write.analyses) {
     MBOPT_RETURN_IF_ERROR(InsertAnalysisLocked(write.job_id, *a));
   }
@@ -63,12 +67,11 @@ void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t tr
     const bool has_records =
         std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->write->progress.has_value(); });
     if (!has_records) {
-      const absl::Status mode = Exec(db_, "PRAGMA synchronous = NORMAL");
+      const absl::Status mode = SetSynchronousLocked(false);
       if (!mode.ok()) {
         for (PendingWrite* p : group) p->status = mode;
         return;
       }
-      synchronous_full_ = false;
     }
   }
   const bool synced = synchronous_full_;
@@ -76,11 +79,20 @@ void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t tr
   if (durability_ == Durability::kCycles && !synchronous_full_) {
     // Back to FULL for everything else; should that fail, the next commit
     // is merely not synced, and the one after tries again.
-    if (Exec(db_, "PRAGMA synchronous = FULL").ok()) synchronous_full_ = true;
+    (void)SetSynchronousLocked(true);
   }
   if (synced && std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->status.ok(); })) {
     ++synced_transactions_;
   }
+}
+
+absl::Status Store::SetSynchronousLocked(bool full) {
+  MBOPT_ASSIGN_OR_RETURN(Statement * pragma, full ? PreparedLocked(pragma_sync_full_, "PRAGMA synchronous = FULL")
+                                                  : PreparedLocked(pragma_sync_normal_, "PRAGMA synchronous = NORMAL"));
+  const absl::Status status = pragma->Run();
+  pragma->Reset();
+  if (status.ok()) synchronous_full_ = full;
+  return status;
 }
 
 void Store::CommitGroupLocked(const std::vector<PendingWrite*>& group, std::int64_t transaction,

@@ -309,7 +309,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
           held.swap(held_);
           held_bytes_ = 0;
           lock.unlock();
-          if (!held.empty()) Deliver(std::move(held), 0, "");
+          if (!held.empty()) Deliver(std::move(held), 0);
           return;
         }
         item = std::move(queue_.front());
@@ -386,22 +386,32 @@ class Worker : public std::enable_shared_from_this<Worker> {
         }
       }
       for (size_t b = 0; b < batches.size(); ++b) {
-        Deliver(std::move(batches[b]), b + 1 == batches.size() ? next_tasks : 0, item.worker_id);
+        Deliver(std::move(batches[b]), b + 1 == batches.size() ? next_tasks : 0);
       }
       cv_.notify_all();
     }
   }
 
-  // Reports a batch of results, frees their places, and queues the tasks
-  // the server handed out with its answer (leased under `worker_id`).
-  void Deliver(std::vector<v1::TaskResult> results, int next_tasks, const std::string& worker_id) {
-    const std::vector<v1::AnalysisTask> next = Report(results, next_tasks, worker_id);
+  // Reports a batch of results (moved into the call, not copied: a result
+  // may be megabytes), frees their places, and queues the up to
+  // `next_tasks` tasks the server handed out with its answer, leased under
+  // the current registration. Each result keeps the registration its own
+  // task came under.
+  void Deliver(std::vector<v1::TaskResult> results, int next_tasks) {
+    v1::TaskResults request;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      for (const v1::TaskResult& r : results) cancelled_.erase(r.task_id());
-      busy_ -= static_cast<int>(results.size());
+      request.set_worker_id(worker_id_);
     }
-    for (const v1::AnalysisTask& task : next) Take(task, worker_id);
+    for (v1::TaskResult& r : results) request.mutable_results()->Add(std::move(r));
+    request.set_next_tasks(next_tasks);
+    const std::vector<v1::AnalysisTask> next = Report(request);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const v1::TaskResult& r : request.results()) cancelled_.erase(r.task_id());
+      busy_ -= request.results_size();
+    }
+    for (const v1::AnalysisTask& task : next) Take(task, request.worker_id());
     cv_.notify_all();
   }
 
@@ -451,14 +461,8 @@ class Worker : public std::enable_shared_from_this<Worker> {
     return *prepared;
   }
 
-  // Delivers results; returns the tasks the server leased with its answer
-  // (`next_tasks` of them at most, for the registration `worker_id`).
-  std::vector<v1::AnalysisTask> Report(const std::vector<v1::TaskResult>& results, int next_tasks,
-                                       const std::string& worker_id) {
-    v1::TaskResults request;
-    request.set_worker_id(worker_id.empty() ? results.front().worker_id() : worker_id);
-    for (const v1::TaskResult& r : results) *request.add_results() = r;
-    request.set_next_tasks(next_tasks);
+  // Delivers results; returns the tasks the server leased with its answer.
+  std::vector<v1::AnalysisTask> Report(const v1::TaskResults& request) {
     Backoff backoff(options_.backoff, backoff_seed_ + 2);
     const auto give_up = Clock::now() + kReportRetryWindow;
     while (true) {
@@ -480,9 +484,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
         return {response.tasks().begin(), response.tasks().end()};
       }
       if (!Retryable(status) || stop_.stopped() || Clock::now() > give_up) {
-        Log(absl::StrCat(results.size() == 1 ? "result of task " : "results of tasks ", results.front().task_id(),
-                         results.size() > 1 ? absl::StrCat(" and ", results.size() - 1, " more") : "",
-                         " not delivered: ", status.error_message()));
+        const int n = request.results_size();
+        Log(absl::StrCat(n == 1 ? "result of task " : "results of tasks ", request.results(0).task_id(),
+                         n > 1 ? absl::StrCat(" and ", n - 1, " more") : "", " not delivered: ", status.error_message()));
         return {};
       }
       if (stop_.WaitFor(backoff.Next())) return {};

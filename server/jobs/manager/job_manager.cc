@@ -405,11 +405,7 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::Ana
   std::vector<slp::CycleRecord> emitted;
   for (const jobs::AnalysisRecord& record : batch) {
     if (!entry.job->running()) break;
-    const std::vector<slp::AnalysisRequest> pending = entry.job->PendingRequests();
-    if (std::none_of(pending.begin(), pending.end(),
-                     [&record](const slp::AnalysisRequest& r) { return r.id == record.request_id; })) {
-      continue;
-    }
+    if (!entry.job->IsPending(record.request_id)) continue;
     absl::StatusOr<std::vector<slp::CycleRecord>> records = entry.job->Apply(record);
     if (!records.ok()) {
       FailJobLocked(entry, absl::StrCat("the optimizer refused analysis ", record.request_id, ": ",
@@ -422,16 +418,10 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::Ana
   if (applied.empty()) return absl::OkStatus();
   if (!emitted.empty() || !entry.job->running()) {
     MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, std::move(emitted), applied));
-  } else {
-    store::JobWrite write;
-    write.job_id = entry.row.id;
-    write.analyses = applied;
-    if (absl::Status status = store_->Commit(write); !status.ok()) {
-      FailJobLocked(entry, absl::StrCat("cannot log analysis ", applied.front()->request_id,
-                                        applied.size() > 1 ? absl::StrCat(" and ", applied.size() - 1, " more") : "",
-                                        ": ", status.message()));
-      return status;
-    }
+  } else if (absl::Status status = store_->Commit(store::JobWrite{entry.row.id, applied, {}, std::nullopt});
+             !status.ok()) {
+    FailJobLocked(entry, absl::StrCat("cannot log analyses: ", status.message()));
+    return status;
   }
   ScheduleLocked(entry);
   Changed(entry);
@@ -481,11 +471,11 @@ std::vector<absl::StatusOr<bool>> JobManager::ReportResults(std::vector<WorkerRe
     std::vector<jobs::AnalysisRecord> batch;
     std::vector<size_t> batch_indices;
     for (size_t i : indices) {
-      absl::StatusOr<jobs::AnalysisRecord> record = TakeResultLocked(**entry, std::move(reports[i]));
+      absl::StatusOr<std::optional<jobs::AnalysisRecord>> record = TakeResultLocked(**entry, std::move(reports[i]));
       if (!record.ok()) {
         answers[i] = record.status();
-      } else if (record->request_id >= 0) {
-        batch.push_back(*std::move(record));
+      } else if (record->has_value()) {
+        batch.push_back(**std::move(record));
         batch_indices.push_back(i);
       }
     }
@@ -495,21 +485,16 @@ std::vector<absl::StatusOr<bool>> JobManager::ReportResults(std::vector<WorkerRe
   return answers;
 }
 
-absl::StatusOr<jobs::AnalysisRecord> JobManager::TakeResultLocked(Entry& entry, WorkerReport report) {
-  jobs::AnalysisRecord dropped;
-  dropped.request_id = -1;
+absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked(Entry& entry,
+                                                                                 WorkerReport report) {
   const std::int64_t request_id = report.record.request_id;
   const std::string expected_prefix = absl::StrCat(report.job_id, "/", request_id, "/");
   if (report.task_id.rfind(expected_prefix, 0) != 0) {
     return absl::InvalidArgumentError(absl::StrCat("task id '", report.task_id, "' does not belong to job '",
                                                    report.job_id, "' request ", request_id));
   }
-  if (entry.job == nullptr || entry.state != JobState::kRunning) return dropped;
-  const std::vector<slp::AnalysisRequest> pending = entry.job->PendingRequests();
-  if (std::none_of(pending.begin(), pending.end(),
-                   [request_id](const slp::AnalysisRequest& r) { return r.id == request_id; })) {
-    return dropped;  // answered already (another attempt won)
-  }
+  if (entry.job == nullptr || entry.state != JobState::kRunning) return std::nullopt;
+  if (!entry.job->IsPending(request_id)) return std::nullopt;  // answered already (another attempt won)
   report.record.worker = report.worker_id;
   absl::StatusOr<jobs::AnalysisRecord> record = entry.job->Intake(std::move(report.record));
   if (!record.ok()) {
@@ -522,10 +507,10 @@ absl::StatusOr<jobs::AnalysisRecord> JobManager::TakeResultLocked(Entry& entry, 
     return absl::InvalidArgumentError(reason);
   }
   absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(report.worker_id, report.task_id);
-  if (!finished.ok()) return dropped;
+  if (!finished.ok()) return std::nullopt;
   record->attempts = finished->attempts;
   record->latency_seconds = finished->latency_seconds;
-  return record;
+  return std::optional<jobs::AnalysisRecord>(*std::move(record));
 }
 
 void JobManager::GiveUp(const scheduler::FinishedTask& task) {

@@ -30,6 +30,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -214,9 +215,9 @@ class JobManager {
   absl::StatusOr<JobView> RestoredViewLocked(Entry& entry, std::size_t first_record);
   // Validates a worker's result for the job (the task, the request still
   // pending, the job's intake) and completes its task: the record to
-  // deliver; request_id -1 when it is to be dropped (not outstanding any
-  // more); InvalidArgument for a result that does not fit its task.
-  absl::StatusOr<jobs::AnalysisRecord> TakeResultLocked(Entry& entry, WorkerReport report);
+  // deliver; nullopt when it is to be dropped (not outstanding any more);
+  // InvalidArgument for a result that does not fit its task.
+  absl::StatusOr<std::optional<jobs::AnalysisRecord>> TakeResultLocked(Entry& entry, WorkerReport report);
   // Applies a batch of the job's results and logs them with what they
   // completed (one transaction).
   absl::Status DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch);
