@@ -73,6 +73,9 @@ function(mbopt_declare_modules)
   mbopt_module(common DIRS common PURE
     LIBS mbopt_common
     SUMMARY "status macros and checks (Abseil status only)")
+  mbopt_module(packed_doubles DIRS common/packed_doubles USES common PURE
+    LIBS mbopt_packed_doubles
+    SUMMARY "vectors of doubles packed losslessly (prediction, zlib) for results on the wire and in the log")
   mbopt_module(x509 DIRS common/x509 USES common
     LIBS mbopt_x509
     SUMMARY "X.509 certificates read and shown (OpenSSL): owned pointers, PEM, host names, dates")
@@ -97,7 +100,7 @@ function(mbopt_declare_modules)
   mbopt_module(slp DIRS server/slp USES lp common PURE
     LIBS mbopt_slp
     SUMMARY "the SLP optimizer core (the LP solver is injected)")
-  mbopt_module(jobs DIRS server/jobs USES slp lp spec common PURE
+  mbopt_module(jobs DIRS server/jobs USES slp lp spec packed_doubles common PURE
     LIBS mbopt_jobs
     SUMMARY "a job: the one driver of the SLP core, with intake, replay, record codec and the analysis record")
 
@@ -119,7 +122,7 @@ function(mbopt_declare_modules)
     SUMMARY "a study optimized in this process: a job with an in-process evaluator (tests, tools)")
 
   # Plumbing and boundaries.
-  mbopt_module(store DIRS server/store USES jobs spec common
+  mbopt_module(store DIRS server/store USES jobs spec packed_doubles common
     LIBS mbopt_store
     SUMMARY "the SQLite job database")
   mbopt_module(scheduler DIRS server/scheduler USES common
@@ -137,7 +140,7 @@ function(mbopt_declare_modules)
   mbopt_module(server_main DIRS server/main USES service auth store jobs common
     LIBS mbopt-server
     SUMMARY "the `mbopt-server` program")
-  mbopt_module(worker_service DIRS worker/service USES secure_channel engine spec spec_io proto common
+  mbopt_module(worker_service DIRS worker/service USES secure_channel engine spec spec_io proto packed_doubles common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
   mbopt_module(worker_main DIRS worker/main USES worker_service engine spec spec_io proto common

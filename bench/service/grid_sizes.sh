@@ -3,8 +3,9 @@
 # the vehicle study with its time grid refined to each POINTS value, one job
 # each on a fresh server with W workers on 127.0.0.1. Prints per grid: the
 # job's outcome and wall time, its analyses, the bytes of one result's
-# values on the wire (8 per double: the objective terms and constraint
-# values of one analysis, the bulk of a TaskResult), the job database's size
+# values as packed (the objective terms and constraint values of one
+# analysis, the bulk of a TaskResult: the same bytes on the wire and in the
+# log; docs/store.md, "How values are stored"), the job database's size
 # after the run and per analysis, and the server's peak resident memory.
 #
 #   bash bench/service/grid_sizes.sh [W] [POINTS...]

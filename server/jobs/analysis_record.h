@@ -22,6 +22,12 @@ struct AnalysisRecord {
   // When ok: one value per objective term and per constraint row (g_h, SI).
   std::vector<double> objective_terms;
   std::vector<double> constraint_values;
+  // The same values as a worker packed them (common/packed_doubles), logged
+  // verbatim so the server need not pack them again; both empty when the
+  // values came unpacked (the store packs them then). A worker's report
+  // carries only these; Job::Intake unpacks them into the vectors above.
+  std::string objective_terms_packed;
+  std::string constraint_values_packed;
   // Simulator sensitivities, when the request wanted them and they were
   // usable: d(value)/d(x_scaled), row-major (one row per objective term,
   // resp. constraint row; one column per design variable). Both empty: none,

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/packed_doubles/packed_doubles.h"
 #include "common/status_macros.h"
 #include "server/jobs/analysis_gradients.h"
 #include "server/jobs/problem_from_study.h"
@@ -28,6 +29,26 @@ std::string FirstNonFinite(const char* what, const std::vector<double>& values) 
     if (!std::isfinite(values[i])) return absl::StrCat(what, " ", i, " is ", values[i]);
   }
   return "";
+}
+
+// A worker's packed values into the record's vectors, at most as many as the
+// study has (so a hostile packing cannot make the server allocate more). The
+// packed bytes stay: the store logs them as they came.
+absl::Status UnpackOne(const char* what, size_t expected, const std::string& packed_values,
+                       std::vector<double>& values) {
+  if (packed_values.empty()) return absl::OkStatus();
+  if (!values.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("result has its ", what, " both packed and unpacked"));
+  }
+  absl::StatusOr<std::vector<double>> unpacked = packed::UnpackDoubles(packed_values, expected);
+  if (!unpacked.ok()) return absl::InvalidArgumentError(absl::StrCat(what, ": ", unpacked.status().message()));
+  values = *std::move(unpacked);
+  return absl::OkStatus();
+}
+
+absl::Status UnpackValues(size_t terms, size_t rows, AnalysisRecord& record) {
+  MBOPT_RETURN_IF_ERROR(UnpackOne("objective terms", terms, record.objective_terms_packed, record.objective_terms));
+  return UnpackOne("constraint values", rows, record.constraint_values_packed, record.constraint_values);
 }
 
 // The optimizer's view of a record: live delivery and replay give it exactly
@@ -93,6 +114,7 @@ absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
   if (record.ok()) {
     const size_t terms = static_cast<size_t>(problem.num_objective_terms);
     const size_t rows = static_cast<size_t>(problem.num_constraints());
+    MBOPT_RETURN_IF_ERROR(UnpackValues(terms, rows, record));
     if (record.objective_terms.size() != terms || record.constraint_values.size() != rows) {
       return absl::InvalidArgumentError(absl::StrCat("result of request ", record.request_id, " has ",
                                                      record.objective_terms.size(), " objective terms and ",
@@ -110,6 +132,8 @@ absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
     if (record.failure.reason.empty()) record.failure.reason = "the analysis failed";
     record.objective_terms.clear();
     record.constraint_values.clear();
+    record.objective_terms_packed.clear();
+    record.constraint_values_packed.clear();
     record.objective_gradients.clear();
     record.constraint_gradients.clear();
     record.gradients_unavailable.clear();

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -60,8 +61,8 @@ constexpr const char* kUsage =
     "                         results of the cycle in progress; normal: the last\n"
     "                         commits. A resume analyses again what was lost and\n"
     "                         ends with the same result (docs/store.md)\n"
-    "  --max-message-mb N     largest message taken or sent, a result or a study\n"
-    "                         (default 256, at most 2047)\n"
+    "  --max-message-mb N     largest message taken or sent, a result or a study,\n"
+    "                         in MiB (default 256, from 0.0625 to 2047)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -134,12 +135,15 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
       }
       flags->server.durability = *durability;
     } else if (name == "--max-message-mb") {
-      if (!ParseInt(name, value, 1, &number)) return false;
-      if (number > 2047) {
-        std::cerr << "mbopt-server: --max-message-mb is at most 2047 (gRPC's limit is 2 GB), got " << number << "\n";
+      // Decimals allowed: small limits are how a test (or a cautious site)
+      // sees results refused without simulating millions of instants.
+      double mb = 0;
+      if (!absl::SimpleAtod(value, &mb) || !(mb >= 0.0625) || mb > 2047) {
+        std::cerr << "mbopt-server: --max-message-mb is a number from 0.0625 to 2047 (gRPC's limit is 2 GB), got '"
+                  << value << "'\n";
         return false;
       }
-      flags->server.max_message_bytes = number << 20;
+      flags->server.max_message_bytes = std::llround(mb * (1 << 20));
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

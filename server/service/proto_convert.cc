@@ -43,6 +43,8 @@ WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
   }
   record.objective_terms.assign(result.objective_terms().begin(), result.objective_terms().end());
   record.constraint_values.assign(result.constraint_values().begin(), result.constraint_values().end());
+  record.objective_terms_packed = result.objective_terms_packed();
+  record.constraint_values_packed = result.constraint_values_packed();
   record.objective_gradients.assign(result.objective_gradients().begin(), result.objective_gradients().end());
   record.constraint_gradients.assign(result.constraint_gradients().begin(), result.constraint_gradients().end());
   record.gradients_unavailable = result.gradients_unavailable();

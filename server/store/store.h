@@ -38,7 +38,7 @@ namespace mbopt::store {
 // The schema version this code writes. A database with a newer version is
 // refused; older versions are migrated on open (docs/store.md lists the
 // versions and their migrations).
-inline constexpr int kSchemaVersion = 6;
+inline constexpr int kSchemaVersion = 7;
 // PRAGMA application_id of an mbopt database ("mbop").
 inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 

@@ -13,6 +13,8 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include "common/packed_doubles/packed_doubles.h"
+
 #include "mbopt/v1/service.grpc.pb.h"
 #include "spec/io/study_io.h"
 #include "worker/engine/study_sensitivities.h"
@@ -42,6 +44,13 @@ v1::AnalysisTask TaskAt(const std::vector<double>& x) {
   return task;
 }
 
+// A result's values as the worker packed them (empty if they do not unpack).
+std::vector<double> Unpacked(const std::string& packed_values) {
+  absl::StatusOr<std::vector<double>> values = packed::UnpackDoubles(packed_values, 1 << 24);
+  EXPECT_TRUE(values.ok()) << values.status();
+  return values.ok() ? *values : std::vector<double>{};
+}
+
 std::vector<double> InitialDesign(const v1::Study& study) {
   std::vector<double> x;
   for (const auto& v : study.variables()) x.push_back(v.initial());
@@ -55,10 +64,15 @@ TEST(TaskEvaluator, ValuesAlignWithTheStudyLayout) {
   v1::TaskResult result;
   EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), &result);
   ASSERT_TRUE(result.ok()) << result.failure_reason();
-  EXPECT_EQ(result.objective_terms_size(), (*prepared)->layout.num_objective_terms());
-  EXPECT_EQ(result.constraint_values_size(), (*prepared)->layout.num_constraints());
+  // Sent packed only.
+  EXPECT_EQ(result.objective_terms_size(), 0);
+  EXPECT_EQ(result.constraint_values_size(), 0);
+  EXPECT_EQ(Unpacked(result.objective_terms_packed()).size(),
+            static_cast<size_t>((*prepared)->layout.num_objective_terms()));
+  EXPECT_EQ(Unpacked(result.constraint_values_packed()).size(),
+            static_cast<size_t>((*prepared)->layout.num_constraints()));
   EXPECT_FALSE(result.formulation().empty());
-  for (double v : result.objective_terms()) EXPECT_TRUE(std::isfinite(v));
+  for (double v : Unpacked(result.objective_terms_packed())) EXPECT_TRUE(std::isfinite(v));
 }
 
 TEST(TaskEvaluator, WrongDimensionIsAFailedResultNotACrash) {
@@ -83,6 +97,8 @@ TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
   EvaluateTask(**prepared, TaskAt(x), &result);
   EXPECT_FALSE(result.ok());
   EXPECT_EQ(result.objective_terms_size(), 0);
+  EXPECT_TRUE(result.objective_terms_packed().empty());
+  EXPECT_TRUE(result.constraint_values_packed().empty());
   // Absurd stiffnesses: the analysis either fails or overflows; both must
   // come back as a failure with a reason, never as values.
   std::vector<double> huge(x.size(), 1e300);
@@ -172,7 +188,8 @@ TEST(TaskEvaluator, StudyWithoutSimulatorSensitivitiesGivesValuesAndTheReason) {
   v1::TaskResult result;
   EvaluateTask(**prepared, task, &result);
   ASSERT_TRUE(result.ok()) << result.failure_reason();
-  EXPECT_EQ(result.objective_terms_size(), (*prepared)->layout.num_objective_terms());
+  EXPECT_EQ(Unpacked(result.objective_terms_packed()).size(),
+            static_cast<size_t>((*prepared)->layout.num_objective_terms()));
   EXPECT_EQ(result.objective_gradients_size(), 0);
   EXPECT_EQ(result.constraint_gradients_size(), 0);
   EXPECT_NE(result.gradients_unavailable().find("speed"), std::string::npos) << result.gradients_unavailable();
@@ -327,7 +344,9 @@ TEST(WorkerService, EvaluatesTasksFetchesTheStudyOnceAndRegistersAgainWhenForgot
     EXPECT_TRUE(r.ok()) << r.failure_reason();
     EXPECT_EQ(r.job_id(), "job-1");
     // Identical inputs, identical outputs: bit identity is the point.
-    EXPECT_EQ(r.objective_terms(0), fake.results_[0].objective_terms(0));
+    EXPECT_FALSE(r.objective_terms_packed().empty());
+    EXPECT_EQ(r.objective_terms_packed(), fake.results_[0].objective_terms_packed());
+    EXPECT_EQ(r.constraint_values_packed(), fake.results_[0].constraint_values_packed());
   }
 }
 

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/packed_doubles/packed_doubles.h"
+
 #include "server/jobs/analysis_gradients.h"
 #include "server/jobs/job_state.h"
 #include "server/jobs/record_codec.h"
@@ -159,6 +161,40 @@ TEST(JobIntake, NonFiniteValueBecomesAFailureOfThatKind) {
   EXPECT_EQ(record->failure.kind, spec::FailureKind::kNonFiniteValue);
   EXPECT_NE(record->failure.reason.find("constraint value 0"), std::string::npos) << record->failure.reason;
   EXPECT_TRUE(record->constraint_values.empty());
+}
+
+// A worker's packed values are unpacked at intake, bit for bit, and kept
+// packed for the log; a packing of more values than the study has, or values
+// sent both ways, is refused.
+TEST(JobIntake, PackedValuesAreUnpackedAndCheckedAgainstTheStudy) {
+  const v1::Study proto = testing::OscillatorStudy();
+  std::unique_ptr<Job> job = NewJob(proto);
+  const AnalysisRecord analytic = AnalyticRecord(proto, job->PendingRequests()[0]);
+  AnalysisRecord candidate = analytic;
+  candidate.objective_terms_packed = packed::PackDoubles(candidate.objective_terms);
+  candidate.constraint_values_packed = packed::PackDoubles(candidate.constraint_values);
+  AnalysisRecord sent_both_ways = candidate;
+  candidate.objective_terms.clear();
+  candidate.constraint_values.clear();
+  absl::StatusOr<AnalysisRecord> record = job->Intake(candidate);
+  ASSERT_TRUE(record.ok()) << record.status();
+  ASSERT_EQ(record->constraint_values.size(), analytic.constraint_values.size());
+  EXPECT_EQ(std::memcmp(record->constraint_values.data(), analytic.constraint_values.data(),
+                        sizeof(double) * analytic.constraint_values.size()),
+            0);
+  EXPECT_EQ(record->constraint_values_packed, candidate.constraint_values_packed);
+
+  EXPECT_EQ(job->Intake(sent_both_ways).status().code(), absl::StatusCode::kInvalidArgument);
+  AnalysisRecord too_many = candidate;
+  std::vector<double> more = analytic.constraint_values;
+  more.push_back(1.0);
+  too_many.constraint_values_packed = packed::PackDoubles(more);
+  const absl::Status refused = job->Intake(too_many).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.message().find("constraint values"), std::string::npos) << refused;
+  AnalysisRecord damaged = candidate;
+  damaged.constraint_values_packed.resize(damaged.constraint_values_packed.size() / 2);
+  EXPECT_EQ(job->Intake(damaged).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST(JobIntake, WrongSizeOrUnknownRequestIsRefused) {

@@ -16,10 +16,13 @@
 #include <limits>
 #include <string>
 #include <thread>
+#include <tuple>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "common/packed_doubles/packed_doubles.h"
 #include "server/store/double_blob.h"
 
 namespace mbopt::store {
@@ -114,6 +117,86 @@ TEST_F(StoreTest, AnalysisRoundTripIsBitExact) {
   EXPECT_TRUE(BitIdentical((*rows)[0].constraint_gradients, a.constraint_gradients));
   EXPECT_EQ((*rows)[0].counters.time_steps, 1234);
   EXPECT_EQ((*rows)[0].worker, "w-1");
+}
+
+void RunSql(const std::string& path, const std::string& sql);
+
+std::string ColumnBlob(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) return "";
+  sqlite3_stmt* stmt = nullptr;
+  std::string blob;
+  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr) == SQLITE_OK && sqlite3_step(stmt) == SQLITE_ROW) {
+    const char* bytes = static_cast<const char*>(sqlite3_column_blob(stmt, 0));
+    blob.assign(bytes == nullptr ? "" : bytes, static_cast<size_t>(sqlite3_column_bytes(stmt, 0)));
+  }
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  return blob;
+}
+
+// Values a worker packed are logged as they came (the server does not pack
+// them again); values that came unpacked are packed by the store. Both read
+// back bit for bit, and a smooth series takes a fraction of 8 bytes a value.
+TEST_F(StoreTest, ValuesAreLoggedPackedAsTheWorkerPackedThem) {
+  std::vector<double> series;
+  for (int i = 0; i < 4001; ++i) {
+    series.push_back(std::sin(1e-3 * i));
+    series.push_back(-series.back());
+  }
+  jobs::AnalysisRecord from_worker;
+  from_worker.request_id = 0;
+  from_worker.objective_terms = AwkwardDoubles();
+  from_worker.constraint_values = series;
+  from_worker.objective_terms_packed = packed::PackDoubles(from_worker.objective_terms);
+  from_worker.constraint_values_packed = packed::PackDoubles(series);
+  jobs::AnalysisRecord unpacked = from_worker;
+  unpacked.request_id = 1;
+  unpacked.objective_terms_packed.clear();
+  unpacked.constraint_values_packed.clear();
+  std::string job_id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    job_id = (*store)->CreateJob(SampleJob())->id;
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, from_worker).ok());
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, unpacked).ok());
+  }
+  EXPECT_EQ(ColumnBlob(path_, "SELECT constraint_values FROM analyses WHERE request_id = 0"),
+            from_worker.constraint_values_packed);
+  EXPECT_EQ(ColumnBlob(path_, "SELECT objective_terms FROM analyses WHERE request_id = 0"),
+            from_worker.objective_terms_packed);
+  const std::string packed_here = ColumnBlob(path_, "SELECT constraint_values FROM analyses WHERE request_id = 1");
+  EXPECT_FALSE(packed_here.empty());
+  EXPECT_LT(packed_here.size() * 4, series.size() * sizeof(double)) << packed_here.size() << " bytes";
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto rows = (*store)->LoadAnalyses(job_id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 2u);
+  for (const jobs::AnalysisRecord& row : *rows) {
+    EXPECT_TRUE(BitIdentical(row.objective_terms, from_worker.objective_terms));
+    EXPECT_TRUE(BitIdentical(row.constraint_values, series));
+  }
+}
+
+// A damaged packed blob is named as lost data, not read as other values.
+TEST_F(StoreTest, DamagedPackedValuesAreDataLoss) {
+  std::string job_id;
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    job_id = (*store)->CreateJob(SampleJob())->id;
+    jobs::AnalysisRecord a;
+    a.objective_terms = {1.0, 2.0};
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, a).ok());
+  }
+  RunSql(path_, "UPDATE analyses SET objective_terms = x'0102030405'");
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  auto rows = (*store)->LoadAnalyses(job_id);
+  ASSERT_FALSE(rows.ok());
+  EXPECT_EQ(rows.status().code(), absl::StatusCode::kDataLoss) << rows.status();
 }
 
 TEST_F(StoreTest, AnalysisWithoutGradientsKeepsTheReason) {
@@ -271,6 +354,43 @@ void RunSql(const std::string& path, const std::string& sql) {
   sqlite3_close(db);
 }
 
+// Rewrites every analysis' values as schema versions before 7 stored them,
+// 8 bytes each, and drops the column that says they are packed.
+void UnpackValuesAsBeforeVersion7(const std::string& path) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* select = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "SELECT rowid, objective_terms, constraint_values FROM analyses", -1, &select,
+                               nullptr),
+            SQLITE_OK);
+  std::vector<std::tuple<std::int64_t, std::string, std::string>> rows;
+  while (sqlite3_step(select) == SQLITE_ROW) {
+    auto blob = [&](int column) {
+      const char* bytes = static_cast<const char*>(sqlite3_column_blob(select, column));
+      const std::string packed_values(bytes == nullptr ? "" : bytes,
+                                      static_cast<size_t>(sqlite3_column_bytes(select, column)));
+      absl::StatusOr<std::vector<double>> values = packed::UnpackDoubles(packed_values, 1 << 20);
+      EXPECT_TRUE(values.ok()) << values.status();
+      return values.ok() ? EncodeDoubles(*values) : std::string();
+    };
+    rows.emplace_back(sqlite3_column_int64(select, 0), blob(1), blob(2));
+  }
+  sqlite3_finalize(select);
+  for (const auto& [rowid, terms, values] : rows) {
+    sqlite3_stmt* update = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(db, "UPDATE analyses SET objective_terms = ?, constraint_values = ? WHERE rowid = ?",
+                                 -1, &update, nullptr),
+              SQLITE_OK);
+    sqlite3_bind_blob(update, 1, terms.data(), static_cast<int>(terms.size()), SQLITE_TRANSIENT);
+    sqlite3_bind_blob(update, 2, values.data(), static_cast<int>(values.size()), SQLITE_TRANSIENT);
+    sqlite3_bind_int64(update, 3, rowid);
+    EXPECT_EQ(sqlite3_step(update), SQLITE_DONE);
+    sqlite3_finalize(update);
+  }
+  sqlite3_close(db);
+  RunSql(path, "ALTER TABLE analyses DROP COLUMN values_packed;");
+}
+
 TEST_F(StoreTest, NewerSchemaVersionIsRefused) {
   { ASSERT_TRUE(Store::Open(path_).ok()); }
   RunSql(path_, "UPDATE schema_version SET version = " + std::to_string(kSchemaVersion + 1));
@@ -308,6 +428,7 @@ TEST_F(StoreTest, JobOwnerIsKeptAndOlderJobsHaveNone) {
     EXPECT_EQ((*store)->GetJob(job_id)->owner, "alice");
   }
   // Exactly the version 4 layout.
+  UnpackValuesAsBeforeVersion7(path_);
   RunSql(path_,
          "ALTER TABLE jobs DROP COLUMN owner; ALTER TABLE analyses DROP COLUMN latency_seconds;"
          "UPDATE schema_version SET version = 4;");
@@ -345,6 +466,7 @@ TEST_F(StoreTest, VersionOneDatabaseIsMigratedKeepingItsAnalyses) {
   }
   // Exactly the version 1 layout: the columns version 2 added are the last
   // three of `analyses`.
+  UnpackValuesAsBeforeVersion7(path_);
   RunSql(path_,
          "ALTER TABLE analyses DROP COLUMN objective_gradients;"
          "ALTER TABLE analyses DROP COLUMN constraint_gradients;"
@@ -400,6 +522,7 @@ TEST_F(StoreTest, VersionTwoFailuresBecomeUnclassified) {
     failed.failure = spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "integrator failed near t = 1");
     ASSERT_TRUE((*store)->AddAnalysis(job_id, failed).ok());
   }
+  UnpackValuesAsBeforeVersion7(path_);
   RunSql(path_,
          "ALTER TABLE analyses DROP COLUMN failure_kind;"
          "DROP TABLE job_sequence;"

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "common/packed_doubles/packed_doubles.h"
 #include "spec/io/analysis_outcome_convert.h"
 #include "spec/io/study_io.h"
 #include "worker/engine/evaluate_study.h"
@@ -16,6 +17,8 @@ void Fail(v1::TaskResult* result, spec::FailureKind kind, std::string reason) {
   result->set_failure_reason(std::move(reason));
   result->clear_objective_terms();
   result->clear_constraint_values();
+  result->clear_objective_terms_packed();
+  result->clear_constraint_values_packed();
   result->clear_objective_gradients();
   result->clear_constraint_gradients();
 }
@@ -59,8 +62,10 @@ void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, v
   result->set_ok(true);
   result->clear_failure_reason();
   result->set_failure_kind(v1::ANALYSIS_FAILURE_KIND_UNSPECIFIED);
-  result->mutable_objective_terms()->Assign(values.objective_terms.begin(), values.objective_terms.end());
-  result->mutable_constraint_values()->Assign(values.constraint_values.begin(), values.constraint_values.end());
+  result->clear_objective_terms();
+  result->clear_constraint_values();
+  result->set_objective_terms_packed(packed::PackDoubles(values.objective_terms));
+  result->set_constraint_values_packed(packed::PackDoubles(values.constraint_values));
   if (!task.want_gradients()) return;
   if (evaluation->gradients.has_value()) {
     AppendRowMajor(evaluation->gradients->objective_terms, result->mutable_objective_gradients());
