@@ -1,11 +1,16 @@
 #include "tests/fuzz/fuzz_checks.h"
 
+#include <bit>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <cstdlib>
 #include <iostream>
 #include <string>
 
 #include "absl/status/status.h"
+#include "common/packed_doubles/packed_doubles.h"
 #include "mbopt/v1/study.pb.h"
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
@@ -77,6 +82,44 @@ void CheckStudyBinary(std::string_view data) {
     return;
   }
   CheckLayout(*study, source);
+}
+
+void CheckPackedValues(std::string_view data) {
+  // The bound the server passes is the study's own count of rows.
+  constexpr std::size_t kBound = std::size_t{1} << 20;
+  absl::StatusOr<std::vector<double>> values = packed::UnpackDoubles(data, kBound);
+  if (!values.ok()) {
+    if (values.status().code() != absl::StatusCode::kInvalidArgument) Fail("packed values: not InvalidArgument", values.status());
+    return;
+  }
+  if (values->size() > kBound) Fail("packed values: more values than the bound", absl::OkStatus());
+  absl::StatusOr<std::vector<double>> again = packed::UnpackDoubles(packed::PackDoubles(*values), kBound);
+  if (!again.ok()) Fail("packed values: a repacking does not unpack", again.status());
+  if (again->size() != values->size() ||
+      (!values->empty() && std::memcmp(again->data(), values->data(), values->size() * sizeof(double)) != 0)) {
+    Fail("packed values: a repacking unpacks to other values", absl::OkStatus());
+  }
+}
+
+std::vector<std::string> PackedValuesSeeds() {
+  std::vector<std::vector<double>> sets(4);
+  for (int i = 0; i < 3001; ++i) {
+    const double f = 0.02 * std::sin(0.01 * i) * std::exp(-1e-3 * i);
+    sets[0].push_back(f);
+    sets[0].push_back(-f);
+  }
+  std::uint64_t state = 88172645463325252ull;  // xorshift: the same seeds everywhere
+  for (int i = 0; i < 2000; ++i) {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    sets[1].push_back(std::bit_cast<double>(state));
+  }
+  sets[2] = {0.0, -0.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN(),
+             std::numeric_limits<double>::denorm_min(), -1.0, 1.0};
+  std::vector<std::string> seeds;
+  for (const auto& set : sets) seeds.push_back(packed::PackDoubles(set));
+  return seeds;
 }
 
 }  // namespace mbopt::fuzz

@@ -7,7 +7,9 @@
 // disagree on the same study.
 #pragma once
 
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace mbopt::fuzz {
 
@@ -21,5 +23,14 @@ void CheckSceneText(std::string_view data);
 
 // A binary mbopt.v1.Study, as a hostile client could send it to the server.
 void CheckStudyBinary(std::string_view data);
+
+// A result's packed values (common/packed_doubles), as a hostile worker
+// could send them: unpacked or refused with InvalidArgument, within the
+// caller's bound; what unpacks packs again to the identical values.
+void CheckPackedValues(std::string_view data);
+
+// Packings the packed_values target starts from: smooth rows as a study
+// makes them, random bit patterns, special values, nothing.
+std::vector<std::string> PackedValuesSeeds();
 
 }  // namespace mbopt::fuzz

@@ -66,12 +66,31 @@ TEST(FuzzSeeds, EveryExampleStudyPassesEveryCheck) {
   }
 }
 
+// The packed_values seeds pass, and so does every single-byte change of
+// them and every truncation (refused or unpacked, never a crash).
+TEST(FuzzSeeds, PackedValuesSeedsAndTheirMutantsAreHandled) {
+  const std::vector<std::string> seeds = PackedValuesSeeds();
+  ASSERT_EQ(seeds.size(), 4u);
+  for (const std::string& seed : seeds) {
+    CheckPackedValues(seed);
+    for (size_t at = 0; at < seed.size(); at += 7) {
+      std::string mutant = seed;
+      mutant[at] = static_cast<char>(mutant[at] ^ 0xA5);
+      CheckPackedValues(mutant);
+      CheckPackedValues(std::string_view(seed).substr(0, at));
+    }
+  }
+}
+
 TEST(FuzzRegressions, EveryKeptFindingIsHandled) {
   const std::filesystem::path root = "tests/fuzz/regressions";
   ASSERT_TRUE(std::filesystem::is_directory(root));
   int replayed = 0;
   for (const auto& [target, check] : std::vector<std::pair<std::string, void (*)(std::string_view)>>{
-           {"study_text", &CheckStudyText}, {"scene_text", &CheckSceneText}, {"study_binary", &CheckStudyBinary}}) {
+           {"study_text", &CheckStudyText},
+           {"scene_text", &CheckSceneText},
+           {"study_binary", &CheckStudyBinary},
+           {"packed_values", &CheckPackedValues}}) {
     if (!std::filesystem::is_directory(root / target)) continue;
     for (const auto& file : std::filesystem::directory_iterator(root / target)) {
       SCOPED_TRACE(file.path().string());

@@ -1,7 +1,8 @@
 // Writes the seed corpora of the fuzzing targets from study files:
 // OUT/study_text/NAME (the study with its scene inline, text format),
 // OUT/study_binary/NAME (the same as a binary message) and
-// OUT/scene_text/NAME (the scene alone). Usage: make_fuzz_seeds OUT STUDY...
+// OUT/scene_text/NAME (the scene alone), and OUT/packed_values/seed-K (the
+// packings of PackedValuesSeeds). Usage: make_fuzz_seeds OUT STUDY...
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include <google/protobuf/text_format.h>
 
 #include "spec/io/study_io.h"
+#include "tests/fuzz/fuzz_checks.h"
 
 namespace {
 
@@ -40,6 +42,13 @@ int main(int argc, char** argv) {
     google::protobuf::TextFormat::PrintToString(study->scene(), &scene_text);
     if (!Write(out / "study_text" / name, study_text) || !Write(out / "scene_text" / name, scene_text) ||
         !Write(out / "study_binary" / name, study->SerializeAsString())) {
+      std::cerr << "make_fuzz_seeds: cannot write under " << out << "\n";
+      return 1;
+    }
+  }
+  const std::vector<std::string> packed_seeds = mbopt::fuzz::PackedValuesSeeds();
+  for (size_t k = 0; k < packed_seeds.size(); ++k) {
+    if (!Write(out / "packed_values" / ("seed-" + std::to_string(k)), packed_seeds[k])) {
       std::cerr << "make_fuzz_seeds: cannot write under " << out << "\n";
       return 1;
     }
