@@ -31,7 +31,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--tls-dir DIR | --tls-cert F --tls-key F --tokens F]\n"
     "                    [--worker-ca F] [--insecure] [--db PATH] [--port-file FILE]\n"
-    "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N]\n"
+    "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N] [--max-result-mb N]\n"
     "                    [--durability full|cycles|normal]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
@@ -63,6 +63,9 @@ constexpr const char* kUsage =
     "                         ends with the same result (docs/store.md)\n"
     "  --max-message-mb N     largest message taken or sent, a result or a study,\n"
     "                         in MiB (default 256, from 0.0625 to 2047)\n"
+    "  --max-result-mb N      largest result taken, in pieces when over the\n"
+    "                         message limit, in MiB (default 1024); the server\n"
+    "                         holds one such result whole while it arrives\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -144,6 +147,13 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
         return false;
       }
       flags->server.max_message_bytes = std::llround(mb * (1 << 20));
+    } else if (name == "--max-result-mb") {
+      double mb = 0;
+      if (!absl::SimpleAtod(value, &mb) || !(mb >= 0.0625) || mb > 65536) {
+        std::cerr << "mbopt-server: --max-result-mb is a number from 0.0625 to 65536, got '" << value << "'\n";
+        return false;
+      }
+      flags->server.max_result_bytes = std::llround(mb * (1 << 20));
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

@@ -150,6 +150,7 @@ grpc::Status WorkerServiceImpl::Register(grpc::ServerContext* context, const v1:
   response->set_heartbeat_interval_ms(static_cast<std::int32_t>(scheduler_->options().heartbeat_interval_ms));
   response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));
   response->set_max_message_bytes(max_message_bytes_);
+  response->set_max_result_bytes(max_result_bytes_);
   return grpc::Status::OK;
 }
 
@@ -232,6 +233,53 @@ grpc::Status WorkerServiceImpl::ReportResults(grpc::ServerContext* context, cons
   if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResults"); !caller.ok()) {
     return ToGrpcStatus(caller.status());
   }
+  return TakeResults(*request, response);
+}
+
+grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* context,
+                                                     grpc::ServerReader<v1::ResultPiece>* reader,
+                                                     v1::ReportResultsResponse* response) {
+  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResultInPieces");
+      !caller.ok()) {
+    return ToGrpcStatus(caller.status());
+  }
+  v1::ResultPiece piece;
+  if (!reader->Read(&piece)) return ToGrpcStatus(absl::InvalidArgumentError("a result in pieces without a piece"));
+  const std::int64_t total = piece.total_bytes();
+  // Refused before anything is held: the size is named on the first piece.
+  if (total <= 0 || total > max_result_bytes_) {
+    return ToGrpcStatus(absl::InvalidArgumentError(absl::StrFormat(
+        "a result of %d bytes in pieces; the server takes results of 1 to %d bytes (mbopt-server --max-result-mb)",
+        total, max_result_bytes_)));
+  }
+  v1::TaskResults request;
+  request.set_worker_id(piece.worker_id());
+  request.set_next_tasks(piece.next_tasks());
+  std::string bytes;
+  // Grown as pieces come, not reserved whole on the first piece's word.
+  bytes.reserve(static_cast<size_t>(std::min<std::int64_t>(total, std::int64_t{64} << 20)));
+  do {
+    if (static_cast<std::int64_t>(bytes.size() + piece.data().size()) > total) {
+      return ToGrpcStatus(absl::InvalidArgumentError(
+          absl::StrFormat("the pieces of a result add up to more than its %d bytes", total)));
+    }
+    bytes += piece.data();
+  } while (reader->Read(&piece));
+  if (static_cast<std::int64_t>(bytes.size()) != total) {
+    return ToGrpcStatus(absl::InvalidArgumentError(
+        absl::StrFormat("the pieces of a result add up to %d of its %d bytes", bytes.size(), total)));
+  }
+  if (!request.add_results()->ParseFromString(bytes)) {
+    return ToGrpcStatus(absl::InvalidArgumentError("the pieces of a result do not make a TaskResult"));
+  }
+  bytes.clear();
+  bytes.shrink_to_fit();
+  return TakeResults(request, response);
+}
+
+grpc::Status WorkerServiceImpl::TakeResults(const v1::TaskResults& request_message,
+                                            v1::ReportResultsResponse* response) {
+  const v1::TaskResults* request = &request_message;
   std::vector<WorkerReport> reports;
   std::vector<int> report_index;  // the answer of each report
   // Each result names the registration its task was leased under (a worker

@@ -46,13 +46,15 @@ class JobServiceImpl final : public v1::JobService::Service {
 class WorkerServiceImpl final : public v1::WorkerService::Service {
  public:
   // The clock is the scheduler's (lease deadlines are on it).
-  // `max_message_bytes` is what workers are told the server receives.
+  // `max_message_bytes` is what workers are told the server receives in
+  // one message, `max_result_bytes` in pieces.
   WorkerServiceImpl(JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock,
-                    std::int64_t max_message_bytes, const CallAuthorizer* authorizer)
+                    std::int64_t max_message_bytes, std::int64_t max_result_bytes, const CallAuthorizer* authorizer)
       : manager_(manager),
         scheduler_(scheduler),
         clock_(clock),
         max_message_bytes_(max_message_bytes),
+        max_result_bytes_(max_result_bytes),
         authorizer_(authorizer) {}
 
   grpc::Status Register(grpc::ServerContext* context, const v1::RegisterWorkerRequest* request,
@@ -65,6 +67,8 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
                             v1::ReportResultResponse* response) override;
   grpc::Status ReportResults(grpc::ServerContext* context, const v1::TaskResults* request,
                              v1::ReportResultsResponse* response) override;
+  grpc::Status ReportResultInPieces(grpc::ServerContext* context, grpc::ServerReader<v1::ResultPiece>* reader,
+                                    v1::ReportResultsResponse* response) override;
   grpc::Status Heartbeat(grpc::ServerContext* context, const v1::HeartbeatRequest* request,
                          v1::HeartbeatResponse* response) override;
   grpc::Status Attach(grpc::ServerContext* context, const v1::AttachRequest* request,
@@ -87,6 +91,8 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   // A worker could not run a task (TaskResult.retry): its attempt fails.
   // Whether that was taken (false: the task was not outstanding any more).
   absl::StatusOr<bool> ReportRetry(const v1::TaskResult& result) const;
+  // ReportResults after the caller was authorized.
+  grpc::Status TakeResults(const v1::TaskResults& request, v1::ReportResultsResponse* response);
   // Leases up to `next_tasks` tasks to the worker into `out` (none for 0).
   void LeaseNextTasks(const std::string& worker_id, int next_tasks,
                       google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const;
@@ -96,6 +102,7 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
 
   const scheduler::Clock* clock_;
   std::int64_t max_message_bytes_;
+  std::int64_t max_result_bytes_;
   const CallAuthorizer* authorizer_;
 };
 

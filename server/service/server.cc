@@ -111,7 +111,8 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
 
   s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get(), s.authorizer_.get());
   s.worker_service_ = std::make_unique<WorkerServiceImpl>(s.manager_.get(), s.scheduler_.get(), s.clock_,
-                                                         s.options_.max_message_bytes, s.authorizer_.get());
+                                                         s.options_.max_message_bytes, s.options_.max_result_bytes,
+                                                         s.authorizer_.get());
   grpc::ServerBuilder builder;
   // Without this, gRPC on Linux binds with SO_REUSEPORT and a second server
   // on a port in use would silently share it instead of failing.

@@ -53,6 +53,10 @@ struct ServerOptions {
   // The largest message the server receives or sends (a study, a result, a
   // job's records); workers are told it when they register.
   std::int64_t max_message_bytes = std::int64_t{256} << 20;
+  // The largest result the server takes, in pieces when it is over
+  // max_message_bytes (the server holds it whole while it reassembles it);
+  // workers are told it when they register.
+  std::int64_t max_result_bytes = std::int64_t{1} << 30;
   // What a machine crash may take from the job database (store.h).
   store::Durability durability = store::Durability::kCycles;
   JobManagerOptions manager;

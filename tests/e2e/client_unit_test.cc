@@ -27,11 +27,22 @@ TEST(ResultSize, ResultOverTheServersLimitBecomesANamedServiceFailure) {
   for (int i = 0; i < 200'000; ++i) result.add_constraint_values(0.5);  // 1.6 MB
   v1::TaskResult small = result;
   small.clear_constraint_values();
-  EXPECT_FALSE(worker::FitResultToServerLimit(0, &result)) << "no limit known";
-  EXPECT_FALSE(worker::FitResultToServerLimit(4 << 20, &result));
+  EXPECT_FALSE(worker::FitResultToServerLimit(0, 0, &result)) << "no limit known";
+  EXPECT_FALSE(worker::FitResultToServerLimit(4 << 20, 0, &result));
   EXPECT_TRUE(result.ok());
-  EXPECT_FALSE(worker::FitResultToServerLimit(1 << 20, &small));
-  ASSERT_TRUE(worker::FitResultToServerLimit(1 << 20, &result));
+  EXPECT_FALSE(worker::FitResultToServerLimit(1 << 20, 0, &small));
+  // Over the message limit but under the result limit: it goes in pieces.
+  EXPECT_FALSE(worker::FitResultToServerLimit(1 << 20, 2 << 20, &result));
+  EXPECT_FALSE(worker::FitsOneMessage(static_cast<std::int64_t>(result.ByteSizeLong()), 1 << 20));
+  EXPECT_TRUE(worker::FitsOneMessage(static_cast<std::int64_t>(small.ByteSizeLong()), 1 << 20));
+  EXPECT_TRUE(result.ok());
+  v1::TaskResult over_pieces = result;
+  ASSERT_TRUE(worker::FitResultToServerLimit(1 << 20, 1 << 20, &over_pieces));
+  EXPECT_NE(over_pieces.failure_reason().find("more than the server takes (1.0 MB, mbopt-server --max-result-mb)"),
+            std::string::npos)
+      << over_pieces.failure_reason();
+  // An older server takes no pieces: its message limit is the limit.
+  ASSERT_TRUE(worker::FitResultToServerLimit(1 << 20, 0, &result));
   EXPECT_FALSE(result.ok());
   EXPECT_FALSE(result.retry()) << "another worker would send the same size";
   EXPECT_EQ(result.failure_kind(), v1::ANALYSIS_FAILURE_SERVICE);

@@ -577,24 +577,46 @@ TEST(BadInput, MutatedExamplesAgreeBetweenValidateAndWorkerEval) {
   EXPECT_GT(accepted, 0);
 }
 
+// A result over the message limit goes in pieces: with 64 KiB messages and
+// results of about 0.19 MB (20,001 instants, packed), the job ends exactly as
+// with the default limits.
+TEST(LargeResults, OverTheMessageLimitTheyGoInPiecesAndTheResultIsTheSame) {
+  ScratchDir dir;
+  v1::Study study;
+  const std::string text = InlinedVehicleStudy(&study);
+  ASSERT_FALSE(text.empty());
+  const std::string path = dir.Write("fine.study.textproto", text + "analysis { time_grid_points: 20001 }\n");
+  auto server = StartServer(dir.File("jobs.db"), {"--max-message-mb", "0.0625"}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  Subprocess worker = StartWorker(server->address);
+  const std::string in_pieces = Comparable(SubmitWatchAndGetResults(server->address, path));
+  worker.Stop(kGuard);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+  EXPECT_NE(in_pieces.find("\"status\": \"converged\""), std::string::npos) << in_pieces;
+  EXPECT_EQ(in_pieces, Comparable(ReferenceResult(1, path)));
+}
+
 // A result larger than the server takes fails its analysis at once, naming
 // both sizes (before: refused by gRPC on every try, the job stalled for three
 // leases and failed with "lease expired").
-TEST(BadInput, ResultOverTheServersMessageLimitIsANamedFailure) {
+TEST(BadInput, ResultOverTheServersLimitIsANamedFailure) {
   ScratchDir dir;
   v1::Study study;
   const std::string text = InlinedVehicleStudy(&study);
   ASSERT_FALSE(text.empty());
   // About 0.19 MB of values packed (20,001 instants; 1.9 MB unpacked).
   const std::string path = dir.Write("fine.study.textproto", text + "analysis { time_grid_points: 20001 }\n");
-  auto server = StartServer(dir.File("jobs.db"), {"--max-message-mb", "0.125"}, "127.0.0.1:0", dir.File("server.log"));
+  auto server = StartServer(dir.File("jobs.db"), {"--max-message-mb", "0.0625", "--max-result-mb", "0.125"},
+                            "127.0.0.1:0", dir.File("server.log"));
   ASSERT_TRUE(server.ok()) << server.status();
   Subprocess worker = StartWorker(server->address);
   auto submitted = Mbopt({"submit", path, "--watch", "--server", server->address});
   constexpr int kExitJobFailed = 4;
   EXPECT_EQ(submitted.exit_code, kExitJobFailed) << Describe(submitted);
   auto results = Mbopt({"results", "job-1", "--server", server->address});
-  EXPECT_NE(results.stdout_text.find("more than the server takes (0.1 MB"), std::string::npos) << Describe(results);
+  EXPECT_NE(results.stdout_text.find("more than the server takes (0.1 MB, mbopt-server --max-result-mb)"),
+            std::string::npos)
+      << Describe(results);
   worker.Stop(kGuard);
   EXPECT_EQ(server->process->Stop(kGuard), 0);
 }

@@ -594,6 +594,53 @@ TEST_F(ServerTest, UnknownJobIsNotFoundNamingTheId) {
   }
 }
 
+// A result in pieces is refused on its first piece when it says it is over
+// the server's result limit (nothing is held), and when its pieces do not add
+// up to what it said or do not make a result; the job goes on.
+TEST_F(ServerTest, ResultInPiecesOverTheLimitOrNotAddingUpIsRefused) {
+  ServerOptions options;
+  options.listen_address = "127.0.0.1:0";
+  options.db_path = (dir_ / "a.db").string();
+  options.lease_ms = kLeaseMs;
+  options.heartbeat_ms = kLeaseMs / 4;
+  options.clock = &clock_;
+  options.max_result_bytes = 1000;
+  absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
+  ASSERT_TRUE(server.ok()) << server.status();
+  Submit(**server, OscillatorStudy());
+  FakeWorker worker((*server)->InProcessChannel(), 5);
+  auto send = [&](std::int64_t total, const std::vector<std::string>& pieces) {
+    grpc::ClientContext context;
+    v1::ReportResultsResponse response;
+    auto writer = worker.stub().ReportResultInPieces(&context, &response);
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      v1::ResultPiece piece;
+      if (i == 0) {
+        piece.set_worker_id(worker.worker_id());
+        piece.set_total_bytes(total);
+      }
+      piece.set_data(pieces[i]);
+      if (!writer->Write(piece)) break;
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  };
+  grpc::Status over = send(2000, {std::string(500, 'a'), std::string(500, 'b')});
+  EXPECT_EQ(over.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(over.error_message(), HasSubstr("--max-result-mb"));
+  grpc::Status more = send(10, {std::string(8, 'a'), std::string(8, 'b')});
+  EXPECT_EQ(more.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(more.error_message(), HasSubstr("more than its 10 bytes"));
+  grpc::Status fewer = send(10, {std::string(5, 'a')});
+  EXPECT_EQ(fewer.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(fewer.error_message(), HasSubstr("5 of its 10 bytes"));
+  grpc::Status garbage = send(4, {std::string("\xff\xff"), std::string("\xff\xff")});
+  EXPECT_EQ(garbage.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(garbage.error_message(), HasSubstr("do not make a TaskResult"));
+  // The job is untouched: the worker still runs it to its end.
+  EXPECT_GT(worker.Run(), 0);
+}
+
 TEST_F(ServerTest, GarbageResultIsRejectedWhileAnotherJobContinues) {
   auto server = StartServer("a.db");
   const std::string first = Submit(*server, OscillatorStudy("first"));

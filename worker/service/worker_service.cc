@@ -208,6 +208,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
     heartbeat_ms_ = response.heartbeat_interval_ms() > 0 ? response.heartbeat_interval_ms()
                                                          : kDefaultHeartbeatMs;
     max_message_bytes_ = response.max_message_bytes();
+    max_result_bytes_ = response.max_result_bytes();
     registered_ = true;
     Log(absl::StrCat("registered with ", options_.server_address, " as ", worker_id_, " (",
                      options_.slots, " slots)"));
@@ -325,14 +326,16 @@ class Worker : public std::enable_shared_from_this<Worker> {
       auto study = StudyFor(task.job_id(), &study_error);
       bool deliver = true;
       std::int64_t max_message_bytes = 0;
+      std::int64_t max_result_bytes = 0;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         max_message_bytes = max_message_bytes_;
+        max_result_bytes = max_result_bytes_;
       }
       const auto started = std::chrono::steady_clock::now();
       if (study != nullptr) {
         EvaluateTask(*study, task, &result);
-        FitResultToServerLimit(max_message_bytes, &result);
+        FitResultToServerLimit(max_message_bytes, max_result_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
         result.set_ok(false);
@@ -462,16 +465,30 @@ class Worker : public std::enable_shared_from_this<Worker> {
   }
 
   // Delivers results; returns the tasks the server leased with its answer.
+  // A result over the message limit (alone in its batch: batches stay
+  // under half the limit) goes in pieces.
   std::vector<v1::AnalysisTask> Report(const v1::TaskResults& request) {
+    std::int64_t max_message_bytes = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      max_message_bytes = max_message_bytes_;
+    }
+    const bool in_pieces =
+        request.results_size() == 1 &&
+        !FitsOneMessage(static_cast<std::int64_t>(request.ByteSizeLong()), max_message_bytes);
+    const std::string serialized = in_pieces ? request.results(0).SerializeAsString() : std::string();
     Backoff backoff(options_.backoff, backoff_seed_ + 2);
     const auto give_up = Clock::now() + kReportRetryWindow;
     while (true) {
       v1::ReportResultsResponse response;
       grpc::ClientContext context;
-      context.set_deadline(Clock::now() + kShortCallDeadline);
+      // Pieces take as long as their bytes do: a second per 10 MB on top.
+      context.set_deadline(Clock::now() + kShortCallDeadline +
+                           std::chrono::seconds(static_cast<std::int64_t>(serialized.size()) / 10'000'000));
       // Not registered for cancellation: a result finished while stopping is
       // still worth delivering.
-      grpc::Status status = stub_->ReportResults(&context, request, &response);
+      grpc::Status status = in_pieces ? SendInPieces(&context, request, serialized, max_message_bytes, &response)
+                                      : stub_->ReportResults(&context, request, &response);
       if (status.ok()) {
         for (int i = 0; i < response.answers_size() && i < request.results_size(); ++i) {
           const v1::ResultAnswer& answer = response.answers(i);
@@ -491,6 +508,27 @@ class Worker : public std::enable_shared_from_this<Worker> {
       }
       if (stop_.WaitFor(backoff.Next())) return {};
     }
+  }
+
+  // ReportResultInPieces with `serialized` (the one result of `request`),
+  // cut into pieces of half a message.
+  grpc::Status SendInPieces(grpc::ClientContext* context, const v1::TaskResults& request,
+                            const std::string& serialized, std::int64_t max_message_bytes,
+                            v1::ReportResultsResponse* response) {
+    std::unique_ptr<grpc::ClientWriter<v1::ResultPiece>> writer = stub_->ReportResultInPieces(context, response);
+    const size_t piece_bytes = static_cast<size_t>(std::max<std::int64_t>(max_message_bytes / 2, 4096));
+    for (size_t at = 0; at < serialized.size(); at += piece_bytes) {
+      v1::ResultPiece piece;
+      if (at == 0) {
+        piece.set_worker_id(request.worker_id());
+        piece.set_total_bytes(static_cast<std::int64_t>(serialized.size()));
+        piece.set_next_tasks(request.next_tasks());
+      }
+      piece.set_data(serialized.substr(at, piece_bytes));
+      if (!writer->Write(piece)) break;  // the server ended the call: Finish says why
+    }
+    writer->WritesDone();
+    return writer->Finish();
   }
 
   void HeartbeatLoop() {
@@ -601,6 +639,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
   std::string worker_id_;
   int heartbeat_ms_ = kDefaultHeartbeatMs;
   std::int64_t max_message_bytes_ = 0;  // the server's, from registration; 0: unknown
+  std::int64_t max_result_bytes_ = 0;   // likewise, in pieces; 0: unknown or none
   std::deque<QueuedTask> queue_;
   int busy_ = 0;                          // tasks queued, being evaluated or held as results
   std::vector<v1::TaskResult> held_;      // results waiting to go back with others
