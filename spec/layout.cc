@@ -301,7 +301,8 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
 
 absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
   const Scene& scene = study.scene;
-  if (const StudyFootprint f = EstimateStudyFootprint(study); f.memory_bytes > kMaxStudyMemoryBytes) {
+  const StudyFootprint f = EstimateStudyFootprint(study);
+  if (f.memory_bytes > kMaxStudyMemoryBytes) {
     return LayoutError(
         study, "constraints",
         absl::StrFormat("the study needs about %.1f GB of memory for its %d objective terms and %d constraint rows "
@@ -313,6 +314,10 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
                         static_cast<double>(kMaxStudyMemoryBytes) / (1 << 30)));
   }
   StudyLayout layout;
+  // A million rows grown by doubling would hold about twice their memory at
+  // the last step; the estimate is their number or more (trimmed below).
+  layout.rows.reserve(static_cast<size_t>(f.constraint_rows));
+  layout.objective_terms.reserve(static_cast<size_t>(f.objective_terms));
   layout.instants_s = scene.time_grid.Instants();
   std::vector<std::string> shape_errors;
   layout.outputs = SignalShapes(study, &shape_errors);
@@ -513,6 +518,10 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
         }
       }
     }
+  }
+  if (layout.rows.capacity() > layout.rows.size() + layout.rows.size() / 4) layout.rows.shrink_to_fit();
+  if (layout.objective_terms.capacity() > layout.objective_terms.size() + layout.objective_terms.size() / 4) {
+    layout.objective_terms.shrink_to_fit();
   }
   return layout;
 }

@@ -80,7 +80,8 @@ absl::StatusOr<std::unique_ptr<Job>> Job::Create(spec::Study study, std::unique_
     MBOPT_ASSIGN_OR_RETURN(settings, SlpOptionsFromStudy(study));
   }
   auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), settings, std::move(lp_solver));
-  return std::unique_ptr<Job>(new Job(std::move(study), std::move(layout), settings, std::move(optimizer)));
+  return std::unique_ptr<Job>(new Job(std::move(study), std::make_shared<const spec::StudyLayout>(std::move(layout)),
+                                      settings, std::move(optimizer)));
 }
 
 absl::StatusOr<std::unique_ptr<Job>> Job::CreateForProblem(slp::ProblemSpec problem, slp::SlpOptions options,
@@ -88,10 +89,11 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateForProblem(slp::ProblemSpec prob
   MBOPT_RETURN_IF_ERROR(problem.Validate());
   MBOPT_RETURN_IF_ERROR(options.Validate());
   auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, std::move(lp_solver));
-  return std::unique_ptr<Job>(new Job(spec::Study{}, spec::StudyLayout{}, options, std::move(optimizer)));
+  return std::unique_ptr<Job>(
+      new Job(spec::Study{}, std::make_shared<const spec::StudyLayout>(), options, std::move(optimizer)));
 }
 
-Job::Job(spec::Study study, spec::StudyLayout layout, slp::SlpOptions options,
+Job::Job(spec::Study study, std::shared_ptr<const spec::StudyLayout> layout, slp::SlpOptions options,
          std::unique_ptr<slp::SlpOptimizer> optimizer)
     : study_(std::move(study)),
       layout_(std::move(layout)),

@@ -64,7 +64,11 @@ class Job {
                                                                std::unique_ptr<lp::LpSolver> lp_solver);
 
   const spec::Study& study() const { return study_; }
-  const spec::StudyLayout& layout() const { return layout_; }
+  const spec::StudyLayout& layout() const { return *layout_; }
+  // The same layout, for holders that outlive the job (the job manager's
+  // views): shared, never copied, since its rows' names are most of a large
+  // study's memory.
+  std::shared_ptr<const spec::StudyLayout> shared_layout() const { return layout_; }
   const slp::ProblemSpec& problem() const { return optimizer_->spec(); }
   const slp::SlpOptions& options() const { return options_; }
   const slp::SlpOptimizer& optimizer() const { return *optimizer_; }
@@ -115,11 +119,11 @@ class Job {
   std::vector<double> PhysicalDesign(const Eigen::VectorXd& x_scaled) const;
 
  private:
-  Job(spec::Study study, spec::StudyLayout layout, slp::SlpOptions options,
+  Job(spec::Study study, std::shared_ptr<const spec::StudyLayout> layout, slp::SlpOptions options,
       std::unique_ptr<slp::SlpOptimizer> optimizer);
 
   spec::Study study_;
-  spec::StudyLayout layout_;
+  std::shared_ptr<const spec::StudyLayout> layout_;
   slp::SlpOptions options_;
   std::unique_ptr<slp::SlpOptimizer> optimizer_;
   std::map<spec::FailureKind, std::int64_t> failures_by_kind_;

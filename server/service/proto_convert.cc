@@ -54,15 +54,17 @@ WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
 
 namespace {
 
-std::string RowName(int row, const std::vector<std::string>& row_names) {
+std::string RowName(int row, const spec::StudyLayout* layout) {
   if (row < 0) return "";
-  if (static_cast<size_t>(row) < row_names.size()) return row_names[static_cast<size_t>(row)];
+  if (layout != nullptr && static_cast<size_t>(row) < layout->rows.size()) {
+    return layout->rows[static_cast<size_t>(row)].name;
+  }
   return absl::StrCat("row ", row);
 }
 
 }  // namespace
 
-v1::CycleRecord ToProto(const slp::CycleRecord& r, const std::vector<std::string>& row_names,
+v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layout,
                         const std::vector<double>& variable_scales, double objective_sign) {
   v1::CycleRecord out;
   out.set_cycle(r.cycle);
@@ -80,12 +82,12 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const std::vector<std::string
   out.set_objective_predicted(objective_sign * r.objective_predicted);
   out.set_max_violation_x0(r.max_violation_x0);
   out.set_max_violation_trial(r.max_violation_trial);
-  out.set_worst_constraint(RowName(r.worst_constraint_trial, row_names));
+  out.set_worst_constraint(RowName(r.worst_constraint_trial, layout));
   out.set_objective_error(r.objective_error);
   out.set_max_approximation_error(r.max_approximation_error);
   out.set_optimality_residual(r.optimality_residual);
   out.set_worst_approximation(r.worst_approximation_row < 0 ? "objective"
-                                                            : RowName(r.worst_approximation_row, row_names));
+                                                            : RowName(r.worst_approximation_row, layout));
   out.set_lp_feasible(r.lp_feasible);
   out.set_infeasibility(r.infeasibility);
   out.set_lp_status(r.lp_status);

@@ -15,9 +15,10 @@ namespace mbopt::service {
 
 v1::JobState ToProto(jobs::JobState state);
 v1::JobSummary ToProto(const JobSummaryData& summary);
-// `row_names`, `variable_scales` and `objective_sign` as in JobView: the
-// objective values go out as reported (a maximized value as itself).
-v1::CycleRecord ToProto(const slp::CycleRecord& record, const std::vector<std::string>& row_names,
+// `layout` (may be null: rows go out as "row N"), `variable_scales` and
+// `objective_sign` as in JobView: the objective values go out as reported (a
+// maximized value as itself).
+v1::CycleRecord ToProto(const slp::CycleRecord& record, const spec::StudyLayout* layout,
                         const std::vector<double>& variable_scales, double objective_sign);
 
 // A worker's result as the job manager takes it (the job's intake then

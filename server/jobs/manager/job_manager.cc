@@ -25,7 +25,8 @@ struct JobManager::Entry {
 
   bool study_ok = false;
   spec::Study study;
-  spec::StudyLayout layout;  // while resident
+  // While resident; shared with the job and with views, never copied.
+  std::shared_ptr<const spec::StudyLayout> layout;
   std::unique_ptr<jobs::Job> job;  // the optimizer of the current run; none once it stopped
   // Failed analyses by kind, kept when the optimizer is released.
   std::map<std::string, std::int64_t> failed_analyses_by_kind;
@@ -143,7 +144,7 @@ void JobManager::EvictLocked(Entry& entry) {
 void JobManager::DropContentLocked(Entry& entry) {
   std::vector<slp::CycleRecord>().swap(entry.records);
   entry.study = spec::Study{};
-  entry.layout = spec::StudyLayout{};  // its rows' names are most of a job's memory
+  entry.layout.reset();  // its rows' names are most of a job's memory
   std::string().swap(entry.row.study);
   entry.resident = false;
 }
@@ -157,7 +158,7 @@ void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {
     absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
     if (layout.ok()) {
       entry.study = *std::move(study);
-      entry.layout = *std::move(layout);
+      entry.layout = std::make_shared<const spec::StudyLayout>(*std::move(layout));
       entry.study_ok = true;
     } else {
       entry.message = std::string(layout.status().message());
@@ -248,7 +249,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   auto entry = std::make_shared<Entry>();
   std::lock_guard<std::mutex> entry_lock(entry->mutex);
   entry->row = std::move(stored);
-  entry->layout = job->layout();
+  entry->layout = job->shared_layout();
   entry->study = std::move(study);
   entry->study_ok = true;
   entry->job = std::move(job);
@@ -300,7 +301,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", unlogged.status().message()));
     return unlogged.status();
   }
-  entry.layout = (*job)->layout();
+  entry.layout = (*job)->shared_layout();
   entry.job = *std::move(job);
   entry.records = std::move(decoded);
   absl::Status status = EnterStateLocked(
@@ -615,7 +616,7 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
   view.version = entry.version;
   view.ended = !Running(entry.state);
   if (entry.study_ok) {
-    for (const spec::ConstraintRow& row : entry.layout.rows) view.row_names.push_back(row.name);
+    view.layout = entry.layout;
     for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
     view.objective_sign = entry.study.objective.ReportedSign();
   }

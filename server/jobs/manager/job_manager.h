@@ -93,7 +93,9 @@ struct JobView {
   std::size_t first_record = 0;           // index of records[0] in the job's log
   std::int64_t version = 0;               // changes with every record or state change
   bool ended = false;                     // the job is not running (nothing more will come)
-  std::vector<std::string> row_names;     // constraint rows, for worst_* indices
+  // The study's layout (constraint rows' names, for worst_* indices);
+  // null when the study is not usable.
+  std::shared_ptr<const spec::StudyLayout> layout;
   std::vector<double> variable_scales;    // physical = scale * x
   double objective_sign = 1.0;            // reported F = sign * the records' F (-1: maximized)
   std::string study_bytes;
