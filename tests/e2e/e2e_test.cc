@@ -577,15 +577,22 @@ TEST(BadInput, MutatedExamplesAgreeBetweenValidateAndWorkerEval) {
   EXPECT_GT(accepted, 0);
 }
 
+// The vehicle study on 20,001 instants, written to `dir`: results of about
+// 0.19 MB of packed values (1.9 MB unpacked). "" if the example is missing.
+std::string FineVehicleStudy(ScratchDir& dir) {
+  v1::Study study;
+  const std::string text = InlinedVehicleStudy(&study);
+  if (text.empty()) return "";
+  return dir.Write("fine.study.textproto", text + "analysis { time_grid_points: 20001 }\n");
+}
+
 // A result over the message limit goes in pieces: with 64 KiB messages and
 // results of about 0.19 MB (20,001 instants, packed), the job ends exactly as
 // with the default limits.
 TEST(LargeResults, OverTheMessageLimitTheyGoInPiecesAndTheResultIsTheSame) {
   ScratchDir dir;
-  v1::Study study;
-  const std::string text = InlinedVehicleStudy(&study);
-  ASSERT_FALSE(text.empty());
-  const std::string path = dir.Write("fine.study.textproto", text + "analysis { time_grid_points: 20001 }\n");
+  const std::string path = FineVehicleStudy(dir);
+  ASSERT_FALSE(path.empty());
   auto server = StartServer(dir.File("jobs.db"), {"--max-message-mb", "0.0625"}, "127.0.0.1:0", dir.File("server.log"));
   ASSERT_TRUE(server.ok()) << server.status();
   Subprocess worker = StartWorker(server->address);
@@ -601,11 +608,8 @@ TEST(LargeResults, OverTheMessageLimitTheyGoInPiecesAndTheResultIsTheSame) {
 // leases and failed with "lease expired").
 TEST(BadInput, ResultOverTheServersLimitIsANamedFailure) {
   ScratchDir dir;
-  v1::Study study;
-  const std::string text = InlinedVehicleStudy(&study);
-  ASSERT_FALSE(text.empty());
-  // About 0.19 MB of values packed (20,001 instants; 1.9 MB unpacked).
-  const std::string path = dir.Write("fine.study.textproto", text + "analysis { time_grid_points: 20001 }\n");
+  const std::string path = FineVehicleStudy(dir);
+  ASSERT_FALSE(path.empty());
   auto server = StartServer(dir.File("jobs.db"), {"--max-message-mb", "0.0625", "--max-result-mb", "0.125"},
                             "127.0.0.1:0", dir.File("server.log"));
   ASSERT_TRUE(server.ok()) << server.status();
