@@ -417,6 +417,12 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::Ana
     for (slp::CycleRecord& r : *records) emitted.push_back(std::move(r));
   }
   if (applied.empty()) return absl::OkStatus();
+  // The next tasks go out before the commit, so that workers analyse while
+  // it syncs: a task is not a record anyone has seen, its result cannot be
+  // taken before this commit (it needs the job's lock held here), a failed
+  // commit drops the job's tasks with the job, and after a crash the resume
+  // asks for them again.
+  ScheduleLocked(entry);
   if (!emitted.empty() || !entry.job->running()) {
     MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, std::move(emitted), applied));
   } else if (absl::Status status = store_->Commit(store::JobWrite{entry.row.id, applied, {}, std::nullopt});
@@ -424,7 +430,6 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::Ana
     FailJobLocked(entry, absl::StrCat("cannot log analyses: ", status.message()));
     return status;
   }
-  ScheduleLocked(entry);
   Changed(entry);
   return absl::OkStatus();
 }
