@@ -196,7 +196,7 @@ absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, c
   return done;
 }
 
-std::optional<FinishedTask> Scheduler::FailLocked(const Key& key, const std::string& reason) {
+std::optional<FinishedTask> Scheduler::FailLocked(Key key, const std::string& reason) {
   Entry& entry = entries_.at(key);
   leases_.erase(entry.task_id);
   entry.leased = false;

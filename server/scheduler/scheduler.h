@@ -190,7 +190,8 @@ class Scheduler {
   int FairShareLocked(const std::string& worker_id) const;
   bool HasOtherLiveWorker(const std::string& worker_id, const std::set<std::string>& excluded) const;
   // Records a failed attempt; returns the finished task if it is given up.
-  std::optional<FinishedTask> FailLocked(const Key& key, const std::string& reason);
+  // The key by value: a caller's may live in the lease this erases.
+  std::optional<FinishedTask> FailLocked(Key key, const std::string& reason);
   // Fails every leased attempt for which `lost` holds, with `reason`; sets
   // *requeued when one was queued again. Returns the tasks given up.
   std::vector<FinishedTask> FailLeasesLocked(const std::function<bool(const Entry&)>& lost,

@@ -283,6 +283,36 @@ TEST(Scheduler, TaskIsGivenUpAfterThreeFailedAttempts) {
   EXPECT_FALSE(scheduler.Enqueue("job-1", 3, {}));  // never retried again
 }
 
+// Failures reported by workers (not expired leases) requeue the task under
+// its own job and give it up on the third. Fail once passed the key stored
+// in the lease it erased, and used it afterwards (a server crashed on it); a
+// job id longer than the short-string buffer puts that key's text on the
+// heap, where a dangling use is likelier to show.
+TEST(Scheduler, FailuresReportedByWorkersRequeueUnderTheJobAndGiveUpOnTheThird) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  const std::string job = "job-with-a-name-longer-than-fifteen-characters";
+  scheduler.Enqueue(job, 3, {0.25});
+  const std::string a = scheduler.RegisterWorker("a", 1);
+  const std::string b = scheduler.RegisterWorker("b", 1);
+  const std::string c = scheduler.RegisterWorker("c", 1);
+  absl::StatusOr<std::optional<FinishedTask>> failed;
+  for (const std::string& worker : {a, b, c}) {
+    auto tasks = scheduler.Acquire(worker, 1);
+    ASSERT_TRUE(tasks.ok());
+    ASSERT_EQ(tasks->size(), 1u) << worker;
+    EXPECT_EQ(tasks->front().job_id, job);
+    failed = scheduler.Fail(worker, tasks->front().task_id, "cannot load the study");
+    ASSERT_TRUE(failed.ok()) << failed.status();
+  }
+  ASSERT_TRUE(failed->has_value());
+  EXPECT_EQ((*failed)->job_id, job);
+  EXPECT_EQ((*failed)->request_id, 3);
+  EXPECT_EQ(scheduler.QueuedCount(), 0);
+  EXPECT_EQ(scheduler.LeasedCount(), 0);
+  EXPECT_FALSE(scheduler.Enqueue(job, 3, {}));  // never retried again
+}
+
 TEST(Scheduler, LateResultIsTakenIfNoOtherAttemptFinished) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());
