@@ -78,6 +78,20 @@ TEST(PackedDoubles, SmoothSeriesOfMaxAbsRowsPackTenfold) {
   EXPECT_LT(packed.size() * 10, rows.size() * sizeof(double)) << packed.size() << " bytes";
 }
 
+// A cheap analysis' few values are stored (byte 1 of the packing: 0), not
+// deflated: deflate's set-up would cost more than the analysis. A fine grid's
+// are deflated (1).
+TEST(PackedDoubles, SmallPayloadsAreStoredAndLargeOnesDeflated) {
+  const std::vector<double> few = MaxAbsRows(20);
+  const std::string small = PackDoubles(few);
+  ASSERT_GT(small.size(), 2u);
+  EXPECT_EQ(small[1], 0);
+  EXPECT_LT(small.size(), few.size() * sizeof(double));
+  ExpectSameBits(few, RoundTrip(few));
+  const std::string large = PackDoubles(MaxAbsRows(30001));
+  EXPECT_EQ(large[1], 1);
+}
+
 TEST(PackedDoubles, RefusesMoreValuesThanTheCallerExpects) {
   const std::string packed = PackDoubles(MaxAbsRows(100));
   const absl::StatusOr<std::vector<double>> unpacked = UnpackDoubles(packed, 199);
