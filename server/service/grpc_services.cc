@@ -151,6 +151,7 @@ grpc::Status WorkerServiceImpl::Register(grpc::ServerContext* context, const v1:
   response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));
   response->set_max_message_bytes(max_message_bytes_);
   response->set_max_result_bytes(max_result_bytes_);
+  response->set_takes_packed_values(true);
   return grpc::Status::OK;
 }
 

@@ -1,5 +1,6 @@
 #include "worker/service/task_evaluator.h"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,20 @@ absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Stud
   if (!layout.ok()) return layout.status();
   prepared->layout = *std::move(layout);
   return std::shared_ptr<const PreparedStudy>(std::move(prepared));
+}
+
+void UnpackValuesForAnOlderServer(v1::TaskResult* result) {
+  auto unpack = [](const std::string& packed_values, google::protobuf::RepeatedField<double>* out) {
+    if (packed_values.empty()) return;
+    // The worker's own packing: it unpacks.
+    absl::StatusOr<std::vector<double>> values =
+        packed::UnpackDoubles(packed_values, std::numeric_limits<std::size_t>::max());
+    if (values.ok()) out->Assign(values->begin(), values->end());
+  };
+  unpack(result->objective_terms_packed(), result->mutable_objective_terms());
+  unpack(result->constraint_values_packed(), result->mutable_constraint_values());
+  result->clear_objective_terms_packed();
+  result->clear_constraint_values_packed();
 }
 
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, v1::TaskResult* result) {

@@ -35,6 +35,10 @@ absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Stud
 
 // Fills everything of `result` except worker_id, task_id, job_id and
 // request_id.
+// For a server that does not read packed values (RegisterWorkerResponse.
+// takes_packed_values): the result's values moved into the unpacked fields.
+void UnpackValuesForAnOlderServer(v1::TaskResult* result);
+
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task,
                   v1::TaskResult* result);
 

@@ -209,6 +209,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
                                                          : kDefaultHeartbeatMs;
     max_message_bytes_ = response.max_message_bytes();
     max_result_bytes_ = response.max_result_bytes();
+    takes_packed_values_ = response.takes_packed_values();
     registered_ = true;
     Log(absl::StrCat("registered with ", options_.server_address, " as ", worker_id_, " (",
                      options_.slots, " slots)"));
@@ -327,14 +328,17 @@ class Worker : public std::enable_shared_from_this<Worker> {
       bool deliver = true;
       std::int64_t max_message_bytes = 0;
       std::int64_t max_result_bytes = 0;
+      bool takes_packed_values = false;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         max_message_bytes = max_message_bytes_;
         max_result_bytes = max_result_bytes_;
+        takes_packed_values = takes_packed_values_;
       }
       const auto started = std::chrono::steady_clock::now();
       if (study != nullptr) {
         EvaluateTask(*study, task, &result);
+        if (!takes_packed_values) UnpackValuesForAnOlderServer(&result);
         FitResultToServerLimit(max_message_bytes, max_result_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
@@ -640,6 +644,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
   int heartbeat_ms_ = kDefaultHeartbeatMs;
   std::int64_t max_message_bytes_ = 0;  // the server's, from registration; 0: unknown
   std::int64_t max_result_bytes_ = 0;   // likewise, in pieces; 0: unknown or none
+  bool takes_packed_values_ = false;    // likewise; false: send values unpacked
   std::deque<QueuedTask> queue_;
   int busy_ = 0;                          // tasks queued, being evaluated or held as results
   std::vector<v1::TaskResult> held_;      // results waiting to go back with others
