@@ -278,15 +278,13 @@ grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* contex
   return TakeResults(request, response);
 }
 
-grpc::Status WorkerServiceImpl::TakeResults(const v1::TaskResults& request_message,
-                                            v1::ReportResultsResponse* response) {
-  const v1::TaskResults* request = &request_message;
+grpc::Status WorkerServiceImpl::TakeResults(const v1::TaskResults& request, v1::ReportResultsResponse* response) {
   std::vector<WorkerReport> reports;
   std::vector<int> report_index;  // the answer of each report
   // Each result names the registration its task was leased under (a worker
   // that registered again may still report tasks of the old one).
-  for (int i = 0; i < request->results_size(); ++i) {
-    const v1::TaskResult& result = request->results(i);
+  for (int i = 0; i < request.results_size(); ++i) {
+    const v1::TaskResult& result = request.results(i);
     v1::ResultAnswer* answer = response->add_answers();
     if (result.retry()) {
       const absl::StatusOr<bool> accepted = ReportRetry(result);
@@ -311,7 +309,7 @@ grpc::Status WorkerServiceImpl::TakeResults(const v1::TaskResults& request_messa
       answer->set_error(std::string(taken[k].status().message()));
     }
   }
-  LeaseNextTasks(request->worker_id(), request->next_tasks(), response->mutable_tasks());
+  LeaseNextTasks(request.worker_id(), request.next_tasks(), response->mutable_tasks());
   return grpc::Status::OK;
 }
 

@@ -62,7 +62,7 @@ TEST(TaskEvaluator, ValuesAlignWithTheStudyLayout) {
   auto prepared = PrepareStudy(proto, "job-1");
   ASSERT_TRUE(prepared.ok()) << prepared.status();
   v1::TaskResult result;
-  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), &result);
+  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), ValueEncoding::kPacked, &result);
   ASSERT_TRUE(result.ok()) << result.failure_reason();
   // Sent packed only.
   EXPECT_EQ(result.objective_terms_size(), 0);
@@ -80,7 +80,7 @@ TEST(TaskEvaluator, WrongDimensionIsAFailedResultNotACrash) {
   auto prepared = PrepareStudy(proto, "job-1");
   ASSERT_TRUE(prepared.ok()) << prepared.status();
   v1::TaskResult result;
-  EvaluateTask(**prepared, TaskAt({1.0}), &result);
+  EvaluateTask(**prepared, TaskAt({1.0}), ValueEncoding::kPacked, &result);
   EXPECT_FALSE(result.ok());
   EXPECT_NE(result.failure_reason().find("design variables"), std::string::npos)
       << result.failure_reason();
@@ -94,7 +94,7 @@ TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
   std::vector<double> x = InitialDesign(proto);
   x[0] = std::numeric_limits<double>::quiet_NaN();
   v1::TaskResult result;
-  EvaluateTask(**prepared, TaskAt(x), &result);
+  EvaluateTask(**prepared, TaskAt(x), ValueEncoding::kPacked, &result);
   EXPECT_FALSE(result.ok());
   EXPECT_EQ(result.objective_terms_size(), 0);
   EXPECT_TRUE(result.objective_terms_packed().empty());
@@ -103,7 +103,7 @@ TEST(TaskEvaluator, NonFiniteInputsOrValuesAreFailedResults) {
   // come back as a failure with a reason, never as values.
   std::vector<double> huge(x.size(), 1e300);
   v1::TaskResult overflow;
-  EvaluateTask(**prepared, TaskAt(huge), &overflow);
+  EvaluateTask(**prepared, TaskAt(huge), ValueEncoding::kPacked, &overflow);
   EXPECT_FALSE(overflow.ok());
   EXPECT_FALSE(overflow.failure_reason().empty());
   // A kind the server can count: never "unspecified" for a failed result.
@@ -115,7 +115,7 @@ TEST(TaskEvaluator, NoGradientsUnlessTheTaskAsks) {
   auto prepared = PrepareStudy(proto, "job-1");
   ASSERT_TRUE(prepared.ok()) << prepared.status();
   v1::TaskResult result;
-  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), &result);
+  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), ValueEncoding::kPacked, &result);
   ASSERT_TRUE(result.ok()) << result.failure_reason();
   EXPECT_EQ(result.objective_gradients_size(), 0);
   EXPECT_EQ(result.constraint_gradients_size(), 0);
@@ -132,7 +132,7 @@ TEST(TaskEvaluator, GradientsWhenAskedAreTheEnginesRowMajor) {
   v1::AnalysisTask task = TaskAt(x);
   task.set_want_gradients(true);
   v1::TaskResult result;
-  EvaluateTask(**prepared, task, &result);
+  EvaluateTask(**prepared, task, ValueEncoding::kPacked, &result);
   ASSERT_TRUE(result.ok()) << result.failure_reason();
   EXPECT_EQ(result.gradients_unavailable(), "");
   const size_t n = x.size();
@@ -159,7 +159,7 @@ TEST(TaskEvaluator, GradientsWhenAskedAreTheEnginesRowMajor) {
   }
   // Deterministic: the same task gives the same bits again.
   v1::TaskResult again;
-  EvaluateTask(**prepared, task, &again);
+  EvaluateTask(**prepared, task, ValueEncoding::kPacked, &again);
   ASSERT_EQ(again.objective_gradients_size(), result.objective_gradients_size());
   ASSERT_EQ(again.constraint_gradients_size(), result.constraint_gradients_size());
   EXPECT_EQ(std::memcmp(again.objective_gradients().data(), result.objective_gradients().data(),
@@ -186,7 +186,7 @@ TEST(TaskEvaluator, StudyWithoutSimulatorSensitivitiesGivesValuesAndTheReason) {
   v1::AnalysisTask task = TaskAt(InitialDesign(proto));
   task.set_want_gradients(true);
   v1::TaskResult result;
-  EvaluateTask(**prepared, task, &result);
+  EvaluateTask(**prepared, task, ValueEncoding::kPacked, &result);
   ASSERT_TRUE(result.ok()) << result.failure_reason();
   EXPECT_EQ(Unpacked(result.objective_terms_packed()).size(),
             static_cast<size_t>((*prepared)->layout.num_objective_terms()));

@@ -612,7 +612,8 @@ TEST_F(ServerTest, ResultInPiecesOverTheLimitOrNotAddingUpIsRefused) {
   auto send = [&](std::int64_t total, const std::vector<std::string>& pieces) {
     grpc::ClientContext context;
     v1::ReportResultsResponse response;
-    auto writer = worker.stub().ReportResultInPieces(&context, &response);
+    std::unique_ptr<grpc::ClientWriter<v1::ResultPiece>> writer =
+        worker.stub().ReportResultInPieces(&context, &response);
     for (size_t i = 0; i < pieces.size(); ++i) {
       v1::ResultPiece piece;
       if (i == 0) {

@@ -1,6 +1,5 @@
 #include "worker/service/task_evaluator.h"
 
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,21 +42,8 @@ absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Stud
   return std::shared_ptr<const PreparedStudy>(std::move(prepared));
 }
 
-void UnpackValuesForAnOlderServer(v1::TaskResult* result) {
-  auto unpack = [](const std::string& packed_values, google::protobuf::RepeatedField<double>* out) {
-    if (packed_values.empty()) return;
-    // The worker's own packing: it unpacks.
-    absl::StatusOr<std::vector<double>> values =
-        packed::UnpackDoubles(packed_values, std::numeric_limits<std::size_t>::max());
-    if (values.ok()) out->Assign(values->begin(), values->end());
-  };
-  unpack(result->objective_terms_packed(), result->mutable_objective_terms());
-  unpack(result->constraint_values_packed(), result->mutable_constraint_values());
-  result->clear_objective_terms_packed();
-  result->clear_constraint_values_packed();
-}
-
-void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, v1::TaskResult* result) {
+void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
+                  v1::TaskResult* result) {
   const std::vector<double> x(task.x_scaled().begin(), task.x_scaled().end());
   absl::StatusOr<engine::StudyEvaluation> evaluation =
       engine::EvaluateStudy(prepared.study, prepared.layout, x, task.want_gradients());
@@ -79,8 +65,15 @@ void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, v
   result->set_failure_kind(v1::ANALYSIS_FAILURE_KIND_UNSPECIFIED);
   result->clear_objective_terms();
   result->clear_constraint_values();
-  result->set_objective_terms_packed(packed::PackDoubles(values.objective_terms));
-  result->set_constraint_values_packed(packed::PackDoubles(values.constraint_values));
+  result->clear_objective_terms_packed();
+  result->clear_constraint_values_packed();
+  if (encoding == ValueEncoding::kPacked) {
+    result->set_objective_terms_packed(packed::PackDoubles(values.objective_terms));
+    result->set_constraint_values_packed(packed::PackDoubles(values.constraint_values));
+  } else {
+    result->mutable_objective_terms()->Assign(values.objective_terms.begin(), values.objective_terms.end());
+    result->mutable_constraint_values()->Assign(values.constraint_values.begin(), values.constraint_values.end());
+  }
   if (!task.want_gradients()) return;
   if (evaluation->gradients.has_value()) {
     AppendRowMajor(evaluation->gradients->objective_terms, result->mutable_objective_gradients());

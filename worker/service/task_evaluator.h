@@ -33,13 +33,14 @@ struct PreparedStudy {
 absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Study& study,
                                                                   const std::string& job_id);
 
+// How a result carries its values: packed (common/packed_doubles) for a
+// server that reads them, as repeated doubles for an older one
+// (RegisterWorkerResponse.takes_packed_values).
+enum class ValueEncoding { kPacked, kUnpacked };
+
 // Fills everything of `result` except worker_id, task_id, job_id and
 // request_id.
-// For a server that does not read packed values (RegisterWorkerResponse.
-// takes_packed_values): the result's values moved into the unpacked fields.
-void UnpackValuesForAnOlderServer(v1::TaskResult* result);
-
-void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task,
+void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
                   v1::TaskResult* result);
 
 }  // namespace mbopt::worker

@@ -337,8 +337,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
       }
       const auto started = std::chrono::steady_clock::now();
       if (study != nullptr) {
-        EvaluateTask(*study, task, &result);
-        if (!takes_packed_values) UnpackValuesForAnOlderServer(&result);
+        EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result);
         FitResultToServerLimit(max_message_bytes, max_result_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
