@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <string>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "server/service/proto_convert.h"
@@ -14,6 +16,7 @@ namespace {
 
 // How often a Watch stream checks whether its client went away.
 constexpr std::int64_t kWatchPollMs = 250;
+constexpr std::int64_t kSummaryIntervalMs = 50;
 
 std::int64_t NowUnixMs() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -94,14 +97,40 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   if (absl::Status access = CheckJobAccess(*context, "Watch", request->job_id()); !access.ok()) {
     return ToGrpcStatus(access);
   }
+  if (absl::Status status = manager_->StartWatching(request->job_id()); !status.ok()) return ToGrpcStatus(status);
+  absl::Cleanup stop_watching = [this, request] { manager_->StopWatching(request->job_id()); };
   std::size_t next_record = 0;
   std::int64_t version = -1;
+  // A job of cheap analyses changes hundreds of times a second; a summary
+  // that brings no record goes out at most every kSummaryIntervalMs (the
+  // last one held back is sent when the interval ends), so watching does not
+  // cost the server a message per batch of results. Records and the final
+  // summary go out at once.
+  std::optional<v1::JobEvent> held_summary;
+  const auto interval = std::chrono::milliseconds(kSummaryIntervalMs);
+  auto last_summary = std::chrono::steady_clock::time_point{};
+  auto summary_due = [&] { return std::chrono::steady_clock::now() >= last_summary + interval; };
+  // `event` may be the held summary itself: it is written before it is dropped.
+  auto write_summary = [&](const v1::JobEvent& event) {
+    last_summary = std::chrono::steady_clock::now();
+    const bool written = writer->Write(event);
+    held_summary.reset();
+    return written;
+  };
   while (!context->IsCancelled()) {
+    std::int64_t wait_ms = kWatchPollMs;
+    if (held_summary) {
+      const auto left = last_summary + interval - std::chrono::steady_clock::now();
+      wait_ms = std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::milliseconds>(left).count());
+    }
     absl::StatusOr<JobView> view =
-        version < 0 ? manager_->Get(request->job_id(), 0)
-                    : manager_->WaitForChange(request->job_id(), next_record, version, kWatchPollMs);
+        version < 0 ? manager_->Get(request->job_id(), 0, JobViewFor::kWatcher)
+                    : manager_->WaitForChange(request->job_id(), next_record, version, wait_ms);
     if (!view.ok()) return ToGrpcStatus(view.status());
-    if (view->version == version) continue;
+    if (view->version == version) {
+      if (held_summary && summary_due() && !write_summary(*held_summary)) return grpc::Status::CANCELLED;
+      continue;
+    }
     version = view->version;
     for (const slp::CycleRecord& r : view->records) {
       v1::JobEvent event;
@@ -111,7 +140,11 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
     next_record = view->first_record + view->records.size();
     v1::JobEvent summary;
     *summary.mutable_summary() = ToProto(view->summary);
-    if (!writer->Write(summary)) return grpc::Status::CANCELLED;
+    if (view->records.empty() && !view->ended && !summary_due()) {
+      held_summary = std::move(summary);
+      continue;
+    }
+    if (!write_summary(summary)) return grpc::Status::CANCELLED;
     if (view->ended) return grpc::Status::OK;
   }
   return grpc::Status::CANCELLED;

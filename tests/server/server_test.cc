@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -853,6 +854,51 @@ TEST_F(ServerTest, WatchReplaysPastRecordsThenStreamsUntilTheJobEnds) {
   EXPECT_TRUE(reader->Finish().ok());
   EXPECT_EQ(last.state(), v1::JOB_STATE_CONVERGED);
   EXPECT_EQ(records_before + streamed, Get(*server, id).cycles_size());
+}
+
+
+TEST_F(ServerTest, WatchSendsProgressAtMostEvery50MsAndEndsFromMemory) {
+  auto server = StartServer("a.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::JobRef ref;
+  ref.set_job_id(id);
+  auto reader = stub->Watch(&context, ref);
+  v1::JobEvent event;
+  ASSERT_TRUE(reader->Read(&event));  // the first summary, before any result
+  ASSERT_TRUE(event.has_summary());
+  const auto started = std::chrono::steady_clock::now();
+  // Every result changes the job; most bring no cycle record.
+  FakeWorker worker(server->InProcessChannel(), 13);
+  std::thread answering([&] { worker.Run(); });
+  int records = 0;
+  int summaries_alone = 0;  // summaries that follow a summary: progress only
+  bool after_summary = true;
+  v1::JobSummary last;
+  while (reader->Read(&event)) {
+    if (event.has_cycle()) {
+      ++records;
+      after_summary = false;
+    } else if (event.has_summary()) {
+      if (after_summary) ++summaries_alone;
+      after_summary = true;
+      last = event.summary();
+    }
+  }
+  const double watched_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  answering.join();
+  EXPECT_TRUE(reader->Finish().ok());
+  EXPECT_EQ(last.state(), v1::JOB_STATE_CONVERGED);
+  const v1::GetJobResponse job = Get(*server, id);
+  EXPECT_EQ(records, job.cycles_size());
+  // The job changes with every result taken (about 40 in some 30 ms here);
+  // each watcher hears of it at most every 50 ms unless a record comes.
+  EXPECT_LE(summaries_alone, static_cast<int>(watched_s / 0.05) + 1)
+      << job.summary().analyses() << " analyses in " << watched_s << " s";
+  // The watcher's last views came from memory: the job gave up its study
+  // and records once, when the stream ended, and the Get above read them back.
+  EXPECT_EQ(server->manager().Evictions(), 2);
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ const char* ServeUsage() {
          "  --slots N            analyses run at once (default 1)\n"
          "  --name NAME          name shown by the server (default host:pid)\n"
          "  --batch N            take up to N tasks at a time and report their results\n"
-         "                       together (default 16, at most 64; never fewer than\n"
+         "                       together (default and most 64; never fewer than\n"
          "                       --slots); the server gives no worker more than its\n"
          "                       share of the work outstanding. 1: one task per slot\n"
          "  --tls-ca FILE        connect over TLS, trusting the server's certificate\n"

@@ -33,7 +33,7 @@ struct WorkerOptions {
   // at least `slots`: tasks handed out together run back to back and their
   // results go back in one call (one round trip and one commit for all).
   // The server caps it at the worker's share of the work outstanding.
-  int batch = 16;
+  int batch = kMaxBatch;
   std::string name;            // shown on the server; empty: host:pid
   // Long-poll length of AcquireTasks.
   int acquire_wait_ms = 5000;

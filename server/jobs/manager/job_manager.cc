@@ -40,6 +40,7 @@ struct JobManager::Entry {
   // grow with the number of finished jobs.
   bool resident = true;
   JobSummaryData stopped_summary;
+  int watchers = 0;  // watch streams open on the job: it stays resident for them
 
   double wall_before_s = 0;  // running time of earlier runs
   bool timing = false;
@@ -135,7 +136,7 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
 }
 
 void JobManager::EvictLocked(Entry& entry) {
-  if (!entry.resident || Running(entry.state) || entry.job != nullptr) return;
+  if (!entry.resident || Running(entry.state) || entry.job != nullptr || entry.watchers > 0) return;
   entry.stopped_summary = SummaryLocked(entry);
   DropContentLocked(entry);
   evictions_.fetch_add(1, std::memory_order_relaxed);
@@ -613,7 +614,7 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   return s;
 }
 
-JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) const {
+JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record, JobViewFor view_for) const {
   JobView view;
   view.summary = SummaryLocked(entry);
   view.first_record = std::min(first_record, entry.records.size());
@@ -625,19 +626,21 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record) con
     for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
     view.objective_sign = entry.study.objective.ReportedSign();
   }
-  view.study_bytes = entry.row.study;
+  if (view_for == JobViewFor::kReader) view.study_bytes = entry.row.study;
   return view;
 }
 
-absl::StatusOr<JobView> JobManager::Get(const std::string& job_id, std::size_t first_record) {
+absl::StatusOr<JobView> JobManager::Get(const std::string& job_id, std::size_t first_record,
+                                        JobViewFor view_for) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
-  return RestoredViewLocked(*entry, first_record);
+  return RestoredViewLocked(*entry, first_record, view_for);
 }
 
-absl::StatusOr<JobView> JobManager::RestoredViewLocked(Entry& entry, std::size_t first_record) {
+absl::StatusOr<JobView> JobManager::RestoredViewLocked(Entry& entry, std::size_t first_record,
+                                                       JobViewFor view_for) {
   MBOPT_RETURN_IF_ERROR(RestoreLocked(entry));
-  JobView view = ViewLocked(entry, first_record);
+  JobView view = ViewLocked(entry, first_record, view_for);
   EvictLocked(entry);
   return view;
 }
@@ -702,7 +705,22 @@ absl::StatusOr<JobView> JobManager::WaitForChange(const std::string& job_id, std
   // A real-time wait: watchers are people, not the job's clock.
   entry->changed.wait_for(lock, std::chrono::milliseconds(std::max<std::int64_t>(0, max_wait_ms)),
                           [&] { return entry->version != version_seen; });
-  return RestoredViewLocked(*entry, first_record);
+  return RestoredViewLocked(*entry, first_record, JobViewFor::kWatcher);
+}
+
+absl::Status JobManager::StartWatching(const std::string& job_id) {
+  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
+  std::lock_guard<std::mutex> lock(entry->mutex);
+  entry->watchers += 1;
+  return absl::OkStatus();
+}
+
+void JobManager::StopWatching(const std::string& job_id) {
+  absl::StatusOr<std::shared_ptr<Entry>> entry = Find(job_id);
+  if (!entry.ok()) return;
+  std::lock_guard<std::mutex> lock((*entry)->mutex);
+  (*entry)->watchers -= 1;
+  EvictLocked(**entry);
 }
 
 std::size_t JobManager::ResidentJobs() {

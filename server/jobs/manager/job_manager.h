@@ -5,12 +5,13 @@
 // domain types only (the gRPC services translate).
 //
 // Ordering, per job (under the job's mutex): a batch of results (one or
-// more that a worker reported together) is given to the optimizer; the
-// results and the records they made it emit are committed in one
-// transaction with the job's progress; only then are the records published
-// to watchers, the worker told its results were taken, and the optimizer's
-// new requests queued. So a result or record is durable before anyone sees
-// it, and a crash at any point is repaired by replay (job.h).
+// more that a worker reported together) is given to the optimizer; its new
+// requests are queued (a task is not a record: workers start on them while
+// the commit syncs); the results and the records they made it emit are
+// committed in one transaction with the job's progress; only then are the
+// records published to watchers and the worker told its results were taken.
+// So a result or record is durable before anyone sees it, and a crash at
+// any point is repaired by replay (job.h).
 //
 // Every change of a job's state goes through one function (EnterStateLocked),
 // which persists it, logs the event and wakes watchers; a store error on the
@@ -101,6 +102,10 @@ struct JobView {
   std::string study_bytes;
 };
 
+// Who a view is for: a reader (Get) gets the study's bytes as well; a
+// watcher does not need them.
+enum class JobViewFor { kReader, kWatcher };
+
 // One result from a worker: where it goes, and the candidate record the
 // job's intake validates (request_id set; x_scaled and attempts are the
 // scheduler's).
@@ -131,7 +136,8 @@ class JobManager {
   absl::StatusOr<std::string> OwnerOf(const std::string& job_id);
 
   // NotFound naming the id for an unknown job.
-  absl::StatusOr<JobView> Get(const std::string& job_id, std::size_t first_record = 0);
+  absl::StatusOr<JobView> Get(const std::string& job_id, std::size_t first_record = 0,
+                              JobViewFor view_for = JobViewFor::kReader);
   absl::StatusOr<std::vector<JobSummaryData>> List();
   // FailedPrecondition when the job has already ended.
   absl::StatusOr<JobSummaryData> Cancel(const std::string& job_id);
@@ -140,7 +146,8 @@ class JobManager {
   absl::StatusOr<JobSummaryData> Resume(const std::string& job_id);
 
   // Waits (real time, at most `max_wait_ms`) until the job's version differs
-  // from `version_seen`, then returns its records from `first_record` on.
+  // from `version_seen`, then returns its records from `first_record` on
+  // (a watcher's view).
   absl::StatusOr<JobView> WaitForChange(const std::string& job_id, std::size_t first_record,
                                         std::int64_t version_seen, std::int64_t max_wait_ms);
 
@@ -169,6 +176,13 @@ class JobManager {
   // The worker's connection closed: its tasks are requeued now
   // (Scheduler::WorkerLost), and those out of attempts reported as failed.
   void WorkerLost(const std::string& worker_id);
+
+  // A watch stream opens and ends on the job: while one is open, a job
+  // that stops keeps its study and records in memory, so the stream's last
+  // views (the final records, then the summary) are not read back from the
+  // database. NotFound for an unknown job.
+  absl::Status StartWatching(const std::string& job_id);
+  void StopWatching(const std::string& job_id);
 
   // Jobs whose study and records are in memory: the running ones (a
   // stopped job keeps only its summary; views read the rest from the
@@ -207,14 +221,14 @@ class JobManager {
   // false and the reason in message.
   void LoadContentLocked(Entry& entry, absl::Status* cycles_status);
   // A stopped job gives up its study and records, keeping its summary; a
-  // running one is left alone. RestoreLocked reads them back.
+  // running or watched one is left alone. RestoreLocked reads them back.
   void EvictLocked(Entry& entry);
   // Frees the study, its bytes and the records (EvictLocked without a new
   // summary).
   void DropContentLocked(Entry& entry);
   absl::Status RestoreLocked(Entry& entry);
   // The view of a job whose records may have to be read from the database.
-  absl::StatusOr<JobView> RestoredViewLocked(Entry& entry, std::size_t first_record);
+  absl::StatusOr<JobView> RestoredViewLocked(Entry& entry, std::size_t first_record, JobViewFor view_for);
   // Validates a worker's result for the job (the task, the request still
   // pending, the job's intake) and completes its task: the record to
   // deliver; nullopt when it is to be dropped (not outstanding any more);
@@ -230,7 +244,7 @@ class JobManager {
   void ScheduleLocked(Entry& entry);
   void FailJobLocked(Entry& entry, const std::string& message);
   JobSummaryData SummaryLocked(const Entry& entry) const;
-  JobView ViewLocked(const Entry& entry, std::size_t first_record) const;
+  JobView ViewLocked(const Entry& entry, std::size_t first_record, JobViewFor view_for) const;
   double WallSecondsLocked(const Entry& entry) const;
   void Changed(Entry& entry);
   // The record of a task the scheduler gave up on (attempts used up, or a
