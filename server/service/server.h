@@ -78,6 +78,7 @@ class MboptServer {
   std::shared_ptr<grpc::Channel> InProcessChannel();
   JobManager& manager() { return *manager_; }
   scheduler::Scheduler& scheduler() { return *scheduler_; }
+  store::Store& store() { return *store_; }  // for tests
 
   // Reads the token table file again and uses it for the calls that start
   // after (SIGHUP of mbopt-server). On error the table in use stays.

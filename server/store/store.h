@@ -109,6 +109,11 @@ class Store {
   // that one that fails fails alone; a caller never waits for more than the
   // commit under way and its own.
   absl::Status Commit(const JobWrite& write);
+  // Commits `writes` (of one or several jobs) in the same group: one
+  // transaction unless a commit is under way, each write in its own
+  // savepoint, one status per write, in order. A worker's results for
+  // several jobs take one transaction instead of one per job.
+  std::vector<absl::Status> CommitAll(const std::vector<const JobWrite*>& writes);
   // Commits one analysis result (Commit of a write with that row only).
   absl::Status AddAnalysis(const std::string& job_id, const jobs::AnalysisRecord& analysis);
   // Transactions that committed writes so far (for tests and benchmarks:

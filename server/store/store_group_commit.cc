@@ -16,16 +16,21 @@ absl::Status Store::AddAnalysis(const std::string& job_id, const jobs::AnalysisR
   return Commit(write);
 }
 
-absl::Status Store::Commit(const JobWrite& write) {
-  PendingWrite mine{&write, absl::OkStatus()};
+absl::Status Store::Commit(const JobWrite& write) { return CommitAll({&write}).front(); }
+
+std::vector<absl::Status> Store::CommitAll(const std::vector<const JobWrite*>& writes) {
+  std::vector<PendingWrite> mine;
+  mine.reserve(writes.size());
+  for (const JobWrite* write : writes) mine.push_back(PendingWrite{write, absl::OkStatus()});
   std::unique_lock<std::mutex> lock(group_mutex_);
-  group_queue_.push_back(&mine);
-  while (!mine.done) {
+  for (PendingWrite& p : mine) group_queue_.push_back(&p);
+  auto all_done = [&] { return std::all_of(mine.begin(), mine.end(), [](const PendingWrite& p) { return p.done; }); };
+  while (!all_done()) {
     if (group_committing_) {
       group_done_.wait(lock);
       continue;
     }
-    // This caller commits everything queued so far, its own write included;
+    // This caller commits everything queued so far, its own writes included;
     // writes that arrive meanwhile wait for the next group.
     group_committing_ = true;
     std::vector<PendingWrite*> group;
@@ -40,7 +45,10 @@ absl::Status Store::Commit(const JobWrite& write) {
     ++analysis_transactions_;
     group_done_.notify_all();
   }
-  return mine.status;
+  std::vector<absl::Status> statuses;
+  statuses.reserve(mine.size());
+  for (PendingWrite& p : mine) statuses.push_back(std::move(p.status));
+  return statuses;
 }
 
 absl::Status Store::WriteLocked(const JobWrite& write) {

@@ -52,10 +52,9 @@ const v1::Study& FakeWorker::StudyOf(const std::string& job_id) {
   return studies_[job_id] = response.study();
 }
 
-grpc::Status FakeWorker::Answer(const v1::AnalysisTask& task, bool* accepted) {
+v1::TaskResult FakeWorker::ResultOf(const v1::AnalysisTask& task) {
   const std::vector<double> x(task.x_scaled().begin(), task.x_scaled().end());
   const v1::Study& study = StudyOf(task.job_id());
-  if (failed_) return grpc::Status(grpc::StatusCode::UNAVAILABLE, "server lost");
   absl::StatusOr<FakeValues> values = EvaluateAnalytically(study, x);
   EXPECT_TRUE(values.ok()) << values.status();
   v1::TaskResult result;
@@ -86,11 +85,26 @@ grpc::Status FakeWorker::Answer(const v1::AnalysisTask& task, bool* accepted) {
       }
     }
   }
+  return result;
+}
+
+grpc::Status FakeWorker::Answer(const v1::AnalysisTask& task, bool* accepted) {
+  if (failed_) return grpc::Status(grpc::StatusCode::UNAVAILABLE, "server lost");
+  const v1::TaskResult result = ResultOf(task);
   grpc::ClientContext context;
   v1::ReportResultResponse response;
   grpc::Status status = stub_->ReportResult(&context, result, &response);
   if (accepted != nullptr) *accepted = response.accepted();
   return status;
+}
+
+grpc::Status FakeWorker::AnswerTogether(const std::vector<v1::AnalysisTask>& tasks,
+                                        v1::ReportResultsResponse* response) {
+  v1::TaskResults request;
+  request.set_worker_id(worker_id_);
+  for (const v1::AnalysisTask& task : tasks) *request.add_results() = ResultOf(task);
+  grpc::ClientContext context;
+  return stub_->ReportResults(&context, request, response);
 }
 
 int FakeWorker::Run(int max_results) {

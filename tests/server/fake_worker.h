@@ -61,8 +61,11 @@ class FakeWorker {
   std::vector<v1::AnalysisTask> Acquire(int max_tasks, int wait_ms = 0);
   // Answers one task with its analytic values; returns the RPC status.
   grpc::Status Answer(const v1::AnalysisTask& task, bool* accepted = nullptr);
+  // Answers `tasks` (of any jobs) in one ReportResults call.
+  grpc::Status AnswerTogether(const std::vector<v1::AnalysisTask>& tasks, v1::ReportResultsResponse* response);
 
  private:
+  v1::TaskResult ResultOf(const v1::AnalysisTask& task);
   const v1::Study& StudyOf(const std::string& job_id);
 
   std::unique_ptr<v1::WorkerService::Stub> stub_;

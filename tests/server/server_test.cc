@@ -823,6 +823,34 @@ TEST_F(ServerTest, LostWorkersTasksAreRetriedElsewhereThenGivenUpAfterThreeAttem
   EXPECT_FALSE(accepted);
 }
 
+TEST_F(ServerTest, ResultsOfSeveralJobsInOneCallAreCommittedInOneTransaction) {
+  auto server = StartServer("a.db");
+  const std::string first = Submit(*server, OscillatorStudy("first"));
+  const std::string second = Submit(*server, OscillatorStudy("second"));
+  FakeWorker worker(server->InProcessChannel(), 3);
+  // The first cycle of both jobs: the initial designs and their perturbations.
+  std::vector<v1::AnalysisTask> tasks = worker.Acquire(64);
+  std::set<std::string> jobs;
+  for (const v1::AnalysisTask& task : tasks) jobs.insert(task.job_id());
+  ASSERT_EQ(jobs, (std::set<std::string>{first, second}));
+  const std::int64_t before = server->store().AnalysisTransactions();
+  v1::ReportResultsResponse response;
+  ASSERT_TRUE(worker.AnswerTogether(tasks, &response).ok());
+  EXPECT_EQ(server->store().AnalysisTransactions(), before + 1);
+  ASSERT_EQ(response.answers_size(), static_cast<int>(tasks.size()));
+  for (const v1::ResultAnswer& answer : response.answers()) {
+    EXPECT_TRUE(answer.accepted());
+    EXPECT_EQ(answer.error(), "");
+  }
+  // Both jobs took their results: each has its first cycle's trial on offer.
+  for (const std::string& id : {first, second}) {
+    EXPECT_EQ(Get(*server, id).summary().analyses(), static_cast<int>(tasks.size() / 2)) << id;
+  }
+  worker.Run();
+  EXPECT_EQ(Get(*server, first).summary().state(), v1::JOB_STATE_CONVERGED);
+  EXPECT_EQ(Get(*server, second).summary().state(), v1::JOB_STATE_CONVERGED);
+}
+
 TEST_F(ServerTest, WatchReplaysPastRecordsThenStreamsUntilTheJobEnds) {
   auto server = StartServer("a.db");
   const std::string id = Submit(*server, OscillatorStudy());

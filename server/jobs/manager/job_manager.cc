@@ -337,66 +337,91 @@ void JobManager::FailJobLocked(Entry& entry, const std::string& message) {
 // Commits the records the optimizer emitted, with the job's progress, in one
 // transaction; when the optimizer has ended, that transaction also stores
 // the final state, and the job then enters it.
-absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records,
-                                             const std::vector<const jobs::AnalysisRecord*>& analyses) {
+absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records) {
+  Delivery delivery = RecordsDeliveryLocked(entry, std::move(records), {});
+  const absl::Status committed = store_->Commit(delivery.write);
+  return FinishDeliveryLocked(entry, std::move(delivery), committed);
+}
+
+JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector<slp::CycleRecord> records,
+                                                       std::vector<const jobs::AnalysisRecord*> analyses) {
   const slp::SlpOptimizer& optimizer = entry.job->optimizer();
-  const JobState state = jobs::JobStateOf(optimizer.state());
-  std::string message;
-  if (state == JobState::kFailed) {
+  Delivery delivery;
+  delivery.needs_commit = true;
+  delivery.with_records = true;
+  delivery.state = jobs::JobStateOf(optimizer.state());
+  if (delivery.state == JobState::kFailed) {
     const spec::AnalysisFailure& last = entry.job->last_failure();
-    message = absl::StrCat("the initial design could not be analysed (", spec::FailureKindName(last.kind),
-                           "): ", last.reason);
-  } else if (state == JobState::kStalled) {
-    message = "the move limits collapsed or every trial point failed";
+    delivery.message = absl::StrCat("the initial design could not be analysed (", spec::FailureKindName(last.kind),
+                                    "): ", last.reason);
+  } else if (delivery.state == JobState::kStalled) {
+    delivery.message = "the move limits collapsed or every trial point failed";
     if (!records.empty() && !records.back().rejection_reason.empty()) {
-      absl::StrAppend(&message, "; last rejection: ", records.back().rejection_reason);
+      absl::StrAppend(&delivery.message, "; last rejection: ", records.back().rejection_reason);
     }
   }
   store::JobProgress progress;
-  progress.state = jobs::JobStateName(state);
-  progress.message = message;
+  progress.state = jobs::JobStateName(delivery.state);
+  progress.message = delivery.message;
   progress.cycles = optimizer.cycles_completed();
   progress.analyses = optimizer.analyses_used();
   progress.wall_seconds = WallSecondsLocked(entry);
-  store::JobWrite write;
-  write.job_id = entry.row.id;
-  write.analyses = analyses;
-  write.cycles.reserve(records.size());
+  delivery.write.job_id = entry.row.id;
+  delivery.write.analyses = std::move(analyses);
+  delivery.write.cycles.reserve(records.size());
   for (const slp::CycleRecord& r : records) {
-    write.cycles.push_back(store::CycleRow{0, r.cycle, r.attempt, jobs::EncodeCycleRecord(r)});
+    delivery.write.cycles.push_back(store::CycleRow{0, r.cycle, r.attempt, jobs::EncodeCycleRecord(r)});
   }
-  write.progress = progress;
-  absl::Status status = store_->Commit(write);
-  if (!status.ok()) {
-    FailJobLocked(entry, absl::StrCat("cannot log ", analyses.empty() ? "" : "analyses and ",
-                                      "cycle records: ", status.message()));
-    return status;
+  delivery.write.progress = progress;
+  delivery.records = std::move(records);
+  return delivery;
+}
+
+absl::Status JobManager::FinishDeliveryLocked(Entry& entry, Delivery delivery, const absl::Status& committed) {
+  if (!committed.ok()) {
+    FailJobLocked(entry, absl::StrCat("cannot log ", delivery.write.analyses.empty() ? "" : "analyses",
+                                      delivery.with_records ? (delivery.write.analyses.empty() ? "cycle records"
+                                                                                               : " and cycle records")
+                                                            : "",
+                                      ": ", committed.message()));
+    return committed;
   }
-  const std::vector<store::CycleRow>& rows = write.cycles;
-  for (slp::CycleRecord& r : records) entry.records.push_back(std::move(r));
-  std::int64_t committed = 0;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    records_committed_ += static_cast<std::int64_t>(rows.size());
-    committed = records_committed_;
-  }
-  if (options_.after_record_commit) {
-    for (std::int64_t n = committed - static_cast<std::int64_t>(rows.size()) + 1; n <= committed; ++n) {
-      options_.after_record_commit(n);
+  if (delivery.with_records) {
+    const std::int64_t rows = static_cast<std::int64_t>(delivery.records.size());
+    for (slp::CycleRecord& r : delivery.records) entry.records.push_back(std::move(r));
+    std::int64_t committed_records = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      records_committed_ += rows;
+      committed_records = records_committed_;
     }
+    if (options_.after_record_commit) {
+      for (std::int64_t n = committed_records - rows + 1; n <= committed_records; ++n) options_.after_record_commit(n);
+    }
+    if (delivery.state != JobState::kRunning) {
+      (void)EnterStateLocked(entry, delivery.state, delivery.message, "ended",
+                             absl::StrCat(jobs::JobStateName(delivery.state), " after ",
+                                          entry.job->optimizer().cycles_completed(), " cycles"),
+                             Persist::kAlreadyStored);
+      return absl::OkStatus();
+    }
+    entry.message = delivery.message;
   }
-  if (state != JobState::kRunning) {
-    (void)EnterStateLocked(entry, state, message, "ended",
-                           absl::StrCat(jobs::JobStateName(state), " after ", optimizer.cycles_completed(), " cycles"),
-                           Persist::kAlreadyStored);
-  } else {
-    entry.message = message;
-  }
+  Changed(entry);
   return absl::OkStatus();
 }
 
 absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch) {
-  if (entry.job == nullptr || entry.state != JobState::kRunning) return absl::OkStatus();
+  absl::StatusOr<Delivery> delivery = PrepareDeliveryLocked(entry, batch);
+  if (!delivery.ok()) return delivery.status();
+  if (!delivery->needs_commit) return absl::OkStatus();
+  const absl::Status committed = store_->Commit(delivery->write);
+  return FinishDeliveryLocked(entry, *std::move(delivery), committed);
+}
+
+absl::StatusOr<JobManager::Delivery> JobManager::PrepareDeliveryLocked(Entry& entry,
+                                                                       const std::vector<jobs::AnalysisRecord>& batch) {
+  if (entry.job == nullptr || entry.state != JobState::kRunning) return Delivery{};
   // The whole batch goes to the optimizer first and is then committed in one
   // transaction with the records it completed: nothing is published, and no
   // worker is told its result was taken, before that commit; a failed commit
@@ -417,7 +442,7 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::Ana
     applied.push_back(&record);
     for (slp::CycleRecord& r : *records) emitted.push_back(std::move(r));
   }
-  if (applied.empty()) return absl::OkStatus();
+  if (applied.empty()) return Delivery{};
   // The next tasks go out before the commit, so that workers analyse while
   // it syncs: a task is not a record anyone has seen, its result cannot be
   // taken before this commit (it needs the job's lock held here), a failed
@@ -425,14 +450,12 @@ absl::Status JobManager::DeliverLocked(Entry& entry, const std::vector<jobs::Ana
   // asks for them again.
   ScheduleLocked(entry);
   if (!emitted.empty() || !entry.job->running()) {
-    MBOPT_RETURN_IF_ERROR(CommitRecordsLocked(entry, std::move(emitted), applied));
-  } else if (absl::Status status = store_->Commit(store::JobWrite{entry.row.id, applied, {}, std::nullopt});
-             !status.ok()) {
-    FailJobLocked(entry, absl::StrCat("cannot log analyses: ", status.message()));
-    return status;
+    return RecordsDeliveryLocked(entry, std::move(emitted), std::move(applied));
   }
-  Changed(entry);
-  return absl::OkStatus();
+  Delivery delivery;
+  delivery.needs_commit = true;
+  delivery.write = store::JobWrite{entry.row.id, std::move(applied), {}, std::nullopt};
+  return delivery;
 }
 
 void JobManager::DeliverGivenUpLocked(Entry& entry, const scheduler::FinishedTask& task) {
@@ -465,29 +488,51 @@ std::vector<absl::StatusOr<bool>> JobManager::ReportResults(std::vector<WorkerRe
       return answers;
     }
   }
-  // Each job's results in the order they came, under its lock once.
+  // Each job's results in the order they came, under its lock. The jobs'
+  // locks are taken in job id order (the map's), the same in every call, and
+  // held until their results are committed: all of them in one transaction.
+  struct JobBatch {
+    std::shared_ptr<Entry> entry;
+    std::unique_lock<std::mutex> lock;
+    std::vector<jobs::AnalysisRecord> records;
+    std::vector<size_t> indices;  // of the reports delivered
+    absl::StatusOr<Delivery> delivery;
+  };
   std::map<std::string, std::vector<size_t>> by_job;
   for (size_t i = 0; i < reports.size(); ++i) by_job[reports[i].job_id].push_back(i);
+  std::vector<JobBatch> batches;
+  batches.reserve(by_job.size());
   for (const auto& [job_id, indices] : by_job) {
     absl::StatusOr<std::shared_ptr<Entry>> entry = Find(job_id);
     if (!entry.ok()) {
       for (size_t i : indices) answers[i] = entry.status();
       continue;
     }
-    std::lock_guard<std::mutex> lock((*entry)->mutex);
-    std::vector<jobs::AnalysisRecord> batch;
-    std::vector<size_t> batch_indices;
+    JobBatch& batch = batches.emplace_back(JobBatch{*entry, std::unique_lock<std::mutex>((*entry)->mutex), {}, {},
+                                                    Delivery{}});
     for (size_t i : indices) {
-      absl::StatusOr<std::optional<jobs::AnalysisRecord>> record = TakeResultLocked(**entry, std::move(reports[i]));
+      absl::StatusOr<std::optional<jobs::AnalysisRecord>> record = TakeResultLocked(*batch.entry, std::move(reports[i]));
       if (!record.ok()) {
         answers[i] = record.status();
       } else if (record->has_value()) {
-        batch.push_back(**std::move(record));
-        batch_indices.push_back(i);
+        batch.records.push_back(**std::move(record));
+        batch.indices.push_back(i);
       }
     }
-    const absl::Status delivered = DeliverLocked(**entry, batch);
-    for (size_t i : batch_indices) answers[i] = delivered.ok() ? absl::StatusOr<bool>(true) : delivered;
+    batch.delivery = PrepareDeliveryLocked(*batch.entry, batch.records);
+  }
+  std::vector<const store::JobWrite*> writes;
+  for (const JobBatch& batch : batches) {
+    if (batch.delivery.ok() && batch.delivery->needs_commit) writes.push_back(&batch.delivery->write);
+  }
+  const std::vector<absl::Status> committed = store_->CommitAll(writes);
+  size_t next_write = 0;
+  for (JobBatch& batch : batches) {
+    absl::Status delivered = batch.delivery.status();
+    if (batch.delivery.ok() && batch.delivery->needs_commit) {
+      delivered = FinishDeliveryLocked(*batch.entry, *std::move(batch.delivery), committed[next_write++]);
+    }
+    for (size_t i : batch.indices) answers[i] = delivered.ok() ? absl::StatusOr<bool>(true) : delivered;
   }
   return answers;
 }

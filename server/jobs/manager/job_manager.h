@@ -234,13 +234,33 @@ class JobManager {
   // deliver; nullopt when it is to be dropped (not outstanding any more);
   // InvalidArgument for a result that does not fit its task.
   absl::StatusOr<std::optional<jobs::AnalysisRecord>> TakeResultLocked(Entry& entry, WorkerReport report);
-  // Applies a batch of the job's results and logs them with what they
-  // completed (one transaction).
+  // What a batch of a job's results (or the records of a replay) makes the
+  // job write, in one transaction, and do once that is committed.
+  struct Delivery {
+    bool needs_commit = false;  // false: nothing was applied, nothing to write
+    store::JobWrite write;      // its analyses point into the caller's batch
+    bool with_records = false;  // the write carries records and the job's progress
+    std::vector<slp::CycleRecord> records;
+    jobs::JobState state = jobs::JobState::kRunning;  // the optimizer's, with records
+    std::string message;
+  };
+  // Applies a batch of the job's results to its optimizer and queues its
+  // new requests; returns the write. An error (the optimizer refused a
+  // result) has failed the job.
+  absl::StatusOr<Delivery> PrepareDeliveryLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch);
+  // The write of the optimizer's new records with the job's progress and
+  // `analyses`.
+  Delivery RecordsDeliveryLocked(Entry& entry, std::vector<slp::CycleRecord> records,
+                                 std::vector<const jobs::AnalysisRecord*> analyses);
+  // After the delivery's commit: publishes its records (and enters the end
+  // state the optimizer reached), or fails the job when `committed` is an
+  // error.
+  absl::Status FinishDeliveryLocked(Entry& entry, Delivery delivery, const absl::Status& committed);
+  // Prepare, commit (alone) and finish a batch.
   absl::Status DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch);
-  // Commits the optimizer's new records with the job's progress and
-  // `analyses` in one transaction.
-  absl::Status CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records,
-                                   const std::vector<const jobs::AnalysisRecord*>& analyses = {});
+  // Commits the optimizer's new records with the job's progress in one
+  // transaction (a replay's records not yet logged).
+  absl::Status CommitRecordsLocked(Entry& entry, std::vector<slp::CycleRecord> records);
   void ScheduleLocked(Entry& entry);
   void FailJobLocked(Entry& entry, const std::string& message);
   JobSummaryData SummaryLocked(const Entry& entry) const;
