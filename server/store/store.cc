@@ -342,6 +342,7 @@ Store::~Store() {
   // Closing checkpoints the WAL into the main file; nothing is lost if it
   // fails (the WAL is replayed on the next open).
   sqlite3_close_v2(db_);
+  if (wal_fd_ >= 0) close(wal_fd_);
 }
 
 absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {

@@ -76,6 +76,10 @@ struct JobWrite {
   std::vector<const jobs::AnalysisRecord*> analyses;
   std::vector<CycleRow> cycles;             // appended to the record log, indices in order
   std::optional<JobProgress> progress;      // updates the job row; required with cycles
+  // At Durability::kCycles: the cycle records are not synced by this
+  // commit; the caller publishes them only after SyncLog (the job manager
+  // does, on its own thread, so that no call waits for the sync).
+  bool defer_sync = false;
 };
 
 class Store {
@@ -122,6 +126,12 @@ class Store {
   // Of those, the ones committed with a sync (all at kFull, those with cycle
   // records at kCycles, none at kNormal).
   std::int64_t SyncedTransactions() const;
+  // Makes every commit that has returned so far durable (fdatasync of the
+  // write-ahead log), without holding up commits meanwhile. No-op at
+  // Durability::kNormal.
+  absl::Status SyncLog();
+  std::int64_t LogSyncs() const;  // SyncLog calls that synced (for tests)
+  Durability durability() const { return durability_; }
   // Testing: called inside each group transaction after its rows are
   // written and before COMMIT, with the transaction's number (1-based), so
   // a test can kill the process in the middle of a group commit.
@@ -202,6 +212,10 @@ class Store {
   std::int64_t analysis_transactions_ = 0;
 
   std::function<void(std::int64_t)> before_commit_;
+
+  mutable std::mutex log_sync_mutex_;  // guards wal_fd_, log_syncs_
+  int wal_fd_ = -1;            // the write-ahead log, opened by SyncLog
+  std::int64_t log_syncs_ = 0;
 };
 
 }  // namespace mbopt::store

@@ -1,5 +1,10 @@
 // Group commit of job writes (store.h, Commit; docs/store.md).
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -72,8 +77,9 @@ void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t tr
   // then a machine crash can take only analyses, which replay asks for
   // again. Every other transaction runs FULL.
   if (durability_ == Durability::kCycles) {
-    const bool has_records =
-        std::any_of(group.begin(), group.end(), [](const PendingWrite* p) { return p->write->progress.has_value(); });
+    const bool has_records = std::any_of(group.begin(), group.end(), [](const PendingWrite* p) {
+      return p->write->progress.has_value() && !p->write->defer_sync;
+    });
     if (!has_records) {
       const absl::Status mode = SetSynchronousLocked(false);
       if (!mode.ok()) {
@@ -144,6 +150,31 @@ void Store::CommitGroupLocked(const std::vector<PendingWrite*>& group, std::int6
 void Store::SetBeforeCommitHook(std::function<void(std::int64_t transaction)> hook) {
   std::lock_guard<std::mutex> lock(group_mutex_);
   before_commit_ = std::move(hook);
+}
+
+absl::Status Store::SyncLog() {
+  if (durability_ == Durability::kNormal) return absl::OkStatus();
+  std::lock_guard<std::mutex> lock(log_sync_mutex_);
+  if (wal_fd_ < 0) {
+    // Its own descriptor: syncing through SQLite's would hold the
+    // connection (and every commit) for the length of the sync. fdatasync
+    // makes durable what was written to the file through any descriptor.
+    wal_fd_ = open((path_ + "-wal").c_str(), O_RDONLY | O_CLOEXEC);
+    if (wal_fd_ < 0) {
+      if (errno == ENOENT) return absl::OkStatus();  // no log yet: every commit is in the main file
+      return absl::UnavailableError(absl::StrCat("cannot open ", path_, "-wal to sync it: ", std::strerror(errno)));
+    }
+  }
+  if (fdatasync(wal_fd_) != 0) {
+    return absl::UnavailableError(absl::StrCat("cannot sync ", path_, "-wal: ", std::strerror(errno)));
+  }
+  ++log_syncs_;
+  return absl::OkStatus();
+}
+
+std::int64_t Store::LogSyncs() const {
+  std::lock_guard<std::mutex> lock(log_sync_mutex_);
+  return log_syncs_;
 }
 
 std::int64_t Store::AnalysisTransactions() const {

@@ -8,10 +8,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <string>
 #include <thread>
@@ -20,6 +22,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
@@ -851,11 +854,54 @@ TEST_F(ServerTest, ResultsOfSeveralJobsInOneCallAreCommittedInOneTransaction) {
   EXPECT_EQ(Get(*server, second).summary().state(), v1::JOB_STATE_CONVERGED);
 }
 
+TEST_F(ServerTest, CycleRecordsArePublishedOnlyOnceTheLogIsSynced) {
+  const v1::GetJobResponse reference = RunToEnd("reference.db", 5);
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool release = false;
+  int syncs_asked = 0;
+  JobManagerOptions manager;
+  manager.before_log_sync = [&] {
+    std::unique_lock<std::mutex> lock(mutex);
+    ++syncs_asked;
+    changed.notify_all();
+    changed.wait(lock, [&] { return release; });
+  };
+  auto server = StartServer("a.db", manager);
+  auto release_sync = [&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    release = true;
+    changed.notify_all();
+  };
+  absl::Cleanup release_before_the_server_stops = release_sync;  // should an assertion end the test early
+  const std::string id = Submit(*server, OscillatorStudy());
+  FakeWorker worker(server->InProcessChannel(), 5);
+  // Answer until a cycle record waits for the sync (the syncing thread is
+  // then held in the hook).
+  while (true) {
+    ASSERT_EQ(worker.Run(1), 1);
+    std::lock_guard<std::mutex> lock(mutex);
+    if (syncs_asked > 0) break;
+  }
+  EXPECT_EQ(Get(*server, id).cycles_size(), 0) << "a record is shown before the log is synced";
+  EXPECT_EQ(server->store().LogSyncs(), 0);
+  // The job goes on meanwhile: results are taken and the next tasks handed
+  // out without waiting for the sync.
+  EXPECT_EQ(worker.Run(3), 3);
+  release_sync();
+  server->manager().WaitForLogSync();
+  EXPECT_GE(server->store().LogSyncs(), 1);
+  EXPECT_GE(Get(*server, id).cycles_size(), 1);
+  worker.Run();
+  ExpectSameCycles(reference, Get(*server, id));
+}
+
 TEST_F(ServerTest, WatchReplaysPastRecordsThenStreamsUntilTheJobEnds) {
   auto server = StartServer("a.db");
   const std::string id = Submit(*server, OscillatorStudy());
   FakeWorker worker(server->InProcessChannel(), 13);
   worker.Run(6);
+  server->manager().WaitForLogSync();  // the records so far are all published
   const int records_before = Get(*server, id).cycles_size();
   auto stub = v1::JobService::NewStub(server->InProcessChannel());
   grpc::ClientContext context;

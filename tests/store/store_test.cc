@@ -698,6 +698,43 @@ TEST_F(StoreTest, CommitsWithCycleRecordsAreSyncedAtTheCyclesLevel) {
   }
 }
 
+// A write whose records the caller syncs later (the job manager's syncing
+// thread) is not synced by its commit at the cycles level; SyncLog syncs the
+// log, except at the normal level, which never syncs.
+TEST_F(StoreTest, DeferredRecordsAreSyncedBySyncLogNotByTheirCommit) {
+  for (const Durability d : {Durability::kFull, Durability::kCycles, Durability::kNormal}) {
+    SCOPED_TRACE(DurabilityName(d));
+    std::filesystem::remove(path_);
+    std::filesystem::remove(path_ + "-wal");
+    std::filesystem::remove(path_ + "-shm");
+    std::string job_id;
+    {
+      auto store = Store::Open(path_, d);
+      ASSERT_TRUE(store.ok()) << store.status();
+      auto job = (*store)->CreateJob(SampleJob());
+      ASSERT_TRUE(job.ok());
+      job_id = job->id;
+      jobs::AnalysisRecord analysis;
+      analysis.request_id = 0;
+      analysis.objective_terms = AwkwardDoubles();
+      JobWrite deferred;
+      deferred.job_id = job_id;
+      deferred.analyses.push_back(&analysis);
+      deferred.cycles.push_back(CycleRow{0, 1, 0, "record"});
+      deferred.progress = JobProgress{"RUNNING", "", 1, 1, 0.5};
+      deferred.defer_sync = true;
+      ASSERT_TRUE((*store)->Commit(deferred).ok());
+      EXPECT_EQ((*store)->SyncedTransactions(), d == Durability::kFull ? 1 : 0);
+      EXPECT_EQ((*store)->LogSyncs(), 0);
+      ASSERT_TRUE((*store)->SyncLog().ok());
+      EXPECT_EQ((*store)->LogSyncs(), d == Durability::kNormal ? 0 : 1);
+    }
+    auto reopened = Store::Open(path_, d);
+    ASSERT_TRUE(reopened.ok()) << reopened.status();
+    EXPECT_EQ((*reopened)->LoadCycles(job_id)->size(), 1u);
+  }
+}
+
 // Group commit: results from many threads at once are all committed (each
 // caller returns after its own row is in), a duplicate fails alone, and
 // they share transactions.

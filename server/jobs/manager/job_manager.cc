@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <iostream>
 #include <utility>
 
@@ -31,7 +32,10 @@ struct JobManager::Entry {
   // Failed analyses by kind, kept when the optimizer is released.
   std::map<std::string, std::int64_t> failed_analyses_by_kind;
 
-  std::vector<slp::CycleRecord> records;
+  std::vector<slp::CycleRecord> records;  // published: durable as the store's level promises
+  // Committed without a sync, by the number of their commit: published once
+  // the log is synced.
+  std::deque<std::pair<std::int64_t, std::vector<slp::CycleRecord>>> unsynced;
   std::int64_t version = 0;
 
   // Whether the study, its bytes and the records are in memory. A stopped
@@ -63,9 +67,70 @@ JobManager::JobManager(store::Store* store, scheduler::Scheduler* scheduler, Stu
       scheduler_(scheduler),
       decoder_(std::move(decoder)),
       options_(std::move(options)),
-      clock_(options_.clock != nullptr ? options_.clock : &steady_clock_) {}
+      clock_(options_.clock != nullptr ? options_.clock : &steady_clock_) {
+  if (store_->durability() == store::Durability::kCycles) syncer_ = std::thread([this] { SyncLoop(); });
+}
 
-JobManager::~JobManager() = default;
+JobManager::~JobManager() {
+  {
+    std::lock_guard<std::mutex> lock(sync_mutex_);
+    stop_syncing_ = true;
+  }
+  sync_wanted_.notify_all();
+  if (syncer_.joinable()) syncer_.join();
+}
+
+void JobManager::SyncLoop() {
+  std::unique_lock<std::mutex> lock(sync_mutex_);
+  while (true) {
+    sync_wanted_.wait(lock, [this] { return stop_syncing_ || !sync_waiting_.empty(); });
+    if (sync_waiting_.empty()) return;  // stopping, nothing left
+    std::set<std::string> jobs;
+    jobs.swap(sync_waiting_);
+    syncing_ = true;
+    // Every commit counted so far has returned: the sync makes it durable.
+    const std::int64_t synced = deferred_commits_;
+    lock.unlock();
+    if (options_.before_log_sync) options_.before_log_sync();
+    // A failed sync is logged; the records are committed all the same (a
+    // crash of the process loses nothing), only a power loss could take
+    // them, as at Durability::kNormal.
+    if (absl::Status status = store_->SyncLog(); !status.ok()) {
+      std::cerr << "mbopt-server: cannot sync the job log: " << status << std::endl;
+    }
+    std::vector<std::string> still_waiting;
+    for (const std::string& id : jobs) {
+      absl::StatusOr<std::shared_ptr<Entry>> entry = Find(id);
+      if (!entry.ok()) continue;
+      std::lock_guard<std::mutex> entry_lock((*entry)->mutex);
+      if (!PublishSyncedLocked(**entry, synced)) still_waiting.push_back(id);
+    }
+    lock.lock();
+    sync_waiting_.insert(still_waiting.begin(), still_waiting.end());
+    syncing_ = false;
+    sync_done_.notify_all();
+  }
+}
+
+void JobManager::WaitForLogSync() {
+  std::unique_lock<std::mutex> lock(sync_mutex_);
+  sync_done_.wait(lock, [this] { return stop_syncing_ || !syncer_.joinable() || (sync_waiting_.empty() && !syncing_); });
+}
+
+void JobManager::PublishUnsyncedLocked(Entry& entry) {
+  PublishSyncedLocked(entry, std::numeric_limits<std::int64_t>::max());
+}
+
+bool JobManager::PublishSyncedLocked(Entry& entry, std::int64_t synced) {
+  bool published = false;
+  while (!entry.unsynced.empty() && entry.unsynced.front().first <= synced) {
+    for (slp::CycleRecord& r : entry.unsynced.front().second) entry.records.push_back(std::move(r));
+    entry.unsynced.pop_front();
+    published = true;
+  }
+  if (published) Changed(entry);
+  return entry.unsynced.empty();
+}
 
 absl::StatusOr<std::shared_ptr<JobManager::Entry>> JobManager::Find(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -130,6 +195,9 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
       if (first_error.ok()) first_error = status;
     }
   }
+  // The state's commit synced the log (or the level never syncs): records
+  // still waiting for a sync are durable now, and come before the state.
+  PublishUnsyncedLocked(entry);
   if (!Running(to)) EvictLocked(entry);
   Changed(entry);
   return first_error;
@@ -373,6 +441,11 @@ JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector
     delivery.write.cycles.push_back(store::CycleRow{0, r.cycle, r.attempt, jobs::EncodeCycleRecord(r)});
   }
   delivery.write.progress = progress;
+  // While the job runs, its records are synced off the calling thread (the
+  // worker's answer, and its next tasks, do not wait for the sync); the
+  // records that end it are synced by their commit.
+  delivery.write.defer_sync =
+      store_->durability() == store::Durability::kCycles && delivery.state == JobState::kRunning;
   delivery.records = std::move(records);
   return delivery;
 }
@@ -388,7 +461,20 @@ absl::Status JobManager::FinishDeliveryLocked(Entry& entry, Delivery delivery, c
   }
   if (delivery.with_records) {
     const std::int64_t rows = static_cast<std::int64_t>(delivery.records.size());
-    for (slp::CycleRecord& r : delivery.records) entry.records.push_back(std::move(r));
+    if (delivery.write.defer_sync) {
+      std::int64_t commit = 0;
+      {
+        std::lock_guard<std::mutex> lock(sync_mutex_);
+        commit = ++deferred_commits_;
+        sync_waiting_.insert(entry.row.id);
+      }
+      sync_wanted_.notify_one();
+      entry.unsynced.emplace_back(commit, std::move(delivery.records));
+    } else {
+      // This commit synced the log: the records still waiting are durable.
+      PublishUnsyncedLocked(entry);
+      for (slp::CycleRecord& r : delivery.records) entry.records.push_back(std::move(r));
+    }
     std::int64_t committed_records = 0;
     {
       std::lock_guard<std::mutex> lock(mutex_);

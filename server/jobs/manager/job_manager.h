@@ -8,10 +8,12 @@
 // more that a worker reported together) is given to the optimizer; its new
 // requests are queued (a task is not a record: workers start on them while
 // the commit syncs); the results and the records they made it emit are
-// committed in one transaction with the job's progress; only then are the
-// records published to watchers and the worker told its results were taken.
-// So a result or record is durable before anyone sees it, and a crash at
-// any point is repaired by replay (job.h).
+// committed in one transaction with the job's progress; only then is the
+// worker told its results were taken, and the records are published to
+// watchers once they are durable (at the default durability, after the
+// log-syncing thread has synced the log: the worker does not wait for it).
+// So a record is durable before anyone sees it, and a crash at any point is
+// repaired by replay (job.h).
 //
 // Every change of a job's state goes through one function (EnterStateLocked),
 // which persists it, logs the event and wakes watchers; a store error on the
@@ -20,7 +22,8 @@
 // The LP solver of each job and the clock are injected.
 //
 // Thread-safe. Optimizer work is short (LP solves) and done on the calling
-// thread under the job's mutex; the store's commits are the only I/O.
+// thread under the job's mutex; the store's commits and the log's syncs
+// (on a thread of the manager's own) are the only I/O.
 #pragma once
 
 #include <atomic>
@@ -32,7 +35,10 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -57,6 +63,9 @@ struct JobManagerOptions {
   // Called after each cycle record is committed, with the number committed
   // by this manager so far (all jobs). For fault-injection tests.
   std::function<void(std::int64_t records_committed)> after_record_commit;
+  // Called by the log's syncing thread before each sync of the job log. For
+  // tests that hold records back from watchers.
+  std::function<void()> before_log_sync;
   // Makes each job's LP solver (one per job and per resume). Required.
   std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver;
   // Measures the jobs' running time; not owned. nullptr: a steady clock.
@@ -184,6 +193,10 @@ class JobManager {
   absl::Status StartWatching(const std::string& job_id);
   void StopWatching(const std::string& job_id);
 
+  // Waits until no cycle record waits for the log's sync (all are
+  // published to views). For tests that read a running job's records.
+  void WaitForLogSync();
+
   // Jobs whose study and records are in memory: the running ones (a
   // stopped job keeps only its summary; views read the rest from the
   // database). For tests and the memory benchmark.
@@ -256,6 +269,16 @@ class JobManager {
   // state the optimizer reached), or fails the job when `committed` is an
   // error.
   absl::Status FinishDeliveryLocked(Entry& entry, Delivery delivery, const absl::Status& committed);
+  // Records committed without a sync (store::JobWrite::defer_sync) wait in
+  // the entry until the syncing thread has synced the log; then they are
+  // published. PublishUnsyncedLocked publishes them all (after a commit
+  // that synced the log anyway); PublishSyncedLocked those committed up to
+  // the sync numbered `synced`.
+  void PublishUnsyncedLocked(Entry& entry);
+  bool PublishSyncedLocked(Entry& entry, std::int64_t synced);
+  // The syncing thread (at Durability::kCycles): syncs the log whenever
+  // records wait for it, then publishes them.
+  void SyncLoop();
   // Prepare, commit (alone) and finish a batch.
   absl::Status DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch);
   // Commits the optimizer's new records with the job's progress in one
@@ -284,6 +307,15 @@ class JobManager {
   bool shutdown_ = false;
   std::int64_t records_committed_ = 0;
   std::atomic<std::int64_t> evictions_{0};
+
+  std::mutex sync_mutex_;  // guards the five below
+  std::condition_variable sync_wanted_;
+  std::condition_variable sync_done_;
+  bool syncing_ = false;  // a sync round is under way
+  std::set<std::string> sync_waiting_;  // jobs with records waiting for a sync
+  std::int64_t deferred_commits_ = 0;   // commits of records without a sync so far
+  bool stop_syncing_ = false;
+  std::thread syncer_;  // runs SyncLoop at Durability::kCycles
 };
 
 }  // namespace mbopt::service
