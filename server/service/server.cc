@@ -120,14 +120,6 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   builder.SetMaxReceiveMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.SetMaxSendMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.AddListeningPort(s.options_.listen_address, credentials, &s.port_);
-  // gRPC's synchronous server ends a thread that finds more than
-  // MAX_POLLERS others waiting for work, and starts one when none is: each
-  // long poll (AcquireTasks, Watch, Attach) holds a thread, so with the
-  // default (2) every call that ends a long poll ended a thread and the next
-  // call started one. A thread start and end cost about as much server CPU
-  // as the call itself.
-  builder.SetSyncServerOption(grpc::ServerBuilder::SyncServerOption::MIN_POLLERS, 2);
-  builder.SetSyncServerOption(grpc::ServerBuilder::SyncServerOption::MAX_POLLERS, 16);
   builder.RegisterService(s.job_service_.get());
   builder.RegisterService(s.worker_service_.get());
   s.grpc_server_ = builder.BuildAndStart();
