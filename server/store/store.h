@@ -124,7 +124,7 @@ class Store {
   // fewer than the writes when they arrived together).
   std::int64_t AnalysisTransactions() const;
   // Of those, the ones committed with a sync (all at kFull, those with cycle
-  // records at kCycles, none at kNormal).
+  // records not deferred to SyncLog at kCycles, none at kNormal).
   std::int64_t SyncedTransactions() const;
   // Makes every commit that has returned so far durable (fdatasync of the
   // write-ahead log), without holding up commits meanwhile. No-op at

@@ -72,15 +72,16 @@ absl::Status Store::WriteLocked(const JobWrite& write) {
 void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t transaction,
                         const std::function<void(std::int64_t)>& before_commit) {
   std::lock_guard<std::mutex> lock(mutex_);
-  // At kCycles a group of results alone is not synced: it reaches the disk
-  // with the next synced commit (the WAL is synced as a whole), and until
-  // then a machine crash can take only analyses, which replay asks for
-  // again. Every other transaction runs FULL.
+  // At kCycles a group of results alone, or with records whose caller syncs
+  // the log itself (JobWrite::defer_sync), is not synced: it reaches the
+  // disk with the next sync (the WAL is synced as a whole), and until then a
+  // machine crash can take only what replay computes again. Every other
+  // transaction runs FULL.
   if (durability_ == Durability::kCycles) {
-    const bool has_records = std::any_of(group.begin(), group.end(), [](const PendingWrite* p) {
+    const bool needs_sync = std::any_of(group.begin(), group.end(), [](const PendingWrite* p) {
       return p->write->progress.has_value() && !p->write->defer_sync;
     });
-    if (!has_records) {
+    if (!needs_sync) {
       const absl::Status mode = SetSynchronousLocked(false);
       if (!mode.ok()) {
         for (PendingWrite* p : group) p->status = mode;

@@ -934,11 +934,11 @@ TEST_F(ServerTest, WatchReplaysPastRecordsThenStreamsUntilTheJobEnds) {
 TEST_F(ServerTest, WatchSendsProgressAtMostEvery50MsAndEndsFromMemory) {
   auto server = StartServer("a.db");
   const std::string id = Submit(*server, OscillatorStudy());
-  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  std::unique_ptr<v1::JobService::Stub> stub = v1::JobService::NewStub(server->InProcessChannel());
   grpc::ClientContext context;
   v1::JobRef ref;
   ref.set_job_id(id);
-  auto reader = stub->Watch(&context, ref);
+  std::unique_ptr<grpc::ClientReader<v1::JobEvent>> reader = stub->Watch(&context, ref);
   v1::JobEvent event;
   ASSERT_TRUE(reader->Read(&event));  // the first summary, before any result
   ASSERT_TRUE(event.has_summary());

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -49,6 +50,22 @@ class StoreTest : public ::testing::Test {
     job.study = std::string("\x00\x01\x02study bytes\xff", 15);
     job.state = "RUNNING";
     return job;
+  }
+
+  // A new database at `durability` (its files removed first) with one job,
+  // whose id goes to *job_id.
+  std::unique_ptr<Store> FreshStoreWithJob(Durability durability, std::string* job_id) {
+    std::filesystem::remove(path_);
+    std::filesystem::remove(path_ + "-wal");
+    std::filesystem::remove(path_ + "-shm");
+    auto store = Store::Open(path_, durability);
+    EXPECT_TRUE(store.ok()) << store.status();
+    if (!store.ok()) return nullptr;
+    auto job = (*store)->CreateJob(SampleJob());
+    EXPECT_TRUE(job.ok()) << job.status();
+    if (!job.ok()) return nullptr;
+    *job_id = job->id;
+    return *std::move(store);
   }
 
   std::filesystem::path dir_;
@@ -666,20 +683,14 @@ TEST_F(StoreTest, DurabilityLevelsSetTheSyncModeAndNamesRoundTrip) {
 TEST_F(StoreTest, CommitsWithCycleRecordsAreSyncedAtTheCyclesLevel) {
   for (const Durability d : {Durability::kFull, Durability::kCycles, Durability::kNormal}) {
     SCOPED_TRACE(DurabilityName(d));
-    std::filesystem::remove(path_);
-    std::filesystem::remove(path_ + "-wal");
-    std::filesystem::remove(path_ + "-shm");
     std::string job_id;
     {
-      auto store = Store::Open(path_, d);
-      ASSERT_TRUE(store.ok()) << store.status();
-      auto job = (*store)->CreateJob(SampleJob());
-      ASSERT_TRUE(job.ok());
-      job_id = job->id;
+      std::unique_ptr<Store> store = FreshStoreWithJob(d, &job_id);
+      ASSERT_NE(store, nullptr);
       jobs::AnalysisRecord first;
       first.request_id = 0;
       first.objective_terms = AwkwardDoubles();
-      ASSERT_TRUE((*store)->AddAnalysis(job_id, first).ok());
+      ASSERT_TRUE(store->AddAnalysis(job_id, first).ok());
       jobs::AnalysisRecord second = first;
       second.request_id = 1;
       JobWrite with_cycle;
@@ -687,9 +698,9 @@ TEST_F(StoreTest, CommitsWithCycleRecordsAreSyncedAtTheCyclesLevel) {
       with_cycle.analyses.push_back(&second);
       with_cycle.cycles.push_back(CycleRow{0, 1, 0, "record"});
       with_cycle.progress = JobProgress{"RUNNING", "", 1, 2, 0.5};
-      ASSERT_TRUE((*store)->Commit(with_cycle).ok());
-      EXPECT_EQ((*store)->AnalysisTransactions(), 2);
-      EXPECT_EQ((*store)->SyncedTransactions(), d == Durability::kFull ? 2 : d == Durability::kCycles ? 1 : 0);
+      ASSERT_TRUE(store->Commit(with_cycle).ok());
+      EXPECT_EQ(store->AnalysisTransactions(), 2);
+      EXPECT_EQ(store->SyncedTransactions(), d == Durability::kFull ? 2 : d == Durability::kCycles ? 1 : 0);
     }
     auto reopened = Store::Open(path_, d);
     ASSERT_TRUE(reopened.ok()) << reopened.status();
@@ -704,16 +715,10 @@ TEST_F(StoreTest, CommitsWithCycleRecordsAreSyncedAtTheCyclesLevel) {
 TEST_F(StoreTest, DeferredRecordsAreSyncedBySyncLogNotByTheirCommit) {
   for (const Durability d : {Durability::kFull, Durability::kCycles, Durability::kNormal}) {
     SCOPED_TRACE(DurabilityName(d));
-    std::filesystem::remove(path_);
-    std::filesystem::remove(path_ + "-wal");
-    std::filesystem::remove(path_ + "-shm");
     std::string job_id;
     {
-      auto store = Store::Open(path_, d);
-      ASSERT_TRUE(store.ok()) << store.status();
-      auto job = (*store)->CreateJob(SampleJob());
-      ASSERT_TRUE(job.ok());
-      job_id = job->id;
+      std::unique_ptr<Store> store = FreshStoreWithJob(d, &job_id);
+      ASSERT_NE(store, nullptr);
       jobs::AnalysisRecord analysis;
       analysis.request_id = 0;
       analysis.objective_terms = AwkwardDoubles();
@@ -723,11 +728,11 @@ TEST_F(StoreTest, DeferredRecordsAreSyncedBySyncLogNotByTheirCommit) {
       deferred.cycles.push_back(CycleRow{0, 1, 0, "record"});
       deferred.progress = JobProgress{"RUNNING", "", 1, 1, 0.5};
       deferred.defer_sync = true;
-      ASSERT_TRUE((*store)->Commit(deferred).ok());
-      EXPECT_EQ((*store)->SyncedTransactions(), d == Durability::kFull ? 1 : 0);
-      EXPECT_EQ((*store)->LogSyncs(), 0);
-      ASSERT_TRUE((*store)->SyncLog().ok());
-      EXPECT_EQ((*store)->LogSyncs(), d == Durability::kNormal ? 0 : 1);
+      ASSERT_TRUE(store->Commit(deferred).ok());
+      EXPECT_EQ(store->SyncedTransactions(), d == Durability::kFull ? 1 : 0);
+      EXPECT_EQ(store->LogSyncs(), 0);
+      ASSERT_TRUE(store->SyncLog().ok());
+      EXPECT_EQ(store->LogSyncs(), d == Durability::kNormal ? 0 : 1);
     }
     auto reopened = Store::Open(path_, d);
     ASSERT_TRUE(reopened.ok()) << reopened.status();

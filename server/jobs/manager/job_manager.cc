@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "common/status_macros.h"
 #include "server/jobs/job_result.h"
 #include "server/jobs/problem_from_study.h"
@@ -416,7 +417,6 @@ JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector
   const slp::SlpOptimizer& optimizer = entry.job->optimizer();
   Delivery delivery;
   delivery.needs_commit = true;
-  delivery.with_records = true;
   delivery.state = jobs::JobStateOf(optimizer.state());
   if (delivery.state == JobState::kFailed) {
     const spec::AnalysisFailure& last = entry.job->last_failure();
@@ -451,15 +451,15 @@ JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector
 }
 
 absl::Status JobManager::FinishDeliveryLocked(Entry& entry, Delivery delivery, const absl::Status& committed) {
+  const bool with_records = delivery.write.progress.has_value();
   if (!committed.ok()) {
-    FailJobLocked(entry, absl::StrCat("cannot log ", delivery.write.analyses.empty() ? "" : "analyses",
-                                      delivery.with_records ? (delivery.write.analyses.empty() ? "cycle records"
-                                                                                               : " and cycle records")
-                                                            : "",
-                                      ": ", committed.message()));
+    std::vector<std::string> what;
+    if (!delivery.write.analyses.empty()) what.push_back("analyses");
+    if (with_records) what.push_back("cycle records");
+    FailJobLocked(entry, absl::StrCat("cannot log ", absl::StrJoin(what, " and "), ": ", committed.message()));
     return committed;
   }
-  if (delivery.with_records) {
+  if (with_records) {
     const std::int64_t rows = static_cast<std::int64_t>(delivery.records.size());
     if (delivery.write.defer_sync) {
       std::int64_t commit = 0;

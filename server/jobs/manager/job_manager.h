@@ -251,8 +251,9 @@ class JobManager {
   // job write, in one transaction, and do once that is committed.
   struct Delivery {
     bool needs_commit = false;  // false: nothing was applied, nothing to write
-    store::JobWrite write;      // its analyses point into the caller's batch
-    bool with_records = false;  // the write carries records and the job's progress
+    // Its analyses point into the caller's batch; it carries records (and
+    // the job's progress) when it has progress.
+    store::JobWrite write;
     std::vector<slp::CycleRecord> records;
     jobs::JobState state = jobs::JobState::kRunning;  // the optimizer's, with records
     std::string message;
