@@ -49,6 +49,14 @@ struct JobProgress {
   double wall_seconds = 0;
 };
 
+// An event to log with a change of the job (Store::CreateJob, SetJobState,
+// JobWrite): in the same transaction, so the change and its line in the
+// event log are one commit (and one sync).
+struct NewEvent {
+  std::string kind;
+  std::string message;
+};
+
 struct EventRow {
   std::int64_t id = 0;
   std::string job_id;

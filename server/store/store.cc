@@ -332,7 +332,15 @@ absl::StatusOr<std::unique_ptr<Store>> Store::Open(const std::string& path, Dura
 }
 
 Store::Store(std::string path, sqlite3* db, Durability durability)
-    : path_(std::move(path)), durability_(durability), synchronous_full_(durability != Durability::kNormal), db_(db) {}
+    : path_(std::move(path)), durability_(durability), synchronous_full_(durability != Durability::kNormal), db_(db) {
+  sqlite3_commit_hook(
+      db_,
+      [](void* store) {
+        static_cast<Store*>(store)->commits_.fetch_add(1, std::memory_order_relaxed);
+        return 0;  // 0: let the commit go on
+      },
+      this);
+}
 
 Store::~Store() {
   for (std::optional<Statement>* prepared : {&insert_analysis_, &select_records_, &insert_cycle_, &update_progress_,
@@ -345,7 +353,7 @@ Store::~Store() {
   if (wal_fd_ >= 0) close(wal_fd_);
 }
 
-absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {
+absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job, const std::optional<NewEvent>& event) {
   std::lock_guard<std::mutex> lock(mutex_);
   JobRow stored = job;
   const std::int64_t now = NowUnixMs();
@@ -375,7 +383,8 @@ absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job) {
     stmt.BindInt(12, stored.analyses);
     stmt.BindDouble(13, stored.wall_seconds);
     stmt.BindText(14, stored.owner);
-    return stmt.Run();
+    MBOPT_RETURN_IF_ERROR(stmt.Run());
+    return event.has_value() ? InsertEventLocked(stored.id, *event) : absl::OkStatus();
   }));
   return stored;
 }
@@ -403,18 +412,20 @@ absl::StatusOr<std::vector<JobRow>> Store::ListJobs() {
   return jobs;
 }
 
-absl::Status Store::SetJobState(const std::string& job_id, const std::string& state,
-                                const std::string& message) {
+absl::Status Store::SetJobState(const std::string& job_id, const std::string& state, const std::string& message,
+                                const std::optional<NewEvent>& event) {
   std::lock_guard<std::mutex> lock(mutex_);
-  MBOPT_ASSIGN_OR_RETURN(Statement stmt,
-                         Statement::Prepare(db_, "UPDATE jobs SET state = ?, message = ?, updated_unix_ms = ? WHERE id = ?"));
-  stmt.BindText(1, state);
-  stmt.BindText(2, message);
-  stmt.BindInt(3, NowUnixMs());
-  stmt.BindText(4, job_id);
-  MBOPT_RETURN_IF_ERROR(stmt.Run());
-  if (sqlite3_changes(db_) != 1) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
-  return absl::OkStatus();
+  return InTransaction(db_, [&]() -> absl::Status {
+    MBOPT_ASSIGN_OR_RETURN(
+        Statement stmt, Statement::Prepare(db_, "UPDATE jobs SET state = ?, message = ?, updated_unix_ms = ? WHERE id = ?"));
+    stmt.BindText(1, state);
+    stmt.BindText(2, message);
+    stmt.BindInt(3, NowUnixMs());
+    stmt.BindText(4, job_id);
+    MBOPT_RETURN_IF_ERROR(stmt.Run());
+    if (sqlite3_changes(db_) != 1) return absl::NotFoundError(absl::StrCat("no job '", job_id, "' in ", path_));
+    return event.has_value() ? InsertEventLocked(job_id, *event) : absl::OkStatus();
+  });
 }
 
 absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& a) {
@@ -590,12 +601,16 @@ absl::StatusOr<std::vector<CycleRow>> Store::LoadCycles(const std::string& job_i
 
 absl::Status Store::AddEvent(const std::string& job_id, const std::string& kind, const std::string& message) {
   std::lock_guard<std::mutex> lock(mutex_);
+  return InsertEventLocked(job_id, NewEvent{kind, message});
+}
+
+absl::Status Store::InsertEventLocked(const std::string& job_id, const NewEvent& event) {
   MBOPT_ASSIGN_OR_RETURN(
       Statement stmt, Statement::Prepare(db_, "INSERT INTO events(job_id, unix_ms, kind, message) VALUES (?,?,?,?)"));
   stmt.BindText(1, job_id);
   stmt.BindInt(2, NowUnixMs());
-  stmt.BindText(3, kind);
-  stmt.BindText(4, message);
+  stmt.BindText(3, event.kind);
+  stmt.BindText(4, event.message);
   return stmt.Run();
 }
 

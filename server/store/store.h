@@ -16,6 +16,7 @@
 // them if it can avoid it.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -76,6 +77,7 @@ struct JobWrite {
   std::vector<const jobs::AnalysisRecord*> analyses;
   std::vector<CycleRow> cycles;             // appended to the record log, indices in order
   std::optional<JobProgress> progress;      // updates the job row; required with cycles
+  std::optional<NewEvent> event = std::nullopt;  // logged with the rest (the job's end)
   // At Durability::kCycles: the cycle records are not synced by this
   // commit; the caller publishes them only after SyncLog (the job manager
   // does, on its own thread, so that no call waits for the sync).
@@ -96,13 +98,14 @@ class Store {
 
   const std::string& path() const { return path_; }
 
-  // Inserts a job; `id` and `seq` of `job` are ignored and assigned. Returns
-  // the row as stored.
-  absl::StatusOr<JobRow> CreateJob(const JobRow& job);
+  // Inserts a job, and `event` with it; `id` and `seq` of `job` are ignored
+  // and assigned. Returns the row as stored.
+  absl::StatusOr<JobRow> CreateJob(const JobRow& job, const std::optional<NewEvent>& event = std::nullopt);
   absl::StatusOr<JobRow> GetJob(const std::string& job_id);  // NotFound
   absl::StatusOr<std::vector<JobRow>> ListJobs();             // by seq
-  absl::Status SetJobState(const std::string& job_id, const std::string& state,
-                           const std::string& message);
+  // Sets the state and its message, and logs `event`, in one transaction.
+  absl::Status SetJobState(const std::string& job_id, const std::string& state, const std::string& message,
+                           const std::optional<NewEvent>& event = std::nullopt);
 
   // Commits `write` atomically: all of it or none (AlreadyExists if the job
   // already has a result for one of the request ids, NotFound for an unknown
@@ -126,6 +129,9 @@ class Store {
   // Of those, the ones committed with a sync (all at kFull, those with cycle
   // records not deferred to SyncLog at kCycles, none at kNormal).
   std::int64_t SyncedTransactions() const;
+  // Transactions committed on this database by this store, of any kind (a
+  // statement outside a transaction is one): what a change costs in commits.
+  std::int64_t Commits() const { return commits_.load(std::memory_order_relaxed); }
   // Makes every commit that has returned so far durable (fdatasync of the
   // write-ahead log), without holding up commits meanwhile. No-op at
   // Durability::kNormal.
@@ -167,6 +173,8 @@ class Store {
   absl::StatusOr<Statement*> PreparedLocked(std::optional<Statement>& slot, const char* sql);
   // One INSERT into analyses; the caller holds mutex_ (and a transaction).
   absl::Status InsertAnalysisLocked(const std::string& job_id, const jobs::AnalysisRecord& analysis);
+  // One INSERT into events; the caller holds mutex_.
+  absl::Status InsertEventLocked(const std::string& job_id, const NewEvent& event);
 
   // The rows of one write; the caller holds mutex_ and a transaction.
   absl::Status WriteLocked(const JobWrite& write);
@@ -192,6 +200,7 @@ class Store {
   mutable std::mutex mutex_;
   bool synchronous_full_ = true;  // the connection's mode now; guarded by mutex_
   std::int64_t synced_transactions_ = 0;  // guarded by mutex_
+  std::atomic<std::int64_t> commits_{0};  // counted by SQLite's commit hook
   sqlite3* db_;  // owned
   // The INSERT of InsertAnalysisLocked, prepared once: preparing it for every
   // analysis was a third of the server's CPU (docs/benchmarks.md). Guarded

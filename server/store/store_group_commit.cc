@@ -66,6 +66,7 @@ absl::Status Store::WriteLocked(const JobWrite& write) {
   if (write.progress.has_value()) {
     MBOPT_RETURN_IF_ERROR(AppendCyclesLocked(write.job_id, write.cycles, *write.progress));
   }
+  if (write.event.has_value()) MBOPT_RETURN_IF_ERROR(InsertEventLocked(write.job_id, *write.event));
   return absl::OkStatus();
 }
 
@@ -79,7 +80,7 @@ void Store::CommitGroup(const std::vector<PendingWrite*>& group, std::int64_t tr
   // transaction runs FULL.
   if (durability_ == Durability::kCycles) {
     const bool needs_sync = std::any_of(group.begin(), group.end(), [](const PendingWrite* p) {
-      return p->write->progress.has_value() && !p->write->defer_sync;
+      return (p->write->progress.has_value() && !p->write->defer_sync) || p->write->event.has_value();
     });
     if (!needs_sync) {
       const absl::Status mode = SetSynchronousLocked(false);

@@ -404,6 +404,39 @@ TEST_F(ServerTest, CancelThenResumeGivesTheSameResult) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 }
 
+// A state change and its line in the event log are one commit (one sync
+// at the default durability), from the submit to the end.
+TEST_F(ServerTest, EachStateChangeIsOneCommitWithItsEvent) {
+  auto server = StartServer("a.db");
+  const store::Store& log = server->store();
+  std::int64_t commits = log.Commits();
+  const std::string id = Submit(*server, OscillatorStudy());
+  EXPECT_EQ(log.Commits(), commits + 1);
+  {
+    FakeWorker worker(server->InProcessChannel(), 10);
+    worker.Run(5);
+  }
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  v1::JobRef ref;
+  ref.set_job_id(id);
+  for (const bool cancel : {true, false}) {
+    commits = log.Commits();
+    grpc::ClientContext context;
+    v1::JobSummary summary;
+    ASSERT_TRUE((cancel ? stub->Cancel(&context, ref, &summary) : stub->Resume(&context, ref, &summary)).ok());
+    EXPECT_EQ(log.Commits(), commits + 1) << (cancel ? "cancel" : "resume");
+  }
+  FakeWorker worker(server->InProcessChannel(), 11);
+  worker.Run();
+  EXPECT_EQ(Get(*server, id).summary().state(), v1::JOB_STATE_CONVERGED);
+  absl::StatusOr<std::vector<store::EventRow>> events = server->store().LoadEvents(id);
+  ASSERT_TRUE(events.ok()) << events.status();
+  std::vector<std::string> kinds;
+  for (const store::EventRow& e : *events) kinds.push_back(e.kind);
+  EXPECT_EQ(kinds, (std::vector<std::string>{"submitted", "cancelled", "resumed", "ended"}));
+  EXPECT_THAT(events->back().message, HasSubstr("CONVERGED after"));
+}
+
 TEST_F(ServerTest, FinishedJobIsServedFromTheLogAfterRestart) {
   std::string id;
   v1::GetJobResponse before;

@@ -293,6 +293,34 @@ TEST_F(StoreTest, EverythingSurvivesCloseAndReopen) {
   EXPECT_NE(second->id, job_id);
 }
 
+// A change of a job and its line in the event log commit together: one
+// commit (one sync), and no event for a change that failed.
+TEST_F(StoreTest, AChangeAndItsEventAreOneCommit) {
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  std::int64_t commits = (*store)->Commits();
+  auto job = (*store)->CreateJob(SampleJob(), NewEvent{"submitted", "a.study.textproto"});
+  ASSERT_TRUE(job.ok()) << job.status();
+  EXPECT_EQ((*store)->Commits(), ++commits);
+  ASSERT_TRUE((*store)->SetJobState(job->id, "CANCELLED", "on request", NewEvent{"cancelled", "on request"}).ok());
+  EXPECT_EQ((*store)->Commits(), ++commits);
+  JobWrite end;
+  end.job_id = job->id;
+  end.progress = JobProgress{"CONVERGED", "", 3, 12, 1.5};
+  end.event = NewEvent{"ended", "CONVERGED after 3 cycles"};
+  ASSERT_TRUE((*store)->Commit(end).ok());
+  EXPECT_EQ((*store)->Commits(), ++commits);
+  EXPECT_TRUE(absl::IsNotFound((*store)->SetJobState("job-404", "FAILED", "", NewEvent{"failed", "no such job"})));
+  EXPECT_TRUE((*store)->LoadEvents("job-404")->empty()) << "the event of a failed change is rolled back with it";
+  auto events = (*store)->LoadEvents(job->id);
+  ASSERT_TRUE(events.ok()) << events.status();
+  std::vector<std::string> logged;
+  for (const EventRow& e : *events) logged.push_back(e.kind + ": " + e.message);
+  EXPECT_EQ(logged, (std::vector<std::string>{"submitted: a.study.textproto", "cancelled: on request",
+                                               "ended: CONVERGED after 3 cycles"}));
+  EXPECT_EQ((*store)->GetJob(job->id)->state, "CONVERGED");
+}
+
 // A job with one analysis, two cycle records and an event.
 std::string AddLoggedJob(Store& store, const JobRow& row) {
   auto job = store.CreateJob(row);

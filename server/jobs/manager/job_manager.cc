@@ -181,27 +181,19 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
   }
   entry.state = to;
   entry.message = std::move(message);
-  absl::Status first_error;
+  absl::Status status;
   if (persist == Persist::kSetState) {
-    absl::Status status = store_->SetJobState(id, jobs::JobStateName(to), entry.message);
-    if (!status.ok()) {
-      LogError(id, status);
-      first_error = status;
-    }
-  }
-  if (!event.empty()) {
-    absl::Status status = store_->AddEvent(id, event, event_detail);
-    if (!status.ok()) {
-      LogError(id, status);
-      if (first_error.ok()) first_error = status;
-    }
+    // The state and its event in one commit: one sync, not two.
+    status = store_->SetJobState(id, jobs::JobStateName(to), entry.message,
+                                 event.empty() ? std::nullopt : std::optional(store::NewEvent{event, event_detail}));
+    if (!status.ok()) LogError(id, status);
   }
   // The state's commit synced the log (or the level never syncs): records
   // still waiting for a sync are durable now, and come before the state.
   PublishUnsyncedLocked(entry);
   if (!Running(to)) EvictLocked(entry);
   Changed(entry);
-  return first_error;
+  return status;
 }
 
 void JobManager::EvictLocked(Entry& entry) {
@@ -315,7 +307,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   row.owner = owner;
   row.study = study_bytes;
   row.state = jobs::JobStateName(JobState::kRunning);
-  MBOPT_ASSIGN_OR_RETURN(store::JobRow stored, store_->CreateJob(row));
+  MBOPT_ASSIGN_OR_RETURN(store::JobRow stored, store_->CreateJob(row, store::NewEvent{"submitted", source_name}));
   auto entry = std::make_shared<Entry>();
   std::lock_guard<std::mutex> entry_lock(entry->mutex);
   entry->row = std::move(stored);
@@ -328,8 +320,8 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_[id] = entry;
   }
-  // CreateJob stored the state; a failing event log does not undo the job.
-  (void)EnterStateLocked(*entry, JobState::kRunning, "", "submitted", source_name, Persist::kAlreadyStored);
+  // CreateJob stored the state and its event.
+  (void)EnterStateLocked(*entry, JobState::kRunning, "", "", "", Persist::kAlreadyStored);
   ScheduleLocked(*entry);
   return id;
 }
@@ -441,6 +433,10 @@ JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector
     delivery.write.cycles.push_back(store::CycleRow{0, r.cycle, r.attempt, jobs::EncodeCycleRecord(r)});
   }
   delivery.write.progress = progress;
+  if (delivery.state != JobState::kRunning) {
+    delivery.write.event = store::NewEvent{
+        "ended", absl::StrCat(jobs::JobStateName(delivery.state), " after ", progress.cycles, " cycles")};
+  }
   // While the job runs, its records are synced off the calling thread (the
   // worker's answer, and its next tasks, do not wait for the sync); the
   // records that end it are synced by their commit.
@@ -485,10 +481,8 @@ absl::Status JobManager::FinishDeliveryLocked(Entry& entry, Delivery delivery, c
       for (std::int64_t n = committed_records - rows + 1; n <= committed_records; ++n) options_.after_record_commit(n);
     }
     if (delivery.state != JobState::kRunning) {
-      (void)EnterStateLocked(entry, delivery.state, delivery.message, "ended",
-                             absl::StrCat(jobs::JobStateName(delivery.state), " after ",
-                                          entry.job->optimizer().cycles_completed(), " cycles"),
-                             Persist::kAlreadyStored);
+      // The write stored the state and its event.
+      (void)EnterStateLocked(entry, delivery.state, delivery.message, "", "", Persist::kAlreadyStored);
       return absl::OkStatus();
     }
     entry.message = delivery.message;

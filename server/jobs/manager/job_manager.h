@@ -223,8 +223,9 @@ class JobManager {
   enum class Persist { kSetState, kAlreadyStored };
   // The one place where a job's state changes. Starts or stops the running
   // time, drops the job's tasks when it stops running, persists the state
-  // (unless already stored), logs the event (if `event` is not empty) and
-  // wakes watchers. Returns the first store error; it is also logged.
+  // with its event (if `event` is not empty) in one commit, unless the
+  // caller's own write stored both (kAlreadyStored: then `event` is empty),
+  // and wakes watchers. Returns the store's error; it is also logged.
   absl::Status EnterStateLocked(Entry& entry, jobs::JobState to, std::string message, const std::string& event,
                                 const std::string& event_detail, Persist persist = Persist::kSetState);
   absl::Status ResumeLocked(Entry& entry, const std::string& why);
