@@ -4,8 +4,16 @@
 
 namespace mbopt::service {
 
+namespace {
+
+bool IsUnixSocketAddress(const std::string& address) {
+  return address.rfind("unix:", 0) == 0 || address.rfind("unix-abstract:", 0) == 0;
+}
+
+}  // namespace
+
 bool IsLoopbackAddress(const std::string& listen_address) {
-  if (listen_address.rfind("unix:", 0) == 0 || listen_address.rfind("unix-abstract:", 0) == 0) return true;
+  if (IsUnixSocketAddress(listen_address)) return true;
   std::string host;
   if (!listen_address.empty() && listen_address.front() == '[') {
     const std::size_t close = listen_address.find(']');
@@ -21,6 +29,12 @@ bool IsLoopbackAddress(const std::string& listen_address) {
   in6_addr v6{};
   if (inet_pton(AF_INET6, host.c_str(), &v6) == 1) return IN6_IS_ADDR_LOOPBACK(&v6);
   return false;
+}
+
+std::string DialAddress(const std::string& listen_address, int port) {
+  if (IsUnixSocketAddress(listen_address)) return listen_address;
+  const std::size_t colon = listen_address.rfind(':');
+  return (colon == std::string::npos ? listen_address : listen_address.substr(0, colon)) + ":" + std::to_string(port);
 }
 
 }  // namespace mbopt::service

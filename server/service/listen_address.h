@@ -13,4 +13,9 @@ namespace mbopt::service {
 // 0.0.0.0, [::] and any name or address of another interface.
 bool IsLoopbackAddress(const std::string& listen_address);
 
+// The address clients dial for a server listening on `listen_address` that
+// got `port` (the port asked for, or the one chosen for port 0): the host
+// with that port, or a Unix domain socket's address unchanged.
+std::string DialAddress(const std::string& listen_address, int port);
+
 }  // namespace mbopt::service

@@ -127,9 +127,7 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
     return absl::UnavailableError(absl::StrCat("cannot listen on ", s.options_.listen_address,
                                                " (address in use or invalid?)"));
   }
-  const std::string& listen = s.options_.listen_address;
-  const size_t colon = listen.rfind(':');
-  s.address_ = absl::StrCat(colon == std::string::npos ? listen : listen.substr(0, colon), ":", s.port_);
+  s.address_ = DialAddress(s.options_.listen_address, s.port_);
 
   const std::int64_t interval =
       s.options_.reaper_interval_ms > 0 ? s.options_.reaper_interval_ms : std::max<std::int64_t>(10, s.options_.lease_ms / 4);

@@ -538,6 +538,30 @@ TEST(ListenAddress, OnlyLoopbackAndLocalSocketsAreLoopback) {
   }
 }
 
+TEST(ListenAddress, ClientsDialTheHostWithTheChosenPortOrTheSocketAsGiven) {
+  EXPECT_EQ(DialAddress("127.0.0.1:0", 40123), "127.0.0.1:40123");
+  EXPECT_EQ(DialAddress("[::1]:0", 40123), "[::1]:40123");
+  EXPECT_EQ(DialAddress("localhost:50051", 50051), "localhost:50051");
+  EXPECT_EQ(DialAddress("unix:/tmp/mbopt.sock", 1), "unix:/tmp/mbopt.sock");
+  EXPECT_EQ(DialAddress("unix-abstract:mbopt", 1), "unix-abstract:mbopt");
+}
+
+// A server on a Unix domain socket says where it is (it said "unix:1"),
+// and a client reaches it there.
+TEST_F(ServerTest, ServerOnAUnixSocketGivesTheSocketAsItsAddress) {
+  ServerOptions options;
+  options.listen_address = "unix:" + (dir_ / "server.sock").string();
+  options.db_path = (dir_ / "a.db").string();
+  absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
+  ASSERT_TRUE(server.ok()) << server.status();
+  EXPECT_EQ((*server)->address(), options.listen_address);
+  auto stub = v1::JobService::NewStub(grpc::CreateChannel((*server)->address(), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  v1::ListJobsResponse response;
+  EXPECT_TRUE(stub->List(&context, v1::ListJobsRequest(), &response).ok());
+}
+
 TEST_F(ServerTest, AddressOffLoopbackIsRefusedWithoutInsecureBeforeAnythingOpens) {
   for (const char* address : {"0.0.0.0:0", "[::]:0", ":0"}) {
     ServerOptions options;
