@@ -124,7 +124,8 @@ TEST(Mechanism, UndeclaredGravityIsNeverEvaluated) {
   EXPECT_EQ(forces.cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(m.counters().force_evaluations, 1);
   EXPECT_EQ(m.counters().gravity_evaluations, 0);
-  const Mechanism with(testing::Pendulum(1.0, 1.0, 0.3));
+  const Model with_gravity = testing::Pendulum(1.0, 1.0, 0.3);
+  const Mechanism with(with_gravity);
   with.AppliedForces(0.0, q, v, &forces);
   EXPECT_EQ(with.counters().gravity_evaluations, 1);
 }
