@@ -3,6 +3,8 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <vector>
 
 #include "worker/service/stop_signal.h"
 #include "worker/service/worker_service.h"
@@ -108,8 +110,11 @@ int ServeMain(const std::vector<std::string>& args) {
     return 2;
   }
   options.security = *std::move(security);
-  // Leaked on purpose: the signal thread may outlive this function.
-  auto* stop = new StopSignal();
+  // Never freed: the signal thread may outlive this function (and static
+  // destruction at exit). Held where leak checkers see it reachable, as the
+  // process's other lifetime objects are.
+  static auto* const stop_signals = new std::vector<std::unique_ptr<StopSignal>>();
+  StopSignal* stop = stop_signals->emplace_back(std::make_unique<StopSignal>()).get();
   StopOnTerminationSignals(stop);
   absl::Status status = RunWorker(options, *stop);
   if (!status.ok()) {
