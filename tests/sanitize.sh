@@ -5,7 +5,9 @@
 # even where the test's own assertions pass. Slower than the plain build
 # (about 2x to build, 2-3x to run), so on demand, not in the test command:
 #   tests/sanitize.sh                 the unit and integration tests
-#   tests/sanitize.sh -L e2e          a ctest selection instead
+#   tests/sanitize.sh -L e2e          a ctest selection instead (the e2e tests
+#                                     labelled multihost and slurm need root;
+#                                     -LE "multihost|slurm" leaves them out)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build-sanitize

@@ -126,11 +126,13 @@ class Store {
   // Transactions that committed writes so far (for tests and benchmarks:
   // fewer than the writes when they arrived together).
   std::int64_t AnalysisTransactions() const;
-  // Of those, the ones committed with a sync (all at kFull, those with cycle
-  // records not deferred to SyncLog at kCycles, none at kNormal).
+  // Of those, the ones committed with a sync (all at kFull; at kCycles those
+  // with cycle records not deferred to SyncLog, or with an event; none at
+  // kNormal).
   std::int64_t SyncedTransactions() const;
-  // Transactions committed on this database by this store, of any kind (a
-  // statement outside a transaction is one): what a change costs in commits.
+  // Commits this store began on its database, of any kind (a statement
+  // outside a transaction is one; SQLite's commit hook, so a commit that
+  // then fails counts too): what a change costs in commits.
   std::int64_t Commits() const { return commits_.load(std::memory_order_relaxed); }
   // Makes every commit that has returned so far durable (fdatasync of the
   // write-ahead log), without holding up commits meanwhile. No-op at

@@ -39,8 +39,9 @@ class Mechanism : public ConstrainedSystem {
  public:
   explicit Mechanism(const Model& model);
   // The mechanism keeps a reference to its model: a temporary would die
-  // before it (the sanitizer build found one such use in a test).
-  explicit Mechanism(Model&&) = delete;
+  // before it (the sanitizer build found one such use in a test). Takes
+  // every rvalue, const or not, before `const Model&` could.
+  explicit Mechanism(const Model&&) = delete;
 
   const Model& model() const { return model_; }
   int num_coordinates() const override { return 3 * static_cast<int>(model_.bodies.size()); }
