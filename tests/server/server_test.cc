@@ -416,14 +416,15 @@ TEST_F(ServerTest, EachStateChangeIsOneCommitWithItsEvent) {
     FakeWorker worker(server->InProcessChannel(), 10);
     worker.Run(5);
   }
-  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  std::unique_ptr<v1::JobService::Stub> stub = v1::JobService::NewStub(server->InProcessChannel());
   v1::JobRef ref;
   ref.set_job_id(id);
   for (const bool cancel : {true, false}) {
     commits = log.Commits();
     grpc::ClientContext context;
     v1::JobSummary summary;
-    ASSERT_TRUE((cancel ? stub->Cancel(&context, ref, &summary) : stub->Resume(&context, ref, &summary)).ok());
+    const grpc::Status status = cancel ? stub->Cancel(&context, ref, &summary) : stub->Resume(&context, ref, &summary);
+    ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_EQ(log.Commits(), commits + 1) << (cancel ? "cancel" : "resume");
   }
   FakeWorker worker(server->InProcessChannel(), 11);
@@ -555,7 +556,8 @@ TEST_F(ServerTest, ServerOnAUnixSocketGivesTheSocketAsItsAddress) {
   absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
   ASSERT_TRUE(server.ok()) << server.status();
   EXPECT_EQ((*server)->address(), options.listen_address);
-  auto stub = v1::JobService::NewStub(grpc::CreateChannel((*server)->address(), grpc::InsecureChannelCredentials()));
+  std::unique_ptr<v1::JobService::Stub> stub =
+      v1::JobService::NewStub(grpc::CreateChannel((*server)->address(), grpc::InsecureChannelCredentials()));
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
   v1::ListJobsResponse response;
