@@ -103,8 +103,11 @@ std::string CycleTableHeader() {
 std::string CycleTableRow(const v1::CycleRecord& r) {
   auto [ml_min, ml_max] = MinMax(r.move_limits());
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%5d %3d %14.7g %10.4g %10.4g %9.3g %4s %4s %9.3g %9.3g %9lld",
-                r.cycle(), r.attempt(), r.objective_trial(), r.max_violation_trial(),
+  // A restoration step shows as "r" and its attempt: it belongs to the
+  // cycle that converged.
+  const std::string attempt = (r.restoration() ? "r" : "") + std::to_string(r.attempt());
+  std::snprintf(buf, sizeof buf, "%5d %3s %14.7g %10.4g %10.4g %9.3g %4s %4s %9.3g %9.3g %9lld",
+                r.cycle(), attempt.c_str(), r.objective_trial(), r.max_violation_trial(),
                 r.max_approximation_error(), r.optimality_residual(), r.lp_feasible() ? "yes" : "no",
                 r.accepted() ? "yes" : "no", ml_min, ml_max,
                 static_cast<long long>(r.analyses_total()));
@@ -182,7 +185,7 @@ std::string ResultsTable(const v1::GetJobResponse& job) {
 std::string ResultsCsv(const v1::GetJobResponse& job) {
   const auto& s = job.summary();
   std::string out = "cycle,attempt,accepted,objective,max_violation,max_approximation_error,"
-                    "optimality_residual,lp_feasible,move_limit_min,move_limit_max,analyses";
+                    "optimality_residual,lp_feasible,move_limit_min,move_limit_max,analyses,restoration";
   for (const auto& name : s.design_names()) out += "," + name;
   out += "\n";
   for (const auto& r : job.cycles()) {
@@ -193,7 +196,8 @@ std::string ResultsCsv(const v1::GetJobResponse& job) {
            JsonWriter::FormatDouble(r.max_approximation_error()) + "," +
            JsonWriter::FormatDouble(r.optimality_residual()) + "," +
            (r.lp_feasible() ? "1" : "0") + "," + JsonWriter::FormatDouble(ml_min) + "," +
-           JsonWriter::FormatDouble(ml_max) + "," + std::to_string(r.analyses_total());
+           JsonWriter::FormatDouble(ml_max) + "," + std::to_string(r.analyses_total()) + "," +
+           (r.restoration() ? "1" : "0");
     for (int i = 0; i < s.design_names_size(); ++i) {
       out += ",";
       if (i < r.x_trial_physical_size()) out += JsonWriter::FormatDouble(r.x_trial_physical(i));
@@ -262,6 +266,7 @@ std::string ResultsJson(const v1::GetJobResponse& job, const std::string& databa
     w.BeginObject();
     w.Field("cycle", r.cycle());
     w.Field("attempts", r.attempt() + 1);
+    w.Field("restoration", r.restoration());
     w.Field("objective", r.objective_trial());
     w.Field("max_violation", r.max_violation_trial());
     w.Field("max_approximation_error", r.max_approximation_error());

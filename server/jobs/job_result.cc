@@ -4,9 +4,8 @@
 
 namespace mbopt::jobs {
 
-std::optional<slp::DesignPoint> BestDesignOfRecords(const std::vector<slp::CycleRecord>& records,
-                                                    const slp::SlpOptions& options) {
-  slp::BestDesign best(options.convergence_violation_tolerance);
+std::optional<slp::DesignPoint> BestDesignOfRecords(const std::vector<slp::CycleRecord>& records) {
+  slp::BestDesign best;
   for (const slp::CycleRecord& record : records) best.OfferRecord(record);
   return best.best();
 }

@@ -6,13 +6,11 @@
 #include <optional>
 #include <vector>
 
-#include "server/slp/options.h"
 #include "server/slp/slp_optimizer.h"
 
 namespace mbopt::jobs {
 
 // None when no record holds an analysed design.
-std::optional<slp::DesignPoint> BestDesignOfRecords(const std::vector<slp::CycleRecord>& records,
-                                                    const slp::SlpOptions& options);
+std::optional<slp::DesignPoint> BestDesignOfRecords(const std::vector<slp::CycleRecord>& records);
 
 }  // namespace mbopt::jobs

@@ -9,7 +9,10 @@ namespace mbopt::jobs {
 namespace {
 
 // 2: optimality_residual after max_approximation_error's row.
-constexpr unsigned char kVersion = 2;
+// 3: restoration after converged. Records of version 2 are still read
+// (restoration false): a database written before it resumes as it was.
+constexpr unsigned char kVersion = 3;
+constexpr unsigned char kOldestReadVersion = 2;
 
 class Writer {
  public:
@@ -134,13 +137,16 @@ std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   w.Bools(r.on_bound);
   w.Int64(r.analyses_total);
   w.Bool(r.converged);
+  w.Bool(r.restoration);
   return std::move(w.out());
 }
 
 absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
-  if (bytes.empty() || static_cast<unsigned char>(bytes[0]) != kVersion) {
+  const unsigned char version = bytes.empty() ? 0 : static_cast<unsigned char>(bytes[0]);
+  if (version < kOldestReadVersion || version > kVersion) {
     return absl::DataLossError(absl::StrCat("a cycle record of ", bytes.size(),
-                                            " bytes does not start with format version ", kVersion));
+                                            " bytes does not start with a format version from ",
+                                            kOldestReadVersion, " to ", kVersion));
   }
   const std::string body = bytes.substr(1);
   Reader r(body);
@@ -172,6 +178,7 @@ absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
   c.on_bound = r.Bools();
   c.analyses_total = r.Int64();
   c.converged = r.Bool();
+  if (version >= 3) c.restoration = r.Bool();
   if (!r.ok() || !r.at_end()) {
     return absl::DataLossError(absl::StrCat("a cycle record of ", bytes.size(), " bytes is truncated or too long"));
   }

@@ -99,6 +99,7 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
   for (bool b : r.on_bound) out.add_on_bound(b);
   out.set_analyses_total(r.analyses_total);
   out.set_converged(r.converged);
+  out.set_restoration(r.restoration);
   return out;
 }
 

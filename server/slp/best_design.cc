@@ -5,8 +5,8 @@
 namespace mbopt::slp {
 
 bool BestDesign::Better(const DesignPoint& a, const DesignPoint& b) const {
-  const bool a_feasible = a.max_violation < violation_tolerance_;
-  const bool b_feasible = b.max_violation < violation_tolerance_;
+  const bool a_feasible = a.max_violation <= 0;
+  const bool b_feasible = b.max_violation <= 0;
   if (a_feasible != b_feasible) return a_feasible;
   if (a_feasible) return a.objective < b.objective;
   return a.max_violation < b.max_violation;

@@ -3,26 +3,25 @@
 // accepted step may raise F within the acceptance thresholds, and a rejected
 // trial may be better than the point the run ended on.
 //
-// Order: a feasible design (maxg < convergence_violation_tolerance, the
-// method's own notion of satisfied constraints) beats an infeasible one;
-// among feasible designs the lower F wins, among infeasible ones the lower
-// maxg. Ties keep the earlier design, so the choice depends only on the
-// sequence of cycle records: the optimizer and a reader of the job's logged
-// records make the same choice.
+// Order: a feasible design (maxg <= 0: every constraint met, not merely
+// within the violation tolerance, which is a stopping criterion and no
+// licence for the result) beats an infeasible one; among feasible designs
+// the lower F wins, among infeasible ones the lower maxg. Ties keep the
+// earlier design, so the choice depends only on the sequence of cycle
+// records: the optimizer and a reader of the job's logged records make the
+// same choice.
 #pragma once
 
 #include <optional>
 
 #include <Eigen/Dense>
 
-#include "server/slp/options.h"
 #include "server/slp/slp_optimizer.h"
 
 namespace mbopt::slp {
 
 class BestDesign {
  public:
-  explicit BestDesign(double violation_tolerance) : violation_tolerance_(violation_tolerance) {}
 
   // Offers a design; one whose values are not finite (a failed analysis) is
   // ignored.
@@ -35,7 +34,6 @@ class BestDesign {
  private:
   bool Better(const DesignPoint& a, const DesignPoint& b) const;
 
-  double violation_tolerance_;
   std::optional<DesignPoint> best_;
 };
 

@@ -10,6 +10,9 @@ namespace mbopt::slp {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// x0 is on a bound within this share of its box half-width (the same
+// tolerance as the records' boundact).
+constexpr double kBoundActivityRelativeTolerance = 1e-6;
 
 // Largest and smallest change of a linear function grad . d over the box.
 double MaxOverBox(const Eigen::VectorXd& grad, const MoveBox& box) {
@@ -47,15 +50,20 @@ double OptimalityResidual(const ProblemSpec& spec, const SlpOptions& o, const Li
     const double slack = 1e-9 * std::max(w, 1e-300);
     const bool at_upper = d >= box.d_upper[i] - slack;
     const bool at_lower = d <= box.d_lower[i] + slack;
-    const bool upper_is_bound = spec.upper[i] - lin.x0[i] <= w;
-    const bool lower_is_bound = lin.x0[i] - spec.lower[i] <= w;
+    // A design bound holds the gradient back only where x0 is on it: a bound
+    // that the box merely reaches is a place the step could go, not a
+    // multiplier of the design x0, and counting it would call x0 optimal
+    // while it could still move freely away from the bound.
+    const double range = spec.upper[i] - spec.lower[i];
+    const double on_bound = kBoundActivityRelativeTolerance * std::max(w, 1e-12 * range);
+    const bool upper_is_bound = spec.upper[i] - lin.x0[i] <= on_bound;
+    const bool lower_is_bound = lin.x0[i] - spec.lower[i] <= on_bound;
     double unbalanced = std::abs(reduced_cost);
     if (at_upper && upper_is_bound) {
       unbalanced = std::max(0.0, reduced_cost);  // a minimum there has reduced cost <= 0
     } else if (at_lower && lower_is_bound) {
       unbalanced = std::max(0.0, -reduced_cost);
     }
-    const double range = spec.upper[i] - spec.lower[i];
     const double typical =
         std::max(std::abs(lin.x0[i]), o.move_limit_floor_fraction_of_range * range);
     residual = std::max(residual, unbalanced * cycle_lp.objective_scale * typical / relative_to);

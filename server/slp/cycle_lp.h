@@ -66,10 +66,11 @@ CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& options,
 // At the LP's optimum the gradient of the objective (for min-max, of the
 // terms weighted by their multipliers) plus the constraint gradients
 // weighted by theirs is balanced by the reduced costs of the step columns d_i.
-// A reduced cost on a side of the box that is a design bound is a bound
-// multiplier of the problem itself (counted only if of the wrong sign); one
-// on a side set by a move limit is gradient that only the move limit holds
-// back, the stationarity residual of the KKT conditions. Per variable it is
+// A reduced cost on a design bound that x0 is on is a bound multiplier of
+// the problem itself (counted only if of the wrong sign); one on a side of
+// the box set by a move limit, or on a bound that the box reaches while x0
+// is away from it, is gradient that x0 could still follow: the stationarity
+// residual of the KKT conditions. Per variable it is
 // made relative as the move limit is:
 //   r_i = |reduced cost_i| * S * max(|x0_i|, floor_fraction * range_i) / max(|F0|, floor)
 // i.e. the relative change of F per unit of the relative move limit f_i that

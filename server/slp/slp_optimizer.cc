@@ -2,15 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "common/check.h"
 #include "server/slp/best_design.h"
 #include "server/slp/cycle_lp.h"
 #include "server/slp/finite_difference.h"
+#include "server/slp/flat_directions.h"
 #include "server/slp/move_limit_strategy.h"
+#include "server/slp/restoration_lp.h"
 
 namespace mbopt::slp {
 
@@ -36,6 +41,21 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // A step counts as on its move limit within this fraction of the half-width
 // (LP vertices sit on the limit up to rounding).
 constexpr double kActivityRelativeTolerance = 1e-6;
+// Restoration steps after a converged design that violates a limit: each
+// aims twice as far inside as the one before, from the same design, in a
+// box twice as wide.
+constexpr int kMaxRestorationSteps = 4;
+// The first restoration step aims at least this far inside (normalized): a
+// violation at the rounding level of the values (1e-16) would give a step
+// that x cannot represent.
+constexpr double kMinRestorationMargin = 1e-9;
+// Locally infeasible: this many accepted cycles in a row whose LPs could not
+// meet the linearized constraints, and the violation fell by less than this
+// share of itself over them.
+constexpr int kLocallyInfeasibleCycles = 6;
+constexpr double kLocallyInfeasibleProgress = 0.01;
+// Rows named in a message about violated constraints.
+constexpr int kRowsNamed = 5;
 
 // The values of one successful analysis and what the core derives from them.
 struct PointValues {
@@ -75,8 +95,7 @@ class SlpOptimizer::Impl {
   Impl(ProblemSpec spec, SlpOptions options, std::unique_ptr<lp::LpSolver> lp_solver)
       : spec_(std::move(spec)),
         options_(options),
-        lp_solver_(std::move(lp_solver)),
-        best_(options_.convergence_violation_tolerance) {
+        lp_solver_(std::move(lp_solver)) {
     MBOPT_CHECK(spec_.Validate().ok(), "invalid ProblemSpec (call Validate first)");
     MBOPT_CHECK(options_.Validate().ok(), "invalid SlpOptions (call Validate first)");
     MBOPT_CHECK(lp_solver_ != nullptr, "no LP solver");
@@ -154,6 +173,7 @@ class SlpOptimizer::Impl {
 
   RunState state() const { return state_; }
   const std::string& end_reason() const { return failure_reason_; }
+  const std::vector<std::string>& result_notes() const { return result_notes_; }
   const Eigen::VectorXd& current_design() const { return x0_; }
   double current_objective() const { return have_x0_ ? v0_.objective : kNaN; }
   double current_max_violation() const { return have_x0_ ? v0_.max_violation : kNaN; }
@@ -166,7 +186,7 @@ class SlpOptimizer::Impl {
   const ProblemSpec& spec() const { return spec_; }
 
  private:
-  enum class Phase { kStartAndPerturb, kPerturb, kTrial };
+  enum class Phase { kStartAndPerturb, kPerturb, kTrial, kRestoration };
 
   struct Perturbation {
     std::vector<Sample> samples;         // successful ones
@@ -216,8 +236,7 @@ class SlpOptimizer::Impl {
       case Phase::kStartAndPerturb: {
         const AnalysisResult& start = results.at(start_request_id_);
         if (start.outcome != AnalysisOutcome::kOk) {
-          state_ = RunState::kFailed;
-          failure_reason_ = "analysis of the initial design failed: " + start.failure_reason;
+          End(RunState::kFailed, "analysis of the initial design failed: " + start.failure_reason);
           return;
         }
         v0_ = MakePointValues(spec_, start);
@@ -235,6 +254,11 @@ class SlpOptimizer::Impl {
       case Phase::kTrial: {
         MBOPT_CHECK(results.size() == 1, "a trial batch has one analysis");
         EvaluateTrial(&results.begin()->second);
+        return;
+      }
+      case Phase::kRestoration: {
+        MBOPT_CHECK(results.size() == 1, "a restoration batch has one analysis");
+        EvaluateRestoration(results.begin()->second);
         return;
       }
     }
@@ -322,7 +346,7 @@ class SlpOptimizer::Impl {
   // A feasible design at or below the user's objective target.
   bool MeetsObjectiveTarget(const PointValues& v) const {
     return options_.objective_target.has_value() && v.objective <= *options_.objective_target &&
-           v.max_violation < options_.convergence_violation_tolerance;
+           v.max_violation <= 0;
   }
   bool AnyFrozen() const {
     return std::find(lin_.frozen.begin(), lin_.frozen.end(), true) != lin_.frozen.end();
@@ -342,14 +366,80 @@ class SlpOptimizer::Impl {
     return r;
   }
 
-  void Emit(CycleRecord record) {
+  // `x0_constraints` and `trial_constraints`: g_h at the record's x0 and
+  // x_trial (empty when not analysed), so that the end notes can name the
+  // violated rows of the best design without keeping every design's rows.
+  void Emit(CycleRecord record, const Eigen::VectorXd& x0_constraints,
+            const Eigen::VectorXd& trial_constraints) {
+    const std::optional<DesignPoint> before = best_.best();
     best_.OfferRecord(record);
+    const std::optional<DesignPoint>& after = best_.best();
+    const bool changed = after.has_value() &&
+                         (!before.has_value() || after->x != before->x ||
+                          after->objective != before->objective ||
+                          after->max_violation != before->max_violation);
+    if (changed) {
+      const bool is_trial = after->x == record.x_trial &&
+                            after->objective == record.objective_trial &&
+                            after->max_violation == record.max_violation_trial;
+      best_violation_values_ = is_trial ? trial_constraints : x0_constraints;
+    }
     new_records_.push_back(std::move(record));
   }
 
-  void Stall(const std::string& why) {
-    state_ = RunState::kStalled;
-    failure_reason_ = why;
+  void Stall(const std::string& why) { End(RunState::kStalled, why); }
+
+  // Every end of the run comes here, so that the notes on its result are
+  // made once, from the state the run ended in.
+  void End(RunState state, std::string reason = "") {
+    state_ = state;
+    failure_reason_ = std::move(reason);
+    result_notes_.clear();
+    const DesignPoint best = best_design();
+    if (spec_.num_constraints() > 0 && std::isfinite(best.max_violation) &&
+        best.max_violation > 0) {
+      result_notes_.push_back(absl::StrCat(
+          "no feasible design found; the least violation is maxg = ", Number(best.max_violation),
+          " (normalized)", ViolatedRowsText(best_violation_values_, " at that design: ")));
+    }
+    for (int i : FlatVariables(spec_, options_, lin_)) {
+      result_notes_.push_back(absl::StrCat(
+          VariableText(i), " changes nothing here: its derivatives of the objective and of "
+          "the active constraints are all below ", kFlatRelativeSensitivity,
+          " relative at the final design; fix it or leave it out of the study"));
+    }
+  }
+
+  static std::string Number(double v) { return absl::StrFormat("%.4g", v); }
+
+  std::string VariableText(int i) const {
+    return absl::StrCat("x", i + 1, " '", spec_.variable_names[i], "'");
+  }
+
+  // "'row' (+0.012), ..." for the most violated rows of `constraints` (g_h
+  // values), most violated first; empty without violated rows.
+  std::string ViolatedRowsText(const Eigen::VectorXd& constraints,
+                               const std::string& lead) const {
+    if (constraints.size() != spec_.num_constraints()) return "";
+    std::vector<std::pair<double, int>> violated;
+    for (int h = 0; h < spec_.num_constraints(); ++h) {
+      const double g =
+          (constraints[h] - spec_.constraint_limits[h]) / spec_.constraint_scales[h];
+      if (g > 0) violated.emplace_back(-g, h);
+    }
+    if (violated.empty()) return "";
+    std::sort(violated.begin(), violated.end());
+    std::string out = lead;
+    const int named = std::min<int>(kRowsNamed, static_cast<int>(violated.size()));
+    for (int k = 0; k < named; ++k) {
+      const int h = violated[k].second;
+      absl::StrAppend(&out, k == 0 ? "" : ", ", "'", spec_.constraint_names[h], "' (+",
+                      Number(-violated[k].first), ")");
+    }
+    if (static_cast<int>(violated.size()) > named) {
+      absl::StrAppend(&out, " and ", violated.size() - named, " more rows");
+    }
+    return out;
   }
 
   // Solves this attempt's LP and asks for the analysis of its optimum. An LP
@@ -392,7 +482,7 @@ class SlpOptimizer::Impl {
       r.on_move_limit.assign(spec_.num_variables(), false);
       r.on_bound.assign(spec_.num_variables(), false);
       r.analyses_total = analyses_used_;
-      Emit(std::move(r));
+      Emit(std::move(r), v0_.constraints, {});
       if (!NextAttempt()) return;
     }
 
@@ -530,7 +620,7 @@ class SlpOptimizer::Impl {
     r.analyses_total = analyses_used_;
 
     if (!decision.accept) {
-      Emit(std::move(r));
+      Emit(std::move(r), v0_.constraints, trial.constraints);
       if (NextAttempt()) SolveAndRequestTrial();
       return;
     }
@@ -542,6 +632,17 @@ class SlpOptimizer::Impl {
                            (relative_change < options_.convergence_objective_tolerance &&
                             trial.max_violation < options_.convergence_violation_tolerance &&
                             r.optimality_residual < options_.convergence_optimality_tolerance && !AnyFrozen());
+    // maxg before each of the last accepted cycles in a row whose LPs were
+    // infeasible, oldest first.
+    if (!r.lp_feasible) {
+      infeasible_lp_violations_.push_back(v0_.max_violation);
+      if (static_cast<int>(infeasible_lp_violations_.size()) > kLocallyInfeasibleCycles) {
+        infeasible_lp_violations_.pop_front();
+      }
+    } else {
+      infeasible_lp_violations_.clear();
+    }
+    const Eigen::VectorXd x0_constraints = v0_.constraints;
     dx_old_ = d;
     dF_old_ = trial.objective - v0_.objective;
     x0_ = x_trial_;
@@ -549,13 +650,23 @@ class SlpOptimizer::Impl {
     ++cycles_completed_;
     previous_rejection_at_min_ = false;
     r.converged = converged;
-    Emit(std::move(r));
+    Emit(std::move(r), x0_constraints, trial.constraints);
     if (converged) {
-      state_ = RunState::kConverged;
+      if (spec_.num_constraints() > 0 && v0_.max_violation > 0) {
+        BeginRestoration(*result);
+        return;
+      }
+      End(RunState::kConverged);
+      return;
+    }
+    if (static_cast<int>(infeasible_lp_violations_.size()) == kLocallyInfeasibleCycles &&
+        v0_.max_violation >
+            (1 - kLocallyInfeasibleProgress) * infeasible_lp_violations_.front()) {
+      Stall(LocallyInfeasibleReason());
       return;
     }
     if (cycle_ >= options_.max_cycles) {
-      state_ = RunState::kMaxCycles;
+      End(RunState::kMaxCycles);
       return;
     }
     ++cycle_;
@@ -568,12 +679,167 @@ class SlpOptimizer::Impl {
     PlanPerturbations();
   }
 
+  // Why a run whose LPs stay infeasible stops: the rows still violated at
+  // its design, and what to try.
+  std::string LocallyInfeasibleReason() const {
+    std::string out = absl::StrCat(
+        "locally infeasible: ", kLocallyInfeasibleCycles,
+        " cycles in a row found no step that meets the linearized constraints, and the "
+        "violation stayed at maxg = ",
+        Number(v0_.max_violation), " (", Number(infeasible_lp_violations_.front()),
+        " before them)");
+    absl::StrAppend(&out, ViolatedRowsText(v0_.constraints, "; rows still violated: "));
+    std::vector<std::string> on_bound;
+    for (int i = 0; i < spec_.num_variables(); ++i) {
+      if (x0_[i] <= spec_.lower[i]) on_bound.push_back(VariableText(i) + " at its lower bound");
+      if (x0_[i] >= spec_.upper[i]) on_bound.push_back(VariableText(i) + " at its upper bound");
+    }
+    absl::StrAppend(&out, "; try another starting design");
+    if (!on_bound.empty()) {
+      absl::StrAppend(&out, " or wider bounds (", absl::StrJoin(on_bound, ", "), ")");
+    } else {
+      absl::StrAppend(&out, ", or check that the limits can be met together");
+    }
+    return out;
+  }
+
+  // The converged design x0 violates a limit by less than the violation
+  // tolerance. Its linearization is the cycle's gradients moved to x0 (the
+  // analysis of x0 brought its own with simulator sensitivities).
+  void BeginRestoration(const AnalysisResult& x0_result) {
+    lin_.x0 = x0_;
+    lin_.terms0 = v0_.terms;
+    lin_.constraints0 = v0_.constraints;
+    if (x0_result.has_gradients()) {
+      lin_.terms_gradient = x0_result.objective_gradients;
+      if (x0_result.constraint_gradients.size() > 0) {
+        lin_.constraints_gradient = x0_result.constraint_gradients;
+      }
+    }
+    restoration_steps_ = 0;
+    restoration_from_violation_ = v0_.max_violation;
+    lp_solver_->ResetWarmStart();
+    SolveRestoration();
+  }
+
+  void SolveRestoration() {
+    ++attempt_;
+    const double widen = std::ldexp(1.0, restoration_steps_);
+    const double margin =
+        std::max(restoration_from_violation_, kMinRestorationMargin) * widen;
+    const Eigen::VectorXd limits =
+        (move_limits_ * widen).cwiseMin(options_.max_move_limit);
+    box_ = ComputeMoveBox(spec_, options_, x0_, limits, lin_.frozen);
+    const RestorationLp rlp = BuildRestorationLp(spec_, options_, lin_, box_, margin);
+    lp::LpSolution sol = lp_solver_->Solve(rlp.lp);
+    const int n = spec_.num_variables();
+    CycleRecord r = NewRecord();
+    r.restoration = true;
+    r.move_limits = limits;
+    r.move_limits_next = move_limits_;
+    r.lp_status = lp::LpStatusName(sol.status);
+    r.lp_iterations = sol.iterations;
+    r.rows_screened_in = static_cast<int>(rlp.kept_constraints.size());
+    r.optimality_residual = kNaN;
+    r.on_move_limit.assign(n, false);
+    r.on_bound.assign(n, false);
+    x_trial_ = x0_;
+    if (sol.status == lp::LpStatus::kOptimal) {
+      const Eigen::VectorXd d = RestorationStep(rlp, sol.x);
+      for (int i = 0; i < n; ++i) {
+        x_trial_[i] = std::clamp(x0_[i] + d[i], spec_.lower[i], spec_.upper[i]);
+      }
+      r.infeasibility = sol.x[rlp.s_column] * margin;
+      r.lp_feasible = r.infeasibility <= options_.infeasibility_tolerance;
+    }
+    if (sol.status != lp::LpStatus::kOptimal || x_trial_ == x0_) {
+      // Nothing to analyse: the linearization offers no move.
+      r.accepted = false;
+      r.rejection_reason =
+          sol.status != lp::LpStatus::kOptimal
+              ? absl::StrCat("restoration LP not solved: ", lp::LpStatusName(sol.status))
+              : "restoration: the linearization offers no move that meets the limits";
+      r.x_trial = x0_;
+      r.objective_trial = kNaN;
+      r.objective_predicted = kNaN;
+      r.max_violation_trial = kNaN;
+      r.objective_error = kNaN;
+      r.max_approximation_error = kNaN;
+      r.analyses_total = analyses_used_;
+      r.converged = true;  // it ends the converged run
+      Emit(std::move(r), v0_.constraints, {});
+      End(RunState::kConverged);
+      return;
+    }
+    pending_restoration_record_ = std::move(r);
+    phase_ = Phase::kRestoration;
+    Request(RequestPurpose::kTrial, -1, 0.0, x_trial_);
+  }
+
+  void EvaluateRestoration(const AnalysisResult& result) {
+    CycleRecord r = std::move(pending_restoration_record_);
+    const Eigen::VectorXd d = x_trial_ - x0_;
+    r.x_trial = x_trial_;
+    double predicted = -std::numeric_limits<double>::infinity();
+    for (int j = 0; j < lin_.terms0.size(); ++j) {
+      predicted = std::max(predicted, lin_.terms0[j] + lin_.terms_gradient.row(j).dot(d));
+    }
+    r.objective_predicted = predicted;
+    r.max_approximation_error = kNaN;
+    r.analyses_total = analyses_used_;
+    PointValues trial;
+    if (result.outcome != AnalysisOutcome::kOk) {
+      r.objective_trial = kNaN;
+      r.max_violation_trial = kNaN;
+      r.objective_error = kNaN;
+      r.rejection_reason = absl::StrCat("restoration analysis failed: ", result.failure_reason);
+    } else {
+      trial = MakePointValues(spec_, result);
+      r.objective_trial = trial.objective;
+      r.max_violation_trial = trial.max_violation;
+      r.worst_constraint_trial = trial.worst_constraint;
+      r.objective_error = std::abs(predicted - trial.objective) /
+                          std::max(std::abs(trial.objective), options_.objective_magnitude_floor);
+      r.accepted = trial.max_violation <= 0;
+      if (!r.accepted) {
+        r.rejection_reason = absl::StrCat("restoration: maxg = ", Number(trial.max_violation),
+                                          " still above 0");
+      }
+    }
+    if (r.accepted) {
+      r.converged = true;
+      const Eigen::VectorXd x0_constraints = v0_.constraints;
+      x0_ = x_trial_;
+      v0_ = trial;
+      Emit(std::move(r), x0_constraints, trial.constraints);
+      End(RunState::kConverged);
+      return;
+    }
+    ++restoration_steps_;
+    const bool last = restoration_steps_ >= kMaxRestorationSteps;
+    r.converged = last;  // the last step ends the converged run
+    Emit(std::move(r), v0_.constraints, trial.constraints);
+    if (last) {
+      End(RunState::kConverged);
+      return;
+    }
+    SolveRestoration();
+  }
+
   ProblemSpec spec_;
   SlpOptions options_;
   std::unique_ptr<lp::LpSolver> lp_solver_;
 
   RunState state_ = RunState::kRunning;
   std::string failure_reason_;
+  std::vector<std::string> result_notes_;
+  Eigen::VectorXd best_violation_values_;  // g_h at best_'s design
+
+  std::deque<double> infeasible_lp_violations_;
+
+  int restoration_steps_ = 0;
+  double restoration_from_violation_ = 0;  // maxg of the converged design
+  CycleRecord pending_restoration_record_;
   std::int64_t next_id_ = 0;
   std::int64_t analyses_used_ = 0;
   std::map<std::int64_t, AnalysisRequest> outstanding_;  // asked, not answered
@@ -620,6 +886,9 @@ absl::Status SlpOptimizer::SubmitResult(const AnalysisResult& result) {
 std::vector<CycleRecord> SlpOptimizer::TakeNewRecords() { return impl_->TakeNewRecords(); }
 RunState SlpOptimizer::state() const { return impl_->state(); }
 const std::string& SlpOptimizer::end_reason() const { return impl_->end_reason(); }
+const std::vector<std::string>& SlpOptimizer::result_notes() const {
+  return impl_->result_notes();
+}
 const Eigen::VectorXd& SlpOptimizer::current_design() const { return impl_->current_design(); }
 double SlpOptimizer::current_objective() const { return impl_->current_objective(); }
 double SlpOptimizer::current_max_violation() const { return impl_->current_max_violation(); }

@@ -86,7 +86,9 @@ enum class RunState {
   kConverged,   // the convergence test of METHOD.md section 3 held, and the
                 // KKT residual was below convergence_optimality_tolerance
   kMaxCycles,   // SlpOptions::max_cycles cycles were run
-  kStalled,     // move limits collapsed or every trial point failed
+  kStalled,     // move limits collapsed, every trial point failed, or the
+                // design stays infeasible with infeasible LPs (locally
+                // infeasible; end_reason() names the rows)
   kFailed,      // x0 of the first cycle could not be analysed
 };
 
@@ -124,7 +126,15 @@ struct CycleRecord {
   std::vector<bool> on_move_limit;  // mvlimact(i)
   std::vector<bool> on_bound;       // boundact(i)
   std::int64_t analyses_total = 0;  // analyses consumed by the run so far
-  bool converged = false;           // this record ended the run converged
+  // The convergence test held on this record, or (restoration) this record
+  // ended the converged run.
+  bool converged = false;
+  // A feasibility restoration step after convergence (docs/method.md
+  // section 7): x_trial is the smallest move from x0 that the linearization
+  // says meets every constraint; accepted when its analysis does (maxg <= 0).
+  // Such a record belongs to the cycle that converged and changes neither
+  // the move limits nor the cycle count.
+  bool restoration = false;
 };
 
 class SlpOptimizer {
@@ -154,6 +164,11 @@ class SlpOptimizer {
   RunState state() const;
   // Why the run ended stalled or failed (empty otherwise).
   const std::string& end_reason() const;
+  // What a user should know about the result once the run has ended, one
+  // sentence each, in a fixed order: that no design met every constraint
+  // (with the least violation), and which variables change nothing at the
+  // final design (flat directions). Empty while running.
+  const std::vector<std::string>& result_notes() const;
   // The current design x0 (scaled): the last accepted trial point, or the
   // initial design before any acceptance. Its values: F (the maximum term
   // for min-max) and maxg (0 without constraints); NaN before x0 was

@@ -80,7 +80,7 @@ TEST(HardcaseScaling, VariablesOfSize1eMinus6And1e6ConvergeWhenScaled) {
   ExpectFiniteEnd(out);
   EXPECT_EQ(out.state, slp::RunState::kConverged);
   EXPECT_NEAR(out.objective, kHs43Optimum, kScalingObjectiveTolerance);
-  EXPECT_LT(out.max_violation, 0.005);
+  EXPECT_LE(out.max_violation, 0.0);
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(out.design[i], Hs43OptimumDesign()[i], kHs43DesignTolerance) << i;
 }
 
@@ -91,7 +91,7 @@ TEST(HardcaseScaling, VariablesOfSize1eMinus6And1e6ConvergeUnscaled) {
   ExpectFiniteEnd(out);
   EXPECT_EQ(out.state, slp::RunState::kConverged);
   EXPECT_NEAR(out.objective, kHs43Optimum, kScalingObjectiveTolerance);
-  EXPECT_LT(out.max_violation, 0.005);
+  EXPECT_LE(out.max_violation, 0.0);
   const Eigen::Vector4d u = out.design.cwiseQuotient(natural);
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(u[i], Hs43OptimumDesign()[i], kHs43DesignTolerance) << i;
 }
@@ -133,7 +133,7 @@ TEST(HardcaseDegenerateLp, TenThousandDuplicatedNearlyParallelRowsSolveAndConver
   ExpectFiniteEnd(out);
   EXPECT_EQ(out.state, slp::RunState::kConverged);
   EXPECT_NEAR(out.objective, -2.0 * a, 0.005 * 2.0 * a);
-  EXPECT_LT(out.max_violation, 0.005);
+  EXPECT_LE(out.max_violation, 0.0);
   int max_rows = 0;
   for (const slp::CycleRecord& r : out.records) {
     EXPECT_EQ(r.lp_status, "optimal") << "cycle " << r.cycle << " attempt " << r.attempt;

@@ -80,7 +80,7 @@ TEST_F(ResponsesRun, MinMaxOfTwoResponsesUnderALinearDesignConstraintReachesTheC
   EXPECT_NEAR(run.objective, 2.0, 1e-5);
   EXPECT_NEAR(run.design[0], 0.0, 1e-4);
   EXPECT_NEAR(run.design[1], 1.0, 1e-4);
-  EXPECT_LT(run.max_violation, 1e-6);
+  EXPECT_LE(run.max_violation, 0.0);
   std::cout << "min-max: F " << run.objective << " at u = " << run.design[0] << ", v = " << run.design[1]
             << " after " << run.analyses << " analyses\n";
 }

@@ -60,6 +60,22 @@ TEST(RecordCodec, RoundTripIsBitExact) {
   EXPECT_EQ(std::memcmp(&x, &r.x_trial[1], sizeof x), 0);
 }
 
+TEST(RecordCodec, RestorationFlagRoundTripsAndVersion2RecordsStillRead) {
+  slp::CycleRecord r = SampleRecord();
+  r.restoration = true;
+  const std::string bytes = EncodeCycleRecord(r);
+  absl::StatusOr<slp::CycleRecord> back = DecodeCycleRecord(bytes);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_TRUE(back->restoration);
+  // A record as version 2 wrote it: no restoration byte at the end.
+  std::string version2 = bytes.substr(0, bytes.size() - 1);
+  version2[0] = 2;
+  absl::StatusOr<slp::CycleRecord> old = DecodeCycleRecord(version2);
+  ASSERT_TRUE(old.ok()) << old.status();
+  EXPECT_FALSE(old->restoration);
+  EXPECT_EQ(old->analyses_total, r.analyses_total);
+}
+
 TEST(RecordCodec, TruncatedOrForeignBytesAreDataLoss) {
   const std::string bytes = EncodeCycleRecord(SampleRecord());
   EXPECT_EQ(DecodeCycleRecord(bytes.substr(0, bytes.size() - 1)).status().code(), absl::StatusCode::kDataLoss);

@@ -75,6 +75,15 @@ TEST(OptimalityResidual, GradientHeldBackByADesignBoundIsAMultiplierNotAResidual
   EXPECT_NEAR(Solve(spec, lin, 0.2).residual, 0.0, kTol);
 }
 
+TEST(OptimalityResidual, ABoundTheBoxReachesAwayFromX0IsNoMultiplier) {
+  // F = 3 + 1.5 x at x0 = 0.5 in [0, 10] with a box of half-width 1: the LP
+  // steps onto the lower bound, but x0 is not on it, so nothing but the
+  // box holds the gradient back there: r = 1.5 * 0.5 / 3.75 = 0.2.
+  const ProblemSpec spec = Box(1, 0.0, 10.0);
+  const Linearization lin = Lin(Eigen::VectorXd::Constant(1, 0.5), 3.75, Eigen::RowVectorXd::Constant(1, 1.5));
+  EXPECT_NEAR(Solve(spec, lin, 2.0).residual, 0.2, kTol);
+}
+
 TEST(OptimalityResidual, ActiveConstraintBalancingTheGradientIsAKktPoint) {
   // min -(x1 + x2) s.t. x1 + x2 <= 2 at x0 = (1, 1), on the constraint: the
   // constraint's multiplier 1 balances the gradient; the LP may slide along
@@ -119,9 +128,9 @@ TEST(OptimalityResidual, MinMaxStationaryCombinationOfTermsIsAKktPoint) {
 DesignPoint Point(double x, double f, double g) { return DesignPoint{Eigen::VectorXd::Constant(1, x), f, g}; }
 
 TEST(BestDesign, FeasibleBeatsLowerObjectiveAndLowerObjectiveWinsAmongFeasible) {
-  BestDesign best(0.005);
+  BestDesign best;
   best.Offer(Point(1, 5.0, 0.2));     // infeasible
-  best.Offer(Point(2, 9.0, 0.001));   // feasible within the tolerance
+  best.Offer(Point(2, 9.0, 0.0));     // feasible: on its limit
   EXPECT_EQ(best.best()->x[0], 2);
   best.Offer(Point(3, 4.0, 0.01));    // lower F, infeasible
   EXPECT_EQ(best.best()->x[0], 2);
@@ -131,8 +140,18 @@ TEST(BestDesign, FeasibleBeatsLowerObjectiveAndLowerObjectiveWinsAmongFeasible) 
   EXPECT_EQ(best.best()->x[0], 4);
 }
 
+TEST(BestDesign, WithinTheViolationToleranceIsNotFeasible) {
+  // A two-load-case run: a design violating a limit by 0.0012 (inside the
+  // 0.005 stopping tolerance) with F = 10.0996, and a later feasible one
+  // with F = 10.117: the result is the feasible one.
+  BestDesign best;
+  best.Offer(Point(1, 10.0996, 0.0012));
+  best.Offer(Point(2, 10.117, -1e-9));
+  EXPECT_EQ(best.best()->x[0], 2);
+}
+
 TEST(BestDesign, LeastViolationAmongInfeasibleAndFailedAnalysesIgnored) {
-  BestDesign best(0.005);
+  BestDesign best;
   best.Offer(Point(1, 1.0, 0.5));
   best.Offer(Point(2, 2.0, 0.1));
   best.Offer(Point(3, std::nan(""), 0.0));
@@ -140,7 +159,7 @@ TEST(BestDesign, LeastViolationAmongInfeasibleAndFailedAnalysesIgnored) {
 }
 
 TEST(BestDesign, RecordOffersX0ThenTrial) {
-  BestDesign best(0.005);
+  BestDesign best;
   CycleRecord r;
   r.x0 = Eigen::VectorXd::Constant(1, 1.0);
   r.objective_x0 = 2.0;

@@ -21,7 +21,6 @@ namespace {
 // bounds the last step, not the distance to the optimum, but on these smooth
 // problems the final F is within the same 0.5 % of the optimum.
 constexpr double kDefaultObjectiveTolerance = 0.005;
-constexpr double kDefaultViolationTolerance = 0.005;
 // With tightened convergence tolerances the method must get the published
 // optimum to 1e-4 relative (the published values have 7-10 digits).
 constexpr double kTightObjectiveTolerance = 1e-4;
@@ -58,7 +57,7 @@ void ExpectDefaultRunReachesOptimum(const TestProblem& p) {
   const RunOutcome out = Solve(p, SlpOptions{});
   EXPECT_EQ(out.state, RunState::kConverged) << p.name;
   EXPECT_LT(RelativeError(out, p), kDefaultObjectiveTolerance) << p.name << " F=" << out.objective;
-  EXPECT_LT(out.max_violation, kDefaultViolationTolerance) << p.name;
+  EXPECT_LE(out.max_violation, 0.0) << p.name;
   ASSERT_FALSE(out.records.empty());
   EXPECT_TRUE(out.records.back().converged);
 }
@@ -68,7 +67,7 @@ void ExpectTightRunReachesOptimum(const TestProblem& p) {
   EXPECT_EQ(out.state, RunState::kConverged) << p.name;
   EXPECT_LT(RelativeError(out, p), kTightObjectiveTolerance) << p.name << " F=" << out.objective;
   EXPECT_LT(DesignError(out, p), kTightDesignTolerance) << p.name;
-  EXPECT_LT(out.max_violation, 1e-6) << p.name;
+  EXPECT_LE(out.max_violation, 0.0) << p.name;
 }
 
 TEST(SlpReference, Hs21WithDefaults) { ExpectDefaultRunReachesOptimum(Hs21()); }
@@ -122,7 +121,7 @@ TEST(SlpReference, KktCheckStopsOnlyAtTheOptimumFromRandomStarts) {
         p.spec.initial[i] = std::uniform_real_distribution<double>(p.spec.lower[i], p.spec.upper[i])(rng);
       }
       const RunOutcome with_kkt = Solve(p, SlpOptions{});
-      EXPECT_LT(with_kkt.max_violation, kDefaultViolationTolerance) << p.name << " start " << start;
+      EXPECT_LE(with_kkt.max_violation, 0.0) << p.name << " start " << start;
       EXPECT_LT(RelativeError(with_kkt, p), 2e-3) << p.name << " start " << start;
       worst_default = std::max(worst_default, RelativeError(with_kkt, p));
       worst_report_only = std::max(worst_report_only, RelativeError(Solve(p, report_test_only), p));

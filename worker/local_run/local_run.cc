@@ -42,6 +42,7 @@ absl::StatusOr<LocalRunResult> RunStudyLocally(const spec::Study& study, const L
   run.cycles = optimizer.cycles_completed();
   run.analyses = optimizer.analyses_used();
   out.end_reason = optimizer.end_reason();
+  out.result_notes = optimizer.result_notes();
   out.total_counters = evaluator.total_counters();
   out.analyses_run = evaluator.analyses_run();
   out.failures_by_kind = job->failures_by_kind();

@@ -63,6 +63,7 @@ struct RunOutcome {
 struct LocalRunResult {
   RunOutcome outcome;
   std::string end_reason;  // the optimizer's, for kStalled / kFailed
+  std::vector<std::string> result_notes;  // the optimizer's notes on the result
   spec::StudyLayout layout;
   // The final design per variable: scaled (as outcome.design), in the
   // parameter's unit as the scene file writes it (scale * x), and in SI.

@@ -415,10 +415,15 @@ JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector
     delivery.message = absl::StrCat("the initial design could not be analysed (", spec::FailureKindName(last.kind),
                                     "): ", last.reason);
   } else if (delivery.state == JobState::kStalled) {
-    delivery.message = "the move limits collapsed or every trial point failed";
+    delivery.message = optimizer.end_reason();
     if (!records.empty() && !records.back().rejection_reason.empty()) {
       absl::StrAppend(&delivery.message, "; last rejection: ", records.back().rejection_reason);
     }
+  }
+  // What the user should know about the result (no feasible design, flat
+  // directions) goes with the state that ends the job.
+  for (const std::string& note : optimizer.result_notes()) {
+    absl::StrAppend(&delivery.message, delivery.message.empty() ? "" : "; ", note);
   }
   store::JobProgress progress;
   progress.state = jobs::JobStateName(delivery.state);
@@ -723,9 +728,9 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
       s.objective = sign * best.objective;
       s.max_violation = best.max_violation;
     }
-  } else if (!entry.records.empty() && options.has_value()) {
+  } else if (!entry.records.empty()) {
     // Not running in this process: the same choice from the logged records.
-    if (std::optional<slp::DesignPoint> best = jobs::BestDesignOfRecords(entry.records, *options)) {
+    if (std::optional<slp::DesignPoint> best = jobs::BestDesignOfRecords(entry.records)) {
       design = best->x;
       s.objective = sign * best->objective;
       s.max_violation = best->max_violation;
