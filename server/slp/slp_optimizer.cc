@@ -387,7 +387,34 @@ class SlpOptimizer::Impl {
     new_records_.push_back(std::move(record));
   }
 
-  void Stall(const std::string& why) { End(RunState::kStalled, why); }
+  void Stall(const std::string& why) { Finish(RunState::kStalled, why); }
+
+  // The run would end in `state`. If its design x0 is a little outside a
+  // limit (0 < maxg < convergence_violation_tolerance) and would be the
+  // result but for that, it first takes restoration steps (section 7 of
+  // docs/method.md); a converged x0 always does. `x0_result` brings x0's
+  // own gradients when the analyses provide them.
+  void Finish(RunState state, std::string reason = "",
+              const AnalysisResult* x0_result = nullptr) {
+    if (WantsRestoration(state)) {
+      restoration_end_state_ = state;
+      restoration_end_reason_ = std::move(reason);
+      BeginRestoration(x0_result);
+      return;
+    }
+    End(state, std::move(reason));
+  }
+
+  bool WantsRestoration(RunState state) const {
+    if (spec_.num_constraints() == 0 || !have_x0_ || AllFrozen()) return false;
+    if (!(v0_.max_violation > 0 &&
+          v0_.max_violation < options_.convergence_violation_tolerance)) {
+      return false;
+    }
+    if (state == RunState::kConverged) return true;
+    const std::optional<DesignPoint>& best = best_.best();
+    return !best.has_value() || best->max_violation > 0 || v0_.objective < best->objective;
+  }
 
   // Every end of the run comes here, so that the notes on its result are
   // made once, from the state the run ended in.
@@ -652,11 +679,7 @@ class SlpOptimizer::Impl {
     r.converged = converged;
     Emit(std::move(r), x0_constraints, trial.constraints);
     if (converged) {
-      if (spec_.num_constraints() > 0 && v0_.max_violation > 0) {
-        BeginRestoration(*result);
-        return;
-      }
-      End(RunState::kConverged);
+      Finish(RunState::kConverged, "", result);
       return;
     }
     if (static_cast<int>(infeasible_lp_violations_.size()) == kLocallyInfeasibleCycles &&
@@ -666,7 +689,7 @@ class SlpOptimizer::Impl {
       return;
     }
     if (cycle_ >= options_.max_cycles) {
-      End(RunState::kMaxCycles);
+      Finish(RunState::kMaxCycles, "", result);
       return;
     }
     ++cycle_;
@@ -706,20 +729,24 @@ class SlpOptimizer::Impl {
   // The converged design x0 violates a limit by less than the violation
   // tolerance. Its linearization is the cycle's gradients moved to x0 (the
   // analysis of x0 brought its own with simulator sensitivities).
-  void BeginRestoration(const AnalysisResult& x0_result) {
+  void BeginRestoration(const AnalysisResult* x0_result) {
     lin_.x0 = x0_;
     lin_.terms0 = v0_.terms;
     lin_.constraints0 = v0_.constraints;
-    if (x0_result.has_gradients()) {
-      lin_.terms_gradient = x0_result.objective_gradients;
-      if (x0_result.constraint_gradients.size() > 0) {
-        lin_.constraints_gradient = x0_result.constraint_gradients;
+    if (x0_result != nullptr && x0_result->has_gradients()) {
+      lin_.terms_gradient = x0_result->objective_gradients;
+      if (x0_result->constraint_gradients.size() > 0) {
+        lin_.constraints_gradient = x0_result->constraint_gradients;
       }
     }
     restoration_steps_ = 0;
     restoration_from_violation_ = v0_.max_violation;
     lp_solver_->ResetWarmStart();
     SolveRestoration();
+  }
+
+  void EndRestoration() {
+    End(restoration_end_state_, std::move(restoration_end_reason_));
   }
 
   void SolveRestoration() {
@@ -766,9 +793,9 @@ class SlpOptimizer::Impl {
       r.objective_error = kNaN;
       r.max_approximation_error = kNaN;
       r.analyses_total = analyses_used_;
-      r.converged = true;  // it ends the converged run
+      r.converged = restoration_end_state_ == RunState::kConverged;  // it ends the run
       Emit(std::move(r), v0_.constraints, {});
-      End(RunState::kConverged);
+      EndRestoration();
       return;
     }
     pending_restoration_record_ = std::move(r);
@@ -807,20 +834,20 @@ class SlpOptimizer::Impl {
       }
     }
     if (r.accepted) {
-      r.converged = true;
+      r.converged = restoration_end_state_ == RunState::kConverged;
       const Eigen::VectorXd x0_constraints = v0_.constraints;
       x0_ = x_trial_;
       v0_ = trial;
       Emit(std::move(r), x0_constraints, trial.constraints);
-      End(RunState::kConverged);
+      EndRestoration();
       return;
     }
     ++restoration_steps_;
     const bool last = restoration_steps_ >= kMaxRestorationSteps;
-    r.converged = last;  // the last step ends the converged run
+    r.converged = last && restoration_end_state_ == RunState::kConverged;
     Emit(std::move(r), v0_.constraints, trial.constraints);
     if (last) {
-      End(RunState::kConverged);
+      EndRestoration();
       return;
     }
     SolveRestoration();
@@ -838,6 +865,8 @@ class SlpOptimizer::Impl {
   std::deque<double> infeasible_lp_violations_;
 
   int restoration_steps_ = 0;
+  RunState restoration_end_state_ = RunState::kConverged;
+  std::string restoration_end_reason_;
   double restoration_from_violation_ = 0;  // maxg of the converged design
   CycleRecord pending_restoration_record_;
   std::int64_t next_id_ = 0;

@@ -76,6 +76,30 @@ TEST(ResultTrust, ConvergedDesignOutsideALimitIsRestoredInside) {
   EXPECT_TRUE(notes.empty()) << notes.front();
 }
 
+// The same problem cut off by max_cycles after one Newton step from the
+// infeasible x = 1.5 (x = 1.41667, maxg = 0.0035): the run still ends
+// max_cycles, on a design that meets the limit, and says nothing of
+// infeasibility.
+TEST(ResultTrust, RunEndingAtMaxCyclesJustOutsideALimitIsRestoredToo) {
+  const ProblemSpec spec = MakeSpec({0.1}, {3.0}, {1.5}, {2.0}, {2.0});
+  const Evaluator eval = FromFunction([](const Eigen::VectorXd& x, Eigen::VectorXd* f,
+                                         Eigen::VectorXd* g) {
+    *f = Eigen::VectorXd::Constant(1, -x[0]);
+    *g = Eigen::VectorXd::Constant(1, x[0] * x[0]);
+  });
+  SlpOptions o;
+  o.initial_move_limit = 0.5;
+  o.max_cycles = 1;
+  std::vector<std::string> notes;
+  const RunOutcome out = RunToEnd(spec, eval, o, &notes);
+  EXPECT_EQ(out.state, RunState::kMaxCycles);
+  ASSERT_EQ(RestorationRecords(out), 1);
+  EXPECT_TRUE(out.records.back().restoration && out.records.back().accepted);
+  EXPECT_FALSE(out.records.back().converged);
+  EXPECT_LE(out.max_violation, 0.0);
+  EXPECT_TRUE(notes.empty()) << notes.front();
+}
+
 // Every reference problem with constraints, at the defaults: the reported
 // design meets every constraint, and the restoration steps are what make
 // some of them do so.
