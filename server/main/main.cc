@@ -276,14 +276,24 @@ int main(int argc, char** argv) {
 
   int signal_number = 0;
   for (;;) {
-    if (sigwait(&stop_signals, &signal_number) != 0) continue;
+    siginfo_t sender{};
+    signal_number = sigwaitinfo(&stop_signals, &sender);
+    if (signal_number < 0) continue;
     if (signal_number != SIGHUP) break;
+    // Who asked, for the audit trail: a reload changes who may call.
+    const std::string from = absl::StrCat("from pid ", sender.si_pid, " uid ", sender.si_uid);
     absl::StatusOr<std::size_t> reloaded = (*server)->ReloadTokens();
-    if (reloaded.ok()) {
-      std::cerr << "mbopt-server: SIGHUP: token table " << flags.server.tokens_file << " read again, " << *reloaded
-                << " tokens\n";
+    if (reloaded.ok() && *reloaded == 0) {
+      std::cerr << "mbopt-server: audit: SIGHUP " << from << ": WARNING: the token table "
+                << flags.server.tokens_file
+                << " is missing or lists no token: EVERY TOKEN IS REVOKED, no call is accepted until the table "
+                   "lists tokens again (and SIGHUP)\n";
+    } else if (reloaded.ok()) {
+      std::cerr << "mbopt-server: audit: SIGHUP " << from << ": token table " << flags.server.tokens_file
+                << " read again, " << *reloaded << " tokens\n";
     } else {
-      std::cerr << "mbopt-server: SIGHUP: " << reloaded.status().message() << "; the table in use stays\n";
+      std::cerr << "mbopt-server: audit: SIGHUP " << from << ": " << reloaded.status().message()
+                << "; the table in use stays\n";
     }
   }
   std::cerr << "mbopt-server: " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM")

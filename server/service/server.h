@@ -81,8 +81,11 @@ class MboptServer {
   store::Store& store() { return *store_; }  // for tests
 
   // Reads the token table file again and uses it for the calls that start
-  // after (SIGHUP of mbopt-server). On error the table in use stays.
-  // Returns the number of tokens.
+  // after (SIGHUP of mbopt-server). Returns the number of tokens; 0 when the
+  // file is missing or lists none: then every token is revoked and no call
+  // is accepted until a table with tokens is read. On error (the file does
+  // not parse, cannot be read, or others may read or write it) the table in
+  // use stays.
   absl::StatusOr<std::size_t> ReloadTokens();
 
   // Graceful stop (see above). Idempotent.

@@ -68,9 +68,14 @@ class SecureServerTest : public ::testing::Test {
     EXPECT_TRUE(made.ok()) << made.status();
     return made.ok() ? *made : auth::KeyAndCertificate{};
   }
-  std::string Write(const std::string& name, const std::string& content) {
+  // Readable by its owner only, as init-tls makes keys and tables;
+  // `mode` for the files of the tests that see other modes refused.
+  std::string Write(const std::string& name, const std::string& content,
+                    std::filesystem::perms mode = std::filesystem::perms::owner_read |
+                                                  std::filesystem::perms::owner_write) {
     const std::string path = (dir_ / name).string();
     std::ofstream(path) << content;
+    std::filesystem::permissions(path, mode);
     return path;
   }
 
@@ -251,6 +256,61 @@ TEST_F(SecureServerTest, MissingOrWrongTokensAreRefusedAndReloadingTheTableRevok
   Write("tokens", "user carol not-a-hash\n");
   EXPECT_THAT(std::string(server_->ReloadTokens().status().message()), HasSubstr("tokens:1:"));
   EXPECT_TRUE(Submit(*Jobs(carol), &job_id).ok());
+}
+
+TEST_F(SecureServerTest, ATokenTableOrKeyOthersMayReadOrWriteIsRefusedAtStart) {
+  using std::filesystem::perms;
+  const perms kOwner = perms::owner_read | perms::owner_write;
+  // A table anyone may write: anyone could add an admin token's hash.
+  ServerOptions options = SecureOptions(server_certificate_);
+  std::filesystem::permissions(options.tokens_file, kOwner | perms::others_write);
+  absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
+  ASSERT_FALSE(server.ok());
+  EXPECT_EQ(server.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(server.status().message(),
+              HasSubstr("the token table " + options.tokens_file + " has mode 0602: writable by every user"));
+  EXPECT_THAT(server.status().message(), HasSubstr("chmod 600 " + options.tokens_file));
+  // A key the group may write, and one anyone may read.
+  std::filesystem::permissions(options.tokens_file, kOwner);
+  for (const perms extra : {perms::group_write, perms::others_read}) {
+    std::filesystem::permissions(options.tls_key_file, kOwner | extra);
+    server = MboptServer::Start(options);
+    ASSERT_FALSE(server.ok());
+    EXPECT_THAT(server.status().message(), HasSubstr("the server's TLS key (--tls-key) " + options.tls_key_file));
+    EXPECT_THAT(server.status().message(), HasSubstr("chmod 600"));
+  }
+  // Fixed, it starts.
+  std::filesystem::permissions(options.tls_key_file, kOwner);
+  StartServer(options);
+}
+
+TEST_F(SecureServerTest, ReloadingAnEmptyOrMissingTableRevokesEveryToken) {
+  using std::filesystem::perms;
+  StartSecureServer();
+  std::string job_id;
+  ASSERT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  Write("tokens", "# every token revoked\n");
+  absl::StatusOr<std::size_t> reloaded = server_->ReloadTokens();
+  ASSERT_TRUE(reloaded.ok()) << reloaded.status();
+  EXPECT_EQ(*reloaded, 0u);
+  EXPECT_EQ(Submit(*Jobs(alice_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(Submit(*Jobs(admin_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  // Back, then deleted.
+  Write("tokens", auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_));
+  ASSERT_EQ(server_->ReloadTokens().value_or(99), 1u);
+  EXPECT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  std::filesystem::remove(dir_ / "tokens");
+  reloaded = server_->ReloadTokens();
+  ASSERT_TRUE(reloaded.ok()) << reloaded.status();
+  EXPECT_EQ(*reloaded, 0u);
+  EXPECT_EQ(Submit(*Jobs(alice_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  // A table others may write is not taken: the one in use stays.
+  Write("tokens", auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_),
+        perms::owner_read | perms::owner_write | perms::others_write);
+  EXPECT_THAT(std::string(server_->ReloadTokens().status().message()), HasSubstr("has mode 0602"));
+  EXPECT_EQ(Submit(*Jobs(alice_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
 }
 
 TEST_F(SecureServerTest, ClientsWithoutTheCaOrWithPlaintextCannotConnectAndAreToldWhy) {
