@@ -168,9 +168,13 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   } while (bobs_list.exit_code == kExitDenied && std::chrono::steady_clock::now() < deadline);
   EXPECT_EQ(bobs_list.exit_code, kExitOk) << Describe(bobs_list);
   EXPECT_THAT(bobs_list.stdout_text, Not(HasSubstr("job-1"))) << "Bob sees only his own jobs";
+  // Alice's job is answered to Bob as one that does not exist.
   auto bob_reads_alices = Mbopt({"status", "job-1", "--server", addr}, bob);
-  EXPECT_EQ(bob_reads_alices.exit_code, kExitDenied) << Describe(bob_reads_alices);
-  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("submitted by another user"));
+  auto bob_reads_none = Mbopt({"status", "job-99", "--server", addr}, bob);
+  EXPECT_EQ(bob_reads_alices.exit_code, kExitBadInput) << Describe(bob_reads_alices);
+  EXPECT_EQ(bob_reads_none.exit_code, kExitBadInput) << Describe(bob_reads_none);
+  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("no job with id 'job-1'"));
+  EXPECT_THAT(bob_reads_none.stderr_text, HasSubstr("no job with id 'job-99'"));
 
   EXPECT_EQ(worker.Stop(kGuard), 0);
   EXPECT_EQ(server->process->Stop(kGuard), 0);

@@ -171,17 +171,23 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
   EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
   EXPECT_EQ(job.summary().owner(), "alice");
 
-  // Bob can neither read nor cancel nor resume Alice's job, nor list it.
+  // Bob can neither read nor cancel nor resume Alice's job, nor list it;
+  // he is answered as for a job that does not exist, word for word, so ids
+  // do not tell him which jobs exist.
+  ::testing::internal::CaptureStderr();
   grpc::Status status = Get(*bob, alices_job, &job);
-  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
-  EXPECT_THAT(status.error_message(), HasSubstr("submitted by another user"));
-  EXPECT_EQ(Cancel(*bob, alices_job).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  const grpc::Status none = Get(*bob, "job-999", &job);
+  EXPECT_EQ(none.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(status.error_message(), std::string(JobManager::NoSuchJob(alices_job).message()));
+  EXPECT_EQ(none.error_message(), std::string(JobManager::NoSuchJob("job-999").message()));
+  EXPECT_EQ(Cancel(*bob, alices_job).error_code(), grpc::StatusCode::NOT_FOUND);
   {
     grpc::ClientContext context;
     v1::JobRef ref;
     ref.set_job_id(alices_job);
     v1::JobSummary summary;
-    EXPECT_EQ(bob->Resume(&context, ref, &summary).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(bob->Resume(&context, ref, &summary).error_code(), grpc::StatusCode::NOT_FOUND);
   }
   {
     grpc::ClientContext context;
@@ -190,7 +196,14 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
     auto stream = bob->Watch(&context, ref);
     v1::JobEvent event;
     EXPECT_FALSE(stream->Read(&event));
-    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  // The log says what happened, and who tried.
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_THAT(log, HasSubstr("audit: refused Get from user bob (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("): job '" + alices_job + "' is another user's (alice)"));
+  for (const char* method : {"Cancel", "Resume", "Watch"}) {
+    EXPECT_THAT(log, HasSubstr(std::string("audit: refused ") + method + " from user bob")) << method;
   }
   const v1::ListJobsResponse bobs_list = List(*bob);
   ASSERT_EQ(bobs_list.jobs_size(), 1);
