@@ -121,6 +121,7 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   // Without this, gRPC on Linux binds with SO_REUSEPORT and a second server
   // on a port in use would silently share it instead of failing.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, static_cast<int>(s.options_.handshake_timeout_ms));
   builder.SetMaxReceiveMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.SetMaxSendMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.AddListeningPort(s.options_.listen_address, credentials, &s.port_);

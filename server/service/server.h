@@ -57,6 +57,11 @@ struct ServerOptions {
   // max_message_bytes (the server holds it whole while it reassembles it);
   // workers are told it when they register.
   std::int64_t max_result_bytes = std::int64_t{1} << 30;
+  // A connection that has not completed its TLS handshake and sent its
+  // HTTP/2 settings this long after it was accepted is closed: idle
+  // connections from anyone who reaches the port would otherwise hold a
+  // descriptor each for gRPC's default of 120 s.
+  std::int64_t handshake_timeout_ms = 10'000;
   // What a machine crash may take from the job database (store.h).
   store::Durability durability = store::Durability::kCycles;
   JobManagerOptions manager;

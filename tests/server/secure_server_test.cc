@@ -3,10 +3,12 @@
 // token or the right certificate gets (and is told).
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -344,6 +346,31 @@ TEST_F(SecureServerTest, ClientsWithoutTheCaOrWithPlaintextCannotConnectAndAreTo
   EXPECT_THAT(secure_channel::DiagnoseConnectionFailure(server_->address(), Client(alice_, ca_.certificate_pem)),
               IsEmpty());
   EXPECT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+}
+
+// A connection that never starts its TLS handshake holds a descriptor of
+// the server; it is closed after the handshake timeout, not gRPC's 120 s.
+TEST_F(SecureServerTest, AnIdleConnectionWithoutHandshakeIsClosedAfterTheHandshakeTimeout) {
+  constexpr std::int64_t kHandshakeTimeoutMs = 300;
+  // Far above the timeout (slow machines), far below gRPC's default 120 s.
+  constexpr int kCloseWithinMs = 20'000;
+  ServerOptions options = SecureOptions(server_certificate_);
+  options.handshake_timeout_ms = kHandshakeTimeoutMs;
+  StartServer(options);
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  const auto start = std::chrono::steady_clock::now();
+  pollfd closed{fd, POLLIN, 0};
+  ASSERT_EQ(::poll(&closed, 1, kCloseWithinMs), 1) << "still open after " << kCloseWithinMs << " ms";
+  char byte = 0;
+  EXPECT_LE(::recv(fd, &byte, 1, 0), 0) << "closed, without a byte";
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(kHandshakeTimeoutMs / 2));
+  ::close(fd);
 }
 
 TEST_F(SecureServerTest, NoPlaintextHttp2IsAnsweredOnTheTlsPort) {
