@@ -24,19 +24,25 @@ void CallAuthorizer::ReplaceTokens(auth::TokenTable tokens) {
 
 absl::StatusOr<auth::Principal> CallAuthorizer::Identify(const grpc::ServerContext& context) const {
   if (!needs_tokens_) return auth::Principal{auth::Role::kAdmin, ""};
+  const auto& metadata = context.client_metadata();
+  const auto header = metadata.find("authorization");
+  if (header == metadata.end()) return IdentifyBearer(std::nullopt);
+  return IdentifyBearer(std::string_view(header->second.data(), header->second.size()));
+}
+
+absl::StatusOr<auth::Principal> CallAuthorizer::IdentifyBearer(std::optional<std::string_view> header) const {
+  if (!needs_tokens_) return auth::Principal{auth::Role::kAdmin, ""};
   std::shared_ptr<const auth::TokenTable> tokens;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     tokens = tokens_;
   }
-  const auto& metadata = context.client_metadata();
-  const auto header = metadata.find("authorization");
-  if (header == metadata.end()) {
+  if (!header) {
     return absl::UnauthenticatedError(
         "this server needs a token with every call: give it with --token-file FILE or MBOPT_TOKEN_FILE "
         "(docs/server.md, \"Security\")");
   }
-  const std::string_view value(header->second.data(), header->second.size());
+  const std::string_view value = *header;
   if (value.substr(0, kBearer.size()) != kBearer) {
     return absl::UnauthenticatedError("the authorization header is not `Bearer TOKEN`");
   }

@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <grpcpp/grpcpp.h>
 
@@ -28,6 +29,12 @@ class CallAuthorizer {
   // verifies client certificates against a worker CA and worker calls must
   // come with one.
   CallAuthorizer(std::optional<auth::TokenTable> tokens, bool workers_need_certificate);
+
+  // The holder of the token in an `authorization` header's value
+  // ("Bearer TOKEN"; nullopt: no such header). Unauthenticated, with words
+  // for the client, without a token of the table. For the check before a
+  // call's message is read (token_metadata_processor.h).
+  absl::StatusOr<auth::Principal> IdentifyBearer(std::optional<std::string_view> header) const;
 
   // Whether calls need tokens (the authorizer was made with a table).
   bool needs_tokens() const { return needs_tokens_; }

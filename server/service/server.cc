@@ -17,6 +17,7 @@
 #include "server/lp/make_clp_lp_solver.h"
 #include "server/service/listen_address.h"
 #include "server/service/proto_convert.h"
+#include "server/service/token_metadata_processor.h"
 
 namespace mbopt::service {
 namespace {
@@ -87,7 +88,11 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecuri
     // calls check for one (call_authorizer.h).
     ssl.client_certificate_request = GRPC_SSL_REQUEST_CLIENT_CERTIFICATE_AND_VERIFY;
   }
-  return grpc::SslServerCredentials(ssl);
+  std::shared_ptr<grpc::ServerCredentials> credentials = grpc::SslServerCredentials(ssl);
+  if (authorizer_->needs_tokens()) {
+    credentials->SetAuthMetadataProcessor(std::make_shared<TokenMetadataProcessor>(authorizer_.get()));
+  }
+  return credentials;
 }
 
 absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions options) {
