@@ -11,9 +11,11 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -213,6 +215,38 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
   // The admin sees both.
   EXPECT_EQ(List(*admin).jobs_size(), 2);
   EXPECT_TRUE(Get(*admin, alices_job, &job).ok());
+}
+
+// Who submitted, cancelled and resumed a job is in its event log in the
+// database, and in the server's audit log.
+TEST_F(SecureServerTest, JobActionsNameWhoDidThemInTheJobsEventsAndTheAuditLog) {
+  StartSecureServer();
+  ::testing::internal::CaptureStderr();
+  std::string job_id;
+  ASSERT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  ASSERT_TRUE(Cancel(*Jobs(admin_), job_id).ok());
+  {
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(job_id);
+    v1::JobSummary summary;
+    ASSERT_TRUE(Jobs(alice_)->Resume(&context, ref, &summary).ok());
+  }
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  absl::StatusOr<std::vector<store::EventRow>> events = server_->store().LoadEvents(job_id);
+  ASSERT_TRUE(events.ok()) << events.status();
+  std::map<std::string, std::string> detail;
+  for (const store::EventRow& e : *events) detail[e.kind] = e.message;
+  EXPECT_THAT(detail["submitted"], HasSubstr("; by user alice (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(detail["cancelled"], HasSubstr("by admin ops (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(detail["resumed"], HasSubstr("resumed on request; by user alice (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("audit: submit " + job_id + " by user alice (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("audit: cancel " + job_id + " by admin ops (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("audit: resume " + job_id + " by user alice (peer ipv4:127.0.0.1:"));
+  for (const std::string& token : {alice_, admin_}) {
+    EXPECT_THAT(log, ::testing::Not(HasSubstr(token))) << "a token in the log";
+    EXPECT_THAT(log, ::testing::Not(HasSubstr(auth::HashToken(token)))) << "a token's hash in the log";
+  }
 }
 
 TEST_F(SecureServerTest, OnlyWorkerTokensActAsWorkersAndWorkerTokensCannotSubmit) {
