@@ -11,6 +11,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "common/private_file.h"
 #include "common/read_file.h"
 
 namespace mbopt::secure_channel {
@@ -115,6 +116,9 @@ absl::StatusOr<ClientSecurity> LoadClientSecurity(const ClientSecurityFlags& fla
     if (!cert.ok()) return cert.status();
     auto key = ReadFile(key_file, key_source);
     if (!key.ok()) return key.status();
+    if (absl::Status mode = CheckSecretFileMode(key_file, absl::StrCat(key_source, ": the client key")); !mode.ok()) {
+      return absl::InvalidArgumentError(mode.message());
+    }
     security.cert_pem = *std::move(cert);
     security.key_pem = *std::move(key);
   }
@@ -125,6 +129,11 @@ absl::StatusOr<ClientSecurity> LoadClientSecurity(const ClientSecurityFlags& fla
   if (!token_file.empty()) {
     auto token = ReadFile(token_file, token_file_source);
     if (!token.ok()) return token.status();
+    // A token others can read is a token others hold.
+    if (absl::Status mode = CheckSecretFileMode(token_file, absl::StrCat(token_file_source, ": the token file"));
+        !mode.ok()) {
+      return absl::InvalidArgumentError(mode.message());
+    }
     security.token = std::string(absl::StripAsciiWhitespace(*token));
     security.token_source = absl::StrCat(token_file_source, " ", token_file);
     if (security.token.empty()) {

@@ -1,6 +1,7 @@
 // mbopt-server: the optimizer server. Command line and behaviour are in
 // docs/server.md.
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -21,6 +22,7 @@
 #include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
 #include "server/main/init_tls_command.h"
+#include "server/main/listener_failure.h"
 #include "server/main/renew_cert_command.h"
 #include "server/service/listen_address.h"
 #include "server/service/server.h"
@@ -70,6 +72,28 @@ constexpr const char* kUsage =
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
     "                         its N-th transaction of results, before COMMIT\n";
+
+// The exit status when gRPC's listener stopped accepting (listener_failure.h):
+// not 0, so that a service manager restarts the server (EX_TEMPFAIL).
+constexpr int kExitListenerFailed = 75;
+
+// Every connection takes a descriptor; a service's soft limit (1024 under
+// systemd) is filled by as many idle connections from anyone who can reach
+// the port. The hard limit is what the administrator allows: use it all.
+void RaiseOpenFilesLimit() {
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_NOFILE, &limit) != 0) return;
+  const rlim_t before = limit.rlim_cur;
+  if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur < limit.rlim_max) {
+    limit.rlim_cur = limit.rlim_max;
+    if (::setrlimit(RLIMIT_NOFILE, &limit) != 0) {
+      std::cerr << "mbopt-server: cannot raise the open-files limit from " << before << " to " << limit.rlim_max
+                << ": " << std::strerror(errno) << "\n";
+      return;
+    }
+    std::cerr << "mbopt-server: open-files limit raised from " << before << " to " << limit.rlim_cur << "\n";
+  }
+}
 
 // A certificate this close to expiring is warned about at every start.
 constexpr std::int64_t kCertificateWarningSeconds = std::int64_t{30} * 86400;
@@ -229,6 +253,9 @@ int main(int argc, char** argv) {
     };
   }
 
+  RaiseOpenFilesLimit();
+  mbopt::server_main::WatchForListenerFailure();
+
   // Signals are taken synchronously by this thread; every other thread
   // (gRPC, reaper) inherits the blocked mask.
   sigset_t stop_signals;
@@ -276,18 +303,35 @@ int main(int argc, char** argv) {
 
   int signal_number = 0;
   for (;;) {
-    if (sigwait(&stop_signals, &signal_number) != 0) continue;
+    siginfo_t sender{};
+    signal_number = sigwaitinfo(&stop_signals, &sender);
+    if (signal_number < 0) continue;
     if (signal_number != SIGHUP) break;
+    // Who asked, for the audit trail: a reload changes who may call.
+    const std::string from = absl::StrCat("from pid ", sender.si_pid, " uid ", sender.si_uid);
     absl::StatusOr<std::size_t> reloaded = (*server)->ReloadTokens();
-    if (reloaded.ok()) {
-      std::cerr << "mbopt-server: SIGHUP: token table " << flags.server.tokens_file << " read again, " << *reloaded
-                << " tokens\n";
+    if (reloaded.ok() && *reloaded == 0) {
+      std::cerr << "mbopt-server: audit: SIGHUP " << from << ": WARNING: the token table "
+                << flags.server.tokens_file
+                << " is missing or lists no token: EVERY TOKEN IS REVOKED, no call is accepted until the table "
+                   "lists tokens again (and SIGHUP)\n";
+    } else if (reloaded.ok()) {
+      std::cerr << "mbopt-server: audit: SIGHUP " << from << ": token table " << flags.server.tokens_file
+                << " read again, " << *reloaded << " tokens\n";
     } else {
-      std::cerr << "mbopt-server: SIGHUP: " << reloaded.status().message() << "; the table in use stays\n";
+      std::cerr << "mbopt-server: audit: SIGHUP " << from << ": " << reloaded.status().message()
+                << "; the table in use stays\n";
     }
   }
-  std::cerr << "mbopt-server: " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM")
-            << ": stopping; running jobs resume on the next start\n";
+  const std::string listener_failure = mbopt::server_main::ListenerFailure();
+  if (!listener_failure.empty()) {
+    std::cerr << "mbopt-server: gRPC stopped accepting connections (" << listener_failure
+              << "; it does not try again): stopping with status " << kExitListenerFailed
+              << " so that the service manager starts the server again; running jobs resume then\n";
+  } else {
+    std::cerr << "mbopt-server: " << (signal_number == SIGINT ? "SIGINT" : "SIGTERM")
+              << ": stopping; running jobs resume on the next start\n";
+  }
   (*server)->Shutdown();
-  return 0;
+  return listener_failure.empty() ? 0 : kExitListenerFailed;
 }

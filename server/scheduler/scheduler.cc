@@ -2,12 +2,31 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <random>
 #include <utility>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 
 namespace mbopt::scheduler {
+namespace {
+
+// Separates a worker id's public part from its secret one.
+constexpr char kSecretSeparator[] = ".";
+
+// 64 bits from the system's random source (getrandom on Linux), in hex.
+std::string RandomHex64() {
+  std::random_device device;
+  const std::uint64_t bits = (std::uint64_t{device()} << 32) ^ device();
+  return absl::StrCat(absl::Hex(bits, absl::kZeroPad16));
+}
+
+}  // namespace
+
+std::string PublicWorkerId(std::string_view worker_id) {
+  return std::string(worker_id.substr(0, worker_id.find(kSecretSeparator)));
+}
 
 absl::Status SchedulerOptions::Validate() const {
   if (lease_ms <= 0) return absl::InvalidArgumentError(absl::StrCat("lease_ms must be > 0, got ", lease_ms));
@@ -26,7 +45,7 @@ Scheduler::Scheduler(const Clock* clock, SchedulerOptions options)
 
 std::string Scheduler::RegisterWorker(const std::string& name, int slots) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::string id = absl::StrCat("w-", next_worker_++);
+  std::string id = absl::StrCat("w-", next_worker_++, kSecretSeparator, RandomHex64());
   workers_[id] = Worker{name, std::max(1, slots), clock_->NowMs()};
   return id;
 }
@@ -182,6 +201,14 @@ absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, c
     return absl::NotFoundError(absl::StrCat("task '", task_id, "' is not outstanding (unknown, finished, "
                                                                "given up, or its job ended)"));
   }
+  // Only a worker that holds or held a lease of this analysis may answer
+  // it: a worker token is shared, and without this any holder could answer
+  // every user's analyses with values of its choosing.
+  const Entry& wanted = entry->second;
+  if (!(wanted.leased && wanted.worker_id == worker_id) && wanted.failed_workers.count(worker_id) == 0) {
+    return absl::PermissionDeniedError(absl::StrCat("task '", task_id, "' was never leased to worker ",
+                                                    PublicWorkerId(worker_id), "; its result is refused"));
+  }
   FinishedTask done{entry->second.job_id, entry->second.request_id, std::move(entry->second.x_scaled),
                     entry->second.attempts, worker_id, ""};
   done.latency_seconds =
@@ -224,7 +251,7 @@ absl::StatusOr<std::optional<FinishedTask>> Scheduler::Fail(const std::string& w
     if (lease == leases_.end() || entries_.at(lease->second).worker_id != worker_id) {
       return absl::NotFoundError(absl::StrCat("task '", task_id, "' is not leased to worker '", worker_id, "'"));
     }
-    result = FailLocked(lease->second, absl::StrCat("worker ", worker_id, ": ", reason));
+    result = FailLocked(lease->second, absl::StrCat("worker ", PublicWorkerId(worker_id), ": ", reason));
   }
   if (!result) task_available_.notify_all();
   return result;
@@ -281,7 +308,8 @@ std::vector<FinishedTask> Scheduler::ExpireLeases() {
     const std::int64_t now = clock_->NowMs();
     given_up = FailLeasesLocked(
         [now](const Entry& e) { return e.lease_deadline_ms <= now; },
-        [](const Entry& e) { return absl::StrCat("lease of task ", e.task_id, " on worker ", e.worker_id, " expired"); },
+        [](const Entry& e) { return absl::StrCat("lease of task ", e.task_id, " on worker ", PublicWorkerId(e.worker_id), " expired");
+        },
         &requeued);
   }
   if (requeued) task_available_.notify_all();
@@ -300,7 +328,7 @@ std::vector<FinishedTask> Scheduler::WorkerLost(const std::string& worker_id) {
     given_up = FailLeasesLocked(
         [&worker_id](const Entry& e) { return e.worker_id == worker_id; },
         [&](const Entry& e) {
-          return absl::StrCat("worker ", worker_id, " (", name, ") disconnected with task ", e.task_id);
+          return absl::StrCat("worker ", PublicWorkerId(worker_id), " (", name, ") disconnected with task ", e.task_id);
         },
         &requeued);
   }

@@ -31,6 +31,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -86,6 +87,10 @@ struct HeartbeatReply {
   std::vector<std::string> cancelled_task_ids;  // no longer wanted: stop working on them
 };
 
+// The part of a worker id that may be shown (in logs, job events and the
+// job log): "w-<n>", without the secret part.
+std::string PublicWorkerId(std::string_view worker_id);
+
 class Scheduler {
  public:
   // `clock` is not owned and must outlive the scheduler.
@@ -93,7 +98,11 @@ class Scheduler {
 
   const SchedulerOptions& options() const { return options_; }
 
-  // Returns the new worker's id ("w-<n>").
+  // Returns the new worker's id: "w-<n>.<64 random bits in hex>". The
+  // random part makes the id a worker's proof of its registration: a holder
+  // of the (shared) worker token cannot guess another worker's id, and so
+  // cannot answer the tasks leased to it. Only PublicWorkerId(id) goes into
+  // messages, events and the job log.
   std::string RegisterWorker(const std::string& name, int slots);
 
   // Queues an analysis of `job_id`; `want_gradients` is passed on to the
@@ -127,7 +136,9 @@ class Scheduler {
   // The worker delivered the result of `task_id`: the task is finished and
   // the caller hands the result to the optimizer. NotFound when the task is
   // not outstanding any more (finished by another attempt, given up, or its
-  // job cancelled): the result must be dropped.
+  // job cancelled): the result must be dropped. PermissionDenied when no
+  // attempt of the task was ever leased to `worker_id` (a worker answering
+  // another's task): refused, and the task stays as it was.
   absl::StatusOr<FinishedTask> Complete(const std::string& worker_id, const std::string& task_id);
 
   // The worker could not run `task_id` (not a failure of the analysis

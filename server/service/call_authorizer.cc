@@ -2,6 +2,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "server/service/audit_log.h"
 
 namespace mbopt::service {
 namespace {
@@ -23,19 +24,25 @@ void CallAuthorizer::ReplaceTokens(auth::TokenTable tokens) {
 
 absl::StatusOr<auth::Principal> CallAuthorizer::Identify(const grpc::ServerContext& context) const {
   if (!needs_tokens_) return auth::Principal{auth::Role::kAdmin, ""};
+  const auto& metadata = context.client_metadata();
+  const auto header = metadata.find("authorization");
+  if (header == metadata.end()) return IdentifyBearer(std::nullopt);
+  return IdentifyBearer(std::string_view(header->second.data(), header->second.size()));
+}
+
+absl::StatusOr<auth::Principal> CallAuthorizer::IdentifyBearer(std::optional<std::string_view> header) const {
+  if (!needs_tokens_) return auth::Principal{auth::Role::kAdmin, ""};
   std::shared_ptr<const auth::TokenTable> tokens;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     tokens = tokens_;
   }
-  const auto& metadata = context.client_metadata();
-  const auto header = metadata.find("authorization");
-  if (header == metadata.end()) {
+  if (!header) {
     return absl::UnauthenticatedError(
         "this server needs a token with every call: give it with --token-file FILE or MBOPT_TOKEN_FILE "
         "(docs/server.md, \"Security\")");
   }
-  const std::string_view value(header->second.data(), header->second.size());
+  const std::string_view value = *header;
   if (value.substr(0, kBearer.size()) != kBearer) {
     return absl::UnauthenticatedError("the authorization header is not `Bearer TOKEN`");
   }
@@ -48,12 +55,25 @@ absl::StatusOr<auth::Principal> CallAuthorizer::Identify(const grpc::ServerConte
   return *principal;
 }
 
+std::string CallAuthorizer::Caller(const grpc::ServerContext& context, const auth::Principal* principal) {
+  if (principal == nullptr || principal->name.empty()) return absl::StrCat("peer ", context.peer());
+  return absl::StrCat(auth::RoleName(principal->role), " ", principal->name, " (peer ", context.peer(), ")");
+}
+
+absl::Status CallAuthorizer::Refuse(const grpc::ServerContext& context, const char* method,
+                                    const auth::Principal* principal, absl::Status why) {
+  AuditLog(absl::StrCat("refused ", method, " from ", Caller(context, principal), ": ", why.message()));
+  return why;
+}
+
 absl::StatusOr<auth::Principal> CallAuthorizer::ForJobs(const grpc::ServerContext& context,
                                                         const char* method) const {
   absl::StatusOr<auth::Principal> principal = Identify(context);
-  if (principal.ok() && principal->role == auth::Role::kWorker) {
-    return absl::PermissionDeniedError(absl::StrCat(
-        "a worker token may only acquire tasks and report results; ", method, " needs a user or admin token"));
+  if (!principal.ok()) return Refuse(context, method, nullptr, principal.status());
+  if (principal->role == auth::Role::kWorker) {
+    return Refuse(context, method, &*principal,
+                  absl::PermissionDeniedError(absl::StrCat("a worker token may only acquire tasks and report results; ",
+                                                           method, " needs a user or admin token")));
   }
   return principal;
 }
@@ -61,17 +81,20 @@ absl::StatusOr<auth::Principal> CallAuthorizer::ForJobs(const grpc::ServerContex
 absl::StatusOr<auth::Principal> CallAuthorizer::ForWorkers(const grpc::ServerContext& context,
                                                            const char* method) const {
   absl::StatusOr<auth::Principal> principal = Identify(context);
-  if (!principal.ok()) return principal;
+  if (!principal.ok()) return Refuse(context, method, nullptr, principal.status());
   if (needs_tokens_ && principal->role != auth::Role::kWorker) {
-    return absl::PermissionDeniedError(absl::StrCat(
-        "a ", auth::RoleName(principal->role), " token cannot act as a worker; ", method, " needs a worker token"));
+    return Refuse(context, method, &*principal,
+                  absl::PermissionDeniedError(absl::StrCat("a ", auth::RoleName(principal->role),
+                                                           " token cannot act as a worker; ", method,
+                                                           " needs a worker token")));
   }
   if (workers_need_certificate_) {
     const std::shared_ptr<const grpc::AuthContext> auth = context.auth_context();
     if (auth == nullptr || !auth->IsPeerAuthenticated()) {
-      return absl::UnauthenticatedError(absl::StrCat(
-          method, " needs a client certificate signed by the server's worker CA (mbopt-worker --tls-cert and "
-                  "--tls-key)"));
+      return Refuse(context, method, &*principal,
+                    absl::UnauthenticatedError(absl::StrCat(
+                        method, " needs a client certificate signed by the server's worker CA (mbopt-worker "
+                                "--tls-cert and --tls-key)")));
     }
   }
   return principal;
@@ -79,13 +102,6 @@ absl::StatusOr<auth::Principal> CallAuthorizer::ForWorkers(const grpc::ServerCon
 
 bool CallAuthorizer::MaySee(const auth::Principal& principal, const std::string& owner) {
   return principal.role == auth::Role::kAdmin || principal.name == owner;
-}
-
-absl::Status CallAuthorizer::CheckMaySee(const auth::Principal& principal, const std::string& job_id,
-                                         const std::string& owner) {
-  if (MaySee(principal, owner)) return absl::OkStatus();
-  return absl::PermissionDeniedError(absl::StrCat(
-      "job '", job_id, "' was submitted by another user; only its owner or an admin may see, cancel or resume it"));
 }
 
 }  // namespace mbopt::service

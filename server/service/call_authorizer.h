@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <grpcpp/grpcpp.h>
 
@@ -29,6 +30,12 @@ class CallAuthorizer {
   // come with one.
   CallAuthorizer(std::optional<auth::TokenTable> tokens, bool workers_need_certificate);
 
+  // The holder of the token in an `authorization` header's value
+  // ("Bearer TOKEN"; nullopt: no such header). Unauthenticated, with words
+  // for the client, without a token of the table. For the check before a
+  // call's message is read (token_metadata_processor.h).
+  absl::StatusOr<auth::Principal> IdentifyBearer(std::optional<std::string_view> header) const;
+
   // Whether calls need tokens (the authorizer was made with a table).
   bool needs_tokens() const { return needs_tokens_; }
   // Takes a new table (the server's SIGHUP), for calls that start after.
@@ -37,15 +44,20 @@ class CallAuthorizer {
 
   // The caller of a JobService method (`method` names it in messages).
   // Unauthenticated without a known token; PermissionDenied for a worker.
+  // Every refusal is written to the audit log (audit_log.h).
   absl::StatusOr<auth::Principal> ForJobs(const grpc::ServerContext& context, const char* method) const;
   // The caller of a WorkerService method: a worker, else as above.
   absl::StatusOr<auth::Principal> ForWorkers(const grpc::ServerContext& context, const char* method) const;
 
-  // PermissionDenied unless `principal` may read, cancel or resume the job
-  // `job_id` submitted by `owner`.
-  static absl::Status CheckMaySee(const auth::Principal& principal, const std::string& job_id,
-                                  const std::string& owner);
-  // Whether a job of `owner` is listed for `principal`.
+  // Who called, for the audit log: "user alice (peer ipv4:10.0.0.5:41234)",
+  // or "peer ..." on a server without tokens or before the token is known.
+  static std::string Caller(const grpc::ServerContext& context, const auth::Principal* principal);
+  // Logs the refusal of `method` to the caller and returns `why`.
+  static absl::Status Refuse(const grpc::ServerContext& context, const char* method,
+                             const auth::Principal* principal, absl::Status why);
+
+  // Whether `principal` may see, cancel or resume (and list) a job
+  // submitted by `owner`.
   static bool MaySee(const auth::Principal& principal, const std::string& owner);
 
  private:

@@ -8,6 +8,7 @@
 #include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "server/service/audit_log.h"
 #include "server/service/proto_convert.h"
 #include "server/service/status_conversion.h"
 
@@ -28,13 +29,20 @@ std::int64_t NowUnixMs() {
 
 // ------------------------------------------------------------------ jobs --
 
-absl::Status JobServiceImpl::CheckJobAccess(const grpc::ServerContext& context, const char* method,
-                                            const std::string& job_id) const {
+absl::StatusOr<auth::Principal> JobServiceImpl::CheckJobAccess(const grpc::ServerContext& context,
+                                                               const char* method, const std::string& job_id) const {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(context, method);
   if (!caller.ok()) return caller.status();
   absl::StatusOr<std::string> owner = manager_->OwnerOf(job_id);
   if (!owner.ok()) return owner.status();
-  return CallAuthorizer::CheckMaySee(*caller, job_id, *owner);
+  if (!CallAuthorizer::MaySee(*caller, *owner)) {
+    // The answer for a job that does not exist: the caller learns nothing
+    // of other users' jobs. The log says what happened.
+    AuditLog(absl::StrCat("refused ", method, " from ", CallAuthorizer::Caller(context, &*caller), ": job '", job_id,
+                          "' is another user's (", *owner, "); answered as if it did not exist"));
+    return JobManager::NoSuchJob(job_id);
+  }
+  return caller;
 }
 
 grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::SubmitJobRequest* request,
@@ -59,16 +67,18 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::Subm
   const std::string source = request->source_name().empty()
                                  ? absl::StrCat("study '", request->study().name(), "'")
                                  : request->source_name();
-  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source, caller->name);
+  const std::string who = CallAuthorizer::Caller(*context, &*caller);
+  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source, caller->name, who);
   if (!id.ok()) return ToGrpcStatus(id.status());
+  AuditLog(absl::StrCat("submit ", *id, " by ", who, ": ", source));
   response->set_job_id(*id);
   return grpc::Status::OK;
 }
 
 grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef* request,
                                  v1::GetJobResponse* response) {
-  if (absl::Status access = CheckJobAccess(*context, "Get", request->job_id()); !access.ok()) {
-    return ToGrpcStatus(access);
+  if (absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Get", request->job_id()); !access.ok()) {
+    return ToGrpcStatus(access.status());
   }
   absl::StatusOr<JobView> view = manager_->Get(request->job_id());
   if (!view.ok()) return ToGrpcStatus(view.status());
@@ -94,8 +104,8 @@ grpc::Status JobServiceImpl::List(grpc::ServerContext* context, const v1::ListJo
 
 grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRef* request,
                                    grpc::ServerWriter<v1::JobEvent>* writer) {
-  if (absl::Status access = CheckJobAccess(*context, "Watch", request->job_id()); !access.ok()) {
-    return ToGrpcStatus(access);
+  if (absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Watch", request->job_id()); !access.ok()) {
+    return ToGrpcStatus(access.status());
   }
   if (absl::Status status = manager_->StartWatching(request->job_id()); !status.ok()) return ToGrpcStatus(status);
   absl::Cleanup stop_watching = [this, request] { manager_->StopWatching(request->job_id()); };
@@ -152,10 +162,12 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
 
 grpc::Status JobServiceImpl::Cancel(grpc::ServerContext* context, const v1::JobRef* request,
                                     v1::JobSummary* response) {
-  if (absl::Status access = CheckJobAccess(*context, "Cancel", request->job_id()); !access.ok()) {
-    return ToGrpcStatus(access);
-  }
-  absl::StatusOr<JobSummaryData> summary = manager_->Cancel(request->job_id());
+  absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Cancel", request->job_id());
+  if (!access.ok()) return ToGrpcStatus(access.status());
+  const std::string who = CallAuthorizer::Caller(*context, &*access);
+  absl::StatusOr<JobSummaryData> summary = manager_->Cancel(request->job_id(), who);
+  AuditLog(absl::StrCat("cancel ", request->job_id(), " by ", who, ": ",
+                        summary.ok() ? "done" : summary.status().message()));
   if (!summary.ok()) return ToGrpcStatus(summary.status());
   *response = ToProto(*summary);
   return grpc::Status::OK;
@@ -163,10 +175,12 @@ grpc::Status JobServiceImpl::Cancel(grpc::ServerContext* context, const v1::JobR
 
 grpc::Status JobServiceImpl::Resume(grpc::ServerContext* context, const v1::JobRef* request,
                                     v1::JobSummary* response) {
-  if (absl::Status access = CheckJobAccess(*context, "Resume", request->job_id()); !access.ok()) {
-    return ToGrpcStatus(access);
-  }
-  absl::StatusOr<JobSummaryData> summary = manager_->Resume(request->job_id());
+  absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Resume", request->job_id());
+  if (!access.ok()) return ToGrpcStatus(access.status());
+  const std::string who = CallAuthorizer::Caller(*context, &*access);
+  absl::StatusOr<JobSummaryData> summary = manager_->Resume(request->job_id(), who);
+  AuditLog(absl::StrCat("resume ", request->job_id(), " by ", who, ": ",
+                        summary.ok() ? "done" : summary.status().message()));
   if (!summary.ok()) return ToGrpcStatus(summary.status());
   *response = ToProto(*summary);
   return grpc::Status::OK;
@@ -176,10 +190,14 @@ grpc::Status JobServiceImpl::Resume(grpc::ServerContext* context, const v1::JobR
 
 grpc::Status WorkerServiceImpl::Register(grpc::ServerContext* context, const v1::RegisterWorkerRequest* request,
                                          v1::RegisterWorkerResponse* response) {
-  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Register"); !caller.ok()) {
-    return ToGrpcStatus(caller.status());
-  }
-  response->set_worker_id(scheduler_->RegisterWorker(request->name(), request->slots()));
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Register");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
+  const std::string worker_id = scheduler_->RegisterWorker(request->name(), request->slots());
+  // Ties the id in the job log's analyses to a name and an address.
+  AuditLog(absl::StrCat("worker ", scheduler::PublicWorkerId(worker_id), " registered by ",
+                        CallAuthorizer::Caller(*context, &*caller), ", name '", request->name().substr(0, 256), "', ",
+                        request->slots(), " slots"));
+  response->set_worker_id(worker_id);
   response->set_heartbeat_interval_ms(static_cast<std::int32_t>(scheduler_->options().heartbeat_interval_ms));
   response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));
   response->set_max_message_bytes(max_message_bytes_);
@@ -232,11 +250,13 @@ grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext* context, const v1:
 
 grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext* context, const v1::TaskResult* request,
                                              v1::ReportResultResponse* response) {
-  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResult"); !caller.ok()) {
-    return ToGrpcStatus(caller.status());
-  }
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResult");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
   const absl::StatusOr<bool> accepted = request->retry() ? ReportRetry(*request)
                                                          : manager_->ReportResult(WorkerReportFromProto(*request));
+  if (absl::IsPermissionDenied(accepted.status())) {
+    return ToGrpcStatus(CallAuthorizer::Refuse(*context, "ReportResult", &*caller, accepted.status()));
+  }
   if (!accepted.ok()) return ToGrpcStatus(accepted.status());
   response->set_accepted(*accepted);
   LeaseNextTasks(request->worker_id(), request->next_tasks(), response->mutable_tasks());
@@ -264,19 +284,16 @@ void WorkerServiceImpl::LeaseNextTasks(const std::string& worker_id, int next_ta
 
 grpc::Status WorkerServiceImpl::ReportResults(grpc::ServerContext* context, const v1::TaskResults* request,
                                               v1::ReportResultsResponse* response) {
-  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResults"); !caller.ok()) {
-    return ToGrpcStatus(caller.status());
-  }
-  return TakeResults(*request, response);
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResults");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
+  return TakeResults(*context, *caller, "ReportResults", *request, response);
 }
 
 grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* context,
                                                      grpc::ServerReader<v1::ResultPiece>* reader,
                                                      v1::ReportResultsResponse* response) {
-  if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResultInPieces");
-      !caller.ok()) {
-    return ToGrpcStatus(caller.status());
-  }
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResultInPieces");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
   v1::ResultPiece piece;
   if (!reader->Read(&piece)) return ToGrpcStatus(absl::InvalidArgumentError("a result in pieces without a piece"));
   const std::int64_t total = piece.total_bytes();
@@ -308,10 +325,12 @@ grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* contex
   }
   bytes.clear();
   bytes.shrink_to_fit();
-  return TakeResults(request, response);
+  return TakeResults(*context, *caller, "ReportResultInPieces", request, response);
 }
 
-grpc::Status WorkerServiceImpl::TakeResults(const v1::TaskResults& request, v1::ReportResultsResponse* response) {
+grpc::Status WorkerServiceImpl::TakeResults(const grpc::ServerContext& context, const auth::Principal& caller,
+                                            const char* method, const v1::TaskResults& request,
+                                            v1::ReportResultsResponse* response) {
   std::vector<WorkerReport> reports;
   std::vector<int> report_index;  // the answer of each report
   // Each result names the registration its task was leased under (a worker
@@ -338,6 +357,8 @@ grpc::Status WorkerServiceImpl::TakeResults(const v1::TaskResults& request, v1::
       answer->set_accepted(*taken[k]);
     } else if (absl::IsUnavailable(taken[k].status())) {
       return ToGrpcStatus(taken[k].status());  // the server is stopping: the worker retries the call
+    } else if (absl::IsPermissionDenied(taken[k].status())) {
+      answer->set_error(std::string(CallAuthorizer::Refuse(context, method, &caller, taken[k].status()).message()));
     } else {
       answer->set_error(std::string(taken[k].status().message()));
     }

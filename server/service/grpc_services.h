@@ -36,8 +36,10 @@ class JobServiceImpl final : public v1::JobService::Service {
   grpc::Status Resume(grpc::ServerContext* context, const v1::JobRef* request, v1::JobSummary* response) override;
 
  private:
-  // OK when the caller may see the job (which exists).
-  absl::Status CheckJobAccess(const grpc::ServerContext& context, const char* method, const std::string& job_id) const;
+  // The caller, when it may see the job (which exists). The same NotFound
+  // for another user's job as for none (logged as a refusal).
+  absl::StatusOr<auth::Principal> CheckJobAccess(const grpc::ServerContext& context, const char* method,
+                                                 const std::string& job_id) const;
 
   JobManager* manager_;
   const CallAuthorizer* authorizer_;
@@ -91,8 +93,10 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   // A worker could not run a task (TaskResult.retry): its attempt fails.
   // Whether that was taken (false: the task was not outstanding any more).
   absl::StatusOr<bool> ReportRetry(const v1::TaskResult& result) const;
-  // ReportResults after the caller was authorized.
-  grpc::Status TakeResults(const v1::TaskResults& request, v1::ReportResultsResponse* response);
+  // ReportResults after `caller` was authorized for `method`. A result
+  // for another worker's task is refused (its answer says why) and logged.
+  grpc::Status TakeResults(const grpc::ServerContext& context, const auth::Principal& caller, const char* method,
+                           const v1::TaskResults& request, v1::ReportResultsResponse* response);
   // Leases up to `next_tasks` tasks to the worker into `out` (none for 0).
   void LeaseNextTasks(const std::string& worker_id, int next_tasks,
                       google::protobuf::RepeatedPtrField<v1::AnalysisTask>* out) const;

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/private_file.h"
 #include "common/read_file.h"
 #include "common/status_macros.h"
 #include "server/auth/certificates.h"
@@ -15,6 +17,7 @@
 #include "server/lp/make_clp_lp_solver.h"
 #include "server/service/listen_address.h"
 #include "server/service/proto_convert.h"
+#include "server/service/token_metadata_processor.h"
 
 namespace mbopt::service {
 namespace {
@@ -40,6 +43,7 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecuri
   std::optional<auth::TokenTable> tokens;
   if (!options_.tokens_file.empty()) {
     MBOPT_ASSIGN_OR_RETURN(tokens, auth::TokenTable::Load(options_.tokens_file));
+    MBOPT_RETURN_IF_ERROR(CheckSecretFileMode(options_.tokens_file, "the token table"));
     if (tokens->size() == 0) {
       return absl::InvalidArgumentError(
           absl::StrCat(options_.tokens_file, ": no tokens in the table: nobody could call the server"));
@@ -66,6 +70,7 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecuri
   }
   MBOPT_ASSIGN_OR_RETURN(std::string certificate, ReadPemFile(options_.tls_cert_file, "--tls-cert"));
   MBOPT_ASSIGN_OR_RETURN(std::string key, ReadPemFile(options_.tls_key_file, "--tls-key"));
+  MBOPT_RETURN_IF_ERROR(CheckSecretFileMode(options_.tls_key_file, "the server's TLS key (--tls-key)"));
   MBOPT_RETURN_IF_ERROR(
       auth::CheckKeyMatchesCertificate(certificate, key, options_.tls_cert_file, options_.tls_key_file));
   MBOPT_ASSIGN_OR_RETURN(auth::CertificateInfo info, auth::InspectCertificate(certificate, options_.tls_cert_file));
@@ -83,7 +88,11 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecuri
     // calls check for one (call_authorizer.h).
     ssl.client_certificate_request = GRPC_SSL_REQUEST_CLIENT_CERTIFICATE_AND_VERIFY;
   }
-  return grpc::SslServerCredentials(ssl);
+  std::shared_ptr<grpc::ServerCredentials> credentials = grpc::SslServerCredentials(ssl);
+  if (authorizer_->needs_tokens()) {
+    credentials->SetAuthMetadataProcessor(std::make_shared<TokenMetadataProcessor>(authorizer_.get()));
+  }
+  return credentials;
 }
 
 absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions options) {
@@ -117,6 +126,7 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   // Without this, gRPC on Linux binds with SO_REUSEPORT and a second server
   // on a port in use would silently share it instead of failing.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, static_cast<int>(s.options_.handshake_timeout_ms));
   builder.SetMaxReceiveMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.SetMaxSendMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.AddListeningPort(s.options_.listen_address, credentials, &s.port_);
@@ -164,10 +174,16 @@ absl::StatusOr<std::size_t> MboptServer::ReloadTokens() {
   if (!authorizer_->needs_tokens()) {
     return absl::FailedPreconditionError("the server was started without a token table (--tokens or --tls-dir)");
   }
-  MBOPT_ASSIGN_OR_RETURN(auth::TokenTable tokens, auth::TokenTable::Load(options_.tokens_file));
-  if (tokens.size() == 0) {
-    return absl::InvalidArgumentError(absl::StrCat(options_.tokens_file, ": no tokens in the table"));
+  // Deleting or emptying the table is a way to revoke every token: it must
+  // not leave the old table in use.
+  std::error_code error;
+  if (!std::filesystem::exists(options_.tokens_file, error) && !error) {
+    authorizer_->ReplaceTokens(auth::TokenTable());
+    return std::size_t{0};
   }
+  MBOPT_ASSIGN_OR_RETURN(auth::TokenTable tokens, auth::TokenTable::Load(options_.tokens_file));
+  // A table others may write could hold a token an attacker added.
+  MBOPT_RETURN_IF_ERROR(CheckSecretFileMode(options_.tokens_file, "the token table"));
   const std::size_t count = tokens.size();
   authorizer_->ReplaceTokens(std::move(tokens));
   return count;

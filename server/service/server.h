@@ -57,6 +57,11 @@ struct ServerOptions {
   // max_message_bytes (the server holds it whole while it reassembles it);
   // workers are told it when they register.
   std::int64_t max_result_bytes = std::int64_t{1} << 30;
+  // A connection that has not completed its TLS handshake and sent its
+  // HTTP/2 settings this long after it was accepted is closed: idle
+  // connections from anyone who reaches the port would otherwise hold a
+  // descriptor each for gRPC's default of 120 s.
+  std::int64_t handshake_timeout_ms = 10'000;
   // What a machine crash may take from the job database (store.h).
   store::Durability durability = store::Durability::kCycles;
   JobManagerOptions manager;
@@ -81,8 +86,11 @@ class MboptServer {
   store::Store& store() { return *store_; }  // for tests
 
   // Reads the token table file again and uses it for the calls that start
-  // after (SIGHUP of mbopt-server). On error the table in use stays.
-  // Returns the number of tokens.
+  // after (SIGHUP of mbopt-server). Returns the number of tokens; 0 when the
+  // file is missing or lists none: then every token is revoked and no call
+  // is accepted until a table with tokens is read. On error (the file does
+  // not parse, cannot be read, or others may read or write it) the table in
+  // use stays.
   absl::StatusOr<std::size_t> ReloadTokens();
 
   // Graceful stop (see above). Idempotent.

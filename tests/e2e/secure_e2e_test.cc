@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -109,6 +110,22 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   EXPECT_THAT(no_token.stderr_text, HasSubstr("needs a token"));
   EXPECT_EQ(Lines(no_token.stderr_text), 1) << no_token.stderr_text;
   const std::string wrong_token_file = dir.Write("wrong.token", "mbopt_00000000\n");
+  // A token others can read is refused by the CLI and the worker before
+  // any call.
+  std::filesystem::permissions(wrong_token_file, std::filesystem::perms::owner_read |
+                                                     std::filesystem::perms::owner_write |
+                                                     std::filesystem::perms::group_read |
+                                                     std::filesystem::perms::others_read);
+  auto readable_token = Mbopt({"status", "job-1", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
+                               wrong_token_file});
+  EXPECT_EQ(readable_token.exit_code, kExitBadInput) << Describe(readable_token);
+  EXPECT_THAT(readable_token.stderr_text, HasSubstr("has mode 0644: readable by every user of this machine"));
+  auto readable_token_worker = RunWorker({"--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
+                                          wrong_token_file});
+  EXPECT_NE(readable_token_worker.exit_code, 0) << Describe(readable_token_worker);
+  EXPECT_THAT(readable_token_worker.stderr_text, HasSubstr("chmod 600 " + wrong_token_file));
+  std::filesystem::permissions(wrong_token_file, std::filesystem::perms::owner_read |
+                                                     std::filesystem::perms::owner_write);
   auto wrong_token = Mbopt({"status", "job-1", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
                             wrong_token_file});
   EXPECT_EQ(wrong_token.exit_code, kExitDenied) << Describe(wrong_token);
@@ -151,9 +168,13 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   } while (bobs_list.exit_code == kExitDenied && std::chrono::steady_clock::now() < deadline);
   EXPECT_EQ(bobs_list.exit_code, kExitOk) << Describe(bobs_list);
   EXPECT_THAT(bobs_list.stdout_text, Not(HasSubstr("job-1"))) << "Bob sees only his own jobs";
+  // Alice's job is answered to Bob as one that does not exist.
   auto bob_reads_alices = Mbopt({"status", "job-1", "--server", addr}, bob);
-  EXPECT_EQ(bob_reads_alices.exit_code, kExitDenied) << Describe(bob_reads_alices);
-  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("submitted by another user"));
+  auto bob_reads_none = Mbopt({"status", "job-99", "--server", addr}, bob);
+  EXPECT_EQ(bob_reads_alices.exit_code, kExitBadInput) << Describe(bob_reads_alices);
+  EXPECT_EQ(bob_reads_none.exit_code, kExitBadInput) << Describe(bob_reads_none);
+  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("no job with id 'job-1'"));
+  EXPECT_THAT(bob_reads_none.stderr_text, HasSubstr("no job with id 'job-99'"));
 
   EXPECT_EQ(worker.Stop(kGuard), 0);
   EXPECT_EQ(server->process->Stop(kGuard), 0);

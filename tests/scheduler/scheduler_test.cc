@@ -334,6 +334,43 @@ TEST(Scheduler, LateResultIsTakenIfNoOtherAttemptFinished) {
   ASSERT_EQ(reply.cancelled_task_ids.size(), 1u);
 }
 
+TEST(Scheduler, OnlyAWorkerThatHoldsOrHeldALeaseOfATaskMayCompleteIt) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {});
+  const std::string holder = scheduler.RegisterWorker("holder", 1);
+  const std::string other = scheduler.RegisterWorker("other", 1);
+  auto leased = scheduler.Acquire(holder, 1);
+  ASSERT_EQ(leased->size(), 1u);
+  const std::string task = leased->front().task_id;
+  // Another registered worker, and one naming the holder's public id only.
+  for (const std::string& impostor : {other, PublicWorkerId(holder), std::string("w-1")}) {
+    absl::StatusOr<FinishedTask> refused = scheduler.Complete(impostor, task);
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kPermissionDenied) << impostor;
+  }
+  EXPECT_EQ(scheduler.LeasedCount(), 1) << "a refused result leaves the lease as it was";
+  // Queued again after the lease expired, it is still the holder's to answer.
+  clock.Advance(kLeaseMs);
+  scheduler.ExpireLeases();
+  EXPECT_EQ(scheduler.Complete(other, task).status().code(), absl::StatusCode::kPermissionDenied);
+  absl::StatusOr<FinishedTask> done = scheduler.Complete(holder, task);
+  ASSERT_TRUE(done.ok()) << done.status();
+  EXPECT_EQ(done->worker_id, holder);
+}
+
+TEST(Scheduler, WorkerIdsCarryASecretPartThatIsNeverShown) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  const std::string first = scheduler.RegisterWorker("a", 1);
+  const std::string second = scheduler.RegisterWorker("b", 1);
+  EXPECT_EQ(PublicWorkerId(first), "w-1");
+  EXPECT_EQ(PublicWorkerId(second), "w-2");
+  // "w-<n>." and 16 hex digits of 64 random bits.
+  EXPECT_EQ(first.size(), std::string("w-1.").size() + 16);
+  EXPECT_NE(first.substr(4), second.substr(4));
+  EXPECT_EQ(PublicWorkerId("w-7"), "w-7");
+}
+
 TEST(Scheduler, UnknownTaskAndUnknownWorkerAreNotFound) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());

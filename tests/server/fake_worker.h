@@ -63,9 +63,11 @@ class FakeWorker {
   grpc::Status Answer(const v1::AnalysisTask& task, bool* accepted = nullptr);
   // Answers `tasks` (of any jobs) in one ReportResults call.
   grpc::Status AnswerTogether(const std::vector<v1::AnalysisTask>& tasks, v1::ReportResultsResponse* response);
+  // The result this worker would report for `task` (its analytic values,
+  // its worker id), not sent: tests alter it to play a hostile worker.
+  v1::TaskResult ResultOf(const v1::AnalysisTask& task);
 
  private:
-  v1::TaskResult ResultOf(const v1::AnalysisTask& task);
   const v1::Study& StudyOf(const std::string& job_id);
 
   std::unique_ptr<v1::WorkerService::Stub> stub_;

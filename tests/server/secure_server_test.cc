@@ -3,15 +3,19 @@
 // token or the right certificate gets (and is told).
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -68,9 +72,14 @@ class SecureServerTest : public ::testing::Test {
     EXPECT_TRUE(made.ok()) << made.status();
     return made.ok() ? *made : auth::KeyAndCertificate{};
   }
-  std::string Write(const std::string& name, const std::string& content) {
+  // Readable by its owner only, as init-tls makes keys and tables;
+  // `mode` for the files of the tests that see other modes refused.
+  std::string Write(const std::string& name, const std::string& content,
+                    std::filesystem::perms mode = std::filesystem::perms::owner_read |
+                                                  std::filesystem::perms::owner_write) {
     const std::string path = (dir_ / name).string();
     std::ofstream(path) << content;
+    std::filesystem::permissions(path, mode);
     return path;
   }
 
@@ -166,17 +175,23 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
   EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
   EXPECT_EQ(job.summary().owner(), "alice");
 
-  // Bob can neither read nor cancel nor resume Alice's job, nor list it.
+  // Bob can neither read nor cancel nor resume Alice's job, nor list it;
+  // he is answered as for a job that does not exist, word for word, so ids
+  // do not tell him which jobs exist.
+  ::testing::internal::CaptureStderr();
   grpc::Status status = Get(*bob, alices_job, &job);
-  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
-  EXPECT_THAT(status.error_message(), HasSubstr("submitted by another user"));
-  EXPECT_EQ(Cancel(*bob, alices_job).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  const grpc::Status none = Get(*bob, "job-999", &job);
+  EXPECT_EQ(none.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(status.error_message(), std::string(JobManager::NoSuchJob(alices_job).message()));
+  EXPECT_EQ(none.error_message(), std::string(JobManager::NoSuchJob("job-999").message()));
+  EXPECT_EQ(Cancel(*bob, alices_job).error_code(), grpc::StatusCode::NOT_FOUND);
   {
     grpc::ClientContext context;
     v1::JobRef ref;
     ref.set_job_id(alices_job);
     v1::JobSummary summary;
-    EXPECT_EQ(bob->Resume(&context, ref, &summary).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(bob->Resume(&context, ref, &summary).error_code(), grpc::StatusCode::NOT_FOUND);
   }
   {
     grpc::ClientContext context;
@@ -185,7 +200,14 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
     auto stream = bob->Watch(&context, ref);
     v1::JobEvent event;
     EXPECT_FALSE(stream->Read(&event));
-    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  // The log says what happened, and who tried.
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_THAT(log, HasSubstr("audit: refused Get from user bob (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("): job '" + alices_job + "' is another user's (alice)"));
+  for (const char* method : {"Cancel", "Resume", "Watch"}) {
+    EXPECT_THAT(log, HasSubstr(std::string("audit: refused ") + method + " from user bob")) << method;
   }
   const v1::ListJobsResponse bobs_list = List(*bob);
   ASSERT_EQ(bobs_list.jobs_size(), 1);
@@ -193,6 +215,38 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
   // The admin sees both.
   EXPECT_EQ(List(*admin).jobs_size(), 2);
   EXPECT_TRUE(Get(*admin, alices_job, &job).ok());
+}
+
+// Who submitted, cancelled and resumed a job is in its event log in the
+// database, and in the server's audit log.
+TEST_F(SecureServerTest, JobActionsNameWhoDidThemInTheJobsEventsAndTheAuditLog) {
+  StartSecureServer();
+  ::testing::internal::CaptureStderr();
+  std::string job_id;
+  ASSERT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  ASSERT_TRUE(Cancel(*Jobs(admin_), job_id).ok());
+  {
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(job_id);
+    v1::JobSummary summary;
+    ASSERT_TRUE(Jobs(alice_)->Resume(&context, ref, &summary).ok());
+  }
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  absl::StatusOr<std::vector<store::EventRow>> events = server_->store().LoadEvents(job_id);
+  ASSERT_TRUE(events.ok()) << events.status();
+  std::map<std::string, std::string> detail;
+  for (const store::EventRow& e : *events) detail[e.kind] = e.message;
+  EXPECT_THAT(detail["submitted"], HasSubstr("; by user alice (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(detail["cancelled"], HasSubstr("by admin ops (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(detail["resumed"], HasSubstr("resumed on request; by user alice (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("audit: submit " + job_id + " by user alice (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("audit: cancel " + job_id + " by admin ops (peer ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr("audit: resume " + job_id + " by user alice (peer ipv4:127.0.0.1:"));
+  for (const std::string& token : {alice_, admin_}) {
+    EXPECT_THAT(log, ::testing::Not(HasSubstr(token))) << "a token in the log";
+    EXPECT_THAT(log, ::testing::Not(HasSubstr(auth::HashToken(token)))) << "a token's hash in the log";
+  }
 }
 
 TEST_F(SecureServerTest, OnlyWorkerTokensActAsWorkersAndWorkerTokensCannotSubmit) {
@@ -253,6 +307,61 @@ TEST_F(SecureServerTest, MissingOrWrongTokensAreRefusedAndReloadingTheTableRevok
   EXPECT_TRUE(Submit(*Jobs(carol), &job_id).ok());
 }
 
+TEST_F(SecureServerTest, ATokenTableOrKeyOthersMayReadOrWriteIsRefusedAtStart) {
+  using std::filesystem::perms;
+  const perms kOwner = perms::owner_read | perms::owner_write;
+  // A table anyone may write: anyone could add an admin token's hash.
+  ServerOptions options = SecureOptions(server_certificate_);
+  std::filesystem::permissions(options.tokens_file, kOwner | perms::others_write);
+  absl::StatusOr<std::unique_ptr<MboptServer>> server = MboptServer::Start(options);
+  ASSERT_FALSE(server.ok());
+  EXPECT_EQ(server.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(server.status().message(),
+              HasSubstr("the token table " + options.tokens_file + " has mode 0602: writable by every user"));
+  EXPECT_THAT(server.status().message(), HasSubstr("chmod 600 " + options.tokens_file));
+  // A key the group may write, and one anyone may read.
+  std::filesystem::permissions(options.tokens_file, kOwner);
+  for (const perms extra : {perms::group_write, perms::others_read}) {
+    std::filesystem::permissions(options.tls_key_file, kOwner | extra);
+    server = MboptServer::Start(options);
+    ASSERT_FALSE(server.ok());
+    EXPECT_THAT(server.status().message(), HasSubstr("the server's TLS key (--tls-key) " + options.tls_key_file));
+    EXPECT_THAT(server.status().message(), HasSubstr("chmod 600"));
+  }
+  // Fixed, it starts.
+  std::filesystem::permissions(options.tls_key_file, kOwner);
+  StartServer(options);
+}
+
+TEST_F(SecureServerTest, ReloadingAnEmptyOrMissingTableRevokesEveryToken) {
+  using std::filesystem::perms;
+  StartSecureServer();
+  std::string job_id;
+  ASSERT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  Write("tokens", "# every token revoked\n");
+  absl::StatusOr<std::size_t> reloaded = server_->ReloadTokens();
+  ASSERT_TRUE(reloaded.ok()) << reloaded.status();
+  EXPECT_EQ(*reloaded, 0u);
+  EXPECT_EQ(Submit(*Jobs(alice_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(Submit(*Jobs(admin_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  // Back, then deleted.
+  Write("tokens", auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_));
+  ASSERT_EQ(server_->ReloadTokens().value_or(99), 1u);
+  EXPECT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  std::filesystem::remove(dir_ / "tokens");
+  reloaded = server_->ReloadTokens();
+  ASSERT_TRUE(reloaded.ok()) << reloaded.status();
+  EXPECT_EQ(*reloaded, 0u);
+  EXPECT_EQ(Submit(*Jobs(alice_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  // A table others may write is not taken: the one in use stays.
+  Write("tokens", auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_),
+        perms::owner_read | perms::owner_write | perms::others_write);
+  EXPECT_THAT(std::string(server_->ReloadTokens().status().message()), HasSubstr("has mode 0602"));
+  EXPECT_EQ(Submit(*Jobs(alice_), &job_id).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+}
+
 TEST_F(SecureServerTest, ClientsWithoutTheCaOrWithPlaintextCannotConnectAndAreToldWhy) {
   StartSecureServer();
   // Plaintext, with a valid token: refused at the connection.
@@ -271,6 +380,31 @@ TEST_F(SecureServerTest, ClientsWithoutTheCaOrWithPlaintextCannotConnectAndAreTo
   EXPECT_THAT(secure_channel::DiagnoseConnectionFailure(server_->address(), Client(alice_, ca_.certificate_pem)),
               IsEmpty());
   EXPECT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+}
+
+// A connection that never starts its TLS handshake holds a descriptor of
+// the server; it is closed after the handshake timeout, not gRPC's 120 s.
+TEST_F(SecureServerTest, AnIdleConnectionWithoutHandshakeIsClosedAfterTheHandshakeTimeout) {
+  constexpr std::int64_t kHandshakeTimeoutMs = 300;
+  // Far above the timeout (slow machines), far below gRPC's default 120 s.
+  constexpr int kCloseWithinMs = 20'000;
+  ServerOptions options = SecureOptions(server_certificate_);
+  options.handshake_timeout_ms = kHandshakeTimeoutMs;
+  StartServer(options);
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(server_->port()));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  const auto start = std::chrono::steady_clock::now();
+  pollfd closed{fd, POLLIN, 0};
+  ASSERT_EQ(::poll(&closed, 1, kCloseWithinMs), 1) << "still open after " << kCloseWithinMs << " ms";
+  char byte = 0;
+  EXPECT_LE(::recv(fd, &byte, 1, 0), 0) << "closed, without a byte";
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(kHandshakeTimeoutMs / 2));
+  ::close(fd);
 }
 
 TEST_F(SecureServerTest, NoPlaintextHttp2IsAnsweredOnTheTlsPort) {

@@ -1,10 +1,18 @@
 // The mbopt-server executable as a process: its readiness line and port
 // file, a clean stop on SIGTERM, and recovery from a SIGKILL in the middle of
 // a job (--crash-after-cycles), checked bit for bit against an in-process run.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -28,7 +36,58 @@ namespace {
 
 using ::mbopt::testing::FakeWorker;
 using ::mbopt::testing::OscillatorStudy;
+using ::testing::HasSubstr;
 using ::testing::StartsWith;
+
+// The open-files limit of the server in the exhaustion tests: enough to
+// start (gRPC's threads and pollers, the database) with room for a few
+// dozen connections, far fewer than the test opens.
+constexpr rlim_t kLowOpenFilesLimit = 96;
+// Idle connections the test opens: well over the limit above.
+constexpr int kFloodConnections = 200;
+// How long the server may take to notice that its listener failed and stop.
+constexpr int kListenerFailureNoticeMs = 20'000;
+
+// Waits up to `timeout_ms` for `pid` to end (without reaping it); true if
+// it did. A pidfd becomes readable when its process ends.
+bool WaitForExit(pid_t pid, int timeout_ms) {
+  const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, pid, 0));
+  if (pidfd < 0) return false;
+  pollfd watch{pidfd, POLLIN, 0};
+  const int ready = ::poll(&watch, 1, timeout_ms);
+  ::close(pidfd);
+  return ready == 1;
+}
+
+// A TCP connection to 127.0.0.1:`port` that sends nothing; -1 on failure.
+int IdleConnection(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return -1;
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// The soft open-files limit of process `pid`, from /proc.
+long SoftOpenFilesLimit(pid_t pid) {
+  std::ifstream limits("/proc/" + std::to_string(pid) + "/limits");
+  std::string line;
+  while (std::getline(limits, line)) {
+    if (line.rfind("Max open files", 0) == 0) return std::strtol(line.c_str() + 14, nullptr, 10);
+  }
+  return -1;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
 
 // A started mbopt-server and the first line it printed.
 struct ServerProcess {
@@ -51,11 +110,31 @@ struct ServerProcess {
   }
 };
 
-std::unique_ptr<ServerProcess> StartServer(const std::vector<std::string>& args) {
+// How the process is started, beyond its arguments.
+struct ProcessSetting {
+  // Soft and hard open-files limits set before exec; 0: inherited.
+  rlim_t open_files_soft = 0;
+  rlim_t open_files_hard = 0;
+  // The process's stderr goes here; "": inherited.
+  std::string stderr_path;
+};
+
+std::unique_ptr<ServerProcess> StartServer(const std::vector<std::string>& args,
+                                           const ProcessSetting& setting = {}) {
   int out[2];
   EXPECT_EQ(::pipe(out), 0);
   const pid_t pid = ::fork();
   if (pid == 0) {
+    if (setting.open_files_hard > 0) {
+      const rlimit limit{setting.open_files_soft, setting.open_files_hard};
+      if (::setrlimit(RLIMIT_NOFILE, &limit) != 0) ::_exit(126);
+    }
+    if (!setting.stderr_path.empty()) {
+      const int err = ::open(setting.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+      if (err < 0) ::_exit(126);
+      ::dup2(err, STDERR_FILENO);
+      ::close(err);
+    }
     ::dup2(out[1], STDOUT_FILENO);
     ::close(out[0]);
     ::close(out[1]);
@@ -166,6 +245,127 @@ TEST_F(ServerProcessTest, RefusesAGarbageDatabaseWithAClearError) {
   const int status = server->Wait();
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 1);
+}
+
+TEST_F(ServerProcessTest, RaisesItsSoftOpenFilesLimitToTheHardLimit) {
+  auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_}, {.open_files_soft = 64, .open_files_hard = 512, .stderr_path = ""});
+  ASSERT_GT(server->port, 0);
+  EXPECT_EQ(SoftOpenFilesLimit(server->pid), 512);
+}
+
+// Idle connections fill the server's descriptor table; gRPC 1.51 then
+// stops accepting for good. The server must not stay up deaf: it stops
+// with status 75 once gRPC's listener failed, so that systemd
+// (Restart=on-failure) starts it again, and the restarted server answers.
+TEST_F(ServerProcessTest, AFullDescriptorTableEndsTheServerForItsManagerToRestart) {
+  const std::string log = (dir_ / "server.log").string();
+  auto server = StartServer({"--listen", "127.0.0.1:0", "--db", db_},
+                            {.open_files_soft = kLowOpenFilesLimit, .open_files_hard = kLowOpenFilesLimit,
+                             .stderr_path = log});
+  ASSERT_GT(server->port, 0);
+  const std::string id = Submit(Connect(server->port));
+  std::vector<int> connections;
+  for (int i = 0; i < kFloodConnections; ++i) {
+    const int fd = IdleConnection(server->port);
+    if (fd >= 0) connections.push_back(fd);
+  }
+  EXPECT_GT(static_cast<rlim_t>(connections.size()), kLowOpenFilesLimit);
+  const auto flooded = std::chrono::steady_clock::now();
+  const bool ended = WaitForExit(server->pid, kListenerFailureNoticeMs);
+  std::printf("%zu idle connections opened; the server ended %.2f s after the last\n", connections.size(),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - flooded).count());
+  for (int fd : connections) ::close(fd);
+  ASSERT_TRUE(ended) << "the server stayed up after its listener failed; its log:\n" << ReadText(log);
+  const int status = server->Wait();
+  ASSERT_TRUE(WIFEXITED(status)) << ReadText(log);
+  EXPECT_EQ(WEXITSTATUS(status), 75);
+  EXPECT_THAT(ReadText(log), HasSubstr("gRPC stopped accepting connections (Failed accept4: Too many open files"));
+
+  // What the service manager does: start it again. It answers, and the
+  // job, interrupted by the stop, is there to resume.
+  server = StartServer({"--listen", "127.0.0.1:0", "--db", db_});
+  ASSERT_GT(server->port, 0);
+  EXPECT_EQ(Get(Connect(server->port), id).summary().job_id(), id);
+}
+
+// Runs the server binary with `args` to its end; returns its exit status.
+int RunServerCommand(const std::vector<std::string>& args) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    static std::string binary = MBOPT_SERVER_BINARY;
+    argv.push_back(binary.data());
+    std::vector<std::string> copies = args;
+    for (std::string& a : copies) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDOUT_FILENO);
+    ::execv(binary.c_str(), argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A field of /proc/<pid>/status in bytes ("VmRSS", "VmHWM").
+std::int64_t ProcessMemoryBytes(pid_t pid, const std::string& field) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind(field + ":", 0) == 0) return std::strtoll(line.c_str() + field.size() + 1, nullptr, 10) * 1024;
+  }
+  return -1;
+}
+
+// A Submit of 128 MB without a token, to a server with TLS and tokens as
+// deploy/README.md sets it up: refused from its headers, before the
+// message is read, so the server's peak memory does not grow by the
+// message's size (it grew by more than twice that when the token was
+// checked in the handler, after gRPC had read and decoded the message).
+TEST_F(ServerProcessTest, ALargeCallWithoutATokenIsRefusedBeforeItsMessageIsRead) {
+  constexpr std::int64_t kMessageBytes = std::int64_t{128} << 20;
+  // What the server may grow by: HTTP/2 flow-control windows, TLS buffers,
+  // gRPC's per-call state; a quarter of the message.
+  constexpr std::int64_t kAllowedGrowthBytes = kMessageBytes / 4;
+  const std::string pki = (dir_ / "pki").string();
+  ASSERT_EQ(RunServerCommand({"init-tls", pki, "--host", "127.0.0.1"}), 0);
+  const std::string log = (dir_ / "server.log").string();
+  auto server = StartServer({"--listen", "127.0.0.1:0", "--tls-dir", pki, "--db", db_}, {.open_files_soft = 0, .open_files_hard = 0, .stderr_path = log});
+  ASSERT_GT(server->port, 0) << ReadText(log);
+  grpc::SslCredentialsOptions tls;
+  tls.pem_root_certs = ReadText(pki + "/ca.pem");
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxSendMessageSize(-1);
+  auto channel = grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(server->port),
+                                           grpc::SslCredentials(tls), arguments);
+  auto stub = v1::JobService::NewStub(channel);
+  {
+    // A first small call: the connection and its TLS session are set up
+    // before the baseline is taken.
+    grpc::ClientContext context;
+    v1::ListJobsResponse response;
+    EXPECT_EQ(stub->List(&context, v1::ListJobsRequest(), &response).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+  }
+  const std::int64_t before = ProcessMemoryBytes(server->pid, "VmRSS");
+  ASSERT_GT(before, 0);
+  v1::SubmitJobRequest request;
+  *request.mutable_study() = OscillatorStudy();
+  request.set_source_name(std::string(static_cast<std::size_t>(kMessageBytes), 'x'));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  v1::SubmitJobResponse response;
+  const grpc::Status status = stub->Submit(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("needs a token"));
+  const std::int64_t peak = ProcessMemoryBytes(server->pid, "VmHWM");
+  // The figures docs/reliability.md quotes.
+  std::printf("server resident before: %.1f MB, peak after a %lld MB call without a token: %.1f MB\n",
+              before / 1048576.0, static_cast<long long>(kMessageBytes >> 20), peak / 1048576.0);
+  EXPECT_LT(peak - before, kAllowedGrowthBytes)
+      << "resident before " << before / 1048576 << " MB, peak after " << peak / 1048576 << " MB";
+  EXPECT_THAT(ReadText(log), HasSubstr("audit: refused /mbopt.v1.JobService/Submit before reading its message"));
 }
 
 TEST_F(ServerProcessTest, KilledMidJobResumesOnRestartWithBitIdenticalRecords) {

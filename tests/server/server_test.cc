@@ -26,6 +26,7 @@
 #include "absl/strings/str_cat.h"
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
+#include "server/scheduler/scheduler.h"
 #include "server/service/listen_address.h"
 #include "server/store/store.h"
 #include "tests/server/fake_worker.h"
@@ -851,6 +852,68 @@ std::vector<v1::AnalysisTask> AcquireOneByOne(FakeWorker& worker) {
     std::vector<v1::AnalysisTask> one = worker.Acquire(1);
     if (one.empty()) return all;
     all.insert(all.end(), one.begin(), one.end());
+  }
+}
+
+// A holder of the (shared) worker token registers a worker of its own and
+// answers the tasks leased to an honest worker with values of its choosing,
+// under its own id or under the honest worker's public id. Every such result
+// is refused and logged; the job ends as a clean run does, bit for bit, and
+// its log names only the honest worker.
+TEST_F(ServerTest, AResultFromAWorkerThatHoldsNoLeaseOfItsTaskIsRefusedAndLogged) {
+  const v1::GetJobResponse clean = RunToEnd("clean.db", 1);
+  auto server = StartServer("a.db");
+  const std::string id = Submit(*server, OscillatorStudy());
+  FakeWorker honest(server->InProcessChannel(), 1, "honest");
+  FakeWorker thief(server->InProcessChannel(), 2, "thief");
+  EXPECT_NE(honest.worker_id(), scheduler::PublicWorkerId(honest.worker_id())) << "ids have a secret part";
+  std::vector<v1::AnalysisTask> leased = honest.Acquire(64);
+  ASSERT_FALSE(leased.empty());
+
+  ::testing::internal::CaptureStderr();
+  int refused = 0;
+  for (const std::string& claimed : {thief.worker_id(), scheduler::PublicWorkerId(honest.worker_id())}) {
+    for (const v1::AnalysisTask& task : leased) {
+      v1::TaskResult forged = thief.ResultOf(task);
+      forged.set_worker_id(claimed);
+      for (double& value : *forged.mutable_objective_terms()) value = 1.0;
+      grpc::ClientContext context;
+      v1::ReportResultResponse response;
+      const grpc::Status status = thief.stub().ReportResult(&context, forged, &response);
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << claimed;
+      EXPECT_THAT(status.error_message(), HasSubstr("was never leased to worker"));
+      refused += status.error_code() == grpc::StatusCode::PERMISSION_DENIED;
+    }
+  }
+  // In a batch, as workers usually report: each result refused in its answer.
+  v1::ReportResultsResponse batch;
+  ASSERT_TRUE(thief.AnswerTogether(leased, &batch).ok());
+  ASSERT_EQ(batch.answers_size(), static_cast<int>(leased.size()));
+  for (const v1::ResultAnswer& answer : batch.answers()) {
+    EXPECT_FALSE(answer.accepted());
+    EXPECT_THAT(answer.error(), HasSubstr("was never leased to worker"));
+  }
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(refused, 2 * static_cast<int>(leased.size()));
+  EXPECT_THAT(log, HasSubstr("audit: refused ReportResult from peer"));
+  EXPECT_THAT(log, HasSubstr("audit: refused ReportResults from peer"));
+  EXPECT_THAT(log, ::testing::Not(HasSubstr(honest.worker_id()))) << "the secret part of an id is never logged";
+
+  // The honest worker's answers are taken, and the job ends as the clean run.
+  for (const v1::AnalysisTask& task : leased) {
+    bool accepted = false;
+    ASSERT_TRUE(honest.Answer(task, &accepted).ok());
+    EXPECT_TRUE(accepted);
+  }
+  honest.Run();
+  const v1::GetJobResponse job = Get(*server, id);
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
+  ExpectSameCycles(job, clean);
+  absl::StatusOr<std::vector<jobs::AnalysisRecord>> analyses = server->store().LoadAnalyses(id);
+  ASSERT_TRUE(analyses.ok()) << analyses.status();
+  ASSERT_FALSE(analyses->empty());
+  for (const jobs::AnalysisRecord& a : *analyses) {
+    EXPECT_EQ(a.worker, scheduler::PublicWorkerId(honest.worker_id())) << "request " << a.request_id;
   }
 }
 

@@ -54,6 +54,9 @@ struct JobManager::Entry {
 
 namespace {
 
+// "; by <actor>" for an event's detail, or "" when nobody is named.
+std::string ByActor(const std::string& actor) { return actor.empty() ? "" : absl::StrCat("; by ", actor); }
+
 void LogError(const std::string& job_id, const absl::Status& status) {
   std::cerr << "mbopt-server: job " << job_id << ": " << status << std::endl;
 }
@@ -136,7 +139,7 @@ bool JobManager::PublishSyncedLocked(Entry& entry, std::int64_t synced) {
 absl::StatusOr<std::shared_ptr<JobManager::Entry>> JobManager::Find(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = jobs_.find(job_id);
-  if (it == jobs_.end()) return absl::NotFoundError(absl::StrCat("no job with id '", job_id, "'"));
+  if (it == jobs_.end()) return NoSuchJob(job_id);
   return it->second;
 }
 
@@ -293,8 +296,12 @@ absl::Status JobManager::Start() {
   return absl::OkStatus();
 }
 
+absl::Status JobManager::NoSuchJob(const std::string& job_id) {
+  return absl::NotFoundError(absl::StrCat("no job with id '", job_id, "'"));
+}
+
 absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, const std::string& source_name,
-                                               const std::string& owner) {
+                                               const std::string& owner, const std::string& actor) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
@@ -307,7 +314,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   row.owner = owner;
   row.study = study_bytes;
   row.state = jobs::JobStateName(JobState::kRunning);
-  MBOPT_ASSIGN_OR_RETURN(store::JobRow stored, store_->CreateJob(row, store::NewEvent{"submitted", source_name}));
+  MBOPT_ASSIGN_OR_RETURN(store::JobRow stored, store_->CreateJob(row, store::NewEvent{"submitted", source_name + ByActor(actor)}));
   auto entry = std::make_shared<Entry>();
   std::lock_guard<std::mutex> entry_lock(entry->mutex);
   entry->row = std::move(stored);
@@ -632,7 +639,9 @@ absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked
   }
   if (entry.job == nullptr || entry.state != JobState::kRunning) return std::nullopt;
   if (!entry.job->IsPending(request_id)) return std::nullopt;  // answered already (another attempt won)
-  report.record.worker = report.worker_id;
+  // Only the public part: the job log must not hold what proves a
+  // worker's registration.
+  report.record.worker = scheduler::PublicWorkerId(report.worker_id);
   absl::StatusOr<jobs::AnalysisRecord> record = entry.job->Intake(std::move(report.record));
   if (!record.ok()) {
     // A result that does not fit its task counts as a failed attempt; the
@@ -644,6 +653,8 @@ absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked
     return absl::InvalidArgumentError(reason);
   }
   absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(report.worker_id, report.task_id);
+  // Another worker's task: refused, and the caller is told (and logs it).
+  if (absl::IsPermissionDenied(finished.status())) return finished.status();
   if (!finished.ok()) return std::nullopt;
   record->attempts = finished->attempts;
   record->latency_seconds = finished->latency_seconds;
@@ -799,7 +810,7 @@ absl::StatusOr<std::string> JobManager::OwnerOf(const std::string& job_id) {
   return entry->row.owner;
 }
 
-absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id) {
+absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id, const std::string& actor) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
   if (!Running(entry->state) && entry->state != JobState::kInterrupted) {
@@ -807,11 +818,11 @@ absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id) {
                                                       jobs::JobStateName(entry->state), ")"));
   }
   MBOPT_RETURN_IF_ERROR(EnterStateLocked(*entry, JobState::kCancelled, "cancelled on request; `resume` continues it",
-                                         "cancelled", ""));
+                                         "cancelled", actor.empty() ? "" : absl::StrCat("by ", actor)));
   return SummaryLocked(*entry);
 }
 
-absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id) {
+absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id, const std::string& actor) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
@@ -824,7 +835,7 @@ absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id) {
                                                       jobs::JobStateName(entry->state), ") and cannot be resumed"));
   }
   MBOPT_RETURN_IF_ERROR(RestoreLocked(*entry));
-  MBOPT_RETURN_IF_ERROR(ResumeLocked(*entry, "resumed on request"));
+  MBOPT_RETURN_IF_ERROR(ResumeLocked(*entry, "resumed on request" + ByActor(actor)));
   return SummaryLocked(*entry);
 }
 

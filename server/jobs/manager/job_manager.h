@@ -139,8 +139,14 @@ class JobManager {
 
   // Validates and starts a study. InvalidArgument from the decoder. `owner`
   // is the name of who submitted it ("" on a server without tokens).
+  // `actor` (here and for Cancel and Resume) says who asked, for the job's
+  // event log ("user alice (peer ipv4:...)"); "": nobody is named.
   absl::StatusOr<std::string> Submit(const std::string& study_bytes, const std::string& source_name,
-                                     const std::string& owner = "");
+                                     const std::string& owner = "", const std::string& actor = "");
+  // The answer for an unknown job: NotFound naming the id. The service
+  // gives the same for another user's job, so that ids do not tell which
+  // jobs exist.
+  static absl::Status NoSuchJob(const std::string& job_id);
   // Who submitted the job. NotFound naming the id for an unknown job.
   absl::StatusOr<std::string> OwnerOf(const std::string& job_id);
 
@@ -149,10 +155,10 @@ class JobManager {
                               JobViewFor view_for = JobViewFor::kReader);
   absl::StatusOr<std::vector<JobSummaryData>> List();
   // FailedPrecondition when the job has already ended.
-  absl::StatusOr<JobSummaryData> Cancel(const std::string& job_id);
+  absl::StatusOr<JobSummaryData> Cancel(const std::string& job_id, const std::string& actor = "");
   // Continues an interrupted or cancelled job (replaying its log); a running
   // job is returned as is. FailedPrecondition for a job that has ended.
-  absl::StatusOr<JobSummaryData> Resume(const std::string& job_id);
+  absl::StatusOr<JobSummaryData> Resume(const std::string& job_id, const std::string& actor = "");
 
   // Waits (real time, at most `max_wait_ms`) until the job's version differs
   // from `version_seen`, then returns its records from `first_record` on
@@ -167,7 +173,9 @@ class JobManager {
   // not fit (wrong size, non-finite) or that the task did not ask for are
   // not an error: the values are taken without them (the reason is logged
   // with the analysis) and the optimizer uses finite differences for that
-  // cycle. NotFound for an unknown job. Unavailable after Shutdown.
+  // cycle. NotFound for an unknown job. PermissionDenied for a task never
+  // leased to the reporting worker (Scheduler::Complete): nothing is taken.
+  // Unavailable after Shutdown.
   absl::StatusOr<bool> ReportResult(WorkerReport report);
   // Several results (a worker's batch), one answer each, in order, as
   // ReportResult would give it. The results of one job are applied to its
