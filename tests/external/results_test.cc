@@ -24,6 +24,7 @@ TEST(JsonResults, ReadsValuesSeriesAndTime) {
 }
 
 TEST(JsonResults, SyntaxErrorNamesFileLineAndColumn) {
+  // Column 21 of line 2 is the '}' where a key was expected.
   const auto results = ParseJsonResults("{\n  \"values\": {\"a\": 1,}\n}\n", "results.json");
   ASSERT_FALSE(results.ok());
   EXPECT_EQ(results.status().code(), absl::StatusCode::kInvalidArgument);
@@ -40,6 +41,14 @@ TEST(JsonResults, UnknownKeyIsRefused) {
   const auto results = ParseJsonResults(R"({"value": {"a": 1}})", "r.json");
   ASSERT_FALSE(results.ok());
   EXPECT_TRUE(Mentions(results.status(), "unknown key \"value\"")) << results.status();
+}
+
+TEST(JsonResults, AKeyGivenTwiceIsRefused) {
+  const auto results = ParseJsonResults(R"({"values": {"a": 1, "b": 2, "a": 3}})", "r.json");
+  ASSERT_FALSE(results.ok());
+  EXPECT_TRUE(Mentions(results.status(), "r.json: key \"a\" is given twice in one object")) << results.status();
+  // The same name in two objects is no duplicate.
+  EXPECT_TRUE(ParseJsonResults(R"({"values": {"a": 1}, "series": {"a": [1]}})", "r.json").ok());
 }
 
 TEST(JsonResults, SeriesMustMatchTime) {

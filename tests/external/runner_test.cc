@@ -104,6 +104,30 @@ TEST(ExternalRunner, ExitCodeThreeIsAFailedAnalysisWithTheTailOfStderr) {
   EXPECT_FALSE(std::filesystem::exists(outcome->run_folder));
 }
 
+TEST(ExternalRunner, AProgramAmongTheFilesRunsFromTheAnalysisFolder) {
+  TempDir base, work;
+  DriverDeclaration driver = ShDriver(base, R"(#!/bin/sh
+. ./input.sh
+printf '{"values": {"b": %s}}' "$b" > results.json
+)");
+  driver.command = {"./run.sh"};
+  const auto outcome = RunExternalAnalysis(driver, kValues, Options(work, "p1"));
+  ASSERT_TRUE(outcome.ok()) << outcome.status();
+  ASSERT_TRUE(outcome->failure.ok()) << outcome->failure.reason;
+  EXPECT_EQ(outcome->results.values.at("b"), -3.0);
+}
+
+TEST(ExternalRunner, ADriverKilledByASignalIsAFailedAnalysis) {
+  TempDir base, work;
+  const DriverDeclaration driver = ShDriver(base, "echo 'about to crash' >&2; kill -SEGV $$\n");
+  const auto outcome = RunExternalAnalysis(driver, kValues, Options(work, "g1"));
+  ASSERT_TRUE(outcome.ok()) << outcome.status();
+  EXPECT_EQ(outcome->failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_EQ(outcome->term_signal, SIGSEGV);
+  EXPECT_TRUE(Mentions(outcome->failure.reason, "was killed by signal 11")) << outcome->failure.reason;
+  EXPECT_TRUE(Mentions(outcome->failure.reason, "about to crash")) << outcome->failure.reason;
+}
+
 TEST(ExternalRunner, DeclaredSuccessCodesAreSuccess) {
   TempDir base, work;
   DriverDeclaration driver = ShDriver(base, "echo '{}' > results.json; exit 3\n");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <set>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
@@ -74,9 +75,24 @@ std::string ExternalResults::FirstNonFinite() const {
 
 absl::StatusOr<ExternalResults> ParseJsonResults(const std::string& text, const std::string& source) {
   json document;
+  // A key given twice in one object would silently keep the last value:
+  // found while parsing, reported once the syntax is known to be right.
+  std::vector<std::set<std::string>> keys_of_open_objects;
+  std::string duplicate;
+  const json::parser_callback_t find_duplicates = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) {
+      keys_of_open_objects.emplace_back();
+    } else if (event == json::parse_event_t::object_end) {
+      keys_of_open_objects.pop_back();
+    } else if (event == json::parse_event_t::key && !keys_of_open_objects.empty() &&
+               !keys_of_open_objects.back().insert(parsed.get<std::string>()).second && duplicate.empty()) {
+      duplicate = parsed.get<std::string>();
+    }
+    return true;
+  };
   // nlohmann reports syntax errors only as exceptions; they end here.
   try {
-    document = json::parse(text);
+    document = json::parse(text, find_duplicates);
   } catch (const json::parse_error& error) {
     // error.byte is the 1-based offset of the character that failed.
     const std::size_t offset = error.byte > 0 ? error.byte - 1 : 0;
@@ -87,6 +103,10 @@ absl::StatusOr<ExternalResults> ParseJsonResults(const std::string& text, const 
     if (colon != std::string::npos) what = what.substr(colon + 2);
     return absl::InvalidArgumentError(
         absl::StrCat(source, ":", LineColumn(text, offset), ": not valid JSON: ", what));
+  }
+  if (!duplicate.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(source, ": key \"", duplicate, "\" is given twice in one object"));
   }
   if (!document.is_object()) {
     return absl::InvalidArgumentError(

@@ -1,8 +1,8 @@
 // A driver's results: named values and named time series, read from the
 // results file it wrote, in one of two formats (docs/external.md):
 //  - JSON: {"values": {"name": number, ...}, "series": {"name": [numbers], ...},
-//    "time": [numbers]}; every key optional, no other key allowed; when "time"
-//    is given every series has its length.
+//    "time": [numbers]}; every key optional, no other key allowed, none
+//    twice in one object; when "time" is given every series has its length.
 //  - Dakota: one "value name" per line (blank lines skipped), as the results
 //    files of Dakota's fork interface without gradients.
 // Errors are InvalidArgument naming the file and the line (and the column or
