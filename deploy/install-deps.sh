@@ -18,6 +18,7 @@ packages=(
   libbenchmark-dev
   libnlopt-cxx-dev
   libsimbody-dev
+  nlohmann-json3-dev
   chromium zlib1g-dev
   clang libclang-rt-14-dev
   slurmctld slurmd slurm-client munge
