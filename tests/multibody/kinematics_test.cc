@@ -3,6 +3,7 @@
 #include "worker/multibody/kinematic_analysis.h"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <gmock/gmock.h>
@@ -103,6 +104,44 @@ TEST(MultibodyKinematics, FastCrankStaysOnItsBranchBetweenCoarseInstants) {
       EXPECT_GT(counters.position_solves, 2 * points);
     }
   }
+}
+
+// A slider-crank with the rod as long as the crank reaches a locking
+// position at th = pi/2 (rod folded onto the crank, the slider at the
+// pivot), where its two branches meet. With no instant there, the analysis
+// does not carry on along either branch as if nothing happened: it names
+// the interval and the lock.
+TEST(MultibodyKinematics, BranchPointBetweenInstantsIsANamedAssemblyFailure) {
+  constexpr double r = 0.5, w = 1.0;
+  const Model model = testing::SliderCrank(r, r, w);
+  const Mechanism m(model);
+  const Assembly assembled = Assemble(m, 0.0);
+  ASSERT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  std::vector<double> times;
+  for (int i = 0; i <= 8; ++i) times.push_back(0.25 * i);
+  KinematicCounters counters;
+  double last_t = -1.0;
+  const spec::AnalysisFailure f = RunKinematics(
+      m, assembled.q, times, KinematicOptions{}, [&](const MotionSample& s) {
+        last_t = s.t_s;
+        return spec::AnalysisFailure::Ok();
+      },
+      &counters);
+  ASSERT_FALSE(f.ok());
+  EXPECT_EQ(f.kind, spec::FailureKind::kAssembly);
+  EXPECT_EQ(last_t, 1.5);  // the last instant before th = pi/2
+  EXPECT_THAT(f.reason, HasSubstr("changes assembly branch between t = "));
+  EXPECT_THAT(f.reason, HasSubstr("locking position"));
+  // The interval named brackets th = pi/2 within the finest subdivision,
+  // 1/1024 of the 0.25 s between instants.
+  double from_s = 0.0, to_s = 0.0;
+  ASSERT_EQ(std::sscanf(f.reason.c_str(), "the mechanism changes assembly branch between t = %lf s and %lf s", &from_s,
+                        &to_s),
+            2)
+      << f.reason;
+  EXPECT_LT(from_s, std::numbers::pi / 2 / w);
+  EXPECT_GE(to_s, std::numbers::pi / 2 / w);
+  EXPECT_LE(to_s - from_s, 0.25 / 1024 * (1 + 1e-9));
 }
 
 // A uniform bar driven at constant speed about its end in a vertical plane:
