@@ -226,6 +226,22 @@ TEST(TabulatedDriver, ATableThatEndsAtTheGridsEndIsFollowedToTheEnd) {
   }
 }
 
+// A force factor whose table ends before the last instant (a model built in
+// code; the scene loader refuses it): the integration stops at the table's
+// end and says so, instead of cutting its step there until it gives up.
+TEST(TabulatedDriver, ATableThatEndsBeforeTheLastInstantIsNamed) {
+  Model model = SpringMass(false, 0.0);
+  Profile factor;
+  factor.kind = Profile::Kind::kTabulated;
+  factor.table = CubicSpline({0.0, 0.25, 0.5}, {0.0, 1.0, 0.5});
+  model.point_forces.push_back(PointForce{At(0, 0.0), Eigen::Vector2d(3.0, 0.0), factor});
+  spec::AnalysisFailure f;
+  Motion(model, &f);
+  ASSERT_FALSE(f.ok());
+  EXPECT_EQ(f.kind, spec::FailureKind::kModelValidity) << f.reason;
+  EXPECT_THAT(f.reason, HasSubstr("a tabulated profile ends at t = 0.5 s, before the instant t = 0.51 s"));
+}
+
 // A mass on a frictionless slide pushed by F0 sin(w t) from rest:
 // x = x0 + F0 / (m w) (t - sin(w t) / w).
 TEST(TimeVaryingForce, HarmonicForceMovesTheMassAsTheClosedForm) {

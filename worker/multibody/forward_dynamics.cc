@@ -415,6 +415,13 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
         const VectorXd q = y.head(n), v = y.segment(n, n);
         return Failed(spec::FailureKind::kModelValidity, system.BoundReason(k < num_bounds ? k : 0, t_reached, q, v));
       }
+      if (t_reached < t) {
+        // Stopped at the end of a table that does not reach the instant (a
+        // scene loader refuses such a table; a model built in code may not).
+        return Failed(spec::FailureKind::kModelValidity,
+                      absl::StrFormat("a tabulated profile ends at t = %.6g s, before the instant t = %.6g s",
+                                      t_reached, t));
+      }
     }
     MotionSample sample;
     sample.t_s = t;
