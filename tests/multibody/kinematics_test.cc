@@ -3,6 +3,7 @@
 #include "worker/multibody/kinematic_analysis.h"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <gmock/gmock.h>
@@ -58,6 +59,89 @@ TEST(MultibodyKinematics, SliderCrankFollowsTheClosedForm) {
   // A kinematic analysis needs no mass matrix and no forces.
   EXPECT_EQ(m.counters().mass_matrix_evaluations, 0);
   EXPECT_EQ(m.counters().force_evaluations, 0);
+}
+
+// A crank at 1e4 rad/s turns 100 rad (101 instants over 1 s) or 10 rad (1001
+// instants) between reporting instants: the analysis follows the branch it
+// assembled on through the motion in between (subdividing the interval), so
+// the slider is where a continuous motion puts it at every instant, to the
+// positions' closure (1e-11 m) with round-off to spare: 1e-9 m. The other
+// branch, x = r cos(th) - sqrt(l^2 - r^2 sin^2(th)), is 0.6 m or more away.
+TEST(MultibodyKinematics, FastCrankStaysOnItsBranchBetweenCoarseInstants) {
+  constexpr double w = 1e4;
+  struct Geometry {
+    double r, l;
+  };
+  for (const Geometry g : {Geometry{0.3, 1.0}, Geometry{0.1, 0.3}}) {
+    const Model model = testing::SliderCrank(g.r, g.l, w);
+    const Mechanism m(model);
+    const Assembly assembled = Assemble(m, 0.0);
+    ASSERT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+    for (const int points : {101, 1001}) {
+      std::vector<double> times;
+      for (int i = 0; i < points; ++i) times.push_back(static_cast<double>(i) / (points - 1));
+      int checked = 0, off = 0;
+      double worst_error_m = 0.0, worst_t_s = 0.0;
+      KinematicCounters counters;
+      const Point slider = At(2, 0.0);
+      const spec::AnalysisFailure f = RunKinematics(
+          m, assembled.q, times, KinematicOptions{}, [&](const MotionSample& s) {
+            const double th = w * s.t_s, sn = std::sin(th), cs = std::cos(th);
+            const double x = g.r * cs + std::sqrt(g.l * g.l - g.r * g.r * sn * sn);
+            const double error = std::abs(m.PointPosition(slider, s.q).x() - x);
+            if (error > kKinematicAgreement) ++off;
+            if (error > worst_error_m) worst_error_m = error, worst_t_s = s.t_s;
+            ++checked;
+            return spec::AnalysisFailure::Ok();
+          },
+          &counters);
+      ASSERT_TRUE(f.ok()) << f.reason;
+      EXPECT_LE(worst_error_m, kKinematicAgreement)
+          << "r = " << g.r << ", " << points << " points: " << off << " instants off, the worst at t = " << worst_t_s;
+      // The reporting grid stays as asked; the motion in between is solved
+      // at instants of its own.
+      EXPECT_EQ(checked, points);
+      EXPECT_GT(counters.position_solves, 2 * points);
+    }
+  }
+}
+
+// A slider-crank with the rod as long as the crank reaches a locking
+// position at th = pi/2 (rod folded onto the crank, the slider at the
+// pivot), where its two branches meet. With no instant there, the analysis
+// does not carry on along either branch as if nothing happened: it names
+// the interval and the lock.
+TEST(MultibodyKinematics, BranchPointBetweenInstantsIsANamedAssemblyFailure) {
+  constexpr double r = 0.5, w = 1.0;
+  const Model model = testing::SliderCrank(r, r, w);
+  const Mechanism m(model);
+  const Assembly assembled = Assemble(m, 0.0);
+  ASSERT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  std::vector<double> times;
+  for (int i = 0; i <= 8; ++i) times.push_back(0.25 * i);
+  KinematicCounters counters;
+  double last_t = -1.0;
+  const spec::AnalysisFailure f = RunKinematics(
+      m, assembled.q, times, KinematicOptions{}, [&](const MotionSample& s) {
+        last_t = s.t_s;
+        return spec::AnalysisFailure::Ok();
+      },
+      &counters);
+  ASSERT_FALSE(f.ok());
+  EXPECT_EQ(f.kind, spec::FailureKind::kAssembly);
+  EXPECT_EQ(last_t, 1.5);  // the last instant before th = pi/2
+  EXPECT_THAT(f.reason, HasSubstr("changes assembly branch between t = "));
+  EXPECT_THAT(f.reason, HasSubstr("locking position"));
+  // The interval named brackets th = pi/2 within the finest subdivision,
+  // 1/1024 of the 0.25 s between instants.
+  double from_s = 0.0, to_s = 0.0;
+  ASSERT_EQ(std::sscanf(f.reason.c_str(), "the mechanism changes assembly branch between t = %lf s and %lf s", &from_s,
+                        &to_s),
+            2)
+      << f.reason;
+  EXPECT_LT(from_s, std::numbers::pi / 2 / w);
+  EXPECT_GE(to_s, std::numbers::pi / 2 / w);
+  EXPECT_LE(to_s - from_s, 0.25 / 1024 * (1 + 1e-9));
 }
 
 // A uniform bar driven at constant speed about its end in a vertical plane:

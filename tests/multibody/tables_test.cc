@@ -1,16 +1,20 @@
 // Tabulated drivers (natural cubic splines) and force curves (linear tables
 // that are never extrapolated).
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "spec/io/study_io.h"
 #include "tests/multibody/mechanisms.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/multibody/scene_analysis.h"
 
 namespace mbopt::multibody {
 namespace {
@@ -145,6 +149,97 @@ TEST(ForceCurve, LeavingTheTableIsAFailedAnalysisNamingTheSpring) {
   ASSERT_FALSE(f.ok());
   EXPECT_EQ(f.kind, spec::FailureKind::kModelValidity);
   EXPECT_THAT(f.reason, HasSubstr("spring 'spring' left the range of its force table"));
+}
+
+// The time a failure's reason names ("... at t = 0.0321 s ..."); NaN if none.
+double NamedTime(const std::string& reason) {
+  const size_t at = reason.find("at t = ");
+  double t = NAN;
+  if (at == std::string::npos || std::sscanf(reason.c_str() + at, "at t = %lf", &t) != 1) return NAN;
+  return t;
+}
+
+// The same swing, x - 1 = 0.05 cos(20 t) + 0.1 sin(20 t) = 0.1118 sin(20 t +
+// 0.4636), reaches the table's end, 0.1 m, at t = (asin(0.1 / 0.1118) -
+// 0.4636) / 20 = 0.032175 s. The analysis ends there at once: the reason
+// names that time, and the integrator took the steps the swing needs up to
+// it, not its whole step budget at the table's edge.
+TEST(ForceCurve, LeavingTheTableEndsTheAnalysisAtOnceNamingTheTime) {
+  const Model model = SpringMass(true, 0.1, 1.05, 2.0);
+  const Mechanism m(model);
+  const Assembly assembled = Assemble(m, 0.0);
+  ASSERT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  std::vector<double> t;
+  for (int k = 0; k <= 100; ++k) t.push_back(0.01 * k);
+  ForwardDynamicsOptions options;
+  options.relative_tolerance = 1e-10;
+  options.absolute_tolerance = 1e-12;
+  ForwardDynamicsCounters counters;
+  int instants = 0;
+  const spec::AnalysisFailure f = IntegrateForward(m, 0.0, assembled.q, assembled.v, t, options,
+                                                   [&](const MotionSample&) {
+                                                     ++instants;
+                                                     return spec::AnalysisFailure::Ok();
+                                                   },
+                                                   &counters);
+  ASSERT_FALSE(f.ok());
+  EXPECT_EQ(f.kind, spec::FailureKind::kModelValidity);
+  EXPECT_THAT(f.reason, HasSubstr("spring 'spring' left the range of its force table"));
+  const double w = 20.0, amplitude = std::hypot(0.05, 0.1), phase = std::atan2(0.05, 0.1);
+  const double t_leave = (std::asin(0.1 / amplitude) - phase) / w;
+  // The reason prints 6 significant digits.
+  EXPECT_NEAR(NamedTime(f.reason), t_leave, 1e-6) << f.reason;
+  EXPECT_EQ(instants, 4);  // 0, 0.01, 0.02 and 0.03 s lie before it
+  // A third of a period at rtol 1e-10 takes a few hundred steps; stepping at
+  // the edge until the integrator gave up took its budget (1e5).
+  EXPECT_LT(counters.steps, 1000);
+  EXPECT_LT(counters.residual_evaluations, 5000);
+}
+
+// The isolator (examples/isolator) with its shaker's motion tabulated up to
+// the time grid's end, as docs/scene.md allows: the analysis reaches the last
+// instant and moves the arm as the harmonic profile the table samples does.
+TEST(TabulatedDriver, ATableThatEndsAtTheGridsEndIsFollowedToTheEnd) {
+  absl::StatusOr<spec::Scene> tabulated = spec::io::LoadSceneFile("tests/multibody/isolator_tabulated.scene.textproto");
+  ASSERT_TRUE(tabulated.ok()) << tabulated.status();
+  absl::StatusOr<spec::Scene> harmonic = spec::io::LoadSceneFile("examples/isolator/isolator.scene.textproto");
+  ASSERT_TRUE(harmonic.ok()) << harmonic.status();
+  harmonic->time_grid = tabulated->time_grid;
+  ASSERT_EQ(std::get<spec::MultibodyModel>(tabulated->model).drivers[0].times_s.back(), tabulated->time_grid.end_s);
+  const std::vector<double> design = {2000.0, 20.0};
+  const spec::AnalysisReport from_table = AnalyzeMultibodyScene(*tabulated, design);
+  ASSERT_TRUE(from_table.ok()) << from_table.failure.reason;
+  const spec::AnalysisReport from_sine = AnalyzeMultibodyScene(*harmonic, design);
+  ASSERT_TRUE(from_sine.ok()) << from_sine.failure.reason;
+  ASSERT_EQ(from_table.times_s.size(), 101u);
+  EXPECT_EQ(from_table.times_s.back(), 0.5);
+  const std::vector<double>& angle_table = from_table.outputs[0].series[0];
+  const std::vector<double>& angle_sine = from_sine.outputs[0].series[0];
+  ASSERT_EQ(angle_table.size(), angle_sine.size());
+  double swing = 0.0;
+  for (double a : angle_sine) swing = std::max(swing, std::abs(a - angle_sine[0]));
+  ASSERT_GT(swing, 1e-4);
+  // The spline through 32 points per period gets the shaker's acceleration
+  // right to 0.2 %; the arm's angle follows to 1 % of its swing.
+  for (size_t k = 0; k < angle_table.size(); ++k) {
+    EXPECT_NEAR(angle_table[k], angle_sine[k], 0.01 * swing) << "t = " << from_table.times_s[k];
+  }
+}
+
+// A force factor whose table ends before the last instant (a model built in
+// code; the scene loader refuses it): the integration stops at the table's
+// end and says so, instead of cutting its step there until it gives up.
+TEST(TabulatedDriver, ATableThatEndsBeforeTheLastInstantIsNamed) {
+  Model model = SpringMass(false, 0.0);
+  Profile factor;
+  factor.kind = Profile::Kind::kTabulated;
+  factor.table = CubicSpline({0.0, 0.25, 0.5}, {0.0, 1.0, 0.5});
+  model.point_forces.push_back(PointForce{At(0, 0.0), Eigen::Vector2d(3.0, 0.0), factor});
+  spec::AnalysisFailure f;
+  Motion(model, &f);
+  ASSERT_FALSE(f.ok());
+  EXPECT_EQ(f.kind, spec::FailureKind::kModelValidity) << f.reason;
+  EXPECT_THAT(f.reason, HasSubstr("a tabulated profile ends at t = 0.5 s, before the instant t = 0.51 s"));
 }
 
 // A mass on a frictionless slide pushed by F0 sin(w t) from rest:

@@ -21,6 +21,7 @@
 // current values from it.
 #pragma once
 
+#include <limits>
 #include <string>
 
 #include <Eigen/Dense>
@@ -58,6 +59,40 @@ class ConstrainedSystem {
   // which element and where. Empty otherwise.
   virtual std::string FailureReason() const { return ""; }
   virtual double* parameters() { return nullptr; }
+
+  // The bounds of the model's validity as functions of the state,
+  // g_k(t, q, v) > 0 while it holds (a force curve's argument inside its
+  // table): the integrator locates where one crosses zero as an event and
+  // ends the analysis there, naming the time (BoundReason). While
+  // `ContinuePastBounds(true)` is in force the system's equations stay
+  // finite a little past a bound (a table continued with its end segment's
+  // slope), so that the integrator's trial steps can cross it; outside such
+  // a scope, past a bound is a failed evaluation as before.
+  virtual int num_validity_bounds() const { return 0; }
+  virtual void ValidityBounds(double /*t*/, const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*v*/,
+                              double* /*g*/) const {}
+  virtual std::string BoundReason(int /*bound*/, double /*t*/, const Eigen::VectorXd& /*q*/,
+                                  const Eigen::VectorXd& /*v*/) const {
+    return "";
+  }
+  virtual void ContinuePastBounds(bool /*on*/) const {}
+
+  // The latest time the equations are defined at (the end of a tabulated
+  // profile's table); +infinity when they hold for all time. The integrator
+  // does not step past it.
+  virtual double DefinedUntil_s() const { return std::numeric_limits<double>::infinity(); }
+};
+
+// Continues a system's equations past its validity bounds for one scope.
+class ContinuedPastBounds {
+ public:
+  explicit ContinuedPastBounds(const ConstrainedSystem& s) : s_(s) { s_.ContinuePastBounds(true); }
+  ~ContinuedPastBounds() { s_.ContinuePastBounds(false); }
+  ContinuedPastBounds(const ContinuedPastBounds&) = delete;
+  ContinuedPastBounds& operator=(const ContinuedPastBounds&) = delete;
+
+ private:
+  const ConstrainedSystem& s_;
 };
 
 // The largest magnitude of a residual; 0 for a system without constraints

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "worker/solve/sundials_handles.h"
@@ -38,6 +39,10 @@ template <class Y, class YDot, class R>
 int EvaluateResidual(const ConstrainedSystem& s, Problem* p, double t, const Y& y, const YDot& y_dot, R& r) {
   const int n = p->n, m = p->m;
   const VectorXd q = y.head(n), v = y.segment(n, n);
+  // Trial states past a validity bound stay finite; the bound's root
+  // function (ValidityBounds below) ends the integration where the motion
+  // crosses it.
+  const ContinuedPastBounds continued(s);
   int flag = s.MassMatrix(q, &p->mass);
   if (flag == 0) flag = s.AppliedForces(t, q, v, &p->forces);
   if (flag == 0 && m > 0) flag = s.ConstraintJacobian(t, q, &p->phi_q);
@@ -68,6 +73,16 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
     Map<VectorXd> r(N_VGetArrayPointer(rr), size);
     return EvaluateResidual(*p->system, p, t, y, y_dot, r);
+  });
+}
+
+// The system's validity bounds as IDAS root functions.
+int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* user_data) {
+  auto* p = static_cast<Problem*>(user_data);
+  return solve::sundials::GuardCallback(&p->callback_failure, "the validity bounds", [&]() -> int {
+    const Map<const VectorXd> y(N_VGetArrayPointer(yy), 2 * p->n + 2 * p->m);
+    p->system->ValidityBounds(t, y.head(p->n), y.segment(p->n, p->n), g);
+    return 0;
   });
 }
 
@@ -291,6 +306,35 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
             (options.max_step_size <= 0.0 || check(IDASetMaxStep(ida, options.max_step_size), "IDASetMaxStep"));
   if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
 
+  // A table that ends at the last instant (a tabulated driver up to the time
+  // grid's end): IDAS would step past it and interpolate back, and the
+  // equations are not defined there.
+  const double defined_until = system.DefinedUntil_s();
+  if (std::isfinite(defined_until) && !times.empty() &&
+      !check(IDASetStopTime(ida, std::min(defined_until, times.back())), "IDASetStopTime")) {
+    return Failed(spec::FailureKind::kIntegrator, sundials_message);
+  }
+
+  // Validity bounds: a start outside is a failure at t0; a crossing later
+  // is an event that ends the integration there (only crossings downwards,
+  // from valid to invalid, count).
+  const int num_bounds = system.num_validity_bounds();
+  std::vector<int> bounds_crossed(static_cast<size_t>(num_bounds), 0);
+  if (num_bounds > 0) {
+    std::vector<double> g(static_cast<size_t>(num_bounds));
+    system.ValidityBounds(t0, q0, v0, g.data());
+    for (int k = 0; k < num_bounds; ++k) {
+      if (!(g[static_cast<size_t>(k)] >= 0.0)) {
+        return Failed(spec::FailureKind::kModelValidity, system.BoundReason(k, t0, q0, v0));
+      }
+    }
+    std::vector<int> downwards(static_cast<size_t>(num_bounds), -1);
+    ok = check(IDARootInit(ida, num_bounds, &ValidityBounds), "IDARootInit") &&
+         check(IDASetRootDirection(ida, downwards.data()), "IDASetRootDirection") &&
+         check(IDASetNoInactiveRootWarn(ida), "IDASetNoInactiveRootWarn");
+    if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+  }
+
   // Sensitivities: initial values by central differences of the consistent
   // start along (dq0/dp_k, dv0/dp_k, e_k).
   const int num_sens = sensitivities != nullptr ? static_cast<int>(sensitivities->parameters.size()) : 0;
@@ -361,6 +405,22 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
         return Failed(spec::FailureKind::kIntegrator,
                       absl::StrFormat("the integrator failed near t = %.6g s (target %.6g s): %s%s", t_reached, t,
                                       sundials_message, p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]"));
+      }
+      if (flag == IDA_ROOT_RETURN) {
+        if (!check(IDAGetRootInfo(ida, bounds_crossed.data()), "IDAGetRootInfo")) {
+          return Failed(spec::FailureKind::kIntegrator, sundials_message);
+        }
+        const int k = static_cast<int>(std::find(bounds_crossed.begin(), bounds_crossed.end(), -1) -
+                                       bounds_crossed.begin());
+        const VectorXd q = y.head(n), v = y.segment(n, n);
+        return Failed(spec::FailureKind::kModelValidity, system.BoundReason(k < num_bounds ? k : 0, t_reached, q, v));
+      }
+      if (t_reached < t) {
+        // Stopped at the end of a table that does not reach the instant (a
+        // scene loader refuses such a table; a model built in code may not).
+        return Failed(spec::FailureKind::kModelValidity,
+                      absl::StrFormat("a tabulated profile ends at t = %.6g s, before the instant t = %.6g s",
+                                      t_reached, t));
       }
     }
     MotionSample sample;

@@ -1,5 +1,9 @@
 #include "worker/multibody/kinematic_analysis.h"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "absl/strings/str_format.h"
 
 namespace mbopt::multibody {
@@ -8,11 +12,53 @@ namespace {
 struct State {
   double t = 0.0;
   Eigen::VectorXd q, v, a;
+  // Sign of det(Phi_q): it changes only through a singular position, so a
+  // change between two instants is a jump to another assembly branch or a
+  // locking position passed in between.
+  int branch_sign = 0;
 };
+
+// A Newton correction from the predicted positions larger than this share
+// of the mechanism's size (or, for an angle, than this many radians: a link
+// turned by it moves its end by that share of its length) means Newton
+// jumped, possibly to another branch: the interval is halved.
+constexpr double kMaxCorrectionFraction = 0.05;
+
+// The mechanism's size: the largest distance between two joint points of one
+// body (a link's length) or from a body's centre to one; 1 m if the joints
+// all sit at the bodies' centres.
+double LinkScale(const Model& model) {
+  std::vector<std::vector<Eigen::Vector2d>> points(model.bodies.size());
+  for (const Joint& j : model.joints) {
+    for (const Point* p : {&j.a, &j.b}) {
+      if (p->body != kGround) points[static_cast<size_t>(p->body)].push_back(p->local_m);
+    }
+  }
+  double scale = 0.0;
+  for (const std::vector<Eigen::Vector2d>& on_body : points) {
+    for (size_t i = 0; i < on_body.size(); ++i) {
+      scale = std::max(scale, on_body[i].norm());
+      for (size_t k = 0; k < i; ++k) scale = std::max(scale, (on_body[i] - on_body[k]).norm());
+    }
+  }
+  return scale > 0.0 ? scale : 1.0;
+}
+
+int DeterminantSign(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu) {
+  // From the pivots' signs, not their product (which may overflow or
+  // underflow for a large mechanism).
+  int sign = lu.permutationP().determinant();
+  const auto pivots = lu.matrixLU().diagonal();
+  for (Eigen::Index k = 0; k < pivots.size(); ++k) {
+    if (pivots[k] < 0.0) sign = -sign;
+  }
+  return sign;
+}
 
 class DrivenMotion {
  public:
-  DrivenMotion(const Mechanism& m, const KinematicOptions& o, KinematicCounters* c) : m_(m), options_(o), counters_(c) {}
+  DrivenMotion(const Mechanism& m, const KinematicOptions& o, KinematicCounters* c)
+      : m_(m), options_(o), counters_(c), scale_m_(LinkScale(m.model())) {}
 
   // Positions, velocities and accelerations at t from `q_guess`.
   spec::AnalysisFailure Solve(double t, Eigen::VectorXd q_guess, State* out) {
@@ -37,21 +83,55 @@ class DrivenMotion {
     m_.AccelerationRightSide(t, q_guess, out->v, &gamma_);
     out->a = lu_.solve(gamma_);
     out->q = std::move(q_guess);
+    out->branch_sign = DeterminantSign(lu_);
     return spec::AnalysisFailure::Ok();
   }
 
   // From `from` to t, halving the interval where Newton fails from the
-  // extrapolated guess (a fast-moving driver between coarse instants).
+  // extrapolated guess or lands off the branch `from` is on (a fast-moving
+  // driver between coarse instants): the answer is the one the continuous
+  // motion gives.
   spec::AnalysisFailure Advance(const State& from, double t, int depth, State* out) {
     const double dt = t - from.t;
-    spec::AnalysisFailure result = Solve(t, from.q + from.v * dt + 0.5 * dt * dt * from.a, out);
-    // A lock is a property of the position, not of the guess: no retry.
-    if (result.ok() || locked_ || depth >= options_.max_interval_halvings) {
+    const Eigen::VectorXd predicted = from.q + from.v * dt + 0.5 * dt * dt * from.a;
+    spec::AnalysisFailure result = Solve(t, predicted, out);
+    if (result.ok()) {
+      const bool flipped = out->branch_sign != from.branch_sign;
+      const double jump = Jump(out->q, predicted);
+      if (!flipped && jump <= kMaxCorrectionFraction) return result;
+      if (depth >= options_.max_interval_halvings) {
+        if (flipped) {
+          return spec::AnalysisFailure::Of(
+              spec::FailureKind::kAssembly,
+              absl::StrFormat("the mechanism changes assembly branch between t = %.9g s and %.9g s: it passes a "
+                              "locking position (singular constraint Jacobian) in between, near %s",
+                              from.t, t, LockingJoint(m_, phi_q_)));
+        }
+        return spec::AnalysisFailure::Of(
+            spec::FailureKind::kAssembly,
+            absl::StrFormat("the driven motion cannot be followed continuously between t = %.9g s and %.9g s: "
+                            "the positions still jump by %.3g of the mechanism's size (%.3g m) over 1/%d of the "
+                            "interval between instants",
+                            from.t, t, jump, scale_m_, 1 << options_.max_interval_halvings));
+      }
+    } else if (locked_ || depth >= options_.max_interval_halvings) {
+      // A lock is a property of the position, not of the guess: no retry.
       return result;
     }
     State middle;
     if (spec::AnalysisFailure f = Advance(from, from.t + 0.5 * dt, depth + 1, &middle); !f.ok()) return f;
     return Advance(middle, t, depth + 1, out);
+  }
+
+  // The largest Newton correction from `predicted`, in shares of the
+  // mechanism's size (angles in radians).
+  double Jump(const Eigen::VectorXd& q, const Eigen::VectorXd& predicted) const {
+    double jump = 0.0;
+    for (Eigen::Index i = 0; i < q.size(); ++i) {
+      const double correction = std::abs(q[i] - predicted[i]);
+      jump = std::max(jump, i % 3 == 2 ? correction : correction / scale_m_);
+    }
+    return jump;
   }
 
   Eigen::VectorXd Multipliers(const State& s) {
@@ -67,6 +147,7 @@ class DrivenMotion {
   const Mechanism& m_;
   const KinematicOptions& options_;
   KinematicCounters* counters_;
+  const double scale_m_;
   Eigen::MatrixXd phi_q_;
   Eigen::VectorXd phi_t_, gamma_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;

@@ -1,6 +1,8 @@
 #include "worker/multibody/mechanism.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/str_format.h"
 
@@ -81,6 +83,56 @@ Mechanism::Mechanism(const Model& model) : model_(model) {
     row_joint_.push_back(d.joint);
   }
   num_rows_ = row;
+  for (size_t k = 0; k < model_.springs.size(); ++k) {
+    const SpringDamper& s = model_.springs[k];
+    for (const bool velocity : {false, true}) {
+      if ((velocity ? s.velocity_curve : s.deflection_curve).empty()) continue;
+      bounds_.push_back(Bound{static_cast<int>(k), velocity, false});
+      bounds_.push_back(Bound{static_cast<int>(k), velocity, true});
+    }
+  }
+}
+
+void Mechanism::ValidityBounds(double t, const VectorXd& q, const VectorXd& v, double* g) const {
+  for (size_t k = 0; k < bounds_.size(); ++k) {
+    const Bound& b = bounds_[k];
+    const SpringDamper& s = model_.springs[static_cast<size_t>(b.spring)];
+    double length = 0.0, rate = 0.0;
+    SpringLengthAndRate(s, q, &v, t, &length, &rate);
+    const LinearTable& table = b.velocity_curve ? s.velocity_curve : s.deflection_curve;
+    const double at = b.velocity_curve ? rate : length - s.free_length_m;
+    g[k] = b.upper ? table.x.back() - at : at - table.x.front();
+  }
+}
+
+std::string Mechanism::BoundReason(int bound, double t, const VectorXd& q, const VectorXd& v) const {
+  const Bound& b = bounds_[static_cast<size_t>(bound)];
+  const SpringDamper& s = model_.springs[static_cast<size_t>(b.spring)];
+  double length = 0.0, rate = 0.0;
+  SpringLengthAndRate(s, q, &v, t, &length, &rate);
+  const LinearTable& table = b.velocity_curve ? s.velocity_curve : s.deflection_curve;
+  return absl::StrFormat(
+      "spring '%s' left the range of its force table at t = %.6g s: its %s reached %.6g %s, the %s end of the "
+      "table (%.6g..%.6g %s)",
+      s.name, t, b.velocity_curve ? "rate of length change" : "deflection",
+      b.velocity_curve ? rate : length - s.free_length_m, b.velocity_curve ? "m/s" : "m",
+      b.upper ? "upper" : "lower", table.x.front(), table.x.back(), b.velocity_curve ? "m/s" : "m");
+}
+
+double Mechanism::DefinedUntil_s() const {
+  double until = std::numeric_limits<double>::infinity();
+  auto limit = [&](const Profile& p) {
+    if (p.kind == Profile::Kind::kTabulated && !p.table.empty()) until = std::min(until, p.table.back());
+  };
+  for (const Driver& d : model_.drivers) limit(d.profile);
+  for (const InputPoint& in : model_.inputs) limit(in.displacement);
+  for (const PointForce& f : model_.point_forces) {
+    if (f.factor) limit(*f.factor);
+  }
+  for (const BodyTorque& torque : model_.torques) {
+    if (torque.factor) limit(*torque.factor);
+  }
+  return until;
 }
 
 VectorXd Mechanism::InitialGuess() const {
@@ -330,14 +382,28 @@ double Mechanism::SpringLength(int spring, const VectorXd& q, double t) const {
   return (PointPosition(s.b, q, t) - PointPosition(s.a, q, t)).norm();
 }
 
+void Mechanism::SpringLengthAndRate(const SpringDamper& s, const VectorXd& q, const VectorXd* v, double t,
+                                    double* length, double* rate) const {
+  const Vector2d d = PointPosition(s.b, q, t) - PointPosition(s.a, q, t);
+  *length = d.norm();
+  *rate = v != nullptr && v->size() == q.size() && *length > 0.0
+              ? d.dot(PointVelocity(s.b, q, *v, t) - PointVelocity(s.a, q, *v, t)) / *length
+              : 0.0;
+}
+
 double Mechanism::SpringTension(int spring, const VectorXd& q, const VectorXd& v, double t) const {
   const SpringDamper& s = model_.springs[static_cast<size_t>(spring)];
-  const Vector2d d = PointPosition(s.b, q, t) - PointPosition(s.a, q, t);
-  const double length = d.norm();
-  const double length_rate =
-      length > 0.0 ? d.dot(PointVelocity(s.b, q, v, t) - PointVelocity(s.a, q, v, t)) / length : 0.0;
+  double length = 0.0, length_rate = 0.0;
+  SpringLengthAndRate(s, q, &v, t, &length, &length_rate);
   const double deflection = length - s.free_length_m;
   double elastic = s.stiffness_n_per_m * deflection, viscous = s.damping_n_s_per_m * length_rate;
+  if (continue_tables_) {
+    // An integrator's trial step across a table's end; the integrator stops
+    // where the motion itself crosses it (ValidityBounds).
+    if (!s.deflection_curve.empty()) elastic = s.deflection_curve.Continued(deflection);
+    if (!s.velocity_curve.empty()) viscous = s.velocity_curve.Continued(length_rate);
+    return elastic + viscous + s.actuator_force_n;
+  }
   // A curve evaluated outside its table: NaN, so that the analysis fails
   // naming the spring (scene_analysis.cc) instead of extrapolating.
   if (!s.deflection_curve.empty() && !s.deflection_curve.Evaluate(deflection, &elastic)) return NAN;

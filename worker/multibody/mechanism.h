@@ -86,12 +86,31 @@ class Mechanism : public ConstrainedSystem {
   const MechanismCounters& counters() const { return counters_; }
   std::string FailureReason() const override { return failure_; }
 
+  // Two bounds per force curve of a spring (its argument above the table's
+  // first x, below its last), in spring order.
+  int num_validity_bounds() const override { return static_cast<int>(bounds_.size()); }
+  void ValidityBounds(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, double* g) const override;
+  std::string BoundReason(int bound, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const override;
+  void ContinuePastBounds(bool on) const override { continue_tables_ = on; }
+  // The earliest end of a tabulated profile (drivers, input points, force
+  // and torque factors).
+  double DefinedUntil_s() const override;
+
  private:
   // One evaluation of every row: whichever outputs are not null.
   void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
                     Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
   BeamNodes BeamCoordinates(const BeamElement& e, const Eigen::VectorXd& q) const;
   double ReferenceAngle(int joint) const { return reference_angle_[static_cast<size_t>(joint)]; }
+  // A spring's length and its rate dL/dt.
+  void SpringLengthAndRate(const SpringDamper& s, const Eigen::VectorXd& q, const Eigen::VectorXd* v, double t,
+                           double* length, double* rate) const;
+
+  struct Bound {
+    int spring = 0;
+    bool velocity_curve = false;  // else the deflection curve
+    bool upper = false;           // else the lower end
+  };
 
   const Model& model_;
   int joint_rows_ = 0;
@@ -100,6 +119,8 @@ class Mechanism : public ConstrainedSystem {
   std::vector<double> reference_angle_;  // phi_b - phi_a of the initial poses
   mutable MechanismCounters counters_;
   mutable std::string failure_;
+  std::vector<Bound> bounds_;
+  mutable bool continue_tables_ = false;
 };
 
 }  // namespace mbopt::multibody

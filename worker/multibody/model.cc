@@ -85,6 +85,13 @@ bool LinearTable::Evaluate(double at, double* value) const {
   return true;
 }
 
+double LinearTable::Continued(double at) const {
+  double value = 0.0;
+  if (Evaluate(at, &value)) return value;
+  const size_t i = at < x.front() ? 0 : x.size() - 2;
+  return y[i] + (y[i + 1] - y[i]) / (x[i + 1] - x[i]) * (at - x[i]);
+}
+
 std::string Model::BodyName(int body) const {
   if (body == kGround) return "ground";
   if (body >= 0 && static_cast<size_t>(body) < bodies.size()) return bodies[static_cast<size_t>(body)].name;

@@ -81,6 +81,10 @@ class CubicSpline {
 struct LinearTable {
   std::vector<double> x, y;
   bool Evaluate(double at, double* value) const;
+  // y at any x: inside the table as Evaluate, outside along the end
+  // segment's line (only for an integrator's trial steps across the table's
+  // end, see ConstrainedSystem::ContinuePastBounds, never for a result).
+  double Continued(double at) const;
   bool empty() const { return x.empty(); }
 };
 
