@@ -48,8 +48,10 @@ class SceneConverter {
       // Silently ignoring a declared effect would give wrong answers.
       if (msg_.effects().has_gravity()) {
         errors_.Add(where_.Child("effects"), "gravity",
-                    "a lumped model moves about its static equilibrium, where gravity is "
-                    "balanced by the spring preloads: leave gravity out");
+                    "a lumped model moves by small amounts about its static equilibrium, where gravity is "
+                    "balanced by the spring preloads, so it has no gravity to declare; for a mechanism that moves "
+                    "under its own weight (large motions, gravity doing work) write it as a `multibody` scene, "
+                    "which takes `effects { gravity { ... } }`");
       }
       if (msg_.effects().has_structural_damping()) {
         errors_.Add(where_.Child("effects"), "structural_damping",
@@ -547,7 +549,10 @@ class SceneConverter {
     }
     if (m.links_size() == 0) errors_.Add(w, "links", "a linkage needs at least one link");
     if (!m.has_driver()) {
-      errors_.Add(w, "driver", "missing: expected the driven link and its pivot");
+      errors_.Add(w, "driver",
+                  "missing: a linkage is driven at a prescribed speed, so it needs its driven link and pivot; to "
+                  "let the mechanism move freely (under its loads, gravity or springs, with no driver) write it as "
+                  "a `multibody` scene, whose drivers are optional (docs/scene.md)");
     } else {
       const Where dw = w.Child("driver");
       const v1::Driver& d = m.driver();

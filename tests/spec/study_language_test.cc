@@ -231,5 +231,55 @@ TEST_F(StudyLanguage, ResponseReadsAParameterWrittenAsAnExpression) {
             read.end());
 }
 
+// Messages written before the multibody model existed say now what does
+// what was asked.
+TEST_F(StudyLanguage, LinkageWithoutADriverPointsToAMultibodyScene) {
+  const std::string path = (dir_ / "linkage.scene.textproto").string();
+  std::ofstream(path) << R"pb(name: "free linkage"
+linkage {
+  joints { name: "O2" ground: true position_m { x { value: 0 } y { value: 0 } } }
+  joints { name: "A" position_m { x { value: 0 } y { value: 0.1 } } }
+  links { name: "crank" joint_a: "O2" joint_b: "A" }
+}
+outputs { name: "angle" link_rotation { link: "crank" } }
+time_grid { start_s: 0 end_s: 1 points: 2 }
+)pb";
+  absl::StatusOr<Scene> scene = LoadSceneFile(path);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(scene.status().message(), HasSubstr("linkage.driver: missing: a linkage is driven at a prescribed speed"));
+  EXPECT_THAT(scene.status().message(), HasSubstr("to let the mechanism move freely"));
+  EXPECT_THAT(scene.status().message(), HasSubstr("write it as a `multibody` scene"));
+}
+
+TEST_F(StudyLanguage, GravityInALumpedScenePointsToAMultibodyScene) {
+  const std::string error = LoadError(std::string(kStudyHead) + kPeakObjective,
+                                      std::string(::mbopt::testing::kOscillatorScene) +
+                                          "effects { gravity { acceleration_m_per_s2 { y { value: -9.81 } } } }\n");
+  EXPECT_THAT(error, HasSubstr("effects.gravity: a lumped model moves by small amounts about its static equilibrium"));
+  EXPECT_THAT(error, HasSubstr("write it as a `multibody` scene, which takes `effects { gravity { ... } }`"));
+}
+
+TEST_F(StudyLanguage, JointTypeOnALinkagePointsToMultibodyJointKinds) {
+  const std::string path = (dir_ / "linkage.scene.textproto").string();
+  std::ofstream(path) << R"pb(name: "slider"
+linkage {
+  joints { name: "O2" type: "slider" ground: true }
+}
+)pb";
+  absl::StatusOr<Scene> scene = LoadSceneFile(path);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(scene.status().message(), HasSubstr(":3:"));
+  EXPECT_THAT(scene.status().message(), HasSubstr("Message type \"mbopt.v1.Joint\" has no field named \"type\""));
+  EXPECT_THAT(scene.status().message(), HasSubstr("write the mechanism as a `multibody` scene, whose joints take "
+                                                  "`kind: JOINT_PRISMATIC`"));
+}
+
+TEST_F(StudyLanguage, ReductionEqualPointsToEquals) {
+  const std::string error = LoadError(std::string(kStudyHead) + kPeakObjective +
+                                      "constraints { name: \"end\" output: \"x\" reduction: REDUCTION_EQUAL limit: 1 }\n");
+  EXPECT_THAT(error, HasSubstr("Unknown enumeration value of \"REDUCTION_EQUAL\""));
+  EXPECT_THAT(error, HasSubstr("to hold a value, write `equals: <value>`"));
+}
+
 }  // namespace
 }  // namespace mbopt::spec::io
