@@ -158,6 +158,50 @@ double RefValue(const ValueRef& ref, const std::vector<double>& f, const std::ve
   return ref.sign * value;
 }
 
+Dimension SignalDimension(const Study& study, int signal) {
+  if (signal < 0 || signal >= study.num_signals()) return Dimension::kAny;
+  if (signal >= study.num_case_signals()) {
+    return study.responses[static_cast<size_t>(signal - study.num_case_signals())].dimension;
+  }
+  return OutputDimension(study.scene.outputs[static_cast<size_t>(signal) % study.scene.outputs.size()]);
+}
+
+namespace {
+
+// A value's unit as reported: as written, else SI by its dimension; an
+// integral over time carries an extra s.
+std::string ValueUnit(const Study& study, const std::string& unit, int signal, Reduction reduction) {
+  std::string text = unit.empty() ? SiUnitName(SignalDimension(study, signal)) : unit;
+  if (reduction == Reduction::kIntegral) text = text.empty() ? "s" : text + " s";
+  return text;
+}
+
+}  // namespace
+
+std::string ReportedObjectiveUnit(const Study& study) {
+  const Objective& o = study.objective;
+  std::vector<std::string> units;
+  switch (o.form) {
+    case Objective::Form::kMinimizeMaxOf:
+    case Objective::Form::kMinimize:
+      return ValueUnit(study, o.unit, o.output, o.reduction);
+    case Objective::Form::kWeightedSum:
+    case Objective::Form::kMaxOver:
+      for (const WeightedTerm& t : o.sum_terms) units.push_back(ValueUnit(study, t.unit, t.output, t.reduction));
+      break;
+    case Objective::Form::kTargetDistance:
+      for (const TargetTerm& t : o.terms) units.push_back(ValueUnit(study, t.unit, t.output, Reduction::kFinal));
+      break;
+    case Objective::Form::kFeasible:
+      return "";
+  }
+  if (units.empty()) return "";
+  for (const std::string& unit : units) {
+    if (unit != units.front()) return "";
+  }
+  return units.front();
+}
+
 double EqualityRowScale(const Constraint& constraint) {
   const double value_si = std::abs(constraint.equals.value_or(0.0) * constraint.si_per_unit);
   const double half_band_si =
@@ -232,7 +276,7 @@ Dimension OutputDimension(const Output& output) {
                             case Q::kSpringLength: return Dimension::kLength;
                             case Q::kSpringForce: return Dimension::kForce;
                             case Q::kKineticEnergy:
-                            case Q::kPotentialEnergy: return Dimension::kAny;
+                            case Q::kPotentialEnergy: return Dimension::kEnergy;
                           }
                           return Dimension::kAny;
                         },

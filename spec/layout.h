@@ -63,6 +63,17 @@ inline constexpr int kRigidLinkStressElements = 6;
 // The physical dimension of an output's values (for unit checks).
 Dimension OutputDimension(const Output& output);
 
+// The dimension of a signal (Study::SignalName): its output's, or the one
+// its response's `unit` gives; kAny when not known.
+Dimension SignalDimension(const Study& study, int signal);
+
+// The unit the objective's value F is reported in: the objective's `unit`,
+// else the SI unit of its output's dimension ("" for a dimensionless or
+// unknown one, never a bare "SI"); with several terms (a weighted sum, the
+// largest of several, a distance to targets) their unit when every term
+// has the same one, else "". An INTEGRAL is in that unit times s. "" for a
+// study without an objective.
+std::string ReportedObjectiveUnit(const Study& study);
 
 enum class ObjectiveForm { kScalar, kMinMax };
 

@@ -885,8 +885,8 @@ class SceneConverter {
       if (spring.joint >= 0 && multibody_.joints[static_cast<size_t>(spring.joint)].kind != JointKind::kRevolute) {
         errors_.Add(rw, "joint", "a rotational spring acts at a revolute joint");
       }
-      spring.stiffness_n_m_per_rad = Num(rw, "stiffness_n_m_per_rad", r.has_stiffness_n_m_per_rad(), r.stiffness_n_m_per_rad(), Dimension::kAny, 0.0);
-      spring.damping_n_m_s_per_rad = Num(rw, "damping_n_m_s_per_rad", r.has_damping_n_m_s_per_rad(), r.damping_n_m_s_per_rad(), Dimension::kAny, 0.0);
+      spring.stiffness_n_m_per_rad = Num(rw, "stiffness_n_m_per_rad", r.has_stiffness_n_m_per_rad(), r.stiffness_n_m_per_rad(), Dimension::kRotationalStiffness, 0.0);
+      spring.damping_n_m_s_per_rad = Num(rw, "damping_n_m_s_per_rad", r.has_damping_n_m_s_per_rad(), r.damping_n_m_s_per_rad(), Dimension::kRotationalDamping, 0.0);
       spring.free_angle_rad = Num(rw, "free_angle_rad", r.has_free_angle_rad(), r.free_angle_rad(), Dimension::kAngle, 0.0);
       multibody_.rotational_springs.push_back(std::move(spring));
     }

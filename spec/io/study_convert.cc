@@ -60,14 +60,6 @@ int FindOutput(const Study& study, const Where& w, const std::string& field, con
   return index;
 }
 
-Dimension SignalDimension(const Study& study, int signal) {
-  if (signal < 0 || signal >= study.num_signals()) return Dimension::kAny;
-  if (signal >= study.num_case_signals()) {
-    return study.responses[static_cast<size_t>(signal - study.num_case_signals())].dimension;
-  }
-  return OutputDimension(study.scene.outputs[static_cast<size_t>(signal) % study.scene.outputs.size()]);
-}
-
 // A name usable in expressions: a letter or '_', then letters, digits, '_'.
 bool IsIdentifier(const std::string& name) {
   if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
@@ -560,7 +552,19 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
         term.output = FindOutput(study, kw, "output", t.output(), errors);
         const std::optional<Reduction> r =
             t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
-        if (sum && (!r.has_value() || !IsWholeSeriesReduction(*r))) {
+        if (sum && r.has_value() && (*r == Reduction::kMax || *r == Reduction::kMaxAbs)) {
+          // A sum of peaks is not smooth, and the optimizer's one bound
+          // variable serves a single maximum: the study states the bounds.
+          errors->Add(
+              kw, "reduction",
+              absl::StrCat("a term of a sum takes one value, and a peak is one only through a bound: for each "
+                           "peak add a scene parameter p (its unit, a value near the peak) and a design variable "
+                           "on it, a response \"", t.output(), *r == Reduction::kMaxAbs ? " - p\" and one \"-" : " - p\"",
+                           *r == Reduction::kMaxAbs ? absl::StrCat(t.output(), " - p\"") : "",
+                           " constrained with REDUCTION_MAX limit: 0, a response \"p\" of the parameter alone, "
+                           "and make that response the term (REDUCTION_FINAL): at the optimum p is the peak "
+                           "(docs/study.md, \"A sum of peaks\")"));
+        } else if (sum && (!r.has_value() || !IsWholeSeriesReduction(*r))) {
           errors->Add(kw, "reduction",
                       "a term takes one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
                       "REDUCTION_RANGE or REDUCTION_MEAN");

@@ -126,5 +126,44 @@ constraints { name: "above" output: "v_value" reduction: REDUCTION_FINAL lower: 
             << " analyses " << run.analyses << "\n";
 }
 
+// A sum of peaks written as docs/study.md says ("A sum of peaks"), with a
+// bound parameter per peak: minimize max_t (u - t)^2 + 2 max_t (v - 2t)^2
+// over t in [0, 1]. The peaks are max(u^2, (u - 1)^2) and max(v^2,
+// (v - 2)^2), least at u = 0.5 and v = 1: F = 0.25 + 2 * 1 = 2.25.
+TEST_F(StudyLanguageRun, SumOfPeaksWrittenWithBoundParametersReachesTheClosedForm) {
+  std::string scene = CarrierScene();
+  const std::string after = "parameters { name: \"v\" value: 2 }\n";
+  scene.insert(scene.find(after) + after.size(), "parameters { name: \"p1\" value: 1 }\nparameters { name: \"p2\" value: 5 }\n");
+  std::ofstream(dir_ / "carrier.scene.textproto") << scene;
+  absl::StatusOr<spec::Study> study = Load(R"pb(name: "sum of peaks"
+scene_file: "carrier.scene.textproto"
+variables { name: "u" parameter: "u" initial: 0.9 lower: -2 upper: 2 }
+variables { name: "v" parameter: "v" lower: -3 upper: 3 }
+variables { name: "p1" parameter: "p1" lower: 0 upper: 10 }
+variables { name: "p2" parameter: "p2" lower: 0 upper: 20 }
+responses { name: "f1" expr: "(u - t)^2" }
+responses { name: "f2" expr: "(v - 2 * t)^2" }
+responses { name: "over1" expr: "f1 - p1" }
+responses { name: "over2" expr: "f2 - p2" }
+responses { name: "peak1" expr: "p1" }
+responses { name: "peak2" expr: "p2" }
+constraints { name: "bound1" output: "over1" reduction: REDUCTION_MAX limit: 0 }
+constraints { name: "bound2" output: "over2" reduction: REDUCTION_MAX limit: 0 }
+objective { minimize_sum { terms { output: "peak1" } terms { output: "peak2" weight: 2 } } }
+optimizer { convergence_objective_tolerance: 1e-6 max_cycles: 200 }
+)pb");
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<LocalRunResult> result = RunStudyLocally(*study, LocalRunOptions{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  const RunOutcome& run = result->outcome;
+  EXPECT_EQ(run.state, slp::RunState::kConverged) << slp::RunStateName(run.state) << " " << result->end_reason;
+  EXPECT_NEAR(run.objective, 2.25, 1e-5);
+  EXPECT_NEAR(run.design[0], 0.5, 1e-4);
+  EXPECT_NEAR(run.design[1], 1.0, 1e-4);
+  EXPECT_LE(run.max_violation, 1e-6);
+  std::cout << "sum of peaks: F " << run.objective << " at u " << run.design[0] << " v " << run.design[1]
+            << " cycles " << run.cycles << " analyses " << run.analyses << "\n";
+}
+
 }  // namespace
 }  // namespace mbopt::local_run

@@ -281,5 +281,65 @@ TEST_F(StudyLanguage, ReductionEqualPointsToEquals) {
   EXPECT_THAT(error, HasSubstr("to hold a value, write `equals: <value>`"));
 }
 
+// A sum of peaks: the message says how to write it with bound parameters.
+TEST_F(StudyLanguage, SumOfPeaksSaysHowToWriteItWithABound) {
+  const std::string error = LoadError(std::string(kStudyHead) +
+                                      "objective { minimize_sum { terms { output: \"acc\" reduction: REDUCTION_MAX_ABS } "
+                                      "terms { output: \"x\" } } }\n");
+  EXPECT_THAT(error, HasSubstr("objective.minimize_sum.terms[0].reduction: a term of a sum takes one value, and a "
+                               "peak is one only through a bound"));
+  EXPECT_THAT(error, HasSubstr("a response \"acc - p\" and one \"-acc - p\" constrained with REDUCTION_MAX limit: 0"));
+}
+
+// Units engineers write, each checked against the field's kind.
+TEST_F(StudyLanguage, UnitsEngineersWriteLoadAndAreCheckedAgainstTheField) {
+  std::string scene = Replace(::mbopt::testing::kOscillatorScene, "damping_n_s_per_m { value: 0.5 }",
+                              "damping_n_s_per_m { param: \"c\" }");
+  scene = Replace(scene, "parameters { name: \"mass\" value: 2 unit: \"kg\" }",
+                  "parameters { name: \"mass\" value: 2 unit: \"kg\" }\nparameters { name: \"c\" value: 0.0005 unit: "
+                  "\"kN s/m\" }");
+  absl::StatusOr<Study> study = Load(std::string(kStudyHead) + kPeakObjective, scene);
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_DOUBLE_EQ(study->scene.parameters[static_cast<size_t>(study->scene.FindParameter("c"))].value_si, 0.5);
+
+  EXPECT_THAT(LoadError(std::string(kStudyHead) + kPeakObjective, Replace(scene, "\"kN s/m\"", "\"N m/rad\"")),
+              HasSubstr("parameter \"c\" has unit \"N m/rad\" (rotational stiffness (torque/angle)) but this field is "
+                        "a damping"));
+  for (const auto& [unit, si] : {std::pair{"N m/rad", 1.0}, std::pair{"N m s/rad", 1.0}, std::pair{"J", 1.0},
+                                 std::pair{"W", 1.0}, std::pair{"kN s/m", 1e3}}) {
+    absl::StatusOr<Unit> found = FindUnit(unit);
+    ASSERT_TRUE(found.ok()) << unit;
+    EXPECT_EQ(found->si_per_unit, si) << unit;
+  }
+  EXPECT_FALSE(UnitFits(*FindUnit("J"), Dimension::kTorque));
+  EXPECT_FALSE(UnitFits(*FindUnit("N m/rad"), Dimension::kStiffness));
+}
+
+// The objective's unit as reported: SI by the output's dimension when none
+// is written, nothing for a dimensionless value, and the terms' common unit.
+TEST_F(StudyLanguage, ObjectiveUnitIsTheOutputsOrTheTermsCommonUnitNeverABareSI) {
+  absl::StatusOr<Study> peak = Load(std::string(kStudyHead) + kPeakObjective);
+  ASSERT_TRUE(peak.ok()) << peak.status();
+  EXPECT_EQ(ReportedObjectiveUnit(*peak), "m/s^2");
+  absl::StatusOr<Study> ratio = Load(std::string(kStudyHead) + "responses { name: \"ratio\" expr: \"x / 0.01\" }\n" +
+                                     "objective { minimize_max_of: \"ratio\" reduction: REDUCTION_MAX }\n");
+  ASSERT_TRUE(ratio.ok()) << ratio.status();
+  EXPECT_EQ(ReportedObjectiveUnit(*ratio), "");
+  absl::StatusOr<Study> same = Load(std::string(kStudyHead) +
+                                    "objective { minimize_max_over { terms { output: \"x\" unit: \"mm\" } "
+                                    "terms { output: \"x\" reduction: REDUCTION_RMS unit: \"mm\" weight: 2 } } }\n");
+  ASSERT_TRUE(same.ok()) << same.status();
+  EXPECT_EQ(ReportedObjectiveUnit(*same), "mm");
+  absl::StatusOr<Study> mixed = Load(std::string(kStudyHead) +
+                                     "objective { minimize_sum { terms { output: \"x\" unit: \"mm\" } "
+                                     "terms { output: \"acc\" reduction: REDUCTION_RMS } } }\n");
+  ASSERT_TRUE(mixed.ok()) << mixed.status();
+  EXPECT_EQ(ReportedObjectiveUnit(*mixed), "");
+  absl::StatusOr<Study> integral = Load(std::string(kStudyHead) +
+                                        "objective { minimize: \"x\" reduction: REDUCTION_INTEGRAL unit: \"mm\" }\n");
+  ASSERT_TRUE(integral.ok()) << integral.status();
+  EXPECT_EQ(ReportedObjectiveUnit(*integral), "mm s");
+}
+
 }  // namespace
 }  // namespace mbopt::spec::io

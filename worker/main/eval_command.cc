@@ -258,12 +258,7 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     err << "mbopt-worker eval: " << values.status().message() << "\n";
     return kExitAnalysisFailed;
   }
-  const std::string objective_unit =
-      study.objective.form == spec::Objective::Form::kTargetDistance ||
-              study.objective.form == spec::Objective::Form::kWeightedSum ||
-              study.objective.form == spec::Objective::Form::kMaxOver
-          ? ""
-          : (study.objective.unit.empty() ? "SI" : study.objective.unit);
+  const std::string objective_unit = spec::ReportedObjectiveUnit(study);
 
   // Every output (per load case), then every response: what a user checks
   // their response expressions against.
