@@ -160,6 +160,8 @@ void AddResponsePlots(const v1::GetJobResponse& job, report::ReportData* data) {
         objective_plot(t.output, spec::Reduction::kFinal, {}, t.si_per_unit, t.unit);
       }
       break;
+    case spec::Objective::Form::kFeasible:
+      break;  // no objective: the constraints' plots follow
   }
 
   int left_out = 0;

@@ -58,6 +58,8 @@ std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& lay
       text.pop_back();
       return text + absl::StrFormat(" (%d terms, min-max form)", layout.num_objective_terms());
     }
+    case spec::Objective::Form::kFeasible:
+      return "none: find a design that meets every constraint (F = 0; the run ends at the first such design)";
     case spec::Objective::Form::kTargetDistance: {
       std::string text = "distance to targets:";
       for (const spec::TargetTerm& t : o.terms) {

@@ -178,6 +178,17 @@ class ExpressionParser {
       Skip();
       if (pos_ < text_.size() && text_[pos_] == '(') return Call(name, start);
       if (std::optional<int> index = names_.find(name); index.has_value()) {
+        if (names_.expand) {
+          absl::StatusOr<std::shared_ptr<const Expression>> expansion = names_.expand(name);
+          if (!expansion.ok()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("column ", start + 1, " of \"", text_, "\": ", expansion.status().message()));
+          }
+          if (*expansion != nullptr) {
+            Inline(**expansion);
+            return absl::OkStatus();
+          }
+        }
         Emit(Expression::Op::kParameter, 0, *index, 1);
         out_->parameters_.push_back(*index);
         return absl::OkStatus();
@@ -220,6 +231,18 @@ class ExpressionParser {
     }
     Emit(arity == 1 ? Expression::Op::kFunction1 : Expression::Op::kFunction2, 0, function, arity == 1 ? 0 : -1);
     return absl::OkStatus();
+  }
+
+  // The code of `e` where a name stood: it leaves one value on the stack,
+  // needing e.max_stack_ above what is there.
+  void Inline(const Expression& e) {
+    for (Expression::Instruction in : e.code_) {
+      if (in.op == Expression::Op::kParameter) in.index += names_.expand_index_offset;
+      out_->code_.push_back(in);
+    }
+    for (int p : e.parameters_) out_->parameters_.push_back(p + names_.expand_index_offset);
+    max_depth_ = std::max(max_depth_, depth_ + e.max_stack_);
+    depth_ += 1;
   }
 
   const std::string& text_;

@@ -28,6 +28,15 @@ class Expression {
     std::function<std::optional<int>(const std::string&)> find;
     std::vector<std::string> all;
     std::string kind = "parameter";  // what a name is, for messages
+    // Names found by `find` that stand for an expression of other names (a
+    // parameter written as `expr`): their code is put in place of the name,
+    // so the result reads only plain names and its derivatives are those of
+    // the whole. Returns nullptr for a plain name, an error to refuse the
+    // name (a cycle). The inlined code's name indices are scene parameter
+    // indices, shifted by `expand_index_offset` (a response numbers
+    // parameters after its signals).
+    std::function<absl::StatusOr<std::shared_ptr<const Expression>>(const std::string&)> expand;
+    int expand_index_offset = 0;
   };
   // InvalidArgument "column N: <what was expected>" (1-based), or naming the
   // unknown parameter with the nearest known names.

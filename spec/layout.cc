@@ -158,6 +158,57 @@ double RefValue(const ValueRef& ref, const std::vector<double>& f, const std::ve
   return ref.sign * value;
 }
 
+Dimension SignalDimension(const Study& study, int signal) {
+  if (signal < 0 || signal >= study.num_signals()) return Dimension::kAny;
+  if (signal >= study.num_case_signals()) {
+    return study.responses[static_cast<size_t>(signal - study.num_case_signals())].dimension;
+  }
+  return OutputDimension(study.scene.outputs[static_cast<size_t>(signal) % study.scene.outputs.size()]);
+}
+
+namespace {
+
+// A value's unit as reported: as written, else SI by its dimension; an
+// integral over time carries an extra s.
+std::string ValueUnit(const Study& study, const std::string& unit, int signal, Reduction reduction) {
+  std::string text = unit.empty() ? SiUnitName(SignalDimension(study, signal)) : unit;
+  if (reduction == Reduction::kIntegral) text = text.empty() ? "s" : text + " s";
+  return text;
+}
+
+}  // namespace
+
+std::string ReportedObjectiveUnit(const Study& study) {
+  const Objective& o = study.objective;
+  std::vector<std::string> units;
+  switch (o.form) {
+    case Objective::Form::kMinimizeMaxOf:
+    case Objective::Form::kMinimize:
+      return ValueUnit(study, o.unit, o.output, o.reduction);
+    case Objective::Form::kWeightedSum:
+    case Objective::Form::kMaxOver:
+      for (const WeightedTerm& t : o.sum_terms) units.push_back(ValueUnit(study, t.unit, t.output, t.reduction));
+      break;
+    case Objective::Form::kTargetDistance:
+      for (const TargetTerm& t : o.terms) units.push_back(ValueUnit(study, t.unit, t.output, Reduction::kFinal));
+      break;
+    case Objective::Form::kFeasible:
+      return "";
+  }
+  if (units.empty()) return "";
+  for (const std::string& unit : units) {
+    if (unit != units.front()) return "";
+  }
+  return units.front();
+}
+
+double EqualityRowScale(const Constraint& constraint) {
+  const double value_si = std::abs(constraint.equals.value_or(0.0) * constraint.si_per_unit);
+  const double half_band_si =
+      constraint.lower && constraint.upper ? 0.5 * (*constraint.upper - *constraint.lower) * constraint.si_per_unit : 0.0;
+  return std::max({value_si, std::abs(constraint.si_per_unit), half_band_si});
+}
+
 OutputShape OutputShapeOf(const Scene& scene, int output) {
   OutputShape shape;
   const Output& out = scene.outputs[static_cast<size_t>(output)];
@@ -225,7 +276,7 @@ Dimension OutputDimension(const Output& output) {
                             case Q::kSpringLength: return Dimension::kLength;
                             case Q::kSpringForce: return Dimension::kForce;
                             case Q::kKineticEnergy:
-                            case Q::kPotentialEnergy: return Dimension::kAny;
+                            case Q::kPotentialEnergy: return Dimension::kEnergy;
                           }
                           return Dimension::kAny;
                         },
@@ -423,6 +474,15 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       layout.objective_form = ObjectiveForm::kMinMax;
       break;
     }
+    case Objective::Form::kFeasible:
+      // One constant term (F = 0); without a constraint there is nothing to find.
+      if (study.constraints.empty()) {
+        return LayoutError(study, "objective",
+                           "a study without an objective finds a design that meets its constraints, and it has "
+                           "none: add constraints, or an objective");
+      }
+      layout.objective_form = ObjectiveForm::kScalar;
+      break;
     case Objective::Form::kTargetDistance: {
       if (objective.terms.empty()) {
         return LayoutError(study, "objective.target_distance.terms", "needs at least one term");
@@ -461,13 +521,15 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
     const bool reduced = IsWholeSeriesReduction(constraint.reduction) && constraint.reduction != Reduction::kFinal;
     MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, constraint.window, layout.instants_s,
                                                              scalar_output, reduced));
+    const bool equality = constraint.equals.has_value();
+    const double equality_scale = equality ? EqualityRowScale(constraint) : 1.0;
     auto add = [&](ValueRef value, double limit, const std::string& name, double t) {
       ConstraintRow row;
       row.name = name;
       row.constraint = static_cast<int>(k);
       row.value = value;
       row.limit_si = limit;
-      row.scale = limit != 0.0 ? std::abs(limit) : 1.0;
+      row.scale = equality ? equality_scale : limit != 0.0 ? std::abs(limit) : 1.0;
       row.time_s = t;
       layout.rows.push_back(std::move(row));
     };
@@ -485,12 +547,21 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
                  " " + side;
         };
         // Neither bound given: `limit` from above, as FINAL always had it.
-        const std::optional<double> upper =
+        std::optional<double> upper =
             constraint.upper || constraint.lower ? constraint.upper : std::optional<double>(constraint.limit);
+        std::optional<double> lower = constraint.lower;
+        if (equality && upper && lower) {
+          // The rows hold the middle half of the band; the other half is the
+          // violation a converged design may keep (SlpOptionsFromStudy), so
+          // that a converged design lies inside the band as written.
+          const double quarter_band = 0.25 * (*upper - *lower);
+          upper = *constraint.equals + quarter_band;
+          lower = *constraint.equals - quarter_band;
+        }
         if (upper) add(ref, *upper * constraint.si_per_unit, name("upper"), t);
-        if (constraint.lower) {
+        if (lower) {
           ref.sign = -1.0;
-          add(ref, -*constraint.lower * constraint.si_per_unit, name("lower"), t);
+          add(ref, -*lower * constraint.si_per_unit, name("lower"), t);
         }
       }
       continue;
@@ -563,6 +634,9 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
     }
     values.objective = std::sqrt(sum);
     values.objective_terms = {values.objective};
+  } else if (objective.form == Objective::Form::kFeasible) {
+    values.objective = 0.0;
+    values.objective_terms = {0.0};
   } else if (objective.form == Objective::Form::kWeightedSum) {
     double sum = 0.0;
     for (size_t k = 0; k < objective.sum_terms.size(); ++k) {

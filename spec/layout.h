@@ -16,13 +16,20 @@
 //    series.
 //  - Objective, target_distance: scalar form, one term:
 //    F = sqrt(sum_k w_k (o_k(final) / unit_k - target_k)^2).
+//  - No objective (a study that finds a feasible design): scalar form, one
+//    term, F = 0 at every design.
 //  - Objective values (terms and F) are reported in objective.unit, except
 //    target_distance, whose F is in the terms' own units.
 //  - Constraint rows, for every instant (instant-major, then series):
 //    MAX: f <= c ("upper"); MIN: -f <= -c ("lower"); MAX_ABS: f <= c
 //    ("upper") and -f <= c ("lower"); FINAL: f(t_last) <= c ("upper").
 //    g and c are SI; scale = |c| (1 when c = 0), so the normalized value
-//    (g - c) / scale is docs/method.md's g/c - 1.
+//    (g - c) / scale is docs/method.md's g/c - 1. The two rows of an
+//    equality (`equals: v tolerance: t`) are scaled by the size of the
+//    value instead (EqualityRowScale), so a narrow band is a tight limit on
+//    the quantity, not a violation of thousands of band widths, and hold
+//    the band's middle half, v -+ t/2 (the outer quarters are the violation
+//    a converged design may keep, jobs::SlpOptionsFromStudy).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +63,18 @@ inline constexpr int kRigidLinkStressElements = 6;
 // The physical dimension of an output's values (for unit checks).
 Dimension OutputDimension(const Output& output);
 
+// The dimension of a signal (Study::SignalName): its output's, or the one
+// its response's `unit` gives; kAny when not known.
+Dimension SignalDimension(const Study& study, int signal);
+
+// The unit the objective's value F is reported in: the objective's `unit`,
+// else the SI unit of its output's dimension ("" for a dimensionless or
+// unknown one, never a bare "SI"); with several terms (a weighted sum, the
+// largest of several, a distance to targets) their unit when every term
+// has the same one, else "". An INTEGRAL is in that unit times s. "" for a
+// study without an objective.
+std::string ReportedObjectiveUnit(const Study& study);
+
 enum class ObjectiveForm { kScalar, kMinMax };
 
 // A reference to one value of an analysis: output, series, sign, and either
@@ -87,10 +106,19 @@ struct ConstraintRow {
   double time_s = 0;    // the instant (0 for scalar outputs)
 };
 
+// The scale of both rows of an equality constraint, SI: the size of the
+// value held, |v|, with floors for a value at or near zero: one of the
+// constraint's unit (1 SI without a unit), and the band's half-width t.
+// Scaling by the bounds v -+ t instead makes the normalized violation of a
+// band around 0 count in band widths: with t = 1e-5 a start 0.02 away is
+// 2,000 times over, every trial is rejected and the move limits collapse.
+double EqualityRowScale(const Constraint& constraint);
+
 struct StudyLayout {
   ObjectiveForm objective_form = ObjectiveForm::kScalar;
   // kMinMax: one per term. kScalar with minimize: the one value. kScalar
-  // with target_distance: empty (the term combines several outputs).
+  // with target_distance: empty (the term combines several outputs); with
+  // no objective: empty (F = 0).
   std::vector<ValueRef> objective_terms;
   // kMinMax and minimize: one per objective term, the factor from its SI
   // value to the term (1 / unit, and a kMaxOver term's weight).

@@ -271,6 +271,22 @@ struct Scene {
   std::variant<LinkageModel, LumpedModel, MultibodyModel> model;
   std::vector<Output> outputs;
   TimeGrid time_grid;
+  // The parameters the time grid's start_expr / end_expr read (sorted): the
+  // grid is computed once, so a study may not vary them.
+  std::vector<int> time_grid_parameters_read;
+  // Per parameter: for one written as `expr`, its expression, reading only
+  // parameters without one (those it names through others are inlined),
+  // and its value_si is its value at the defaults; null for a value. Every
+  // Number and response that names such a parameter holds its expression
+  // instead, so nothing reads its slot of a parameter vector, and a design
+  // variable or a load case cannot set it. Empty in a scene built in code.
+  std::vector<std::shared_ptr<const Expression>> parameter_expressions;
+  // Parameter p's expression (parameter_expressions), or null.
+  std::shared_ptr<const Expression> ParameterExpression(int p) const {
+    return p >= 0 && p < static_cast<int>(parameter_expressions.size())
+               ? parameter_expressions[static_cast<size_t>(p)]
+               : nullptr;
+  }
   IntegratorSettings integrator;
 
   int FindParameter(const std::string& name) const;  // -1 if absent

@@ -60,7 +60,11 @@ struct WeightedTerm {
 
 struct Objective {
   // kMaxOver: F = the largest of several terms (min-max over responses).
-  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance, kWeightedSum, kMaxOver } form = Form::kMinimize;
+  // kFeasible: no objective (the study file has none): F = 0 at every
+  // design, and the run ends at the first accepted design that meets every
+  // constraint (SlpOptionsFromStudy sets the objective target 0).
+  enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance, kWeightedSum, kMaxOver, kFeasible } form =
+      Form::kMinimize;
   // kWeightedSum: the terms summed. kMaxOver: the terms whose largest value
   // is F; MAX and MAX_ABS give a term per instant of the window, the
   // whole-series reductions one; weights are positive.
@@ -77,6 +81,10 @@ struct Objective {
   double ReportedSign() const { return maximize ? -1.0 : 1.0; }
 };
 
+// The band of `equals: v` written without a tolerance: +- this share of |v|
+// (of one unit when |v| is below one unit).
+inline constexpr double kDefaultEqualityRelativeTolerance = 1e-4;
+
 struct Constraint {
   std::string name;
   int output = -1;
@@ -86,6 +94,10 @@ struct Constraint {
   // one; `limit` and `equals` +- tolerance are written as these at load).
   std::optional<double> lower;
   std::optional<double> upper;
+  // Written as `equals` (in `unit`): the value the band [lower, upper] is
+  // centred on. Its rows are scaled by the size of this value, not by their
+  // bounds (EqualityRowScale in spec/layout.h).
+  std::optional<double> equals;
   std::string unit;
   double si_per_unit = 1.0;
   TimeWindow window;

@@ -106,6 +106,8 @@ absl::StatusOr<StudyGradients> ComputeStudyGradients(
       row[i] *= factor[i];
     }
     out.objective_terms.push_back(std::move(row));
+  } else if (objective.form == Objective::Form::kFeasible) {
+    out.objective_terms.push_back(std::vector<double>(n, 0.0));  // F = 0 everywhere
   } else if (objective.form == Objective::Form::kWeightedSum) {
     std::vector<double> row(n, 0.0);
     for (size_t k = 0; k < objective.sum_terms.size(); ++k) {

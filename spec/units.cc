@@ -37,6 +37,8 @@ std::vector<Unit> MakeTable() {
       {"kN/m", 1e3, D::kStiffness},
       {"lbf/in", kPoundForce / kInch, D::kStiffness},
       {"N s/m", 1.0, D::kDamping},
+      {"kN s/m", 1e3, D::kDamping},
+      {"N s/mm", 1e3, D::kDamping},
       {"lbf s/in", kPoundForce / kInch, D::kDamping},
       {"kg m^2", 1.0, D::kInertia},
       {"lbf in s^2", kPoundForce * kInch, D::kInertia},
@@ -61,7 +63,17 @@ std::vector<Unit> MakeTable() {
       {"deg/s", kPi / 180.0, D::kAngularVelocity},
       {"rpm", 2 * kPi / 60.0, D::kAngularVelocity},
       {"N m", 1.0, D::kTorque},
+      {"N mm", 1e-3, D::kTorque},
+      {"kN m", 1e3, D::kTorque},
       {"lbf in", kPoundForce * kInch, D::kTorque},
+      {"J", 1.0, D::kEnergy},
+      {"kJ", 1e3, D::kEnergy},
+      {"mJ", 1e-3, D::kEnergy},
+      {"W", 1.0, D::kPower},
+      {"kW", 1e3, D::kPower},
+      {"N m/rad", 1.0, D::kRotationalStiffness},
+      {"N m/deg", 180.0 / kPi, D::kRotationalStiffness},
+      {"N m s/rad", 1.0, D::kRotationalDamping},
   };
 }
 
@@ -106,8 +118,42 @@ const char* DimensionName(Dimension d) {
       return "angular velocity";
     case Dimension::kTorque:
       return "torque";
+    case Dimension::kEnergy:
+      return "energy";
+    case Dimension::kPower:
+      return "power";
+    case Dimension::kRotationalStiffness:
+      return "rotational stiffness (torque/angle)";
+    case Dimension::kRotationalDamping:
+      return "rotational damping (torque time/angle)";
   }
   return "unknown";
+}
+
+const char* SiUnitName(Dimension d) {
+  switch (d) {
+    case Dimension::kAny: return "";
+    case Dimension::kLength: return "m";
+    case Dimension::kMass: return "kg";
+    case Dimension::kTime: return "s";
+    case Dimension::kAngle: return "rad";
+    case Dimension::kForce: return "N";
+    case Dimension::kStiffness: return "N/m";
+    case Dimension::kDamping: return "N s/m";
+    case Dimension::kInertia: return "kg m^2";
+    case Dimension::kPressure: return "Pa";
+    case Dimension::kArea: return "m^2";
+    case Dimension::kDensity: return "kg/m^3";
+    case Dimension::kVelocity: return "m/s";
+    case Dimension::kAcceleration: return "m/s^2";
+    case Dimension::kAngularVelocity: return "rad/s";
+    case Dimension::kTorque: return "N m";
+    case Dimension::kEnergy: return "J";
+    case Dimension::kPower: return "W";
+    case Dimension::kRotationalStiffness: return "N m/rad";
+    case Dimension::kRotationalDamping: return "N m s/rad";
+  }
+  return "";
 }
 
 absl::StatusOr<Unit> FindUnit(const std::string& name) {

@@ -31,9 +31,17 @@ enum class Dimension {
   kAcceleration,
   kAngularVelocity,
   kTorque,
+  kEnergy,               // J; the same SI units as torque, but not a torque
+  kPower,
+  kRotationalStiffness,  // torque / angle
+  kRotationalDamping,    // torque * time / angle
 };
 
 const char* DimensionName(Dimension d);
+
+// The SI unit of a dimension as the unit table writes it ("N/m", "J"); ""
+// for kAny (dimensionless, or not known).
+const char* SiUnitName(Dimension d);
 
 struct Unit {
   std::string name;

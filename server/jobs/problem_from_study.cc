@@ -1,6 +1,9 @@
 #include "server/jobs/problem_from_study.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
+#include "spec/layout.h"
 
 namespace mbopt::jobs {
 namespace {
@@ -52,6 +55,19 @@ absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study) {
       s.convergence_objective_tolerance.value_or(options.convergence_objective_tolerance);
   options.convergence_violation_tolerance =
       s.convergence_violation_tolerance.value_or(options.convergence_violation_tolerance);
+  if (!s.convergence_violation_tolerance.has_value()) {
+    // An equality's rows are scaled by the value's size, so that the move
+    // limits see its violations in proportion (spec::EqualityRowScale), and
+    // hold the middle half of its band: the violation a converged design may
+    // keep is narrowed to the outer quarter on each side, or "converged"
+    // could end outside a band narrower than the default tolerance.
+    for (const spec::Constraint& c : study.constraints) {
+      if (!c.equals.has_value() || !c.lower.has_value() || !c.upper.has_value()) continue;
+      const double quarter_band_si = 0.25 * (*c.upper - *c.lower) * c.si_per_unit;
+      options.convergence_violation_tolerance =
+          std::min(options.convergence_violation_tolerance, quarter_band_si / spec::EqualityRowScale(c));
+    }
+  }
   options.convergence_optimality_tolerance =
       s.convergence_optimality_tolerance.value_or(options.convergence_optimality_tolerance);
   options.screening_threshold = s.screening_threshold.value_or(options.screening_threshold);
@@ -65,6 +81,9 @@ absl::StatusOr<slp::SlpOptions> SlpOptionsFromStudy(const spec::Study& study) {
   if (s.objective_target.has_value()) {
     options.objective_target = study.objective.ReportedSign() * *s.objective_target;
   }
+  // Without an objective F is 0 everywhere: the first accepted design that
+  // meets the constraints is the answer, and nothing after it is better.
+  if (study.objective.form == spec::Objective::Form::kFeasible) options.objective_target = 0.0;
   absl::Status valid = InStudy(study, options.Validate());
   if (!valid.ok()) return valid;
   return options;

@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -47,8 +48,10 @@ class SceneConverter {
       // Silently ignoring a declared effect would give wrong answers.
       if (msg_.effects().has_gravity()) {
         errors_.Add(where_.Child("effects"), "gravity",
-                    "a lumped model moves about its static equilibrium, where gravity is "
-                    "balanced by the spring preloads: leave gravity out");
+                    "a lumped model moves by small amounts about its static equilibrium, where gravity is "
+                    "balanced by the spring preloads, so it has no gravity to declare; for a mechanism that moves "
+                    "under its own weight (large motions, gravity doing work) write it as a `multibody` scene, "
+                    "which takes `effects { gravity { ... } }`");
       }
       if (msg_.effects().has_structural_damping()) {
         errors_.Add(where_.Child("effects"), "structural_damping",
@@ -87,10 +90,94 @@ class SceneConverter {
         out.si_per_unit = unit->si_per_unit;
       }
       if (!std::isfinite(p.value())) errors_.Add(w, "value", "must be a finite number");
+      if (!p.expr().empty() && p.value() != 0.0) errors_.Add(w, "expr", "give value or expr, not both");
       out.value_si = p.value() * out.si_per_unit;
       units_.push_back(unit.ok() ? unit->dimension : Dimension::kAny);
       scene_.parameters.push_back(std::move(out));
     }
+    // Expressions after every name is known, so one may read a parameter
+    // written below it.
+    resolve_state_.assign(scene_.parameters.size(), ResolveState::kUnresolved);
+    scene_.parameter_expressions.assign(scene_.parameters.size(), nullptr);
+    for (int i = 0; i < msg_.parameters_size(); ++i) {
+      if (!msg_.parameters(i).expr().empty()) (void)ResolveParameter(i);
+    }
+    for (int i = 0; i < msg_.parameters_size(); ++i) {
+      // Its value at the defaults of the parameters it reads.
+      if (const auto expression = scene_.ParameterExpression(i)) {
+        scene_.parameters[static_cast<size_t>(i)].value_si = expression->Evaluate(scene_.DefaultParameterValues());
+      }
+    }
+    for (int i = 0; i < msg_.parameters_size(); ++i) {
+      const Parameter& parameter = scene_.parameters[static_cast<size_t>(i)];
+      if (scene_.ParameterExpression(i) != nullptr && !std::isfinite(parameter.value_si)) {
+        errors_.Add(where_.Child("parameters", i), "expr",
+                    absl::StrCat("\"", msg_.parameters(i).expr(), "\" is ", parameter.value_si,
+                                 " at the other parameters' values"));
+      }
+    }
+  }
+
+  // The names of a scene's expressions: its parameters, those written as
+  // `expr` standing for their expressions.
+  Expression::Names ParameterNames() {
+    Expression::Names names;
+    names.find = [this](const std::string& name) -> std::optional<int> {
+      const int index = scene_.FindParameter(name);
+      return index >= 0 ? std::optional<int>(index) : std::nullopt;
+    };
+    for (const Parameter& parameter : scene_.parameters) names.all.push_back(parameter.name);
+    names.expand = [this](const std::string& name) -> absl::StatusOr<std::shared_ptr<const Expression>> {
+      const int index = scene_.FindParameter(name);
+      if (index < 0 || index >= msg_.parameters_size() || msg_.parameters(index).expr().empty()) return nullptr;
+      if (absl::Status s = ResolveParameter(index); !s.ok()) return s;
+      return scene_.ParameterExpression(index);
+    };
+    return names;
+  }
+
+  // Parses parameter i's `expr` once, after those it reads. A parameter met
+  // again while its own expression is being read closes a cycle, refused
+  // with the cycle's names.
+  absl::Status ResolveParameter(int i) {
+    const size_t at = static_cast<size_t>(i);
+    switch (resolve_state_[at]) {
+      case ResolveState::kResolved:
+        return absl::OkStatus();
+      case ResolveState::kFailed:
+        return absl::InvalidArgumentError(
+            absl::StrCat("parameter \"", scene_.parameters[at].name, "\" has an expression that is refused"));
+      case ResolveState::kResolving: {
+        std::vector<std::string> cycle;
+        const auto from = std::find(resolving_.begin(), resolving_.end(), i);
+        for (auto it = from; it != resolving_.end(); ++it) cycle.push_back(scene_.parameters[static_cast<size_t>(*it)].name);
+        cycle.push_back(scene_.parameters[at].name);
+        const std::string text = absl::StrCat(
+            "parameters read each other in a cycle: ", absl::StrJoin(cycle, " -> "),
+            "; one of them must be a value (`value: ...`), not an expression");
+        if (!cycle_reported_) errors_.Add(where_.Child("parameters", i), "expr", text);
+        cycle_reported_ = true;
+        return absl::InvalidArgumentError(text);
+      }
+      case ResolveState::kUnresolved:
+        break;
+    }
+    resolve_state_[at] = ResolveState::kResolving;
+    resolving_.push_back(i);
+    absl::StatusOr<std::shared_ptr<const Expression>> parsed =
+        Expression::Parse(msg_.parameters(i).expr(), ParameterNames());
+    resolving_.pop_back();
+    if (!parsed.ok()) {
+      resolve_state_[at] = ResolveState::kFailed;
+      // A cycle is reported once, where it closed; the parameters on it fail too.
+      if (!cycle_reported_ || parsed.status().message().find("in a cycle") == std::string_view::npos) {
+        errors_.Add(where_.Child("parameters", i), "expr", std::string(parsed.status().message()));
+      }
+      return parsed.status();
+    }
+    scene_.parameter_expressions[at] = *std::move(parsed);
+    resolve_state_[at] = ResolveState::kResolved;
+    return absl::OkStatus();
   }
 
   // A Number field `field` of the message at `w`; `present` says whether the
@@ -128,17 +215,16 @@ class SceneConverter {
                                         n.param(), scene_.parameters[out.param].unit,
                                         DimensionName(unit_dimension), DimensionName(dimension)));
           }
+          // A parameter written as `expr`: the field follows its expression.
+          if (const auto expression = scene_.ParameterExpression(out.param)) {
+            out.expression = expression;
+            out.param = -1;
+          }
         }
         break;
       }
       case v1::Number::kExpr: {
-        Expression::Names names;
-        names.find = [this](const std::string& name) -> std::optional<int> {
-          const int index = scene_.FindParameter(name);
-          return index >= 0 ? std::optional<int>(index) : std::nullopt;
-        };
-        for (const Parameter& parameter : scene_.parameters) names.all.push_back(parameter.name);
-        absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(n.expr(), names);
+        absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(n.expr(), ParameterNames());
         if (!parsed.ok()) {
           errors_.Add(w, field, std::string(parsed.status().message()));
           break;
@@ -463,7 +549,10 @@ class SceneConverter {
     }
     if (m.links_size() == 0) errors_.Add(w, "links", "a linkage needs at least one link");
     if (!m.has_driver()) {
-      errors_.Add(w, "driver", "missing: expected the driven link and its pivot");
+      errors_.Add(w, "driver",
+                  "missing: a linkage is driven at a prescribed speed, so it needs its driven link and pivot; to "
+                  "let the mechanism move freely (under its loads, gravity or springs, with no driver) write it as "
+                  "a `multibody` scene, whose drivers are optional (docs/scene.md)");
     } else {
       const Where dw = w.Child("driver");
       const v1::Driver& d = m.driver();
@@ -796,8 +885,8 @@ class SceneConverter {
       if (spring.joint >= 0 && multibody_.joints[static_cast<size_t>(spring.joint)].kind != JointKind::kRevolute) {
         errors_.Add(rw, "joint", "a rotational spring acts at a revolute joint");
       }
-      spring.stiffness_n_m_per_rad = Num(rw, "stiffness_n_m_per_rad", r.has_stiffness_n_m_per_rad(), r.stiffness_n_m_per_rad(), Dimension::kAny, 0.0);
-      spring.damping_n_m_s_per_rad = Num(rw, "damping_n_m_s_per_rad", r.has_damping_n_m_s_per_rad(), r.damping_n_m_s_per_rad(), Dimension::kAny, 0.0);
+      spring.stiffness_n_m_per_rad = Num(rw, "stiffness_n_m_per_rad", r.has_stiffness_n_m_per_rad(), r.stiffness_n_m_per_rad(), Dimension::kRotationalStiffness, 0.0);
+      spring.damping_n_m_s_per_rad = Num(rw, "damping_n_m_s_per_rad", r.has_damping_n_m_s_per_rad(), r.damping_n_m_s_per_rad(), Dimension::kRotationalDamping, 0.0);
       spring.free_angle_rad = Num(rw, "free_angle_rad", r.has_free_angle_rad(), r.free_angle_rad(), Dimension::kAngle, 0.0);
       multibody_.rotational_springs.push_back(std::move(spring));
     }
@@ -1118,7 +1207,29 @@ class SceneConverter {
       return;
     }
     const Where w = where_.Child("time_grid");
-    const v1::TimeGrid& g = msg_.time_grid();
+    v1::TimeGrid g = msg_.time_grid();
+    // An end written as an expression becomes its value here: the checks
+    // below then see numbers, as if the file had written them.
+    for (const auto& [field, expr, set] :
+         {std::tuple{"start_expr", g.start_expr(), &v1::TimeGrid::set_start_s},
+          std::tuple{"end_expr", g.end_expr(), &v1::TimeGrid::set_end_s}}) {
+      if (expr.empty()) continue;
+      const std::string number_field = std::string(field) == "start_expr" ? "start_s" : "end_s";
+      if ((number_field == "start_s" ? g.start_s() : g.end_s()) != 0.0) {
+        errors_.Add(w, field, absl::StrCat("give ", number_field, " or ", field, ", not both"));
+      }
+      absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(expr, ParameterNames());
+      if (!parsed.ok()) {
+        errors_.Add(w, field, std::string(parsed.status().message()));
+        continue;
+      }
+      (g.*set)((*parsed)->Evaluate(scene_.DefaultParameterValues()));
+      for (int p : (*parsed)->parameters()) scene_.time_grid_parameters_read.push_back(p);
+    }
+    std::sort(scene_.time_grid_parameters_read.begin(), scene_.time_grid_parameters_read.end());
+    scene_.time_grid_parameters_read.erase(
+        std::unique(scene_.time_grid_parameters_read.begin(), scene_.time_grid_parameters_read.end()),
+        scene_.time_grid_parameters_read.end());
     scene_.time_grid.start_s = g.start_s();
     scene_.time_grid.end_s = g.end_s();
     scene_.time_grid.points = g.points();
@@ -1185,6 +1296,10 @@ class SceneConverter {
   Errors& errors_;
   Scene scene_;
   std::vector<Dimension> units_;  // per parameter
+  enum class ResolveState { kUnresolved, kResolving, kResolved, kFailed };
+  std::vector<ResolveState> resolve_state_;  // per parameter, for those written as `expr`
+  std::vector<int> resolving_;               // the chain being resolved, for naming a cycle
+  bool cycle_reported_ = false;
   std::map<std::string, int> lumped_bodies_, lumped_elements_;
   std::map<std::string, int> linkage_links_, linkage_joints_;
 };

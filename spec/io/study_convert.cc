@@ -60,14 +60,6 @@ int FindOutput(const Study& study, const Where& w, const std::string& field, con
   return index;
 }
 
-Dimension SignalDimension(const Study& study, int signal) {
-  if (signal < 0 || signal >= study.num_signals()) return Dimension::kAny;
-  if (signal >= study.num_case_signals()) {
-    return study.responses[static_cast<size_t>(signal - study.num_case_signals())].dimension;
-  }
-  return OutputDimension(study.scene.outputs[static_cast<size_t>(signal) % study.scene.outputs.size()]);
-}
-
 // A name usable in expressions: a letter or '_', then letters, digits, '_'.
 bool IsIdentifier(const std::string& name) {
   if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
@@ -110,6 +102,12 @@ std::vector<LoadCase> ConvertCases(const v1::Study& m, const Study& study, const
       const int parameter = study.scene.FindParameter(value.parameter());
       if (parameter < 0) {
         errors->Add(pw, "parameter", absl::StrCat("unknown scene parameter \"", value.parameter(), "\""));
+        continue;
+      }
+      if (study.scene.ParameterExpression(parameter) != nullptr) {
+        errors->Add(pw, "parameter",
+                    absl::StrCat("parameter \"", value.parameter(),
+                                 "\" is an expression of other parameters (`expr` in the scene): set those it reads"));
         continue;
       }
       if (set_by_variables.count(parameter) > 0) {
@@ -197,6 +195,18 @@ std::vector<Response> ConvertResponses(const v1::Study& m, const Study& study, c
     for (const Response& e : responses) names.all.push_back(e.name);
     for (const Parameter& p : scene.parameters) names.all.push_back(p.name);
     names.all.push_back("t");
+    // A parameter written as `expr` reads as its expression, like in the scene.
+    names.expand_index_offset = num_signals;
+    names.expand = [&](const std::string& name) -> absl::StatusOr<std::shared_ptr<const Expression>> {
+      for (int s = 0; s < num_case_signals; ++s) {
+        if (study.SignalName(s) == name) return nullptr;
+      }
+      for (const Response& e : responses) {
+        if (e.name == name) return nullptr;
+      }
+      const int p = scene.FindParameter(name);
+      return scene.ParameterExpression(p);
+    };
     if (r.expr().empty()) {
       errors->Add(w, "expr", "a response needs an expression, e.g. \"seat_position - body_position\"");
     } else if (absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(r.expr(), names);
@@ -250,7 +260,65 @@ std::optional<Reduction> ToReduction(v1::Reduction r) {
   }
 }
 
-TimeWindow ConvertWindow(const Where& w, const v1::TimeWindow& m, Errors* errors) {
+// The parameters a design variable or a load case sets: what changes from
+// one analysis of the study to another.
+std::set<int> VariedParameters(const Study& study) {
+  std::set<int> varied;
+  for (const DesignVariable& v : study.variables) {
+    if (v.parameter >= 0) varied.insert(v.parameter);
+    varied.insert(v.also_sets.begin(), v.also_sets.end());
+  }
+  for (const LoadCase& c : study.cases) {
+    for (const auto& [parameter, value] : c.parameter_values_si) varied.insert(parameter);
+  }
+  return varied;
+}
+
+// Refuses, at `field`, reading parameters that the study varies: `what` is
+// computed once for the whole study.
+void CheckReadsNoVariedParameter(const Where& w, const std::string& field, const std::string& what,
+                                 const std::vector<int>& parameters_read, const Study& study, Errors* errors) {
+  const std::set<int> varied = VariedParameters(study);
+  for (int p : parameters_read) {
+    if (varied.count(p) == 0) continue;
+    errors->Add(w, field,
+                absl::StrCat(what, " is the same at every design point, but it reads parameter \"",
+                             study.scene.parameters[static_cast<size_t>(p)].name,
+                             "\", which a design variable or load case sets"));
+    return;
+  }
+}
+
+// The value of an expression of the scene's parameters that the study holds
+// fixed (a window's end, an `equals` value), SI, at the scene file's values.
+std::optional<double> FixedExpression(const Where& w, const std::string& field, const std::string& text,
+                                      const Study& study, const std::string& what, Errors* errors) {
+  const Scene& scene = study.scene;
+  Expression::Names names;
+  names.find = [&](const std::string& name) -> std::optional<int> {
+    const int index = scene.FindParameter(name);
+    return index >= 0 ? std::optional<int>(index) : std::nullopt;
+  };
+  for (const Parameter& parameter : scene.parameters) names.all.push_back(parameter.name);
+  names.expand = [&](const std::string& name) -> absl::StatusOr<std::shared_ptr<const Expression>> {
+    const int index = scene.FindParameter(name);
+    return scene.ParameterExpression(index);
+  };
+  absl::StatusOr<std::shared_ptr<const Expression>> parsed = Expression::Parse(text, names);
+  if (!parsed.ok()) {
+    errors->Add(w, field, std::string(parsed.status().message()));
+    return std::nullopt;
+  }
+  CheckReadsNoVariedParameter(w, field, what, (*parsed)->parameters(), study, errors);
+  const double value = (*parsed)->Evaluate(scene.DefaultParameterValues());
+  if (!std::isfinite(value)) {
+    errors->Add(w, field, absl::StrCat("\"", text, "\" is ", value, " at the scene's parameter values"));
+    return std::nullopt;
+  }
+  return value;
+}
+
+TimeWindow ConvertWindow(const Where& w, const v1::TimeWindow& m, const Study& study, Errors* errors) {
   TimeWindow window;
   if (m.has_from_s()) {
     if (!std::isfinite(m.from_s())) errors->Add(w, "from_s", "must be a finite number");
@@ -259,6 +327,14 @@ TimeWindow ConvertWindow(const Where& w, const v1::TimeWindow& m, Errors* errors
   if (m.has_to_s()) {
     if (!std::isfinite(m.to_s())) errors->Add(w, "to_s", "must be a finite number");
     window.to_s = m.to_s();
+  }
+  if (!m.from_expr().empty()) {
+    if (m.has_from_s()) errors->Add(w, "from_expr", "give from_s or from_expr, not both");
+    window.from_s = FixedExpression(w, "from_expr", m.from_expr(), study, "a window", errors);
+  }
+  if (!m.to_expr().empty()) {
+    if (m.has_to_s()) errors->Add(w, "to_expr", "give to_s or to_expr, not both");
+    window.to_s = FixedExpression(w, "to_expr", m.to_expr(), study, "a window", errors);
   }
   if (window.from_s && window.to_s && !(*window.from_s <= *window.to_s)) {
     errors->Add(w, "to_s", absl::StrFormat("the window ends (%g s) before it starts (%g s)", *window.to_s,
@@ -331,6 +407,11 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     out.parameter = scene.FindParameter(v.parameter());
     if (out.parameter < 0) {
       errors->Add(w, "parameter", absl::StrCat("unknown scene parameter \"", v.parameter(), "\""));
+    } else if (scene.ParameterExpression(out.parameter) != nullptr) {
+      errors->Add(w, "parameter",
+                  absl::StrCat("parameter \"", v.parameter(),
+                               "\" is an expression of other parameters (`expr` in the scene); a design variable "
+                               "sets a parameter with a value, e.g. one the expression reads"));
     } else if (!bound.insert(out.parameter).second) {
       errors->Add(
           w, "parameter",
@@ -340,6 +421,10 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
       const int also = scene.FindParameter(v.also_sets(a));
       if (also < 0) {
         errors->Add(w, "also_sets", a, absl::StrCat("unknown scene parameter \"", v.also_sets(a), "\""));
+      } else if (scene.ParameterExpression(also) != nullptr) {
+        errors->Add(w, "also_sets", a,
+                    absl::StrCat("parameter \"", v.also_sets(a),
+                                 "\" is an expression of other parameters (`expr` in the scene): it follows them"));
       } else if (!bound.insert(also).second) {
         errors->Add(w, "also_sets", a,
                     absl::StrCat("parameter \"", v.also_sets(a), "\" is already set by a variable"));
@@ -382,6 +467,8 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     errors->Add(where, "variables", "a study needs at least one design variable");
 
   study.cases = ConvertCases(m, study, where, errors);
+  CheckReadsNoVariedParameter(where, m.has_scene() ? "scene.time_grid" : "scene_file", "the scene's time grid",
+                              study.scene.time_grid_parameters_read, study, errors);
   study.responses = ConvertResponses(m, study, where, errors);
 
   // Objective.
@@ -465,7 +552,19 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
         term.output = FindOutput(study, kw, "output", t.output(), errors);
         const std::optional<Reduction> r =
             t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
-        if (sum && (!r.has_value() || !IsWholeSeriesReduction(*r))) {
+        if (sum && r.has_value() && (*r == Reduction::kMax || *r == Reduction::kMaxAbs)) {
+          // A sum of peaks is not smooth, and the optimizer's one bound
+          // variable serves a single maximum: the study states the bounds.
+          errors->Add(
+              kw, "reduction",
+              absl::StrCat("a term of a sum takes one value, and a peak is one only through a bound: for each "
+                           "peak add a scene parameter p (its unit, a value near the peak) and a design variable "
+                           "on it, a response \"", t.output(), *r == Reduction::kMaxAbs ? " - p\" and one \"-" : " - p\"",
+                           *r == Reduction::kMaxAbs ? absl::StrCat(t.output(), " - p\"") : "",
+                           " constrained with REDUCTION_MAX limit: 0, a response \"p\" of the parameter alone, "
+                           "and make that response the term (REDUCTION_FINAL): at the optimum p is the peak "
+                           "(docs/study.md, \"A sum of peaks\")"));
+        } else if (sum && (!r.has_value() || !IsWholeSeriesReduction(*r))) {
           errors->Add(kw, "reduction",
                       "a term takes one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
                       "REDUCTION_RANGE or REDUCTION_MEAN");
@@ -477,7 +576,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                       "or REDUCTION_MEAN");
         }
         term.reduction = r.value_or(Reduction::kFinal);
-        if (t.has_window()) term.window = ConvertWindow(kw.Child("window"), t.window(), errors);
+        if (t.has_window()) term.window = ConvertWindow(kw.Child("window"), t.window(), study, errors);
         term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
         if (!std::isfinite(term.weight)) errors->Add(kw, "weight", "must be a finite number");
         if (!sum && !(term.weight > 0.0)) {
@@ -492,9 +591,21 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
       break;
     }
     case v1::Objective::FORM_NOT_SET:
+      if (!m.has_objective()) {
+        // No objective at all: find a design that meets the constraints.
+        obj.form = Objective::Form::kFeasible;
+        if (m.constraints_size() == 0) {
+          errors->Add(where, "objective",
+                      "missing, and the study has no constraints either: a study without an objective finds a "
+                      "design that meets its constraints; add constraints, or an objective (`minimize_max_of`, "
+                      "`minimize`, `maximize`, `minimize_sum`, `minimize_max_over` or `target_distance`)");
+        }
+        break;
+      }
       errors->Add(where, "objective",
-                  "missing: expected `minimize_max_of`, `minimize`, `maximize`, `minimize_sum`, "
-                  "`minimize_max_over` or `target_distance`");
+                  "empty: expected `minimize_max_of`, `minimize`, `maximize`, `minimize_sum`, "
+                  "`minimize_max_over` or `target_distance` (or no `objective` at all, to find a design that "
+                  "meets the constraints)");
       break;
   }
   const bool termwise = obj.form == Objective::Form::kWeightedSum || obj.form == Objective::Form::kMaxOver;
@@ -503,9 +614,9 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
       errors->Add(ow, "window", "target_distance takes final values; it has no window");
     }
     if (termwise) errors->Add(ow, "window", "each term has a window of its own (terms[k].window)");
-    obj.window = ConvertWindow(ow.Child("window"), o.window(), errors);
+    obj.window = ConvertWindow(ow.Child("window"), o.window(), study, errors);
   }
-  if (obj.form != Objective::Form::kTargetDistance && !termwise) {
+  if (obj.form != Objective::Form::kTargetDistance && obj.form != Objective::Form::kFeasible && !termwise) {
     obj.si_per_unit =
         UnitFactor(ow, "unit", o.unit(),
                    SignalDimension(study, obj.output),
@@ -531,7 +642,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "missing: expected REDUCTION_MAX, REDUCTION_MAX_ABS, REDUCTION_MIN, REDUCTION_FINAL, "
                   "REDUCTION_RMS, REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN");
     }
-    if (c.has_window()) out.window = ConvertWindow(w.Child("window"), c.window(), errors);
+    if (c.has_window()) out.window = ConvertWindow(w.Child("window"), c.window(), study, errors);
     for (const auto& [field, present, value] :
          {std::tuple{"limit", true, c.limit()}, std::tuple{"lower", c.has_lower(), c.lower()},
           std::tuple{"upper", c.has_upper(), c.upper()}, std::tuple{"equals", c.has_equals(), c.equals()},
@@ -540,19 +651,34 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     }
     const bool bounds = c.has_lower() || c.has_upper();
     const bool limit_given = c.limit() != 0.0;
+    // `equals_expr` is SI: in the constraint's unit from here on, as `equals`.
+    std::optional<double> equals = c.has_equals() ? std::optional<double>(c.equals()) : std::nullopt;
+    if (!c.equals_expr().empty()) {
+      if (c.has_equals()) errors->Add(w, "equals_expr", "give equals or equals_expr, not both");
+      const std::optional<double> si = FixedExpression(w, "equals_expr", c.equals_expr(), study, "an `equals` value", errors);
+      absl::StatusOr<Unit> unit = FindUnit(c.unit());
+      equals = si.has_value() && unit.ok() ? *si / unit->si_per_unit : 0.0;
+    }
     if (IsWholeSeriesReduction(out.reduction)) {
       // One value per series: limit (<=), lower/upper, or equals +- tolerance.
-      if (c.has_equals()) {
+      if (equals.has_value()) {
         if (bounds || limit_given) {
           errors->Add(w, "equals", "give equals (with tolerance) or limit or lower/upper, not several");
         }
-        if (!(c.tolerance() > 0.0)) {
+        if (c.tolerance() < 0.0) {
           errors->Add(w, "tolerance",
-                      absl::StrFormat("an equality constraint needs a tolerance > 0 (the band it may lie in), got %g",
-                                      c.tolerance()));
+                      absl::StrFormat("the half-width of the band the value may lie in: > 0, or 0 (absent) for "
+                                      "%g of the value, got %g",
+                                      kDefaultEqualityRelativeTolerance, c.tolerance()));
         }
-        out.lower = c.equals() - c.tolerance();
-        out.upper = c.equals() + c.tolerance();
+        // Absent: a small share of the value (of one unit for a value of 0),
+        // the band a user means by "equal".
+        const double tolerance = c.tolerance() > 0.0 ? c.tolerance()
+                                                     : kDefaultEqualityRelativeTolerance *
+                                                           std::max(std::abs(*equals), 1.0);
+        out.equals = *equals;
+        out.lower = *equals - tolerance;
+        out.upper = *equals + tolerance;
       } else if (bounds) {
         if (limit_given) errors->Add(w, "limit", "give limit or lower/upper, not both");
         if (c.has_lower()) out.lower = c.lower();
@@ -565,7 +691,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
       }
     } else {
       // One row per instant: the limit's side is the reduction's.
-      if (c.has_equals() || c.tolerance() != 0.0) {
+      if (equals.has_value() || c.tolerance() != 0.0) {
         errors->Add(w, "equals", "equals and tolerance need a reduction with one value per series (FINAL, RMS, "
                                  "INTEGRAL, RANGE, MEAN)");
       }
@@ -640,7 +766,11 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     }
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
     if (p.has_objective_target()) {
-      if (!std::isfinite(p.objective_target())) {
+      if (obj.form == Objective::Form::kFeasible) {
+        errors->Add(w, "objective_target",
+                    "the study has no objective: it stops at the first design that meets its constraints; leave "
+                    "objective_target out");
+      } else if (!std::isfinite(p.objective_target())) {
         errors->Add(w, "objective_target", "must be a finite number");
       } else {
         s.objective_target = p.objective_target();

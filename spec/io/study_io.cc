@@ -17,6 +17,7 @@
 #include "spec/io/scene_convert.h"
 #include "spec/io/study_convert.h"
 #include "spec/io/utf8_check.h"
+#include "spec/io/parse_hints.h"
 #include "spec/limits.h"
 
 namespace mbopt::spec::io {
@@ -29,7 +30,7 @@ class CollectErrors : public google::protobuf::io::ErrorCollector {
   explicit CollectErrors(std::string file) : file_(std::move(file)) {}
   void AddError(int line, google::protobuf::io::ColumnNumber column,
                 const std::string& message) override {
-    messages_.push_back(Format(line, column, message));
+    messages_.push_back(Format(line, column, WithParseHint(message)));
   }
   void AddWarning(int line, google::protobuf::io::ColumnNumber column,
                   const std::string& message) override {
@@ -81,7 +82,7 @@ absl::Status ParseText(const std::string& text, const std::string& name, google:
     if (!status.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(name, ": not a valid ",
                                                      message->GetDescriptor()->name(),
-                                                     " in JSON: ", status.message().as_string()));
+                                                     " in JSON: ", WithParseHint(status.message().as_string())));
     }
     return absl::OkStatus();
   }

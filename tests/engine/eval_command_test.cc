@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/spec/oscillator_scene.h"
+
 namespace mbopt::worker {
 namespace {
 
@@ -76,6 +78,28 @@ TEST(EvalCommand, BadInputIsExitCodeTwoWithAMessage) {
   EXPECT_THAT(r.err, HasSubstr("no/such.study.textproto"));
   r = Eval({kVehicle, "--frobnicate"});
   EXPECT_EQ(r.code, kExitBadInput);
+}
+
+// A parameter written as an expression follows the ones it reads; setting
+// it alone would be ignored by every number computed from it, so it is
+// refused.
+TEST(EvalCommand, SetRefusesAParameterWrittenAsAnExpression) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "eval_derived_parameter";
+  std::filesystem::create_directories(dir);
+  std::string scene = ::mbopt::testing::kOscillatorScene;
+  const std::string mass = "parameters { name: \"mass\" value: 2 unit: \"kg\" }\n";
+  scene.insert(scene.find(mass) + mass.size(), "parameters { name: \"double_k\" expr: \"2 * k\" }\n");
+  std::ofstream(dir / "oscillator.scene.textproto") << scene;
+  const std::string study = (dir / "oscillator.study.textproto").string();
+  std::ofstream(study) << R"pb(name: "derived"
+scene_file: "oscillator.scene.textproto"
+variables { name: "x1" parameter: "k" scale: 10 lower: 5 upper: 20 }
+objective { minimize_max_of: "acc" reduction: REDUCTION_MAX_ABS }
+)pb";
+  const EvalRun r = Eval({study, "--set", "double_k=5"});
+  EXPECT_EQ(r.code, kExitBadInput);
+  EXPECT_THAT(r.err, HasSubstr("parameter \"double_k\" is an expression of other parameters"));
+  EXPECT_EQ(Eval({study, "--set", "k=50"}).code, kExitOk);
 }
 
 TEST(EvalCommand, FailedAnalysisIsExitCodeOneWithTheReason) {

@@ -149,6 +149,12 @@ absl::Status ApplySet(const spec::Study& study, const std::string& assignment,
         absl::StrCat("--set: \"", name, "\" is neither a design variable (",
                      absl::StrJoin(names, ", "), ") nor a scene parameter"));
   }
+  if (study.scene.ParameterExpression(p) != nullptr) {
+    // Nothing reads its own value: every use computes it from those it reads.
+    return absl::InvalidArgumentError(absl::StrCat("--set: parameter \"", name,
+                                                   "\" is an expression of other parameters (`expr` in the scene); "
+                                                   "set those it reads"));
+  }
   for (size_t k = 0; k < study.variables.size(); ++k) {
     if (study.variables[k].parameter == p) {
       // A bound parameter moves its variable, so the design stays consistent.
@@ -252,12 +258,7 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     err << "mbopt-worker eval: " << values.status().message() << "\n";
     return kExitAnalysisFailed;
   }
-  const std::string objective_unit =
-      study.objective.form == spec::Objective::Form::kTargetDistance ||
-              study.objective.form == spec::Objective::Form::kWeightedSum ||
-              study.objective.form == spec::Objective::Form::kMaxOver
-          ? ""
-          : (study.objective.unit.empty() ? "SI" : study.objective.unit);
+  const std::string objective_unit = spec::ReportedObjectiveUnit(study);
 
   // Every output (per load case), then every response: what a user checks
   // their response expressions against.

@@ -12,6 +12,7 @@
 #include "server/jobs/job_result.h"
 #include "server/jobs/problem_from_study.h"
 #include "server/jobs/record_codec.h"
+#include "spec/layout.h"
 
 namespace mbopt::service {
 
@@ -705,7 +706,7 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   Eigen::VectorXd design;
   std::optional<slp::SlpOptions> options;
   if (entry.study_ok) {
-    s.objective_unit = entry.study.objective.unit;
+    s.objective_unit = spec::ReportedObjectiveUnit(entry.study);
     if (entry.job != nullptr) {
       options = entry.job->options();
     } else if (absl::StatusOr<slp::SlpOptions> from_study = jobs::SlpOptionsFromStudy(entry.study);
