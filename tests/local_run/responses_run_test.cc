@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
+#include "tests/local_run/carrier_study_fixture.h"
 #include "tests/spec/oscillator_scene.h"
 #include "worker/engine/analysis.h"
 #include "worker/local_run/local_run.h"
@@ -54,21 +55,7 @@ objective { minimize_max_of: "force" reduction: REDUCTION_MAX_ABS unit: "N" }
 // itself.
 const char* const kMaximizeStudy = ::mbopt::testing::kHillStudy;
 
-class ResponsesRun : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    dir_ = std::filesystem::path(::testing::TempDir()) / ("responses_run_" + test);
-    std::filesystem::create_directories(dir_);
-    std::ofstream(dir_ / "carrier.scene.textproto") << CarrierScene();
-  }
-  absl::StatusOr<spec::Study> Load(const std::string& text) {
-    const std::string path = (dir_ / "carrier.study.textproto").string();
-    std::ofstream(path) << text;
-    return spec::io::LoadStudyFile(path);
-  }
-  std::filesystem::path dir_;
-};
+class ResponsesRun : public ::mbopt::testing::CarrierStudyTest {};
 
 TEST_F(ResponsesRun, MinMaxOfTwoResponsesUnderALinearDesignConstraintReachesTheClosedForm) {
   absl::StatusOr<spec::Study> study = Load(kMinMaxStudy);
