@@ -329,24 +329,29 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
                                : values(term.output) * (term.reduction == Reduction::kMaxAbs ? 2 : 1);
     }
   }
+  // Each row's name holds its constraint's name (docs/study.md, "Limits").
+  std::int64_t row_name_bytes = 0;
   for (const Constraint& c : study.constraints) {
     const std::int64_t all = values(c.output);
     const std::int64_t series = c.output >= 0 && c.output < num_signals ? shapes[static_cast<size_t>(c.output)].series : 0;
+    const std::int64_t before = f.constraint_rows;
     if (IsWholeSeriesReduction(c.reduction)) {
       f.constraint_rows += series * std::max(1, (c.upper ? 1 : 0) + (c.lower ? 1 : 0));
     } else {
       f.constraint_rows += c.reduction == Reduction::kMaxAbs ? 2 * all : all;
     }
+    row_name_bytes += (f.constraint_rows - before) * static_cast<std::int64_t>(c.name.size());
   }
   const std::int64_t n = static_cast<std::int64_t>(study.variables.size());
   const std::int64_t per_value = 8 * ((n + 1)            // x0's and the perturbations' values
                                       + n                // the linearization's gradient
                                       + 5 * (n + 2) / 2) // the dense LP row and the solver's copy
-                                 + 120;                  // the row's layout entry and name
+                                 + 120;                  // the row's layout entry and the
+                                                         // name's instant and node
   std::int64_t series_values = 0;
   for (int signal = 0; signal < num_signals; ++signal) series_values += values(signal);
   f.series_bytes = 8 * series_values * (study.optimizer.simulator_sensitivities ? n + 1 : 1);
-  f.memory_bytes = (f.objective_terms + f.constraint_rows) * per_value + f.series_bytes;
+  f.memory_bytes = (f.objective_terms + f.constraint_rows) * per_value + row_name_bytes + f.series_bytes;
   return f;
 }
 

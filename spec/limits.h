@@ -12,6 +12,13 @@ namespace mbopt::spec {
 // Study and scene files: regular files no larger than this.
 inline constexpr std::int64_t kMaxInputFileBytes = 16 << 20;
 
+// Strings. A name is copied into every constraint row of its output (one
+// per node and instant: a million rows at 10^5 instants), so a long name
+// costs its length a million times; other strings (expressions, units,
+// descriptions, references) are copied once.
+inline constexpr int kMaxNameBytes = 256;
+inline constexpr int kMaxStringBytes = 64 << 10;
+
 // Counts.
 inline constexpr int kMaxTimeGridPoints = 1'000'000;
 inline constexpr int kMaxLinkageFlexibleElements = 200;  // per linkage link

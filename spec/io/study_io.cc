@@ -160,7 +160,11 @@ absl::StatusOr<Study> ConvertParsed(const std::string& path, const ParsedStudy& 
           ? study_where.Child("scene")
           : Where(parsed.scene_file, v1::Scene::descriptor(), &parsed.scene_file_tree);
   CheckUtf8Strings(parsed.study, study_where, &errors);  // an inline scene too
-  if (!parsed.scene_file.empty()) CheckUtf8Strings(parsed.scene, scene_where, &errors);
+  CheckStringLengths(parsed.study, study_where, &errors);
+  if (!parsed.scene_file.empty()) {
+    CheckUtf8Strings(parsed.scene, scene_where, &errors);
+    CheckStringLengths(parsed.scene, scene_where, &errors);
+  }
   if (!errors.empty()) return errors.ToStatus();
   Scene scene = ConvertScene(parsed.scene, scene_where, &errors);
   if (!errors.empty()) return errors.ToStatus();
@@ -213,6 +217,7 @@ absl::StatusOr<Scene> ParseSceneText(const std::string& text, const std::string&
   Errors errors;
   const Where where(source_name, v1::Scene::descriptor(), &tree);
   CheckUtf8Strings(message, where, &errors);
+  CheckStringLengths(message, where, &errors);
   if (!errors.empty()) return errors.ToStatus();
   Scene scene = ConvertScene(message, where, &errors);
   MBOPT_RETURN_IF_ERROR(errors.ToStatus());
@@ -221,8 +226,10 @@ absl::StatusOr<Scene> ParseSceneText(const std::string& text, const std::string&
 
 absl::StatusOr<Scene> SceneFromProto(const v1::Scene& message, const std::string& source_name) {
   Errors errors;
-  Scene scene =
-      ConvertScene(message, Where(source_name, v1::Scene::descriptor(), nullptr), &errors);
+  const Where where(source_name, v1::Scene::descriptor(), nullptr);
+  CheckStringLengths(message, where, &errors);
+  if (!errors.empty()) return errors.ToStatus();
+  Scene scene = ConvertScene(message, where, &errors);
   MBOPT_RETURN_IF_ERROR(errors.ToStatus());
   return scene;
 }
@@ -236,6 +243,8 @@ absl::StatusOr<Study> StudyFromProto(const v1::Study& message, const std::string
   }
   Errors errors;
   const Where where(source_name, v1::Study::descriptor(), nullptr);
+  CheckStringLengths(message, where, &errors);  // the inline scene too
+  if (!errors.empty()) return errors.ToStatus();
   Scene scene = ConvertScene(message.scene(), where.Child("scene"), &errors);
   if (!errors.empty()) return errors.ToStatus();
   Study study = ConvertStudy(message, std::move(scene), where, &errors);

@@ -1,7 +1,11 @@
 #include "spec/io/utf8_check.h"
 
+#include <functional>
 #include <string>
 #include <vector>
+
+#include "absl/strings/str_format.h"
+#include "spec/limits.h"
 
 namespace mbopt::spec::io {
 namespace {
@@ -46,9 +50,10 @@ bool IsUtf8(const std::string& text) {
 
 constexpr char kNotUtf8[] = "text is not valid UTF-8";
 
-}  // namespace
-
-void CheckUtf8Strings(const google::protobuf::Message& message, const Where& where, Errors* errors) {
+// Calls `check` for every string of `message` (recursively) with where it
+// is, its field's name and its index (-1 unless repeated).
+void ForEachString(const google::protobuf::Message& message, const Where& where,
+                   const std::function<void(const Where&, const std::string&, int, const std::string&)>& check) {
   const google::protobuf::Reflection* reflection = message.GetReflection();
   std::vector<const FieldDescriptor*> fields;
   reflection->ListFields(message, &fields);
@@ -57,22 +62,42 @@ void CheckUtf8Strings(const google::protobuf::Message& message, const Where& whe
     if (field->type() == FieldDescriptor::TYPE_STRING) {
       if (field->is_repeated()) {
         for (int i = 0; i < reflection->FieldSize(message, field); ++i) {
-          if (!IsUtf8(reflection->GetRepeatedString(message, field, i))) errors->Add(where, name, i, kNotUtf8);
+          check(where, name, i, reflection->GetRepeatedString(message, field, i));
         }
-      } else if (!IsUtf8(reflection->GetString(message, field))) {
-        errors->Add(where, name, kNotUtf8);
+      } else {
+        check(where, name, -1, reflection->GetString(message, field));
       }
     } else if (field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
       if (field->is_map()) continue;  // the schemas have no maps
       if (field->is_repeated()) {
         for (int i = 0; i < reflection->FieldSize(message, field); ++i) {
-          CheckUtf8Strings(reflection->GetRepeatedMessage(message, field, i), where.Child(name, i), errors);
+          ForEachString(reflection->GetRepeatedMessage(message, field, i), where.Child(name, i), check);
         }
       } else {
-        CheckUtf8Strings(reflection->GetMessage(message, field), where.Child(name), errors);
+        ForEachString(reflection->GetMessage(message, field), where.Child(name), check);
       }
     }
   }
+}
+
+}  // namespace
+
+void CheckUtf8Strings(const google::protobuf::Message& message, const Where& where, Errors* errors) {
+  ForEachString(message, where, [errors](const Where& w, const std::string& field, int index, const std::string& text) {
+    if (!IsUtf8(text)) errors->Add(w, field, index, kNotUtf8);
+  });
+}
+
+void CheckStringLengths(const google::protobuf::Message& message, const Where& where, Errors* errors) {
+  ForEachString(message, where, [errors](const Where& w, const std::string& field, int index, const std::string& text) {
+    const bool is_name = field == "name";
+    const std::size_t limit = static_cast<std::size_t>(is_name ? kMaxNameBytes : kMaxStringBytes);
+    if (text.size() > limit) {
+      errors->Add(w, field, index,
+                  absl::StrFormat("%s of %d bytes, more than the limit of %d", is_name ? "a name" : "text",
+                                  text.size(), limit));
+    }
+  });
 }
 
 }  // namespace mbopt::spec::io

@@ -606,6 +606,14 @@ TEST_F(ServerTest, OversizedStudyOrSourceNameIsRefusedNamingTheLimit) {
                  "more than the limit of 32 MB");
   expect_refused([](v1::SubmitJobRequest& r) { r.set_source_name(std::string(5000, 'p')); },
                  "source_name has 5000 bytes");
+  // A 100 KB study whose constraint name has 100,000 characters: each of its
+  // rows carried a copy, and the server grew to 2.4 GB.
+  expect_refused(
+      [](v1::SubmitJobRequest& r) {
+        ASSERT_GT(r.study().constraints_size(), 0);
+        r.mutable_study()->mutable_constraints(0)->set_name(std::string(100'000, 'c'));
+      },
+      "constraints[0].name: a name of 100000 bytes, more than the limit of 256");
   grpc::ClientContext context;
   v1::ListJobsResponse jobs;
   ASSERT_TRUE(stub->List(&context, v1::ListJobsRequest(), &jobs).ok());

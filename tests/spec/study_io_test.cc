@@ -383,6 +383,50 @@ TEST_F(StudyFiles, TextThatIsNotUtf8IsRefusedNamingTheField) {
       << "valid UTF-8 is accepted";
 }
 
+// A name is copied into every row of its constraint (a million at 10^5
+// instants): a 100 KB study whose constraint had a 100,000-character name
+// took a server to 2.4 GB. Names are bounded where a study is read, on the
+// file path and on the server's, with the field and its line.
+TEST_F(StudyFiles, LongNamesAreRefusedWhereTheStudyIsRead) {
+  const std::string long_name(100'000, 'n');
+  const std::string study = Replace(kStudy, "name: \"travel\"", "name: \"" + long_name + "\"");
+  EXPECT_THAT(LoadError(kScene, study),
+              HasSubstr(StudyAt("constraints {", study) + "15: constraints[0].name: a name of 100000 bytes, "
+                        "more than the limit of 256"));
+  EXPECT_THAT(LoadError(Replace(kScene, "name: \"k\"", "name: \"" + std::string(300, 'k') + "\""), kStudy),
+              HasSubstr("name: a name of 300 bytes, more than the limit of 256"));
+  // The server's path: a submitted message, without lines.
+  Write("oscillator.scene.textproto", kScene);
+  auto message = ReadStudyProto(Write("oscillator.study.textproto", kStudy));
+  ASSERT_TRUE(message.ok()) << message.status();
+  message->mutable_constraints(0)->set_name(long_name);
+  auto submitted = StudyFromProto(*message, "request");
+  ASSERT_FALSE(submitted.ok());
+  EXPECT_THAT(std::string(submitted.status().message()),
+              HasSubstr("request: constraints[0].name: a name of 100000 bytes"));
+  // Other strings have a larger bound: a long description is fine, a
+  // description over 64 KiB is not.
+  Write("oscillator.scene.textproto", kScene);
+  EXPECT_TRUE(LoadStudyFile(Write("long.study.textproto", std::string(kStudy) + "description: \"" +
+                                                            std::string(10'000, 'd') + "\"\n"))
+                  .ok());
+  EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "description: \"" + std::string(70'000, 'd') + "\"\n"),
+              HasSubstr("description: text of 70000 bytes, more than the limit of 65536"));
+}
+
+TEST_F(StudyFiles, MemoryEstimateCountsTheConstraintNameInEveryRow) {
+  Write("oscillator.scene.textproto", kScene);
+  auto short_name = LoadStudyFile(Write("short.study.textproto", kStudy));
+  auto long_name = LoadStudyFile(
+      Write("long.study.textproto", Replace(kStudy, "name: \"travel\"", "name: \"" + std::string(206, 't') + "\"")));
+  ASSERT_TRUE(short_name.ok() && long_name.ok());
+  const StudyFootprint a = EstimateStudyFootprint(*short_name);
+  const StudyFootprint b = EstimateStudyFootprint(*long_name);
+  ASSERT_EQ(a.constraint_rows, b.constraint_rows);
+  EXPECT_GT(a.constraint_rows, 0);
+  EXPECT_EQ(b.memory_bytes - a.memory_bytes, a.constraint_rows * 200);
+}
+
 TEST_F(StudyFiles, OptimizerSettingsOutsideTheMethodsRangesAreRefusedAtLoad) {
   EXPECT_THAT(LoadError(kScene, std::string(kStudy) + "optimizer { initial_move_limit: 1e300 }\n"),
               HasSubstr("optimizer.initial_move_limit: must be at most 1"));
