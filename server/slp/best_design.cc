@@ -12,14 +12,17 @@ bool BestDesign::Better(const DesignPoint& a, const DesignPoint& b) const {
   return a.max_violation < b.max_violation;
 }
 
-void BestDesign::Offer(const DesignPoint& point) {
-  if (!std::isfinite(point.objective) || !std::isfinite(point.max_violation)) return;
-  if (!best_.has_value() || Better(point, *best_)) best_ = point;
+bool BestDesign::Offer(const DesignPoint& point) {
+  if (!std::isfinite(point.objective) || !std::isfinite(point.max_violation)) return false;
+  if (best_.has_value() && !Better(point, *best_)) return false;
+  best_ = point;
+  return true;
 }
 
-void BestDesign::OfferRecord(const CycleRecord& record) {
-  Offer(DesignPoint{record.x0, record.objective_x0, record.max_violation_x0});
-  Offer(DesignPoint{record.x_trial, record.objective_trial, record.max_violation_trial});
+BestDesign::Taken BestDesign::OfferRecord(const CycleRecord& record) {
+  const bool x0 = Offer(DesignPoint{record.x0, record.objective_x0, record.max_violation_x0});
+  const bool trial = Offer(DesignPoint{record.x_trial, record.objective_trial, record.max_violation_trial});
+  return trial ? Taken::kTrial : x0 ? Taken::kX0 : Taken::kNone;
 }
 
 }  // namespace mbopt::slp

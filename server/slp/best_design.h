@@ -24,10 +24,12 @@ class BestDesign {
  public:
 
   // Offers a design; one whose values are not finite (a failed analysis) is
-  // ignored.
-  void Offer(const DesignPoint& point);
-  // Offers a cycle record's designs: x0, then the trial point.
-  void OfferRecord(const CycleRecord& record);
+  // ignored. True when it became the best.
+  bool Offer(const DesignPoint& point);
+  // Which of a record's designs became the best when offered (x0 first,
+  // then the trial point).
+  enum class Taken { kNone, kX0, kTrial };
+  Taken OfferRecord(const CycleRecord& record);
 
   const std::optional<DesignPoint>& best() const { return best_; }
 

@@ -82,6 +82,15 @@ PointValues MakePointValues(const ProblemSpec& spec, const AnalysisResult& r) {
   return v;
 }
 
+// A record whose trial point has no values (its analysis failed, or there
+// was none): every measure of the trial is NaN.
+void MarkTrialWithoutValues(CycleRecord* r) {
+  r->objective_trial = kNaN;
+  r->max_violation_trial = kNaN;
+  r->objective_error = kNaN;
+  r->max_approximation_error = kNaN;
+}
+
 Eigen::VectorXd Stack(const AnalysisResult& r) {
   Eigen::VectorXd v(r.objective_terms.size() + r.constraint_values.size());
   v << r.objective_terms, r.constraint_values;
@@ -371,18 +380,10 @@ class SlpOptimizer::Impl {
   // violated rows of the best design without keeping every design's rows.
   void Emit(CycleRecord record, const Eigen::VectorXd& x0_constraints,
             const Eigen::VectorXd& trial_constraints) {
-    const std::optional<DesignPoint> before = best_.best();
-    best_.OfferRecord(record);
-    const std::optional<DesignPoint>& after = best_.best();
-    const bool changed = after.has_value() &&
-                         (!before.has_value() || after->x != before->x ||
-                          after->objective != before->objective ||
-                          after->max_violation != before->max_violation);
-    if (changed) {
-      const bool is_trial = after->x == record.x_trial &&
-                            after->objective == record.objective_trial &&
-                            after->max_violation == record.max_violation_trial;
-      best_violation_values_ = is_trial ? trial_constraints : x0_constraints;
+    switch (best_.OfferRecord(record)) {
+      case BestDesign::Taken::kX0: best_violation_values_ = x0_constraints; break;
+      case BestDesign::Taken::kTrial: best_violation_values_ = trial_constraints; break;
+      case BestDesign::Taken::kNone: break;
     }
     new_records_.push_back(std::move(record));
   }
@@ -597,10 +598,7 @@ class SlpOptimizer::Impl {
     PointValues trial;
     if (result->outcome != AnalysisOutcome::kOk) {
       in.trial_failed = true;
-      r.objective_trial = kNaN;
-      r.max_violation_trial = kNaN;
-      r.objective_error = kNaN;
-      r.max_approximation_error = kNaN;
+      MarkTrialWithoutValues(&r);
     } else {
       trial = MakePointValues(spec_, *result);
       r.objective_trial = trial.objective;
@@ -669,7 +667,9 @@ class SlpOptimizer::Impl {
     } else {
       infeasible_lp_violations_.clear();
     }
-    const Eigen::VectorXd x0_constraints = v0_.constraints;
+    // x0's values are replaced below: moved, not copied (a million rows on
+    // a fine grid).
+    const Eigen::VectorXd x0_constraints = std::move(v0_.constraints);
     dx_old_ = d;
     dF_old_ = trial.objective - v0_.objective;
     x0_ = x_trial_;
@@ -787,11 +787,8 @@ class SlpOptimizer::Impl {
               ? absl::StrCat("restoration LP not solved: ", lp::LpStatusName(sol.status))
               : "restoration: the linearization offers no move that meets the limits";
       r.x_trial = x0_;
-      r.objective_trial = kNaN;
+      MarkTrialWithoutValues(&r);
       r.objective_predicted = kNaN;
-      r.max_violation_trial = kNaN;
-      r.objective_error = kNaN;
-      r.max_approximation_error = kNaN;
       r.analyses_total = analyses_used_;
       r.converged = restoration_end_state_ == RunState::kConverged;  // it ends the run
       Emit(std::move(r), v0_.constraints, {});
@@ -816,9 +813,7 @@ class SlpOptimizer::Impl {
     r.analyses_total = analyses_used_;
     PointValues trial;
     if (result.outcome != AnalysisOutcome::kOk) {
-      r.objective_trial = kNaN;
-      r.max_violation_trial = kNaN;
-      r.objective_error = kNaN;
+      MarkTrialWithoutValues(&r);
       r.rejection_reason = absl::StrCat("restoration analysis failed: ", result.failure_reason);
     } else {
       trial = MakePointValues(spec_, result);
@@ -835,7 +830,7 @@ class SlpOptimizer::Impl {
     }
     if (r.accepted) {
       r.converged = restoration_end_state_ == RunState::kConverged;
-      const Eigen::VectorXd x0_constraints = v0_.constraints;
+      const Eigen::VectorXd x0_constraints = std::move(v0_.constraints);
       x0_ = x_trial_;
       v0_ = trial;
       Emit(std::move(r), x0_constraints, trial.constraints);

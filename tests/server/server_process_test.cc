@@ -337,9 +337,9 @@ TEST_F(ServerProcessTest, ALargeCallWithoutATokenIsRefusedBeforeItsMessageIsRead
   tls.pem_root_certs = ReadText(pki + "/ca.pem");
   grpc::ChannelArguments arguments;
   arguments.SetMaxSendMessageSize(-1);
-  auto channel = grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(server->port),
-                                           grpc::SslCredentials(tls), arguments);
-  auto stub = v1::JobService::NewStub(channel);
+  std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
+      "127.0.0.1:" + std::to_string(server->port), grpc::SslCredentials(tls), arguments);
+  std::unique_ptr<v1::JobService::Stub> stub = v1::JobService::NewStub(channel);
   {
     // A first small call: the connection and its TLS session are set up
     // before the baseline is taken.
