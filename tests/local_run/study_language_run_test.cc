@@ -39,43 +39,39 @@ constraints { name: "on_circle" output: "circle" reduction: REDUCTION_FINAL equa
          std::to_string(equals) + " tolerance: " + std::to_string(tolerance) + " }\n";
 }
 
-class StudyLanguageRun : public ::mbopt::testing::CarrierStudyTest {};
+class StudyLanguageRun : public ::mbopt::testing::CarrierStudyTest {
+ protected:
+  // Runs the circle study whose equality `circle` = `equals` +- `tolerance`
+  // holds on the circle of `radius`: converged, inside the band as written
+  // (the rows hold its middle half, and a converged design may keep a
+  // violation of the outer quarter), every row met, at the nearest point.
+  void ExpectConvergesInsideTheBand(const std::string& circle, double equals, double tolerance, double radius) {
+    absl::StatusOr<spec::Study> study = Load(CircleStudy(circle, equals, tolerance));
+    ASSERT_TRUE(study.ok()) << study.status();
+    absl::StatusOr<LocalRunResult> result = RunStudyLocally(*study, LocalRunOptions{});
+    ASSERT_TRUE(result.ok()) << result.status();
+    const RunOutcome& run = result->outcome;
+    EXPECT_EQ(run.state, slp::RunState::kConverged) << slp::RunStateName(run.state) << " " << result->end_reason;
+    const double u = run.design[0], v = run.design[1];
+    EXPECT_LE(std::abs(u * u + v * v - radius * radius), tolerance) << "u " << u << " v " << v;
+    EXPECT_LE(run.max_violation, 0.0);
+    EXPECT_NEAR(run.objective, NearestDistanceSquared(radius), 1e-3);
+    std::cout << circle << " = " << equals << " +- " << tolerance << ": F " << run.objective << " maxg "
+              << run.max_violation << " cycles " << run.cycles << " analyses " << run.analyses << "\n";
+  }
+};
 
 // A band of 1e-5 around 0 (the circle written u^2 + v^2 - 1 = 0): the rows
 // are scaled by the quantity's size, not by the band, so the first trial is
 // not 300,000 band widths over and the run ends converged with its design
 // inside the band.
 TEST_F(StudyLanguageRun, NarrowEqualityBandAroundZeroConvergesInsideTheBand) {
-  absl::StatusOr<spec::Study> study = Load(CircleStudy("u^2 + v^2 - 1", 0.0, 1e-5));
-  ASSERT_TRUE(study.ok()) << study.status();
-  absl::StatusOr<LocalRunResult> result = RunStudyLocally(*study, LocalRunOptions{});
-  ASSERT_TRUE(result.ok()) << result.status();
-  const RunOutcome& run = result->outcome;
-  EXPECT_EQ(run.state, slp::RunState::kConverged) << slp::RunStateName(run.state) << " " << result->end_reason;
-  const double u = run.design[0], v = run.design[1];
-  // Inside the band as written (the rows hold its middle half, and a
-  // converged design may keep a violation of the outer quarter).
-  EXPECT_LE(std::abs(u * u + v * v - 1.0), 1e-5) << "u " << u << " v " << v;
-  EXPECT_LE(run.max_violation, 0.0);
-  EXPECT_NEAR(run.objective, NearestDistanceSquared(1.0), 1e-3);
-  std::cout << "band 1e-5 around 0: F " << run.objective << " maxg " << run.max_violation << " cycles "
-            << run.cycles << " analyses " << run.analyses << "\n";
+  ExpectConvergesInsideTheBand("u^2 + v^2 - 1", 0.0, 1e-5, 1.0);
 }
 
 // A band of 1e-5 of the value (u^2 + v^2 = 4 +- 4e-5).
 TEST_F(StudyLanguageRun, EqualityBandOfAHundredThousandthOfItsValueConvergesInsideTheBand) {
-  absl::StatusOr<spec::Study> study = Load(CircleStudy("u^2 + v^2", 4.0, 4e-5));
-  ASSERT_TRUE(study.ok()) << study.status();
-  absl::StatusOr<LocalRunResult> result = RunStudyLocally(*study, LocalRunOptions{});
-  ASSERT_TRUE(result.ok()) << result.status();
-  const RunOutcome& run = result->outcome;
-  EXPECT_EQ(run.state, slp::RunState::kConverged) << slp::RunStateName(run.state) << " " << result->end_reason;
-  const double u = run.design[0], v = run.design[1];
-  EXPECT_LE(std::abs(u * u + v * v - 4.0), 4e-5) << "u " << u << " v " << v;
-  EXPECT_LE(run.max_violation, 0.0);
-  EXPECT_NEAR(run.objective, NearestDistanceSquared(2.0), 1e-3);
-  std::cout << "band 1e-5 of 4: F " << run.objective << " maxg " << run.max_violation << " cycles " << run.cycles
-            << " analyses " << run.analyses << "\n";
+  ExpectConvergesInsideTheBand("u^2 + v^2", 4.0, 4e-5, 2.0);
 }
 
 // No objective: find u, v on the unit circle (`equals: 1` with its default
