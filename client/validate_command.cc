@@ -46,6 +46,10 @@ std::string ObjectiveText(const spec::Study& study, const spec::StudyLayout& lay
                                 OutputName(study, t.output), WindowText(t.window), t.unit.empty() ? "" : " in ",
                                 t.unit);
       }
+      if (layout.objective_form == spec::ObjectiveForm::kSumOfMax) {
+        text += absl::StrFormat(" (%d terms in %d groups, sum-of-maxima form)", layout.num_objective_terms(),
+                                static_cast<int>(layout.objective_group_sizes.size()));
+      }
       return text;
     }
     case spec::Objective::Form::kMaxOver: {

@@ -321,7 +321,7 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
   f.objective_terms = objective.form == Objective::Form::kMinimizeMaxOf
                           ? values(objective.output) * (objective.reduction == Reduction::kMaxAbs ? 2 : 1)
                           : 1;
-  if (objective.form == Objective::Form::kMaxOver) {
+  if (objective.form == Objective::Form::kMaxOver || objective.form == Objective::Form::kWeightedSum) {
     f.objective_terms = 0;
     for (const WeightedTerm& term : objective.sum_terms) {
       f.objective_terms += IsWholeSeriesReduction(term.reduction)
@@ -431,19 +431,42 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       if (objective.sum_terms.empty()) {
         return LayoutError(study, "objective.minimize_sum.terms", "needs at least one term");
       }
+      const bool peaks = std::any_of(objective.sum_terms.begin(), objective.sum_terms.end(),
+                                     [](const WeightedTerm& t) { return IsPeakReduction(t.reduction); });
       for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
         const WeightedTerm& term = objective.sum_terms[k];
         const std::string field = absl::StrCat("objective.minimize_sum.terms[", k, "]");
         if (!valid_output(term.output)) return LayoutError(study, field, "names no scene output or response");
-        if (layout.outputs[static_cast<size_t>(term.output)].series != 1) {
-          return LayoutError(study, field, "a term needs a single-series output");
-        }
-        const bool reduced = term.reduction != Reduction::kFinal;
+        const OutputShape& shape = layout.outputs[static_cast<size_t>(term.output)];
+        const bool peak = IsPeakReduction(term.reduction);
+        if (!peak && shape.series != 1) return LayoutError(study, field, "a term needs a single-series output");
+        const bool reduced = !peak && term.reduction != Reduction::kFinal;
         MBOPT_ASSIGN_OR_RETURN(const auto window, WindowInstants(study, field, term.window, layout.instants_s,
                                                                  scalar(term.output), reduced));
-        layout.sum_refs.push_back(SeriesRef(term.output, 0, term.reduction, window));
+        if (!peaks) {
+          layout.sum_refs.push_back(SeriesRef(term.output, 0, term.reduction, window));
+          continue;
+        }
+        // A sum with peaks: each term is a group of the min-max terms whose
+        // largest is its value (study.h, IsPeakReduction).
+        const size_t before = layout.objective_terms.size();
+        if (!peak) {
+          layout.objective_terms.push_back(SeriesRef(term.output, 0, term.reduction, window));
+          layout.objective_term_factors.push_back(term.weight / term.si_per_unit);
+        } else {
+          const double sign = term.reduction == Reduction::kMin ? -1.0 : 1.0;
+          for (int i = window.first; i <= window.second; ++i) {
+            for (int s = 0; s < shape.series; ++s) {
+              layout.objective_terms.push_back(At(term.output, s, i, sign));
+              if (term.reduction == Reduction::kMaxAbs) layout.objective_terms.push_back(At(term.output, s, i, -1.0));
+            }
+          }
+          layout.objective_term_factors.resize(layout.objective_terms.size(),
+                                               std::abs(term.weight) / term.si_per_unit);
+        }
+        layout.objective_group_sizes.push_back(static_cast<int>(layout.objective_terms.size() - before));
       }
-      layout.objective_form = ObjectiveForm::kScalar;
+      layout.objective_form = peaks ? ObjectiveForm::kSumOfMax : ObjectiveForm::kScalar;
       break;
     }
     case Objective::Form::kMaxOver: {
@@ -642,7 +665,7 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
   } else if (objective.form == Objective::Form::kFeasible) {
     values.objective = 0.0;
     values.objective_terms = {0.0};
-  } else if (objective.form == Objective::Form::kWeightedSum) {
+  } else if (objective.form == Objective::Form::kWeightedSum && layout.objective_form == ObjectiveForm::kScalar) {
     double sum = 0.0;
     for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
       const WeightedTerm& term = objective.sum_terms[k];
@@ -655,11 +678,19 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
     for (size_t k = 0; k < layout.objective_terms.size(); ++k) {
       values.objective_terms.push_back(value(layout.objective_terms[k]) * layout.objective_term_factors[k]);
     }
-    values.objective = -std::numeric_limits<double>::infinity();
-    for (double term : values.objective_terms) {
-      // A NaN term makes F NaN: it must not hide behind max().
-      if (std::isnan(term) || term > values.objective) values.objective = term;
-      if (std::isnan(values.objective)) break;
+    // F: the largest term, or with groups the sum of each group's largest.
+    const std::vector<int> one_group = {static_cast<int>(values.objective_terms.size())};
+    const std::vector<int>& groups = layout.objective_group_sizes.empty() ? one_group : layout.objective_group_sizes;
+    values.objective = 0.0;
+    size_t next = 0;
+    for (int size : groups) {
+      double group_max = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < size; ++k, ++next) {
+        const double term = values.objective_terms[next];
+        // A NaN term makes F NaN: it must not hide behind max().
+        if (!std::isnan(group_max) && (std::isnan(term) || term > group_max)) group_max = term;
+      }
+      values.objective = groups.size() == 1 ? group_max : values.objective + group_max;
     }
   }
 

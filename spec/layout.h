@@ -75,7 +75,9 @@ Dimension SignalDimension(const Study& study, int signal);
 // study without an objective.
 std::string ReportedObjectiveUnit(const Study& study);
 
-enum class ObjectiveForm { kScalar, kMinMax };
+// kSumOfMax: F = sum over groups of the group's largest term (a weighted sum
+// with peaks; StudyLayout::objective_group_sizes).
+enum class ObjectiveForm { kScalar, kMinMax, kSumOfMax };
 
 // A reference to one value of an analysis: output, series, sign, and either
 // one instant or a reduction of the series over the instants [first, last].
@@ -120,18 +122,23 @@ struct StudyLayout {
   // with target_distance: empty (the term combines several outputs); with
   // no objective: empty (F = 0).
   std::vector<ValueRef> objective_terms;
-  // kMinMax and minimize: one per objective term, the factor from its SI
-  // value to the term (1 / unit, and a kMaxOver term's weight).
+  // kMinMax, kSumOfMax and minimize: one per objective term, the factor from
+  // its SI value to the term (1 / unit, and a kMaxOver or kSumOfMax term's
+  // weight; |weight| for a minimum with a negative weight).
   std::vector<double> objective_term_factors;
   // kScalar with minimize_sum: one per term of study.objective.sum_terms.
   std::vector<ValueRef> sum_refs;
+  // kSumOfMax: one group per term of study.objective.sum_terms, in order: the
+  // number of objective_terms whose largest is that term's value (1 for a
+  // whole-series term, the window's instants and series for a peak).
+  std::vector<int> objective_group_sizes;
   std::vector<ConstraintRow> rows;
   // One per signal: the scene's outputs, then the study's responses.
   std::vector<OutputShape> outputs;
   std::vector<double> instants_s;    // the grid
 
   int num_objective_terms() const {
-    return objective_form == ObjectiveForm::kMinMax ? static_cast<int>(objective_terms.size()) : 1;
+    return objective_form == ObjectiveForm::kScalar ? 1 : static_cast<int>(objective_terms.size());
   }
   int num_constraints() const { return static_cast<int>(rows.size()); }
 };

@@ -26,6 +26,11 @@ struct DesignVariable {
 
 enum class Reduction { kMax, kMaxAbs, kMin, kFinal, kRms, kIntegral, kRange, kMean };
 
+// A term of a weighted sum whose value is the largest of a family of values
+// (REDUCTION_MAX, REDUCTION_MAX_ABS, or REDUCTION_MIN with a negative
+// weight, which is |weight| times the largest of -f).
+inline bool IsPeakReduction(Reduction r) { return r == Reduction::kMax || r == Reduction::kMaxAbs || r == Reduction::kMin; }
+
 // FINAL and the reductions over a window give one value per series; the
 // others one per instant.
 inline bool IsWholeSeriesReduction(Reduction r) {
@@ -65,7 +70,9 @@ struct Objective {
   // constraint (SlpOptionsFromStudy sets the objective target 0).
   enum class Form { kMinimizeMaxOf, kMinimize, kTargetDistance, kWeightedSum, kMaxOver, kFeasible } form =
       Form::kMinimize;
-  // kWeightedSum: the terms summed. kMaxOver: the terms whose largest value
+  // kWeightedSum: the terms summed; a peak term (IsPeakTerm) is its maximum
+  // over its window, taken through a bound variable of its own.
+  // kMaxOver: the terms whose largest value
   // is F; MAX and MAX_ABS give a term per instant of the window, the
   // whole-series reductions one; weights are positive.
   std::vector<WeightedTerm> sum_terms;

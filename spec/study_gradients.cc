@@ -108,7 +108,7 @@ absl::StatusOr<StudyGradients> ComputeStudyGradients(
     out.objective_terms.push_back(std::move(row));
   } else if (objective.form == Objective::Form::kFeasible) {
     out.objective_terms.push_back(std::vector<double>(n, 0.0));  // F = 0 everywhere
-  } else if (objective.form == Objective::Form::kWeightedSum) {
+  } else if (objective.form == Objective::Form::kWeightedSum && layout.objective_form == ObjectiveForm::kScalar) {
     std::vector<double> row(n, 0.0);
     for (size_t k = 0; k < objective.sum_terms.size(); ++k) {
       const WeightedTerm& term = objective.sum_terms[k];

@@ -29,8 +29,18 @@ absl::StatusOr<slp::ProblemSpec> ProblemSpecFromStudy(const spec::Study& study, 
     problem.upper[i] = v.upper;
     problem.initial[i] = v.initial;
   }
-  problem.objective_form = layout.objective_form == spec::ObjectiveForm::kMinMax ? slp::ObjectiveForm::kMinMax
-                                                                                 : slp::ObjectiveForm::kScalar;
+  switch (layout.objective_form) {
+    case spec::ObjectiveForm::kScalar:
+      problem.objective_form = slp::ObjectiveForm::kScalar;
+      break;
+    case spec::ObjectiveForm::kMinMax:
+      problem.objective_form = slp::ObjectiveForm::kMinMax;
+      break;
+    case spec::ObjectiveForm::kSumOfMax:
+      problem.objective_form = slp::ObjectiveForm::kSumOfMax;
+      problem.objective_group_sizes = layout.objective_group_sizes;
+      break;
+  }
   problem.num_objective_terms = layout.num_objective_terms();
   const int m = layout.num_constraints();
   problem.constraint_limits.resize(m);

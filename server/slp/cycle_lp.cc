@@ -32,13 +32,31 @@ double MinOverBox(const Eigen::VectorXd& grad, const MoveBox& box) {
 
 }  // namespace
 
-double ObjectiveValue(const Eigen::VectorXd& terms) { return terms.maxCoeff(); }
+double PredictedObjective(const ProblemSpec& spec, const Linearization& lin, const Eigen::VectorXd& d,
+                          const CycleLp* cycle_lp) {
+  const std::vector<ObjectiveGroup> groups = spec.ObjectiveGroups();
+  std::vector<double> group_max(groups.size(), -kInf);
+  auto offer = [&](int j, int g) {
+    group_max[g] = std::max(group_max[g], lin.terms0[j] + lin.terms_gradient.row(j).dot(d));
+  };
+  if (cycle_lp != nullptr && spec.HasBoundVariables()) {
+    for (size_t k = 0; k < cycle_lp->kept_terms.size(); ++k) offer(cycle_lp->kept_terms[k], cycle_lp->kept_term_groups[k]);
+  } else {
+    for (size_t g = 0; g < groups.size(); ++g) {
+      for (int j = groups[g].first; j < groups[g].first + groups[g].size; ++j) offer(j, static_cast<int>(g));
+    }
+  }
+  if (group_max.size() == 1) return group_max[0];
+  double sum = 0;
+  for (double m : group_max) sum += m;
+  return sum;
+}
 
 double OptimalityResidual(const ProblemSpec& spec, const SlpOptions& o, const Linearization& lin,
                           const MoveBox& box, const CycleLp& cycle_lp,
                           const lp::LpSolution& solution) {
   if (solution.x[cycle_lp.s_column] > o.infeasibility_tolerance) return kInf;
-  const double f0 = ObjectiveValue(lin.terms0);
+  const double f0 = ObjectiveValue(spec, lin.terms0);
   const double relative_to = std::max(std::abs(f0), o.objective_magnitude_floor);
   double residual = 0;
   for (int i = 0; i < spec.num_variables(); ++i) {
@@ -69,15 +87,18 @@ double OptimalityResidual(const ProblemSpec& spec, const SlpOptions& o, const Li
     residual = std::max(residual, unbalanced * cycle_lp.objective_scale * typical / relative_to);
   }
   // Complementarity at x0: a row that carries a multiplier must be active at
-  // x0, not only at x*. A min-max term below F0, or a constraint below its
-  // limit, with a multiplier says that the LP's optimum x* lies away from x0
-  // (a vertex of other rows), however small the reduced costs are there.
-  const bool minmax = cycle_lp.beta_column >= 0;
+  // x0, not only at x*. A term below its group's largest, or a constraint
+  // below its limit, with a multiplier says that the LP's optimum x* lies
+  // away from x0 (a vertex of other rows), however small the reduced costs
+  // are there.
   double complementarity = 0;
   int row = 0;
-  if (minmax) {
-    for (int j : cycle_lp.kept_terms) {
-      const double gap = (f0 - lin.terms0[j]) / cycle_lp.objective_scale;
+  if (cycle_lp.beta_column >= 0) {
+    const std::vector<ObjectiveGroup> groups = spec.ObjectiveGroups();
+    for (size_t k = 0; k < cycle_lp.kept_terms.size(); ++k) {
+      const ObjectiveGroup& g = groups[static_cast<size_t>(cycle_lp.kept_term_groups[k])];
+      const double group_max = lin.terms0.segment(g.first, g.size).maxCoeff();
+      const double gap = (group_max - lin.terms0[cycle_lp.kept_terms[k]]) / cycle_lp.objective_scale;
       complementarity += std::abs(solution.row_duals[row]) * std::max(0.0, gap);
       ++row;
     }
@@ -113,28 +134,36 @@ MoveBox ComputeMoveBox(const ProblemSpec& spec, const SlpOptions& o, const Eigen
 CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& o, const Linearization& lin,
                      const MoveBox& box) {
   const int n = spec.num_variables();
-  const bool minmax = spec.objective_form == ObjectiveForm::kMinMax;
-  const double f0 = ObjectiveValue(lin.terms0);
+  const bool bounded = spec.HasBoundVariables();
+  const std::vector<ObjectiveGroup> groups = spec.ObjectiveGroups();
+  const int num_groups = bounded ? static_cast<int>(groups.size()) : 0;
+  const double f0 = ObjectiveValue(spec, lin.terms0);
   CycleLp out;
 
-  // Objective terms: keep those near the maximum and any that could overtake
-  // the current maximum term inside the box.
-  if (minmax) {
-    Eigen::Index top = 0;
-    lin.terms0.maxCoeff(&top);
+  // Objective terms, group by group: keep those near the group's maximum and
+  // any that could overtake the group's current maximum term inside the box.
+  std::vector<double> group_max(groups.size(), 0.0);
+  for (int g = 0; g < num_groups; ++g) {
+    const ObjectiveGroup& group = groups[static_cast<size_t>(g)];
+    Eigen::Index top_in_group = 0;
+    group_max[g] = lin.terms0.segment(group.first, group.size).maxCoeff(&top_in_group);
+    const int top = group.first + static_cast<int>(top_in_group);
     const double top_floor =
         lin.terms0[top] + MinOverBox(lin.terms_gradient.row(top).transpose(), box);
-    const double denom = std::max(std::abs(f0), o.objective_magnitude_floor);
-    for (int j = 0; j < lin.terms0.size(); ++j) {
-      const double normalized = (lin.terms0[j] - f0) / denom;
+    const double denom = std::max(std::abs(group_max[g]), o.objective_magnitude_floor);
+    for (int j = group.first; j < group.first + group.size; ++j) {
+      const double normalized = (lin.terms0[j] - group_max[g]) / denom;
       const double reach =
           lin.terms0[j] + MaxOverBox(lin.terms_gradient.row(j).transpose(), box);
       if (j == top || normalized > o.objective_screening_threshold || reach > top_floor) {
         out.kept_terms.push_back(j);
+        out.kept_term_groups.push_back(g);
       }
     }
-  } else {
+  }
+  if (!bounded) {
     out.kept_terms.push_back(0);
+    out.kept_term_groups.push_back(0);
   }
   // Constraints: keep the critical and potentially critical ones, and any
   // whose linearization could reach its limit inside the box.
@@ -146,19 +175,24 @@ CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& o, const Lineari
     if (normalized > o.screening_threshold || reach > c) out.kept_constraints.push_back(h);
   }
 
-  double spread = 0;
-  for (int j : out.kept_terms) {
-    spread = std::max(spread, (lin.terms_gradient.row(j).transpose().cwiseAbs().array() *
+  // How far F can move inside the box: per group, the largest reach of a
+  // kept term, summed over the groups.
+  std::vector<double> group_spread(groups.size(), 0.0);
+  for (size_t k = 0; k < out.kept_terms.size(); ++k) {
+    double& spread = group_spread[static_cast<size_t>(out.kept_term_groups[k])];
+    spread = std::max(spread, (lin.terms_gradient.row(out.kept_terms[k]).transpose().cwiseAbs().array() *
                                box.half_width.array())
                                   .sum());
   }
+  double spread = group_spread[0];
+  for (size_t g = 1; g < group_spread.size(); ++g) spread += group_spread[g];
   out.objective_scale = std::max({std::abs(f0), spread, o.objective_magnitude_floor});
   const double scale = out.objective_scale;
 
-  const int columns = n + (minmax ? 1 : 0) + 1;
-  out.beta_column = minmax ? n : -1;
+  const int columns = n + num_groups + 1;
+  out.beta_column = bounded ? n : -1;
   out.s_column = columns - 1;
-  const int term_rows = minmax ? static_cast<int>(out.kept_terms.size()) : 0;
+  const int term_rows = bounded ? static_cast<int>(out.kept_terms.size()) : 0;
   const int rows = term_rows + static_cast<int>(out.kept_constraints.size());
 
   lp::LinearProgram& lp = out.lp;
@@ -167,10 +201,12 @@ CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& o, const Lineari
   lp.column_upper.resize(columns);
   lp.column_lower.head(n) = box.d_lower;
   lp.column_upper.head(n) = box.d_upper;
-  if (minmax) {
-    lp.objective[out.beta_column] = 1.0;
-    lp.column_lower[out.beta_column] = -kInf;
-    lp.column_upper[out.beta_column] = kInf;
+  if (bounded) {
+    for (int g = 0; g < num_groups; ++g) {
+      lp.objective[out.beta_column + g] = 1.0;
+      lp.column_lower[out.beta_column + g] = -kInf;
+      lp.column_upper[out.beta_column + g] = kInf;
+    }
   } else {
     lp.objective.head(n) = lin.terms_gradient.row(0).transpose() / scale;
   }
@@ -184,9 +220,10 @@ CycleLp BuildCycleLp(const ProblemSpec& spec, const SlpOptions& o, const Lineari
   int r = 0;
   for (int k = 0; k < term_rows; ++k, ++r) {
     const int j = out.kept_terms[k];
+    const int g = out.kept_term_groups[k];
     lp.rows.row(r).head(n) = lin.terms_gradient.row(j) / scale;
-    lp.rows(r, out.beta_column) = -1.0;
-    lp.row_upper[r] = (f0 - lin.terms0[j]) / scale;
+    lp.rows(r, out.beta_column + g) = -1.0;
+    lp.row_upper[r] = (group_max[g] - lin.terms0[j]) / scale;
   }
   for (int h : out.kept_constraints) {
     const double sh = spec.constraint_scales[h];

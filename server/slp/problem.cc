@@ -56,6 +56,22 @@ absl::Status ProblemSpec::Validate() const {
     return absl::InvalidArgumentError(absl::StrCat(
         "ProblemSpec: num_objective_terms = ", num_objective_terms, " must be >= 1"));
   }
+  if (objective_form == ObjectiveForm::kSumOfMax) {
+    long long total = 0;
+    for (int size : objective_group_sizes) {
+      if (size < 1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("ProblemSpec: an objective group has ", size, " terms; each needs at least 1"));
+      }
+      total += size;
+    }
+    if (objective_group_sizes.empty() || total != num_objective_terms) {
+      return absl::InvalidArgumentError(absl::StrCat("ProblemSpec: the objective groups hold ", total,
+                                                     " terms; num_objective_terms = ", num_objective_terms));
+    }
+  } else if (!objective_group_sizes.empty()) {
+    return absl::InvalidArgumentError("ProblemSpec: objective groups belong to the sum-of-maxima form only");
+  }
   const int m = num_constraints();
   if (static_cast<int>(constraint_names.size()) != m || constraint_scales.size() != m) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -76,6 +92,25 @@ absl::Status ProblemSpec::Validate() const {
     }
   }
   return absl::OkStatus();
+}
+
+std::vector<ObjectiveGroup> ProblemSpec::ObjectiveGroups() const {
+  if (objective_form != ObjectiveForm::kSumOfMax) return {ObjectiveGroup{0, num_objective_terms}};
+  std::vector<ObjectiveGroup> groups;
+  groups.reserve(objective_group_sizes.size());
+  int first = 0;
+  for (int size : objective_group_sizes) {
+    groups.push_back(ObjectiveGroup{first, size});
+    first += size;
+  }
+  return groups;
+}
+
+double ObjectiveValue(const ProblemSpec& spec, const Eigen::VectorXd& terms) {
+  if (spec.objective_form != ObjectiveForm::kSumOfMax) return terms.maxCoeff();
+  double sum = 0;
+  for (const ObjectiveGroup& g : spec.ObjectiveGroups()) sum += terms.segment(g.first, g.size).maxCoeff();
+  return sum;
 }
 
 }  // namespace mbopt::slp

@@ -61,7 +61,7 @@ constexpr int kRowsNamed = 5;
 struct PointValues {
   Eigen::VectorXd terms;
   Eigen::VectorXd constraints;
-  double objective = 0;      // F = max_j f_j
+  double objective = 0;      // F (ObjectiveValue)
   double max_violation = 0;  // maxg; 0 without constraints
   int worst_constraint = -1;
 };
@@ -70,7 +70,7 @@ PointValues MakePointValues(const ProblemSpec& spec, const AnalysisResult& r) {
   PointValues v;
   v.terms = r.objective_terms;
   v.constraints = r.constraint_values;
-  v.objective = ObjectiveValue(v.terms);
+  v.objective = ObjectiveValue(spec, v.terms);
   for (int h = 0; h < spec.num_constraints(); ++h) {
     const double g =
         (v.constraints[h] - spec.constraint_limits[h]) / spec.constraint_scales[h];
@@ -579,11 +579,7 @@ class SlpOptimizer::Impl {
           x_trial_[i] <= spec_.lower[i] + tol || x_trial_[i] >= spec_.upper[i] - tol;
     }
     // Linear predictions at x*.
-    double predicted = -std::numeric_limits<double>::infinity();
-    for (int j : cycle_lp_.kept_terms) {
-      predicted = std::max(predicted, lin_.terms0[j] + lin_.terms_gradient.row(j).dot(d));
-    }
-    r.objective_predicted = predicted;
+    r.objective_predicted = PredictedObjective(spec_, lin_, d, &cycle_lp_);
 
     MoveLimitInput in;
     in.move_limits = move_limits_;
@@ -604,7 +600,7 @@ class SlpOptimizer::Impl {
       r.objective_trial = trial.objective;
       r.max_violation_trial = trial.max_violation;
       r.worst_constraint_trial = trial.worst_constraint;
-      r.objective_error = std::abs(predicted - trial.objective) /
+      r.objective_error = std::abs(r.objective_predicted - trial.objective) /
                           std::max(std::abs(trial.objective), options_.objective_magnitude_floor);
       r.max_approximation_error = r.objective_error;
       r.worst_approximation_row = -1;
@@ -804,11 +800,7 @@ class SlpOptimizer::Impl {
     CycleRecord r = std::move(pending_restoration_record_);
     const Eigen::VectorXd d = x_trial_ - x0_;
     r.x_trial = x_trial_;
-    double predicted = -std::numeric_limits<double>::infinity();
-    for (int j = 0; j < lin_.terms0.size(); ++j) {
-      predicted = std::max(predicted, lin_.terms0[j] + lin_.terms_gradient.row(j).dot(d));
-    }
-    r.objective_predicted = predicted;
+    r.objective_predicted = PredictedObjective(spec_, lin_, d, nullptr);
     r.max_approximation_error = kNaN;
     r.analyses_total = analyses_used_;
     PointValues trial;
@@ -820,7 +812,7 @@ class SlpOptimizer::Impl {
       r.objective_trial = trial.objective;
       r.max_violation_trial = trial.max_violation;
       r.worst_constraint_trial = trial.worst_constraint;
-      r.objective_error = std::abs(predicted - trial.objective) /
+      r.objective_error = std::abs(r.objective_predicted - trial.objective) /
                           std::max(std::abs(trial.objective), options_.objective_magnitude_floor);
       r.accepted = trial.max_violation <= 0;
       if (!r.accepted) {

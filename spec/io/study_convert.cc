@@ -552,22 +552,11 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
         term.output = FindOutput(study, kw, "output", t.output(), errors);
         const std::optional<Reduction> r =
             t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
-        if (sum && r.has_value() && (*r == Reduction::kMax || *r == Reduction::kMaxAbs)) {
-          // A sum of peaks is not smooth, and the optimizer's one bound
-          // variable serves a single maximum: the study states the bounds.
-          errors->Add(
-              kw, "reduction",
-              absl::StrCat("a term of a sum takes one value, and a peak is one only through a bound: for each "
-                           "peak add a scene parameter p (its unit, a value near the peak) and a design variable "
-                           "on it, a response \"", t.output(), *r == Reduction::kMaxAbs ? " - p\" and one \"-" : " - p\"",
-                           *r == Reduction::kMaxAbs ? absl::StrCat(t.output(), " - p\"") : "",
-                           " constrained with REDUCTION_MAX limit: 0, a response \"p\" of the parameter alone, "
-                           "and make that response the term (REDUCTION_FINAL): at the optimum p is the peak "
-                           "(docs/study.md, \"A sum of peaks\")"));
-        } else if (sum && (!r.has_value() || !IsWholeSeriesReduction(*r))) {
+        if (sum && !r.has_value()) {
           errors->Add(kw, "reduction",
-                      "a term takes one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
-                      "REDUCTION_RANGE or REDUCTION_MEAN");
+                      "a term is one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
+                      "REDUCTION_RANGE or REDUCTION_MEAN, or a peak: REDUCTION_MAX, REDUCTION_MAX_ABS, or "
+                      "REDUCTION_MIN with a negative weight");
         }
         if (!sum && (!r.has_value() || *r == Reduction::kMin)) {
           errors->Add(kw, "reduction",
@@ -582,6 +571,22 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
         if (!sum && !(term.weight > 0.0)) {
           errors->Add(kw, "weight", absl::StrFormat("a term of the largest must weigh more than 0, got %g",
                                                     term.weight));
+        }
+        // A peak enters a sum through a bound variable, which can only push a
+        // largest value down: a peak with a negative weight (or a minimum
+        // with a positive one) would be maximized, which no bound states.
+        if (sum && r.has_value() && (*r == Reduction::kMax || *r == Reduction::kMaxAbs) && !(term.weight > 0.0)) {
+          errors->Add(kw, "weight",
+                      absl::StrFormat("a peak (%s) in a sum must weigh more than 0, got %g: a sum can push a peak "
+                                      "down, not up (to raise the smallest value use REDUCTION_MIN with a negative "
+                                      "weight)",
+                                      *r == Reduction::kMax ? "REDUCTION_MAX" : "REDUCTION_MAX_ABS", term.weight));
+        }
+        if (sum && r.has_value() && *r == Reduction::kMin && !(term.weight < 0.0)) {
+          errors->Add(kw, "weight",
+                      absl::StrFormat("REDUCTION_MIN in a sum needs a negative weight (raising the smallest value), "
+                                      "got %g: a sum cannot push a smallest value down",
+                                      term.weight));
         }
         term.unit = t.unit();
         term.si_per_unit = UnitFactor(kw, "unit", t.unit(), SignalDimension(study, term.output),

@@ -2,6 +2,7 @@
 // scales, studies without an objective, parameters as expressions, units
 // engineers write and the messages that say what to write instead.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -281,14 +282,60 @@ TEST_F(StudyLanguage, ReductionEqualPointsToEquals) {
   EXPECT_THAT(error, HasSubstr("to hold a value, write `equals: <value>`"));
 }
 
-// A sum of peaks: the message says how to write it with bound parameters.
-TEST_F(StudyLanguage, SumOfPeaksSaysHowToWriteItWithABound) {
-  const std::string error = LoadError(std::string(kStudyHead) +
-                                      "objective { minimize_sum { terms { output: \"acc\" reduction: REDUCTION_MAX_ABS } "
-                                      "terms { output: \"x\" } } }\n");
-  EXPECT_THAT(error, HasSubstr("objective.minimize_sum.terms[0].reduction: a term of a sum takes one value, and a "
-                               "peak is one only through a bound"));
-  EXPECT_THAT(error, HasSubstr("a response \"acc - p\" and one \"-acc - p\" constrained with REDUCTION_MAX limit: 0"));
+// A sum of peaks: each term is a group of the optimizer's terms whose largest
+// is its value (MAX_ABS: f and -f at every instant; a whole-series term: one),
+// and F adds the groups' largest, weighted.
+TEST_F(StudyLanguage, SumOfPeaksLaysOutOneGroupPerTerm) {
+  absl::StatusOr<Study> study = Load(std::string(kStudyHead) +
+                                     "objective { minimize_sum { terms { output: \"acc\" reduction: REDUCTION_MAX_ABS "
+                                     "weight: 2 } terms { output: \"x\" unit: \"mm\" } terms { output: \"x\" "
+                                     "reduction: REDUCTION_MIN weight: -3 } } }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  absl::StatusOr<StudyLayout> layout = MakeStudyLayout(*study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const int instants = static_cast<int>(layout->instants_s.size());
+  ASSERT_GT(instants, 2);
+  EXPECT_EQ(layout->objective_form, ObjectiveForm::kSumOfMax);
+  EXPECT_EQ(layout->objective_group_sizes, (std::vector<int>{2 * instants, 1, instants}));
+  EXPECT_EQ(layout->num_objective_terms(), 3 * instants + 1);
+
+  // Values: acc_i = sin(i) - 0.3 and x_i = 0.01 (i - 2)^2 m.
+  std::vector<std::vector<std::vector<double>>> series(layout->outputs.size());
+  int acc = -1, x = -1;
+  for (size_t o = 0; o < layout->outputs.size(); ++o) {
+    if (study->SignalName(static_cast<int>(o)) == "acc") acc = static_cast<int>(o);
+    if (study->SignalName(static_cast<int>(o)) == "x") x = static_cast<int>(o);
+    series[o].assign(static_cast<size_t>(layout->outputs[o].series), std::vector<double>(static_cast<size_t>(instants), 0.0));
+  }
+  ASSERT_GE(acc, 0);
+  ASSERT_GE(x, 0);
+  double peak_acc = 0, min_x = 1e300;
+  for (int i = 0; i < instants; ++i) {
+    series[static_cast<size_t>(acc)][0][static_cast<size_t>(i)] = std::sin(i) - 0.3;
+    series[static_cast<size_t>(x)][0][static_cast<size_t>(i)] = 0.01 * (i - 2) * (i - 2);
+    peak_acc = std::max(peak_acc, std::abs(std::sin(i) - 0.3));
+    min_x = std::min(min_x, 0.01 * (i - 2) * (i - 2));
+  }
+  std::vector<const std::vector<std::vector<double>>*> outputs;
+  for (const auto& s : series) outputs.push_back(&s);
+  absl::StatusOr<StudyValues> values = ComputeStudyValues(*study, *layout, outputs);
+  ASSERT_TRUE(values.ok()) << values.status();
+  const double x_final_mm = 1e3 * 0.01 * (instants - 3) * (instants - 3);
+  EXPECT_NEAR(values->objective, 2 * peak_acc + x_final_mm - 3 * min_x, 1e-9);
+}
+
+// Only a sum that pushes a peak down has a bound: a peak with a negative
+// weight, or a smallest value with a positive one, is refused with what to
+// write instead.
+TEST_F(StudyLanguage, SumOfPeaksRefusesPeaksItWouldRaise) {
+  EXPECT_THAT(LoadError(std::string(kStudyHead) +
+                        "objective { minimize_sum { terms { output: \"acc\" reduction: REDUCTION_MAX weight: -1 } "
+                        "terms { output: \"x\" } } }\n"),
+              HasSubstr("objective.minimize_sum.terms[0].weight: a peak (REDUCTION_MAX) in a sum must weigh more "
+                        "than 0, got -1"));
+  EXPECT_THAT(LoadError(std::string(kStudyHead) +
+                        "objective { minimize_sum { terms { output: \"acc\" reduction: REDUCTION_MIN } } }\n"),
+              HasSubstr("objective.minimize_sum.terms[0].weight: REDUCTION_MIN in a sum needs a negative weight"));
 }
 
 // Units engineers write, each checked against the field's kind.
