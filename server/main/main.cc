@@ -35,6 +35,7 @@ constexpr const char* kUsage =
     "                    [--worker-ca F] [--insecure] [--db PATH] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N] [--max-result-mb N]\n"
     "                    [--durability full|cycles|normal]\n"
+    "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
@@ -68,6 +69,11 @@ constexpr const char* kUsage =
     "  --max-result-mb N      largest result taken, in pieces when over the\n"
     "                         message limit, in MiB (default 1024); the server\n"
     "                         holds one such result whole while it arrives\n"
+    "  --max-running-jobs N   jobs that run at once (default 64); the others wait,\n"
+    "                         QUEUED, and start in submission order (0: no limit)\n"
+    "  --max-running-jobs-per-user N  the same per user (default 16)\n"
+    "  --max-queued-jobs-per-user N   waiting jobs a user may have; more are refused\n"
+    "                         at submit (default 1000)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -178,6 +184,17 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
         return false;
       }
       flags->server.max_result_bytes = std::llround(mb * (1 << 20));
+    } else if (name == "--max-running-jobs") {
+      if (!ParseInt(name, value, 0, &number)) return false;
+      flags->server.manager.admission.max_running_jobs = static_cast<int>(std::min<std::int64_t>(number, 1 << 30));
+    } else if (name == "--max-running-jobs-per-user") {
+      if (!ParseInt(name, value, 0, &number)) return false;
+      flags->server.manager.admission.max_running_jobs_per_user =
+          static_cast<int>(std::min<std::int64_t>(number, 1 << 30));
+    } else if (name == "--max-queued-jobs-per-user") {
+      if (!ParseInt(name, value, 0, &number)) return false;
+      flags->server.manager.admission.max_queued_jobs_per_user =
+          static_cast<int>(std::min<std::int64_t>(number, 1 << 30));
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;
@@ -234,6 +251,11 @@ int main(int argc, char** argv) {
     return mbopt::server_main::RunAddTokenCommand(argc - 2, argv + 2);
   }
   Flags flags;
+  // Admission defaults (docs/server.md, "Admission"): a server shared by
+  // many users runs a bounded number of jobs, and no user crowds out others.
+  flags.server.manager.admission.max_running_jobs = 64;
+  flags.server.manager.admission.max_running_jobs_per_user = 16;
+  flags.server.manager.admission.max_queued_jobs_per_user = 1000;
   if (!ParseFlags(argc, argv, &flags)) return 2;
   if (flags.server.heartbeat_ms >= flags.server.lease_ms) {
     // Keep the default heartbeat sensible for short test leases.

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -403,6 +404,115 @@ TEST_F(ServerTest, CancelThenResumeGivesTheSameResult) {
   v1::JobSummary summary;
   grpc::Status status = stub->Resume(&context, ref, &summary);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+}
+
+JobManagerOptions OneRunningJob(int max_queued_per_user = 0) {
+  JobManagerOptions manager;
+  manager.admission.max_running_jobs = 1;
+  manager.admission.max_queued_jobs_per_user = max_queued_per_user;
+  return manager;
+}
+
+// With one job allowed to run, the next ones wait (QUEUED, saying where they
+// are in the queue) and start in submission order as the running one ends;
+// a job that waited gives the result it gives when it runs at once.
+TEST_F(ServerTest, JobsBeyondTheRunningLimitWaitAndStartInSubmissionOrder) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  auto server = StartServer("queue.db", OneRunningJob());
+  const std::string a = Submit(*server, OscillatorStudy());
+  const std::string b = Submit(*server, OscillatorStudy());
+  const std::string c = Submit(*server, OscillatorStudy());
+  EXPECT_EQ(Get(*server, a).summary().state(), v1::JOB_STATE_RUNNING);
+  v1::GetJobResponse waiting_b = Get(*server, b);
+  EXPECT_EQ(waiting_b.summary().state(), v1::JOB_STATE_QUEUED);
+  EXPECT_THAT(waiting_b.summary().message(), HasSubstr("waiting to run: 0 jobs ahead in the queue"));
+  EXPECT_THAT(waiting_b.summary().message(), HasSubstr("--max-running-jobs 1"));
+  EXPECT_THAT(Get(*server, c).summary().message(), HasSubstr("1 job ahead"));
+
+  // One result at a time: never two jobs running, and each starts (in
+  // submission order) only once the one before it has ended.
+  FakeWorker worker(server->InProcessChannel(), 7);
+  const std::vector<std::string> ids = {a, b, c};
+  std::vector<int> started_at(3, -1), ended_at(3, -1);
+  for (int step = 0; step < 1000 && ended_at[2] < 0; ++step) {
+    int running = 0;
+    for (int j = 0; j < 3; ++j) {
+      const v1::JobState state = Get(*server, ids[static_cast<size_t>(j)]).summary().state();
+      running += state == v1::JOB_STATE_RUNNING ? 1 : 0;
+      if (state != v1::JOB_STATE_QUEUED && started_at[static_cast<size_t>(j)] < 0) started_at[static_cast<size_t>(j)] = step;
+      if (state == v1::JOB_STATE_CONVERGED && ended_at[static_cast<size_t>(j)] < 0) ended_at[static_cast<size_t>(j)] = step;
+    }
+    ASSERT_LE(running, 1) << "step " << step;
+    worker.Run(1);
+  }
+  ASSERT_GE(ended_at[2], 0);
+  EXPECT_EQ(started_at[0], 0);
+  EXPECT_EQ(started_at[1], ended_at[0]);
+  EXPECT_EQ(started_at[2], ended_at[1]);
+  for (const std::string& id : ids) {
+    v1::GetJobResponse done = Get(*server, id);
+    EXPECT_EQ(done.summary().state(), v1::JOB_STATE_CONVERGED) << id;
+    ExpectSameCycles(reference, done);
+  }
+}
+
+TEST_F(ServerTest, AUserWithTooManyWaitingJobsIsRefusedSayingTheLimit) {
+  auto server = StartServer("quota.db", OneRunningJob(/*max_queued_per_user=*/1));
+  Submit(*server, OscillatorStudy());  // runs
+  Submit(*server, OscillatorStudy());  // waits
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::SubmitJobRequest request;
+  *request.mutable_study() = OscillatorStudy();
+  request.set_source_name("third.study.textproto");
+  v1::SubmitJobResponse response;
+  grpc::Status status = stub->Submit(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("already has 1 jobs waiting to run (the server's "
+                                                "--max-queued-jobs-per-user)"));
+}
+
+// A waiting job stays waiting across a stop of the server and starts after
+// the job that ran before it; cancelled while waiting, it never starts, and
+// `resume` puts it back in the queue.
+TEST_F(ServerTest, WaitingJobsKeepTheirPlaceAcrossARestartAndCanBeCancelled) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  std::string a, b, c;
+  {
+    auto server = StartServer("restart.db", OneRunningJob());
+    a = Submit(*server, OscillatorStudy());
+    b = Submit(*server, OscillatorStudy());
+    c = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 5);
+    worker.Run(6);
+    server->Shutdown();
+  }
+  auto server = StartServer("restart.db", OneRunningJob());
+  EXPECT_EQ(Get(*server, a).summary().state(), v1::JOB_STATE_RUNNING);
+  EXPECT_EQ(Get(*server, b).summary().state(), v1::JOB_STATE_QUEUED);
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  v1::JobRef ref;
+  ref.set_job_id(c);
+  {
+    grpc::ClientContext context;
+    v1::JobSummary summary;
+    ASSERT_TRUE(stub->Cancel(&context, ref, &summary).ok());
+    EXPECT_EQ(summary.state(), v1::JOB_STATE_CANCELLED);
+  }
+  {
+    grpc::ClientContext context;
+    v1::JobSummary summary;
+    ASSERT_TRUE(stub->Resume(&context, ref, &summary).ok());
+    EXPECT_EQ(summary.state(), v1::JOB_STATE_QUEUED);
+    EXPECT_THAT(summary.message(), HasSubstr("1 job ahead"));
+  }
+  FakeWorker worker(server->InProcessChannel(), 6);
+  worker.Run();
+  for (const std::string& id : {a, b, c}) {
+    v1::GetJobResponse done = Get(*server, id);
+    EXPECT_EQ(done.summary().state(), v1::JOB_STATE_CONVERGED) << id;
+    ExpectSameCycles(reference, done);
+  }
 }
 
 // A state change and its line in the event log are one commit (one sync

@@ -72,7 +72,8 @@ JobManager::JobManager(store::Store* store, scheduler::Scheduler* scheduler, Stu
       scheduler_(scheduler),
       decoder_(std::move(decoder)),
       options_(std::move(options)),
-      clock_(options_.clock != nullptr ? options_.clock : &steady_clock_) {
+      clock_(options_.clock != nullptr ? options_.clock : &steady_clock_),
+      admission_(options_.admission) {
   if (store_->durability() == store::Durability::kCycles) syncer_ = std::thread([this] { SyncLoop(); });
 }
 
@@ -158,6 +159,12 @@ double JobManager::WallSecondsLocked(const Entry& entry) const {
 absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string message, const std::string& event,
                                           const std::string& event_detail, Persist persist) {
   const std::string& id = entry.row.id;
+  if (entry.state != to) {
+    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+    if (entry.state == JobState::kRunning) admission_.Stopped(entry.row.owner);
+    if (to == JobState::kRunning) admission_.Started(entry.row.owner);
+    if (entry.state == JobState::kQueued) admission_.Remove(id);
+  }
   if (to == JobState::kRunning) {
     if (!entry.timing) {
       entry.timing = true;
@@ -285,6 +292,20 @@ absl::Status JobManager::Start() {
       FailJobLocked(*entry, absl::StrCat("cannot read the cycle log: ", cycles.message()));
       continue;
     }
+    if (entry->state == JobState::kQueued) {
+      if (!entry->study_ok) {
+        FailJobLocked(*entry, absl::StrCat("cannot start: the stored study is invalid: ", entry->message));
+        continue;
+      }
+      std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+      admission_.Enqueue(entry->row.seq, id, entry->row.owner);
+      continue;
+    }
+    if (entry->state == JobState::kRunning) {
+      // It was admitted before the server ended: it counts as running.
+      std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+      admission_.Started(entry->row.owner);
+    }
     if (Running(entry->state) || entry->state == JobState::kInterrupted) {
       const std::string why = entry->state == JobState::kInterrupted ? "the server was stopped"
                                                                      : "the server ended without stopping the job";
@@ -294,6 +315,7 @@ absl::Status JobManager::Start() {
       EvictLocked(*entry);
     }
   }
+  AdmitWaiting();
   return absl::OkStatus();
 }
 
@@ -303,23 +325,39 @@ absl::Status JobManager::NoSuchJob(const std::string& job_id) {
 
 absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, const std::string& source_name,
                                                const std::string& owner, const std::string& actor) {
+  std::lock_guard<std::mutex> admit_lock(admit_mutex_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
   MBOPT_ASSIGN_OR_RETURN(spec::Study study, decoder_(study_bytes, source_name));
   MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study, options_.make_lp_solver()));
+  bool room = false;
+  {
+    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+    room = admission_.HasRoomFor(owner);
+    if (!room) MBOPT_RETURN_IF_ERROR(admission_.CheckQueueRoom(owner));
+  }
+  // A queued job keeps its study, not its optimizer: ResumeLocked makes one
+  // when its turn comes.
+  if (!room) job.reset();
+  const JobState state = room ? JobState::kRunning : JobState::kQueued;
   store::JobRow row;
   row.study_name = study.name;
   row.source_name = source_name;
   row.owner = owner;
   row.study = study_bytes;
-  row.state = jobs::JobStateName(JobState::kRunning);
+  row.state = jobs::JobStateName(state);
   MBOPT_ASSIGN_OR_RETURN(store::JobRow stored, store_->CreateJob(row, store::NewEvent{"submitted", source_name + ByActor(actor)}));
   auto entry = std::make_shared<Entry>();
   std::lock_guard<std::mutex> entry_lock(entry->mutex);
   entry->row = std::move(stored);
-  entry->layout = job->shared_layout();
+  if (room) {
+    entry->layout = job->shared_layout();
+  } else {
+    MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
+    entry->layout = std::make_shared<const spec::StudyLayout>(std::move(layout));
+  }
   entry->study = std::move(study);
   entry->study_ok = true;
   entry->job = std::move(job);
@@ -328,13 +366,52 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_[id] = entry;
   }
-  // CreateJob stored the state and its event.
+  if (!room) {
+    // CreateJob stored the state and its event.
+    entry->state = JobState::kQueued;
+    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+    admission_.Enqueue(entry->row.seq, id, owner);
+    Changed(*entry);
+    return id;
+  }
   (void)EnterStateLocked(*entry, JobState::kRunning, "", "", "", Persist::kAlreadyStored);
   ScheduleLocked(*entry);
   return id;
 }
 
-absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
+void JobManager::AdmitWaiting() {
+  std::lock_guard<std::mutex> admit_lock(admit_mutex_);
+  while (true) {
+    std::optional<std::string> next;
+    {
+      std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+      if (admission_.queued() == 0) return;
+      next = admission_.NextToStart();
+    }
+    if (!next.has_value()) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (shutdown_) return;
+    }
+    absl::StatusOr<std::shared_ptr<Entry>> entry = Find(*next);
+    if (!entry.ok()) {
+      std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+      admission_.Remove(*next);
+      continue;
+    }
+    std::lock_guard<std::mutex> lock((*entry)->mutex);
+    if ((*entry)->state != JobState::kQueued) {
+      std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+      admission_.Remove(*next);
+      continue;
+    }
+    // A failure has failed the job (or left it interrupted): it left the queue either way.
+    absl::Status started = ResumeLocked(**entry, "its turn in the queue came", "started");
+    if (!started.ok()) LogError(*next, started);
+  }
+}
+
+absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why, const std::string& event) {
   const std::string& id = entry.row.id;
   if (!entry.study_ok) {
     const std::string message = absl::StrCat("cannot resume: the stored study is invalid: ", entry.message);
@@ -375,7 +452,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why) {
   entry.job = *std::move(job);
   entry.records = std::move(decoded);
   absl::Status status = EnterStateLocked(
-      entry, JobState::kRunning, "", "resumed",
+      entry, JobState::kRunning, "", event,
       absl::StrCat(why, "; replayed ", analyses->size(), " analyses and ", logged_records.size(), " cycle records"));
   if (!status.ok()) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", status.message()));
@@ -573,6 +650,12 @@ absl::StatusOr<bool> JobManager::ReportResult(WorkerReport report) {
 }
 
 std::vector<absl::StatusOr<bool>> JobManager::ReportResults(std::vector<WorkerReport> reports) {
+  std::vector<absl::StatusOr<bool>> answers = IntakeResults(std::move(reports));
+  AdmitWaiting();
+  return answers;
+}
+
+std::vector<absl::StatusOr<bool>> JobManager::IntakeResults(std::vector<WorkerReport> reports) {
   std::vector<absl::StatusOr<bool>> answers(reports.size(), false);
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -674,15 +757,18 @@ absl::Status JobManager::ReportWorkerError(const std::string& worker_id, const s
   MBOPT_ASSIGN_OR_RETURN(std::optional<scheduler::FinishedTask> given_up,
                          scheduler_->Fail(worker_id, task_id, reason));
   if (given_up) GiveUp(*given_up);
+  AdmitWaiting();
   return absl::OkStatus();
 }
 
 void JobManager::WorkerLost(const std::string& worker_id) {
   for (const scheduler::FinishedTask& task : scheduler_->WorkerLost(worker_id)) GiveUp(task);
+  AdmitWaiting();
 }
 
 void JobManager::ExpireLeases() {
   for (const scheduler::FinishedTask& task : scheduler_->ExpireLeases()) GiveUp(task);
+  AdmitWaiting();
 }
 
 JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
@@ -699,6 +785,10 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   s.owner = entry.row.owner;
   s.state = entry.state;
   s.message = entry.message;
+  if (entry.state == JobState::kQueued) {
+    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+    s.message = admission_.WhyWaiting(entry.row.id);
+  }
   s.created_unix_ms = entry.row.created_unix_ms;
   s.wall_seconds = WallSecondsLocked(entry);
   s.cycles = entry.row.cycles;
@@ -813,29 +903,51 @@ absl::StatusOr<std::string> JobManager::OwnerOf(const std::string& job_id) {
 
 absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id, const std::string& actor) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
-  std::lock_guard<std::mutex> lock(entry->mutex);
-  if (!Running(entry->state) && entry->state != JobState::kInterrupted) {
-    return absl::FailedPreconditionError(absl::StrCat("job '", job_id, "' has already ended (",
-                                                      jobs::JobStateName(entry->state), ")"));
+  JobSummaryData summary;
+  {
+    std::lock_guard<std::mutex> lock(entry->mutex);
+    if (!Running(entry->state) && entry->state != JobState::kInterrupted) {
+      return absl::FailedPreconditionError(absl::StrCat("job '", job_id, "' has already ended (",
+                                                        jobs::JobStateName(entry->state), ")"));
+    }
+    MBOPT_RETURN_IF_ERROR(EnterStateLocked(*entry, JobState::kCancelled,
+                                           "cancelled on request; `resume` continues it", "cancelled",
+                                           actor.empty() ? "" : absl::StrCat("by ", actor)));
+    summary = SummaryLocked(*entry);
   }
-  MBOPT_RETURN_IF_ERROR(EnterStateLocked(*entry, JobState::kCancelled, "cancelled on request; `resume` continues it",
-                                         "cancelled", actor.empty() ? "" : absl::StrCat("by ", actor)));
-  return SummaryLocked(*entry);
+  AdmitWaiting();
+  return summary;
 }
 
 absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id, const std::string& actor) {
+  std::lock_guard<std::mutex> admit_lock(admit_mutex_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   std::lock_guard<std::mutex> lock(entry->mutex);
-  if (entry->state == JobState::kRunning) return SummaryLocked(*entry);
+  if (entry->state == JobState::kRunning || entry->state == JobState::kQueued) return SummaryLocked(*entry);
   if (!jobs::IsResumable(entry->state)) {
     return absl::FailedPreconditionError(absl::StrCat("job '", job_id, "' has ended (",
                                                       jobs::JobStateName(entry->state), ") and cannot be resumed"));
   }
   MBOPT_RETURN_IF_ERROR(RestoreLocked(*entry));
+  bool room = false;
+  {
+    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+    room = admission_.HasRoomFor(entry->row.owner);
+    if (!room) MBOPT_RETURN_IF_ERROR(admission_.CheckQueueRoom(entry->row.owner));
+  }
+  if (!room) {
+    MBOPT_RETURN_IF_ERROR(EnterStateLocked(*entry, JobState::kQueued, "", "queued",
+                                           "resume asked while the running limits are reached" + ByActor(actor)));
+    {
+      std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+      admission_.Enqueue(entry->row.seq, job_id, entry->row.owner);
+    }
+    return SummaryLocked(*entry);
+  }
   MBOPT_RETURN_IF_ERROR(ResumeLocked(*entry, "resumed on request" + ByActor(actor)));
   return SummaryLocked(*entry);
 }
@@ -900,7 +1012,8 @@ void JobManager::Shutdown() {
   scheduler_->Shutdown();
   for (const auto& entry : entries) {
     std::lock_guard<std::mutex> lock(entry->mutex);
-    if (!Running(entry->state)) continue;
+    // A queued job stays queued: it waits for its turn after the restart too.
+    if (!Running(entry->state) || entry->state == JobState::kQueued) continue;
     (void)EnterStateLocked(*entry, JobState::kInterrupted, "the server was stopped; the job resumes when it starts again",
                            "interrupted", "server stopped");
   }

@@ -45,6 +45,7 @@
 #include "server/jobs/analysis_record.h"
 #include "server/jobs/job.h"
 #include "server/jobs/job_state.h"
+#include "server/jobs/manager/admission.h"
 #include "server/lp/linear_program.h"
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
@@ -70,6 +71,8 @@ struct JobManagerOptions {
   std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver;
   // Measures the jobs' running time; not owned. nullptr: a steady clock.
   const scheduler::Clock* clock = nullptr;
+  // How many jobs run at once; the others wait (QUEUED) in submission order.
+  AdmissionLimits admission;
 };
 
 struct JobSummaryData {
@@ -137,8 +140,11 @@ class JobManager {
   // fails is marked FAILED with the reason; the others go on.
   absl::Status Start();
 
-  // Validates and starts a study. InvalidArgument from the decoder. `owner`
-  // is the name of who submitted it ("" on a server without tokens).
+  // Validates and starts a study, or queues it (QUEUED) while the running
+  // limits are reached (JobManagerOptions::admission). InvalidArgument from
+  // the decoder; ResourceExhausted when the owner may not queue one more
+  // job. `owner` is the name of who submitted it ("" on a server without
+  // tokens).
   // `actor` (here and for Cancel and Resume) says who asked, for the job's
   // event log ("user alice (peer ipv4:...)"); "": nobody is named.
   absl::StatusOr<std::string> Submit(const std::string& study_bytes, const std::string& source_name,
@@ -156,8 +162,9 @@ class JobManager {
   absl::StatusOr<std::vector<JobSummaryData>> List();
   // FailedPrecondition when the job has already ended.
   absl::StatusOr<JobSummaryData> Cancel(const std::string& job_id, const std::string& actor = "");
-  // Continues an interrupted or cancelled job (replaying its log); a running
-  // job is returned as is. FailedPrecondition for a job that has ended.
+  // Continues an interrupted or cancelled job (replaying its log), or queues
+  // it while the running limits are reached; a running or queued job is
+  // returned as is. FailedPrecondition for a job that has ended.
   absl::StatusOr<JobSummaryData> Resume(const std::string& job_id, const std::string& actor = "");
 
   // Waits (real time, at most `max_wait_ms`) until the job's version differs
@@ -225,6 +232,11 @@ class JobManager {
   struct Entry;
 
   absl::StatusOr<std::shared_ptr<Entry>> Find(const std::string& job_id);
+  // Starts queued jobs while the limits allow, oldest first. Called with no
+  // lock held, after every call that may have stopped a job.
+  void AdmitWaiting();
+  // The body of ReportResults (AdmitWaiting follows it, outside its locks).
+  std::vector<absl::StatusOr<bool>> IntakeResults(std::vector<WorkerReport> reports);
   // The following run under the entry's mutex.
   // How EnterStateLocked records a state: SetJobState, or already stored
   // by the caller in the same transaction as other rows.
@@ -236,7 +248,9 @@ class JobManager {
   // and wakes watchers. Returns the store's error; it is also logged.
   absl::Status EnterStateLocked(Entry& entry, jobs::JobState to, std::string message, const std::string& event,
                                 const std::string& event_detail, Persist persist = Persist::kSetState);
-  absl::Status ResumeLocked(Entry& entry, const std::string& why);
+  // Makes the job's optimizer again (replaying its log) and runs it; `event`
+  // names the change in the job's event log.
+  absl::Status ResumeLocked(Entry& entry, const std::string& why, const std::string& event = "resumed");
   // Loads the study (decoded and laid out) and the cycle records of the
   // entry's row (row.study must be set); `cycles_status` says whether the
   // cycle log could be read. A study that cannot be decoded leaves study_ok
@@ -317,6 +331,12 @@ class JobManager {
   bool shutdown_ = false;
   std::int64_t records_committed_ = 0;
   std::atomic<std::int64_t> evictions_{0};
+
+  // Lock order: admit_mutex_, then mutex_ or a job's mutex, then
+  // admission_mutex_ (taken last and briefly, by EnterStateLocked too).
+  std::mutex admit_mutex_;  // one admission decision at a time (Submit, Resume, AdmitWaiting)
+  mutable std::mutex admission_mutex_;  // guards admission_
+  Admission admission_;
 
   std::mutex sync_mutex_;  // guards the five below
   std::condition_variable sync_wanted_;
