@@ -20,6 +20,7 @@
 #include "mbopt/v1/service.pb.h"
 #include "spec/layout.h"
 #include "spec/study.h"
+#include "worker/engine/external_analyzer.h"
 
 namespace mbopt::worker {
 
@@ -39,8 +40,8 @@ absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Stud
 enum class ValueEncoding { kPacked, kUnpacked };
 
 // Fills everything of `result` except worker_id, task_id, job_id and
-// request_id.
+// request_id. `external` runs external scenes (null: they fail).
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
-                  v1::TaskResult* result);
+                  v1::TaskResult* result, const engine::ExternalAnalyzer* external = nullptr);
 
 }  // namespace mbopt::worker

@@ -10,6 +10,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <mutex>
 #include <set>
 #include <string>
@@ -337,7 +338,10 @@ class Worker : public std::enable_shared_from_this<Worker> {
       }
       const auto started = std::chrono::steady_clock::now();
       if (study != nullptr) {
-        EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result);
+        std::optional<external::ExternalSceneAnalyzer> analyzer;
+        if (options_.external != nullptr) analyzer.emplace(*options_.external, task.task_id());
+        EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result,
+                     analyzer.has_value() ? &*analyzer : nullptr);
         FitResultToServerLimit(max_message_bytes, max_result_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
