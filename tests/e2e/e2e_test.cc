@@ -56,14 +56,16 @@ std::string SubmitWatchAndGetResults(const std::string& address, const std::stri
   return results.stdout_text;
 }
 
-// A study (default: the vehicle) on a fresh server with `workers` plain workers.
-std::string ReferenceResult(int workers, const std::string& study = VehicleStudy()) {
+// A study (default: the vehicle) on a fresh server with `workers` workers
+// started with `worker_args`.
+std::string ReferenceResult(int workers, const std::string& study = VehicleStudy(),
+                            const std::vector<std::string>& worker_args = {}) {
   ScratchDir dir;
   auto server = StartServer(dir.File("ref.db"), {}, "127.0.0.1:0", dir.File("server.log"));
   EXPECT_TRUE(server.ok()) << server.status();
   if (!server.ok()) return "";
   std::vector<Subprocess> pool;
-  for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address));
+  for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address, worker_args));
   std::string json = SubmitWatchAndGetResults(server->address, study);
   for (auto& w : pool) w.Stop(kGuard);
   EXPECT_EQ(server->process->Stop(kGuard), 0) << "server did not shut down cleanly";
@@ -209,8 +211,9 @@ TEST(EndToEnd, KilledWorkersTaskIsRequeuedWithoutWaitingForItsLease) {
 // the uninterrupted run's result, bit for bit.
 void ExpectServerKilledMidJobResumesBitIdentically(
     const std::string& study, const std::vector<std::string>& server_args = {},
-    const std::vector<std::string>& crash_flags = {"--crash-after-cycles", "2"}, int min_cycles_at_restart = 2) {
-  const std::string reference = Comparable(ReferenceResult(2, study));
+    const std::vector<std::string>& crash_flags = {"--crash-after-cycles", "2"}, int min_cycles_at_restart = 2,
+    const std::vector<std::string>& worker_args = {}) {
+  const std::string reference = Comparable(ReferenceResult(2, study, worker_args));
   ASSERT_FALSE(reference.empty());
 
   ScratchDir dir;
@@ -222,7 +225,7 @@ void ExpectServerKilledMidJobResumesBitIdentically(
   ASSERT_TRUE(first.ok()) << first.status();
   std::vector<Subprocess> pool;
   for (int i = 0; i < 2; ++i) {
-    pool.push_back(StartWorker(first->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
+    pool.push_back(StartWorker(first->address, worker_args, dir.File(absl::StrCat("worker", i, ".log"))));
   }
   auto submitted = Mbopt({"submit", study, "--server", first->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
@@ -326,6 +329,46 @@ TEST(EndToEnd, RunJsonStartsEverythingAndPrintsOneJsonObject) {
   EXPECT_EQ(Comparable(run.stdout_text), reference);
   const std::string database = JsonField(json, "database");
   EXPECT_NE(database.find("/mbopt/runs/vehicle-"), std::string::npos) << "where the job is kept\n" << json;
+}
+
+// A simulator mbopt did not write (examples/external: a python3 script
+// behind a declared driver) optimized through the service: `mbopt run
+// --drivers` with two local workers gives the same result, bit for bit, as
+// submit and watch to a server with two workers started with --drivers, and
+// the optimum sits on the travel limit.
+TEST(EndToEnd, ExternalSimulatorStudyRunsThroughRunAndSubmitAlike) {
+  const std::string reference = Comparable(ReferenceResult(2, ExternalStudy(), {"--drivers", ExternalDrivers()}));
+  ASSERT_FALSE(reference.empty());
+  auto run = Mbopt({"run", ExternalStudy(), "--workers", "2", "--drivers", ExternalDrivers(), "--json",
+                    "--discard-db"},
+                   {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()});
+  ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);
+  EXPECT_EQ(Comparable(run.stdout_text), reference);
+  EXPECT_EQ(JsonField(run.stdout_text, "status"), "converged") << run.stdout_text;
+  const double max_violation = std::stod(JsonField(run.stdout_text, "max_violation"));
+  EXPECT_LE(max_violation, 0.0) << "the reported design meets the travel limit";
+  EXPECT_GT(max_violation, -1e-3) << "and the limit is active at the optimum";
+}
+
+// A server killed in the middle of the external study resumes it with the
+// uninterrupted run's result, bit for bit: the driver is deterministic and
+// its numbers are parsed exactly.
+TEST(EndToEnd, ExternalSimulatorJobKilledMidJobResumesBitIdentically) {
+  ExpectServerKilledMidJobResumesBitIdentically(ExternalStudy(), {}, {"--crash-after-cycles", "2"}, 2,
+                                                {"--drivers", ExternalDrivers()});
+}
+
+// A drivers file with a problem stops `mbopt run` before anything starts,
+// naming the file, the line and the field.
+TEST(BadInput, RunWithABadDriversFileNamesItsProblem) {
+  ScratchDir dir;
+  const std::string drivers = dir.Write("bad.drivers.textproto", "driver {\n  name: \"x\"\n  timeout_s: -1\n}\n");
+  auto run = Mbopt({"run", ExternalStudy(), "--drivers", drivers, "--discard-db"},
+                   {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()});
+  EXPECT_EQ(run.exit_code, kExitBadInput) << Describe(run);
+  EXPECT_NE(run.stderr_text.find("bad.drivers.textproto:"), std::string::npos) << Describe(run);
+  EXPECT_NE(run.stderr_text.find("driver[0]."), std::string::npos) << Describe(run);
+  EXPECT_EQ(run.stdout_text.find("server at"), std::string::npos) << "nothing was started";
 }
 
 // From `mbopt run` to the report page in two commands: run keeps its
