@@ -21,6 +21,7 @@
 #include "spec/layout.h"
 #include "spec/study.h"
 #include "worker/engine/external_analyzer.h"
+#include "worker/external/scene_analyzer.h"
 
 namespace mbopt::worker {
 
@@ -33,6 +34,10 @@ struct PreparedStudy {
 // InvalidArgument if the study (as the server sent it) does not convert.
 absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Study& study,
                                                                   const std::string& job_id);
+
+// Why this worker cannot run any task of `study` (an external scene whose
+// driver `external` does not declare, or no drivers at all); "" when it can.
+std::string CannotRun(const spec::Study& study, const external::ExternalWorkerSettings* external);
 
 // How a result carries its values: packed (common/packed_doubles) for a
 // server that reads them, as repeated doubles for an older one

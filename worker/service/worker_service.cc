@@ -337,7 +337,14 @@ class Worker : public std::enable_shared_from_this<Worker> {
         takes_packed_values = takes_packed_values_;
       }
       const auto started = std::chrono::steady_clock::now();
-      if (study != nullptr) {
+      const std::string cannot_run = study != nullptr ? CannotRun(study->study, options_.external) : "";
+      if (!cannot_run.empty()) {
+        // Not the design point's fault: another worker may declare the
+        // driver (the server prefers one that has not failed the task).
+        result.set_ok(false);
+        result.set_retry(true);
+        result.set_failure_reason(cannot_run);
+      } else if (study != nullptr) {
         std::optional<external::ExternalSceneAnalyzer> analyzer;
         if (options_.external != nullptr) analyzer.emplace(*options_.external, task.task_id());
         EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result,
