@@ -62,6 +62,26 @@ std::string DefaultRunDatabasePath(const std::string& study_path) {
   return (dir / (stem + "-" + stamp + "-" + std::to_string(getpid()) + ".db")).string();
 }
 
+// Waits until `count` workers have registered with the local server (a
+// failure guard of 60 s: a worker that cannot start says why in its log).
+absl::Status WaitForWorkers(v1::JobService::Stub& job_service, int count) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (true) {
+    v1::ListWorkersResponse workers;
+    grpc::ClientContext context;
+    SetUnaryDeadline(&context);
+    grpc::Status status = job_service.ListWorkers(&context, v1::ListWorkersRequest(), &workers);
+    if (status.ok() && workers.workers_size() >= count) return absl::OkStatus();
+    if (std::chrono::steady_clock::now() > deadline) {
+      return absl::DeadlineExceededError(absl::StrCat("mbopt run: ", status.ok() ? workers.workers_size() : 0, " of ",
+                                                      count, " local workers registered within 60 s"));
+    }
+    // Workers register within milliseconds of starting; polling is cheaper
+    // than a notification the server does not offer.
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 // The local workers' --drivers and --keep-runs. The drivers file is checked
 // here (`mbopt-worker drivers FILE`), before anything starts: a worker that
 // refused it would only say so in its log.
@@ -147,6 +167,13 @@ int RunCommandMain(const Args& args) {
   }
 
   auto job_service = ConnectJobService(address);
+  if (!cluster_options.worker_args.empty()) {
+    // The server refuses a study naming a driver no registered worker
+    // declares: submit once the local workers have registered theirs.
+    if (absl::Status registered = WaitForWorkers(*job_service, num_workers); !registered.ok()) {
+      return Fail(std::string(registered.message()), kExitUnreachable);
+    }
+  }
   v1::SubmitJobRequest request;
   *request.mutable_study() = *std::move(study);
   request.set_source_name(path);

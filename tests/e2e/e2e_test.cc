@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <sys/stat.h>
 
+#include <chrono>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -56,6 +57,21 @@ std::string SubmitWatchAndGetResults(const std::string& address, const std::stri
   return results.stdout_text;
 }
 
+// `mbopt workers` lists `count` workers or more (polled with a deadline as
+// a failure guard: registration has no event a client could wait for).
+std::string WorkersWhenRegistered(const std::string& address, size_t count) {
+  const auto deadline = std::chrono::steady_clock::now() + kGuard;
+  while (true) {
+    auto listed = Mbopt({"workers", "--server", address});
+    EXPECT_EQ(listed.exit_code, kExitOk) << Describe(listed);
+    size_t rows = 0;
+    for (char c : listed.stdout_text) rows += c == '\n';
+    if (rows >= count + 1 || std::chrono::steady_clock::now() > deadline || listed.exit_code != kExitOk) {
+      return listed.stdout_text;
+    }
+  }
+}
+
 // A study (default: the vehicle) on a fresh server with `workers` workers
 // started with `worker_args`.
 std::string ReferenceResult(int workers, const std::string& study = VehicleStudy(),
@@ -66,6 +82,8 @@ std::string ReferenceResult(int workers, const std::string& study = VehicleStudy
   if (!server.ok()) return "";
   std::vector<Subprocess> pool;
   for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address, worker_args));
+  // A study naming a driver is refused until a worker declaring it has registered.
+  if (!worker_args.empty()) WorkersWhenRegistered(server->address, static_cast<size_t>(workers));
   std::string json = SubmitWatchAndGetResults(server->address, study);
   for (auto& w : pool) w.Stop(kGuard);
   EXPECT_EQ(server->process->Stop(kGuard), 0) << "server did not shut down cleanly";
@@ -227,6 +245,7 @@ void ExpectServerKilledMidJobResumesBitIdentically(
   for (int i = 0; i < 2; ++i) {
     pool.push_back(StartWorker(first->address, worker_args, dir.File(absl::StrCat("worker", i, ".log"))));
   }
+  if (!worker_args.empty()) WorkersWhenRegistered(first->address, pool.size());
   auto submitted = Mbopt({"submit", study, "--server", first->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
@@ -356,6 +375,56 @@ TEST(EndToEnd, ExternalSimulatorStudyRunsThroughRunAndSubmitAlike) {
 TEST(EndToEnd, ExternalSimulatorJobKilledMidJobResumesBitIdentically) {
   ExpectServerKilledMidJobResumesBitIdentically(ExternalStudy(), {}, {"--crash-after-cycles", "2"}, 2,
                                                 {"--drivers", ExternalDrivers()});
+}
+
+// Workers say what they can run: a study naming a driver no registered
+// worker declares is refused at submit, naming what the workers do declare;
+// once a worker declares it, the job runs, and only on that worker.
+TEST(EndToEnd, ExternalStudyIsRefusedWithoutItsDriverAndRunsOnlyWhereDeclared) {
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), {}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  Subprocess plain = StartWorker(server->address, {"--name", "plain"}, dir.File("plain.log"));
+  WorkersWhenRegistered(server->address, 1);
+  auto refused = Mbopt({"submit", ExternalStudy(), "--server", server->address});
+  EXPECT_EQ(refused.exit_code, kExitBadInput) << Describe(refused);
+  EXPECT_NE(refused.stderr_text.find("no registered worker declares driver \"quarter_car\"; the registered "
+                                     "workers declare no drivers"),
+            std::string::npos)
+      << Describe(refused);
+
+  Subprocess able = StartWorker(server->address, {"--name", "able", "--drivers", ExternalDrivers()},
+                                dir.File("able.log"));
+  const std::string listed = WorkersWhenRegistered(server->address, 2);
+  EXPECT_NE(listed.find("driver quarter_car"), std::string::npos) << listed;
+  auto submitted = Mbopt({"submit", ExternalStudy(), "--server", server->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto watched = Mbopt({"watch", job, "--server", server->address});
+  EXPECT_EQ(watched.exit_code, kExitOk) << Describe(watched);
+  auto after = Mbopt({"workers", "--server", server->address});
+  // Every analysis ran on the worker that declares the driver; none was
+  // handed to the other and back.
+  std::istringstream rows(after.stdout_text);
+  std::string line;
+  int checked = 0;
+  while (std::getline(rows, line)) {
+    std::istringstream fields(line);
+    std::string id, name;
+    long long slots = 0, analyses = -1;
+    fields >> id >> name >> slots >> analyses;
+    if (name == "plain") {
+      EXPECT_EQ(analyses, 0) << after.stdout_text;
+    }
+    if (name == "able") {
+      EXPECT_GT(analyses, 0) << after.stdout_text;
+    }
+    checked += name == "plain" || name == "able";
+  }
+  EXPECT_EQ(checked, 2) << after.stdout_text;
+  EXPECT_EQ(plain.Stop(kGuard), 0);
+  EXPECT_EQ(able.Stop(kGuard), 0);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
 }
 
 // A drivers file with a problem stops `mbopt run` before anything starts,

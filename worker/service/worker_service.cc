@@ -181,6 +181,11 @@ class Worker : public std::enable_shared_from_this<Worker> {
     v1::RegisterWorkerRequest request;
     request.set_name(options_.name);
     request.set_slots(options_.slots);
+    // What it can run, so the server hands it only tasks it can run. No
+    // FMU platform yet: this worker loads no FMUs.
+    if (options_.external != nullptr) {
+      for (const external::DriverDeclaration& driver : options_.external->drivers) request.add_drivers(driver.name);
+    }
     v1::RegisterWorkerResponse response;
     grpc::ClientContext context;
     context.set_deadline(Clock::now() + kShortCallDeadline);
