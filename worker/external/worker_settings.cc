@@ -57,6 +57,14 @@ absl::StatusOr<std::unique_ptr<ExternalWorkerSettings>> LoadExternalSettings(con
   return settings;
 }
 
+void RemoveDefaultWorkDirectoryIfEmpty(const ExternalOptions& options, const ExternalWorkerSettings* settings) {
+  if (settings == nullptr || !options.work_directory.empty()) return;
+  std::error_code ec;
+  if (std::filesystem::is_empty(settings->work_directory, ec) && !ec) {
+    std::filesystem::remove(settings->work_directory, ec);
+  }
+}
+
 const char* ExternalOptionsUsage() {
   return "  --drivers FILE       the analysis drivers this worker offers (a\n"
          "                       .drivers.textproto, docs/external.md): the external\n"

@@ -28,6 +28,11 @@ bool SetExternalOption(const std::string& name, const std::string& value, Extern
 // field); null settings when no drivers file is given.
 absl::StatusOr<std::unique_ptr<ExternalWorkerSettings>> LoadExternalSettings(const ExternalOptions& options);
 
+// Removes the default work directory (<temp dir>/mbopt-runs-<pid>) when the
+// process leaves it empty; a directory given with --work-dir is the
+// user's and stays.
+void RemoveDefaultWorkDirectoryIfEmpty(const ExternalOptions& options, const ExternalWorkerSettings* settings);
+
 // The options' lines of a usage text.
 const char* ExternalOptionsUsage();
 

@@ -270,6 +270,7 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     analyzer = std::make_unique<external::ExternalSceneAnalyzer>(**external_settings, "eval");
   }
   const spec::AnalysisReport report = engine::AnalyzeCases(study, parameters, analyzer.get());
+  external::RemoveDefaultWorkDirectoryIfEmpty(external_options, external_settings->get());
   const bool ok = report.ok();
   if (!series_out.empty()) {
     if (absl::Status written = WriteSeries(study, *layout, report, parameters, series_out); !written.ok()) {

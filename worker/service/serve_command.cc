@@ -138,6 +138,7 @@ int ServeMain(const std::vector<std::string>& args) {
   StopSignal* stop = stop_signals->emplace_back(std::make_unique<StopSignal>()).get();
   StopOnTerminationSignals(stop);
   absl::Status status = RunWorker(options, *stop);
+  external::RemoveDefaultWorkDirectoryIfEmpty(external_options, options.external);
   if (!status.ok()) {
     std::fprintf(stderr, "mbopt-worker: %s\n", std::string(status.message()).c_str());
     return absl::IsPermissionDenied(status) ? 3 : 2;
