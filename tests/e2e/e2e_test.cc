@@ -178,8 +178,10 @@ TEST(EndToEnd, ResultsAreIdenticalWithOneTwoAndFourWorkers) {
 // kills itself (SIGKILL) holding its third task, then a survivor; checks
 // that the job ends with the result of an undisturbed run and returns the
 // job's status text.
-std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_args) {
-  const std::string reference = Comparable(ReferenceResult(1));
+std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_args,
+                                         const std::string& study = VehicleStudy(),
+                                         const std::vector<std::string>& worker_args = {}) {
+  const std::string reference = Comparable(ReferenceResult(1, study, worker_args));
   EXPECT_FALSE(reference.empty());
   ScratchDir dir;
   auto server = StartServer(dir.File("jobs.db"), server_args, "127.0.0.1:0", dir.File("server.log"));
@@ -187,9 +189,11 @@ std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_
   if (!server.ok()) return "";
   // The doomed worker takes tasks alone first, so that it surely receives its
   // third task while the first cycle's batch is in progress.
-  Subprocess doomed = StartWorker(server->address, {"--die-after-tasks", "3", "--name", "doomed"},
-                                  dir.File("doomed.log"));
-  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  std::vector<std::string> doomed_args = {"--die-after-tasks", "3", "--name", "doomed"};
+  doomed_args.insert(doomed_args.end(), worker_args.begin(), worker_args.end());
+  Subprocess doomed = StartWorker(server->address, doomed_args, dir.File("doomed.log"));
+  if (!worker_args.empty()) WorkersWhenRegistered(server->address, 1);
+  auto submitted = Mbopt({"submit", study, "--server", server->address});
   EXPECT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto died = doomed.Wait(kGuard);
@@ -197,7 +201,9 @@ std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_
   if (died.ok()) {
     EXPECT_EQ(*died, kKilledBySigkill);
   }
-  Subprocess survivor = StartWorker(server->address, {"--name", "survivor"}, dir.File("survivor.log"));
+  std::vector<std::string> survivor_args = {"--name", "survivor"};
+  survivor_args.insert(survivor_args.end(), worker_args.begin(), worker_args.end());
+  Subprocess survivor = StartWorker(server->address, survivor_args, dir.File("survivor.log"));
 
   auto watched = Mbopt({"watch", job, "--server", server->address});
   EXPECT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
@@ -367,6 +373,13 @@ TEST(EndToEnd, ExternalSimulatorStudyRunsThroughRunAndSubmitAlike) {
   const double max_violation = std::stod(JsonField(run.stdout_text, "max_violation"));
   EXPECT_LE(max_violation, 0.0) << "the reported design meets the travel limit";
   EXPECT_GT(max_violation, -1e-3) << "and the limit is active at the optimum";
+}
+
+// A worker of the external study killed (SIGKILL) as it receives a task,
+// in the middle of a cycle: a worker declaring the same driver takes the
+// task over and the job ends with the undisturbed run's result, bit for bit.
+TEST(EndToEnd, ExternalSimulatorWorkerKilledMidCycleDoesNotChangeTheResult) {
+  RunWithAWorkerKilledMidCycle(kFastLeases, ExternalStudy(), {"--drivers", ExternalDrivers()});
 }
 
 // A server killed in the middle of the external study resumes it with the
