@@ -215,6 +215,22 @@ int ListCommand(const Args& args) {
   return kExitOk;
 }
 
+int WorkersCommand(const Args& args) {
+  auto parsed = Parse(args, {{"--server"}, {}}, 0, "mbopt workers [--server ADDRESS]");
+  if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  auto connected = Connect(*parsed);
+  if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
+  Connection& c = std::get<Connection>(connected);
+  v1::ListWorkersResponse response;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  grpc::Status status = c.job_service->ListWorkers(&context, v1::ListWorkersRequest(), &response);
+  if (!status.ok()) return FailRpc(status, c.address, &c.security);
+  std::printf("%s\n", WorkersHeader().c_str());
+  for (const auto& worker : response.workers()) std::printf("%s\n", WorkersRow(worker).c_str());
+  return kExitOk;
+}
+
 namespace {
 
 int CancelOrResume(const ParsedArgs& parsed, bool cancel, int workers) {

@@ -14,6 +14,9 @@ int SubmitCommand(const Args& args);
 int WatchCommand(const Args& args);
 int StatusCommand(const Args& args);
 int ListCommand(const Args& args);
+// `mbopt workers`: the server's registered workers, their slots,
+// capabilities (drivers, FMU platform) and analyses done.
+int WorkersCommand(const Args& args);
 int CancelCommand(const Args& args);
 int ResumeCommand(const Args& args);
 int ResultsCommand(const Args& args);

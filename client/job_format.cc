@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_format.h"
 #include "client/exit_codes.h"
 #include "client/json_writer.h"
 #include "client/report/report_from_proto.h"
@@ -145,6 +146,7 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   }
   out += "wall time:     " + Format("%.2f", s.wall_seconds()) + " s\n";
   if (!s.message().empty()) out += "message:       " + s.message() + "\n";
+  if (!s.waiting_for().empty()) out += "waiting:       " + s.waiting_for() + "\n";
   if (!s.failed_analyses_by_kind().empty()) out += "failed:        " + FailedAnalysesText(s) + "\n";
   if (s.design_size() > 0) out += "design:\n" + DesignLines(s, study);
   return out;
@@ -166,6 +168,20 @@ std::string ListRow(const v1::JobSummary& s) {
                 static_cast<long long>(s.analyses()), objective.c_str(),
                 s.owner().empty() ? "-" : s.owner().c_str());
   return buf;
+}
+
+std::string WorkersHeader() {
+  return absl::StrFormat("%-8s %-24s %5s %9s %5s %8s  %s", "WORKER", "NAME", "SLOTS", "ANALYSES", "HELD", "SILENT",
+                "CAN RUN");
+}
+
+std::string WorkersRow(const v1::WorkerSummary& w) {
+  // Built-in scenes run everywhere; the rest is what the worker declared.
+  std::string can_run = "built-in scenes";
+  for (const std::string& driver : w.drivers()) can_run += ", driver " + driver;
+  if (!w.fmu_platform().empty()) can_run += ", FMUs for " + w.fmu_platform();
+  return absl::StrFormat("%-8s %-24s %5d %9d %5d %7.1fs  %s", w.id(), w.name(), w.slots(), w.analyses_done(),
+                         w.tasks_held(), static_cast<double>(w.silent_ms()) / 1000.0, can_run);
 }
 
 std::string ResultsTable(const v1::GetJobResponse& job) {
@@ -252,6 +268,7 @@ std::string ResultsJson(const v1::GetJobResponse& job, const std::string& databa
   w.EndObject();
   w.Field("wall_seconds", s.wall_seconds());
   w.Field("message", s.message());
+  if (!s.waiting_for().empty()) w.Field("waiting_for", s.waiting_for());
   // Sorted by kind name: the map's order on the wire is unspecified.
   const std::map<std::string, std::int64_t> failed(s.failed_analyses_by_kind().begin(),
                                                    s.failed_analyses_by_kind().end());

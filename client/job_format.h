@@ -29,6 +29,9 @@ std::string SummaryText(const v1::JobSummary& summary, const v1::Study* study = 
 // One line for `list`.
 std::string ListHeader();
 std::string ListRow(const v1::JobSummary& summary);
+// `mbopt workers`: one row per registered worker.
+std::string WorkersHeader();
+std::string WorkersRow(const v1::WorkerSummary& worker);
 
 // `results` formats. The JSON is one object: status, cycles, analyses,
 // objective, objective_unit, max_violation, design (name -> physical value),

@@ -92,9 +92,10 @@ absl::StatusOr<std::unique_ptr<LocalCluster>> LocalCluster::Start(
     SpawnOptions worker_spawn;
     worker_spawn.silence_stdout = true;
     worker_spawn.stderr_path = absl::StrCat(options.log_dir, "/worker-", i, ".log");
-    auto worker = Subprocess::Start({options.worker_binary, "serve", "--server", cluster->address_,
-                                     "--slots", "1", "--name", absl::StrCat("local-", i)},
-                                    worker_spawn);
+    std::vector<std::string> argv = {options.worker_binary, "serve", "--server", cluster->address_,
+                                     "--slots", "1", "--name", absl::StrCat("local-", i)};
+    argv.insert(argv.end(), options.worker_args.begin(), options.worker_args.end());
+    auto worker = Subprocess::Start(argv, worker_spawn);
     if (!worker.ok()) return worker.status();
     cluster->workers_.push_back(*std::move(worker));
   }

@@ -17,6 +17,7 @@ constexpr char kUsage[] =
     "\n"
     "commands:\n"
     "  run FILE [--workers N] [--db PATH | --discard-db] [--json] [--quiet]\n"
+    "           [--drivers FILE [--keep-runs]]\n"
     "                        start a local server and N workers, optimize, print the result;\n"
     "                        keeps the job database (its path is printed) unless --discard-db\n"
     "  validate FILE         check a study and its scene offline; print its layout\n"
@@ -24,6 +25,7 @@ constexpr char kUsage[] =
     "  watch JOB             follow a job's cycles until it ends\n"
     "  status JOB            a job's state, objective and design\n"
     "  list                  all jobs on the server\n"
+    "  workers               the server's registered workers: slots, drivers, analyses done\n"
     "  cancel JOB            stop a job\n"
     "  resume JOB [--db PATH [--workers N]]\n"
     "                        continue an interrupted job\n"
@@ -58,6 +60,7 @@ int main(int argc, char** argv) {
   if (command == "watch") return WatchCommand(args);
   if (command == "status") return StatusCommand(args);
   if (command == "list") return ListCommand(args);
+  if (command == "workers") return WorkersCommand(args);
   if (command == "cancel") return CancelCommand(args);
   if (command == "resume") return ResumeCommand(args);
   if (command == "results") return ResultsCommand(args);

@@ -11,7 +11,9 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "client/args.h"
@@ -22,6 +24,7 @@
 #include "client/job_format.h"
 #include "client/local_cluster.h"
 #include "client/study_file.h"
+#include "client/subprocess.h"
 #include "client/temp_dir.h"
 #include "client/watch.h"
 
@@ -59,13 +62,59 @@ std::string DefaultRunDatabasePath(const std::string& study_path) {
   return (dir / (stem + "-" + stamp + "-" + std::to_string(getpid()) + ".db")).string();
 }
 
+// Waits until `count` workers have registered with the local server (a
+// failure guard of 60 s: a worker that cannot start says why in its log).
+absl::Status WaitForWorkers(v1::JobService::Stub& job_service, int count) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (true) {
+    v1::ListWorkersResponse workers;
+    grpc::ClientContext context;
+    SetUnaryDeadline(&context);
+    grpc::Status status = job_service.ListWorkers(&context, v1::ListWorkersRequest(), &workers);
+    if (status.ok() && workers.workers_size() >= count) return absl::OkStatus();
+    if (std::chrono::steady_clock::now() > deadline) {
+      return absl::DeadlineExceededError(absl::StrCat("mbopt run: ", status.ok() ? workers.workers_size() : 0, " of ",
+                                                      count, " local workers registered within 60 s"));
+    }
+    // Workers register within milliseconds of starting; polling is cheaper
+    // than a notification the server does not offer.
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+// The local workers' --drivers and --keep-runs. The drivers file is checked
+// here (`mbopt-worker drivers FILE`), before anything starts: a worker that
+// refused it would only say so in its log.
+absl::StatusOr<std::vector<std::string>> LocalWorkerDriverArgs(const ParsedArgs& parsed,
+                                                               const std::string& worker_binary) {
+  const std::string drivers = parsed.Value("--drivers");
+  if (drivers.empty()) {
+    if (parsed.Has("--keep-runs")) return absl::InvalidArgumentError("--keep-runs needs --drivers FILE");
+    return std::vector<std::string>{};
+  }
+  std::error_code ec;
+  const std::string absolute = std::filesystem::absolute(drivers, ec).string();
+  if (ec) return absl::InvalidArgumentError(absl::StrCat("--drivers ", drivers, ": ", ec.message()));
+  absl::StatusOr<Subprocess::Output> checked =
+      RunCommand({worker_binary, "drivers", absolute}, std::chrono::seconds(60));
+  if (!checked.ok()) return checked.status();
+  if (checked->exit_code != 0) {
+    return absl::InvalidArgumentError(absl::StrCat("--drivers ", drivers, ":\n", checked->stderr_text));
+  }
+  std::vector<std::string> args = {"--drivers", absolute};
+  if (parsed.Has("--keep-runs")) args.push_back("--keep-runs");
+  return args;
+}
+
 }  // namespace
 
 int RunCommandMain(const Args& args) {
-  auto parsed = ParseArgs(args, {{"--workers", "--db"}, {"--json", "--quiet", "--discard-db"}});
+  auto parsed =
+      ParseArgs(args, {{"--workers", "--db", "--drivers"}, {"--json", "--quiet", "--discard-db", "--keep-runs"}});
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   if (parsed->positional.size() != 1) {
-    return Fail("usage: mbopt run STUDY_FILE [--workers N] [--db PATH | --discard-db] [--json] [--quiet]",
+    return Fail("usage: mbopt run STUDY_FILE [--workers N] [--db PATH | --discard-db] [--json] [--quiet]\n"
+                "                 [--drivers FILE [--keep-runs]]",
                 kExitBadInput);
   }
   if (!parsed->Value("--db").empty() && parsed->Has("--discard-db")) {
@@ -86,6 +135,8 @@ int RunCommandMain(const Args& args) {
   if (!server_binary.ok()) return Fail(std::string(server_binary.status().message()), kExitBadInput);
   auto worker_binary = FindMboptBinary("mbopt-worker", "MBOPT_WORKER_BIN", "worker/main");
   if (!worker_binary.ok()) return Fail(std::string(worker_binary.status().message()), kExitBadInput);
+  auto worker_args = LocalWorkerDriverArgs(*parsed, *worker_binary);
+  if (!worker_args.ok()) return Fail(std::string(worker_args.status().message()), kExitBadInput);
 
   Interrupts::Install();  // before any thread (gRPC's included) is started
   TempDir temp;
@@ -107,6 +158,7 @@ int RunCommandMain(const Args& args) {
   cluster_options.db_path = db_path;
   cluster_options.log_dir = temp.path();
   cluster_options.workers = num_workers;
+  cluster_options.worker_args = *std::move(worker_args);
   auto cluster = LocalCluster::Start(cluster_options);
   if (!cluster.ok()) return Fail(std::string(cluster.status().message()), kExitUnreachable);
   const std::string address = (*cluster)->address();
@@ -115,6 +167,13 @@ int RunCommandMain(const Args& args) {
   }
 
   auto job_service = ConnectJobService(address);
+  if (!cluster_options.worker_args.empty()) {
+    // The server refuses a study naming a driver no registered worker
+    // declares: submit once the local workers have registered theirs.
+    if (absl::Status registered = WaitForWorkers(*job_service, num_workers); !registered.ok()) {
+      return Fail(std::string(registered.message()), kExitUnreachable);
+    }
+  }
   v1::SubmitJobRequest request;
   *request.mutable_study() = *std::move(study);
   request.set_source_name(path);

@@ -140,13 +140,13 @@ function(mbopt_declare_modules)
   mbopt_module(server_main DIRS server/main USES service auth store jobs common
     LIBS mbopt-server
     SUMMARY "the `mbopt-server` program")
-  mbopt_module(worker_service DIRS worker/service USES secure_channel engine spec spec_io proto packed_doubles common
+  mbopt_module(external DIRS worker/external USES engine spec_io spec proto common
+    LIBS mbopt_external mbopt_external_drivers_file
+    SUMMARY "analyses run by external simulation codes: declared drivers (their file), per-analysis folders, process groups with a time limit, results files, external scenes mapped onto the engine's reports")
+  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine spec spec_io proto packed_doubles common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(external DIRS worker/external USES spec_io spec proto common
-    LIBS mbopt_external mbopt_external_drivers_file
-    SUMMARY "analyses run by external simulation codes: declared drivers (their file), per-analysis folders, process groups with a time limit, results files")
-  mbopt_module(worker_main DIRS worker/main USES worker_service engine spec spec_io proto common
+  mbopt_module(worker_main DIRS worker/main USES worker_service external engine spec spec_io proto common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE

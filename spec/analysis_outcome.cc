@@ -49,6 +49,8 @@ const char* FormulationName(Formulation f) {
       return "elastodynamic";
     case Formulation::kStatic:
       return "static";
+    case Formulation::kExternal:
+      return "external";
   }
   return "unknown";
 }

@@ -18,6 +18,7 @@ enum class Formulation {
   kDynamic,        // free degrees of freedom integrated in time (CVODES)
   kElastodynamic,  // beam-element links on the driven motion (CVODES, stiff)
   kStatic,         // static equilibrium at each instant (KINSOL): no inertia, no damping
+  kExternal,       // an external simulation code through a declared driver (worker/external)
 };
 const char* FormulationName(Formulation f);
 

@@ -77,7 +77,7 @@ absl::StatusOr<std::pair<int, int>> WindowInstants(const Study& study, const std
                                                    bool needs_series) {
   if (scalar_output) {
     if (!window.whole_grid() || needs_series) {
-      return LayoutError(study, field, "a scalar output (mass) has no time series to window or reduce");
+      return LayoutError(study, field, "a scalar output (mass, an external value) has no time series to window or reduce");
     }
     return std::pair<int, int>{0, 0};
   }
@@ -212,7 +212,8 @@ double EqualityRowScale(const Constraint& constraint) {
 OutputShape OutputShapeOf(const Scene& scene, int output) {
   OutputShape shape;
   const Output& out = scene.outputs[static_cast<size_t>(output)];
-  shape.scalar = std::holds_alternative<MassOutput>(out.kind);
+  const auto* external = std::get_if<ExternalResultOutput>(&out.kind);
+  shape.scalar = std::holds_alternative<MassOutput>(out.kind) || (external != nullptr && !external->series);
   shape.instants = shape.scalar ? 1 : static_cast<int>(scene.time_grid.Instants().size());
   if (const auto* stress = std::get_if<BendingStressOutput>(&out.kind)) {
     // A flexible link of a multibody model: every node, 0 (end a) to n (end b).
@@ -263,6 +264,8 @@ Dimension OutputDimension(const Output& output) {
                         [](const BendingStressOutput&) { return Dimension::kPressure; },
                         [](const DriveTorqueOutput&) { return Dimension::kTorque; },
                         [](const MassOutput&) { return Dimension::kMass; },
+                        // The driver's own SI quantity, unknown here.
+                        [](const ExternalResultOutput&) { return Dimension::kAny; },
                         [](const MultibodyOutput& m) {
                           using Q = MultibodyOutput::Quantity;
                           switch (m.quantity) {

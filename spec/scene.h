@@ -208,6 +208,20 @@ struct MultibodyModel {
   std::vector<MultibodyTorque> torques;
 };
 
+// ---- external (an analysis by a simulation code the worker declares as a
+// driver; worker/external runs it, docs/external.md)
+// A value given to one of the driver's declared parameters.
+struct ExternalInput {
+  std::string name;  // the driver's parameter
+  Number value;      // SI
+};
+// Which driver runs the analysis is the worker's to check: its declared
+// parameters are known only where it is declared.
+struct ExternalModel {
+  std::string driver;
+  std::vector<ExternalInput> inputs;  // names unique
+};
+
 // ---- outputs
 enum class Axis { kX, kY };
 struct PointPositionOutput { int link = -1; int point = -1; int joint = -1; Axis axis = Axis::kX; };  // link point, or joint if joint >= 0
@@ -225,6 +239,12 @@ struct BodyAccelerationOutput {
 struct BendingStressOutput { int link = -1; };
 struct DriveTorqueOutput {};
 struct MassOutput {};
+// A named value (one per analysis, like mass) or a named time series of an
+// external driver's results.
+struct ExternalResultOutput {
+  std::string name;  // as written in the results file
+  bool series = false;
+};
 // An output of a multibody scene. Reactions are the force body a's side of
 // the joint exerts on body b; a driver's effort is the torque (revolute) or
 // force (prismatic) it applies to body b.
@@ -244,7 +264,8 @@ struct MultibodyOutput {
 struct Output {
   std::string name;
   std::variant<PointPositionOutput, LinkRotationOutput, ElementDeflectionOutput,
-               BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput>
+               BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput,
+               ExternalResultOutput>
       kind;
 };
 
@@ -268,7 +289,7 @@ struct Scene {
   std::string source_file;  // for messages
   std::vector<Parameter> parameters;
   Effects effects;
-  std::variant<LinkageModel, LumpedModel, MultibodyModel> model;
+  std::variant<LinkageModel, LumpedModel, MultibodyModel, ExternalModel> model;
   std::vector<Output> outputs;
   TimeGrid time_grid;
   // The parameters the time grid's start_expr / end_expr read (sorted): the

@@ -43,11 +43,77 @@ absl::Status SchedulerOptions::Validate() const {
 Scheduler::Scheduler(const Clock* clock, SchedulerOptions options)
     : clock_(clock), options_(std::move(options)) {}
 
-std::string Scheduler::RegisterWorker(const std::string& name, int slots) {
+bool TaskNeeds::RunnableBy(const WorkerCapabilities& capabilities) const {
+  return driver.empty() ||
+         std::find(capabilities.drivers.begin(), capabilities.drivers.end(), driver) != capabilities.drivers.end();
+}
+
+std::string TaskNeeds::Describe() const { return driver.empty() ? "" : absl::StrCat("driver \"", driver, "\""); }
+
+std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::string id = absl::StrCat("w-", next_worker_++, kSecretSeparator, RandomHex64());
-  workers_[id] = Worker{name, std::max(1, slots), clock_->NowMs()};
+  const std::int64_t number = next_worker_++;
+  std::string id = absl::StrCat("w-", number, kSecretSeparator, RandomHex64());
+  Worker& worker = workers_[id];
+  worker.name = name;
+  worker.slots = std::max(1, slots);
+  worker.last_seen_ms = clock_->NowMs();
+  worker.capabilities = std::move(capabilities);
+  worker.number = number;
   return id;
+}
+
+void Scheduler::SetJobNeeds(const std::string& job_id, TaskNeeds needs) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (needs.driver.empty()) {
+      job_needs_.erase(job_id);
+    } else {
+      job_needs_[job_id] = std::move(needs);
+    }
+  }
+  task_available_.notify_all();
+}
+
+bool Scheduler::SomeWorkerCan(const TaskNeeds& needs) const {
+  // Built-in scenes need no particular worker, and none registered yet is
+  // no reason to refuse them: every worker runs them.
+  if (needs.driver.empty()) return true;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [id, worker] : workers_) {
+    if (needs.RunnableBy(worker.capabilities)) return true;
+  }
+  return false;
+}
+
+std::vector<std::string> Scheduler::OfferedDrivers() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::set<std::string> drivers;
+  for (const auto& [id, worker] : workers_) drivers.insert(worker.capabilities.drivers.begin(), worker.capabilities.drivers.end());
+  return {drivers.begin(), drivers.end()};
+}
+
+std::vector<WorkerView> Scheduler::Workers() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::map<std::string, int> held;
+  for (const auto& [task_id, key] : leases_) ++held[entries_.at(key).worker_id];
+  std::vector<std::pair<std::int64_t, WorkerView>> numbered;
+  const std::int64_t now = clock_->NowMs();
+  for (const auto& [id, worker] : workers_) {
+    WorkerView view;
+    view.public_id = PublicWorkerId(id);
+    view.name = worker.name;
+    view.slots = worker.slots;
+    view.capabilities = worker.capabilities;
+    view.analyses_done = worker.analyses_done;
+    view.tasks_held = held.count(id) != 0 ? held.at(id) : 0;
+    view.silent_ms = std::max<std::int64_t>(0, now - worker.last_seen_ms);
+    numbered.emplace_back(worker.number, std::move(view));
+  }
+  std::sort(numbered.begin(), numbered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<WorkerView> out;
+  for (auto& [number, view] : numbered) out.push_back(std::move(view));
+  return out;
 }
 
 bool Scheduler::Enqueue(const std::string& job_id, std::int64_t request_id, std::vector<double> x_scaled,
@@ -116,7 +182,11 @@ std::vector<Task> Scheduler::AcquireLocked(const std::string& worker_id, int max
     for (size_t step = 0; step < queues_.size() && !found; ++step) {
       if (start == queues_.end()) start = queues_.begin();
       auto& [job_id, queue] = *start;
-      for (auto it = queue.begin(); it != queue.end(); ++it) {
+      // A job whose tasks this worker cannot run is passed over whole.
+      const auto needs = job_needs_.find(job_id);
+      const bool runnable =
+          needs == job_needs_.end() || needs->second.RunnableBy(workers_.at(worker_id).capabilities);
+      for (auto it = queue.begin(); runnable && it != queue.end(); ++it) {
         Entry& entry = entries_.at(Key{job_id, *it});
         // A retry goes to a worker that has not failed it yet, if one is around.
         if (entry.failed_workers.count(worker_id) != 0 && HasOtherLiveWorker(worker_id, entry.failed_workers)) {
@@ -220,6 +290,7 @@ absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, c
   }
   entries_.erase(entry);
   finished_.insert(key);
+  if (worker != workers_.end()) ++worker->second.analyses_done;
   return done;
 }
 
@@ -349,6 +420,7 @@ bool Scheduler::WaitForShutdown(std::int64_t wait_ms) const {
 void Scheduler::DropJob(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
   queues_.erase(job_id);
+  job_needs_.erase(job_id);
   for (auto it = entries_.lower_bound(Key{job_id, INT64_MIN}); it != entries_.end() && it->first.first == job_id;) {
     if (it->second.leased) leases_.erase(it->second.task_id);
     it = entries_.erase(it);

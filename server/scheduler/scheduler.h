@@ -57,6 +57,32 @@ struct SchedulerOptions {
   absl::Status Validate() const;
 };
 
+// What a worker can run beyond the built-in models (it says so when it
+// registers): a task that needs more goes only to a worker that has it.
+struct WorkerCapabilities {
+  std::vector<std::string> drivers;  // analysis drivers it declares
+  std::string fmu_platform;          // FMU binaries it loads; empty: none
+};
+
+// What every task of a job needs of its worker; default: any worker.
+struct TaskNeeds {
+  std::string driver;  // non-empty: a worker declaring this driver
+  bool RunnableBy(const WorkerCapabilities& capabilities) const;
+  // "driver \"x\"", for messages; "" when any worker will do.
+  std::string Describe() const;
+};
+
+// A registered worker as `mbopt workers` shows it.
+struct WorkerView {
+  std::string public_id;  // "w-<n>"
+  std::string name;
+  int slots = 1;
+  WorkerCapabilities capabilities;
+  std::int64_t analyses_done = 0;  // results taken from it
+  int tasks_held = 0;              // leased to it now
+  std::int64_t silent_ms = 0;      // on the scheduler's clock
+};
+
 // A task as handed to a worker.
 struct Task {
   std::string task_id;  // "<job id>/<request id>/<attempt>", unique on the server
@@ -103,7 +129,18 @@ class Scheduler {
   // of the (shared) worker token cannot guess another worker's id, and so
   // cannot answer the tasks leased to it. Only PublicWorkerId(id) goes into
   // messages, events and the job log.
-  std::string RegisterWorker(const std::string& name, int slots);
+  std::string RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities = {});
+
+  // Every task of `job_id` (queued now or later) goes only to a worker
+  // that can run it; DropJob forgets it.
+  void SetJobNeeds(const std::string& job_id, TaskNeeds needs);
+  // Whether a registered worker can run tasks with `needs`; always true when
+  // they need nothing beyond the built-in models.
+  bool SomeWorkerCan(const TaskNeeds& needs) const;
+  // The drivers the registered workers declare, sorted, each once.
+  std::vector<std::string> OfferedDrivers() const;
+  // The registered workers, in registration order.
+  std::vector<WorkerView> Workers() const;
 
   // Queues an analysis of `job_id`; `want_gradients` is passed on to the
   // worker with every attempt. A request already queued, leased or finished
@@ -194,6 +231,9 @@ class Scheduler {
     std::string name;
     int slots = 1;
     std::int64_t last_seen_ms = 0;
+    WorkerCapabilities capabilities;
+    std::int64_t number = 0;         // n of "w-<n>"
+    std::int64_t analyses_done = 0;
   };
 
   std::vector<Task> AcquireLocked(const std::string& worker_id, int max_tasks);
@@ -217,6 +257,7 @@ class Scheduler {
   bool shutdown_ = false;
   std::int64_t next_worker_ = 1;
   std::map<std::string, Worker> workers_;
+  std::map<std::string, TaskNeeds> job_needs_;         // jobs whose tasks need more than any worker
   std::map<Key, Entry> entries_;                       // queued or leased
   std::set<Key> finished_;                             // never re-queued
   std::map<std::string, std::deque<std::int64_t>> queues_;  // job -> queued request ids

@@ -8,6 +8,7 @@
 #include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "server/service/audit_log.h"
 #include "server/service/proto_convert.h"
 #include "server/service/status_conversion.h"
@@ -17,6 +18,8 @@ namespace {
 
 // How often a Watch stream checks whether its client went away.
 constexpr std::int64_t kWatchPollMs = 250;
+// The most drivers a worker's registration keeps.
+constexpr int kMaxDeclaredDrivers = 1000;
 constexpr std::int64_t kSummaryIntervalMs = 50;
 
 std::int64_t NowUnixMs() {
@@ -98,6 +101,26 @@ grpc::Status JobServiceImpl::List(grpc::ServerContext* context, const v1::ListJo
   if (!jobs.ok()) return ToGrpcStatus(jobs.status());
   for (const JobSummaryData& s : *jobs) {
     if (CallAuthorizer::MaySee(*caller, s.owner)) *response->add_jobs() = ToProto(s);
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context, const v1::ListWorkersRequest*,
+                                         v1::ListWorkersResponse* response) {
+  // Users see every worker: a worker belongs to the server, not to a job,
+  // and nothing listed lets anyone act as one (docs/server.md, "Security").
+  absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "ListWorkers");
+  if (!caller.ok()) return ToGrpcStatus(caller.status());
+  for (const scheduler::WorkerView& w : manager_->Workers()) {
+    v1::WorkerSummary* out = response->add_workers();
+    out->set_id(w.public_id);
+    out->set_name(w.name);
+    out->set_slots(w.slots);
+    for (const std::string& driver : w.capabilities.drivers) out->add_drivers(driver);
+    out->set_fmu_platform(w.capabilities.fmu_platform);
+    out->set_analyses_done(w.analyses_done);
+    out->set_tasks_held(w.tasks_held);
+    out->set_silent_ms(w.silent_ms);
   }
   return grpc::Status::OK;
 }
@@ -192,11 +215,19 @@ grpc::Status WorkerServiceImpl::Register(grpc::ServerContext* context, const v1:
                                          v1::RegisterWorkerResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Register");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
-  const std::string worker_id = scheduler_->RegisterWorker(request->name(), request->slots());
+  scheduler::WorkerCapabilities capabilities;
+  // Bounded as every name a client sends: a worker may declare many
+  // drivers, each a file-safe name of at most 100 characters.
+  for (int i = 0; i < request->drivers_size() && i < kMaxDeclaredDrivers; ++i) {
+    capabilities.drivers.push_back(request->drivers(i).substr(0, 100));
+  }
+  capabilities.fmu_platform = request->fmu_platform().substr(0, 100);
+  const std::string worker_id = scheduler_->RegisterWorker(request->name(), request->slots(), capabilities);
   // Ties the id in the job log's analyses to a name and an address.
   AuditLog(absl::StrCat("worker ", scheduler::PublicWorkerId(worker_id), " registered by ",
                         CallAuthorizer::Caller(*context, &*caller), ", name '", request->name().substr(0, 256), "', ",
-                        request->slots(), " slots"));
+                        request->slots(), " slots",
+                        capabilities.drivers.empty() ? "" : absl::StrCat(", drivers ", absl::StrJoin(capabilities.drivers, " "))));
   response->set_worker_id(worker_id);
   response->set_heartbeat_interval_ms(static_cast<std::int32_t>(scheduler_->options().heartbeat_interval_ms));
   response->set_lease_ms(static_cast<std::int32_t>(scheduler_->options().lease_ms));

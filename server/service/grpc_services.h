@@ -34,6 +34,8 @@ class JobServiceImpl final : public v1::JobService::Service {
                      grpc::ServerWriter<v1::JobEvent>* writer) override;
   grpc::Status Cancel(grpc::ServerContext* context, const v1::JobRef* request, v1::JobSummary* response) override;
   grpc::Status Resume(grpc::ServerContext* context, const v1::JobRef* request, v1::JobSummary* response) override;
+  grpc::Status ListWorkers(grpc::ServerContext* context, const v1::ListWorkersRequest* request,
+                           v1::ListWorkersResponse* response) override;
 
  private:
   // The caller, when it may see the job (which exists). The same NotFound

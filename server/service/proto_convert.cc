@@ -13,6 +13,7 @@ v1::JobSummary ToProto(const JobSummaryData& s) {
   out.set_job_id(s.job_id);
   out.set_study_name(s.study_name);
   out.set_owner(s.owner);
+  out.set_waiting_for(s.waiting_for);
   out.set_state(ToProto(s.state));
   out.set_cycles(s.cycles);
   out.set_analyses(s.analyses);

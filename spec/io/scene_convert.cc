@@ -38,10 +38,13 @@ class SceneConverter {
       case v1::Scene::kMultibody:
         scene_.model = ConvertMultibody(msg_.multibody(), where_.Child("multibody"));
         break;
+      case v1::Scene::kExternal:
+        scene_.model = ConvertExternal(msg_.external(), where_.Child("external"));
+        break;
       case v1::Scene::MODEL_NOT_SET:
         errors_.Add(where_, "",
-                    "the scene has no model: expected `linkage { ... }`, `lumped { ... }` or "
-                    "`multibody { ... }`");
+                    "the scene has no model: expected `linkage { ... }`, `lumped { ... }`, "
+                    "`multibody { ... }` or `external { ... }`");
         return scene_;
     }
     if (msg_.model_case() == v1::Scene::kLumped && msg_.has_effects()) {
@@ -58,6 +61,13 @@ class SceneConverter {
                     "structural damping applies to flexible links; a lumped model takes its "
                     "damping from its elements");
       }
+    }
+    if (msg_.model_case() == v1::Scene::kExternal && msg_.has_effects()) {
+      // The driver's simulator models what it models; an effect declared
+      // here would be silently ignored.
+      errors_.Add(where_, "effects",
+                  "an external scene's effects are its driver's: declare gravity or damping in the "
+                  "simulator's own input, through the driver's parameters");
     }
     if (const auto* mb = std::get_if<MultibodyModel>(&scene_.model);
         mb != nullptr && mb->flexible_links.empty() && msg_.effects().has_structural_damping()) {
@@ -1034,12 +1044,48 @@ class SceneConverter {
     return out;
   }
 
+  // ----------------------------------------------------------- external --
+  ExternalModel ConvertExternal(const v1::ExternalModel& m, const Where& w) {
+    ExternalModel out;
+    out.driver = m.driver();
+    // The driver itself is the worker's to check (its declared parameters
+    // are known only there); the name must at least be one a worker could
+    // declare.
+    if (m.driver().empty()) {
+      errors_.Add(w, "driver", "missing: expected the name of an analysis driver a worker declares");
+    } else if (!IsDriverName(m.driver())) {
+      errors_.Add(w, "driver",
+                  absl::StrCat("\"", m.driver(), "\" is not a driver name: expected letters, digits, '_', '-' "
+                               "and '.', not starting with '.', at most 100 characters"));
+    }
+    std::set<std::string> names;
+    for (int i = 0; i < m.inputs_size(); ++i) {
+      const v1::ExternalInput& in = m.inputs(i);
+      const Where iw = w.Child("inputs", i);
+      if (in.name().empty()) errors_.Add(iw, "name", "an input needs the name of one of the driver's parameters");
+      if (!names.insert(in.name()).second) {
+        errors_.Add(iw, "name", absl::StrCat("duplicate input \"", in.name(), "\""));
+      }
+      out.inputs.push_back({in.name(), Num(iw, "value", in.has_value(), in.value(), Dimension::kAny)});
+    }
+    return out;
+  }
+
+  static bool IsDriverName(const std::string& name) {
+    if (name.empty() || name.size() > 100 || name[0] == '.') return false;
+    return std::all_of(name.begin(), name.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+             c == '.';
+    });
+  }
+
   // ------------------------------------------------------------ outputs --
   void ConvertOutputs() {
     std::set<std::string> names;
     const bool lumped = std::holds_alternative<LumpedModel>(scene_.model);
     const bool linkage = std::holds_alternative<LinkageModel>(scene_.model);
     const bool multibody = std::holds_alternative<MultibodyModel>(scene_.model);
+    const bool external = std::holds_alternative<ExternalModel>(scene_.model);
     auto lookup = [&](const std::map<std::string, int>& table, const Where& w,
                       const std::string& field, const std::string& name, const char* what) {
       auto it = table.find(name);
@@ -1154,14 +1200,27 @@ class SceneConverter {
           needs = "multibody";
           out.kind = multibody ? MultibodyOutputOf(o, ow) : MultibodyOutput{};
           break;
+        case v1::Output::kExternalValue:
+        case v1::Output::kExternalSeries: {
+          needs = "external";
+          const bool series = o.kind_case() == v1::Output::kExternalSeries;
+          const v1::ExternalResultOutput& r = series ? o.external_series() : o.external_value();
+          if (r.name().empty()) {
+            errors_.Add(ow.Child(series ? "external_series" : "external_value"), "name",
+                        "missing: expected the name the driver writes in its results file");
+          }
+          out.kind = ExternalResultOutput{r.name(), series};
+          break;
+        }
         case v1::Output::KIND_NOT_SET:
           errors_.Add(ow, "", "the output has no kind (e.g. `element_deflection { ... }`)");
           break;
       }
-      const char* model_kind = lumped ? "lumped" : linkage ? "linkage" : "multibody";
+      const char* model_kind = lumped ? "lumped" : linkage ? "linkage" : external ? "external" : "multibody";
       if (needs != nullptr && std::string(needs) != model_kind) {
         errors_.Add(ow, "",
-                    absl::StrCat("output \"", o.name(), "\" needs a ", needs, " model; this scene's model is ",
+                    absl::StrCat("output \"", o.name(), "\" needs ", needs[0] == 'e' ? "an " : "a ", needs,
+                                 " model; this scene's model is ",
                                  model_kind));
       }
       scene_.outputs.push_back(std::move(out));

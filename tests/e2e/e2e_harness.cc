@@ -20,6 +20,14 @@ std::string VehicleStudy() {
   return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/vehicle/vehicle.study.textproto";
 }
 
+std::string ExternalStudy() {
+  return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/external/quarter_car.study.textproto";
+}
+
+std::string ExternalDrivers() {
+  return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/external/quarter_car.drivers.textproto";
+}
+
 std::string VehicleSensitivityStudy() {
   return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/vehicle/vehicle_sensitivity.study.textproto";
 }

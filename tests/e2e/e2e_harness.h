@@ -23,6 +23,11 @@ std::string ServerBinary();
 std::string WorkerBinary();
 // The vehicle example (examples/vehicle/vehicle.study.textproto).
 std::string VehicleStudy();
+// The external-simulator example (examples/external): its study, and the
+// drivers file its workers need (--drivers).
+std::string ExternalStudy();
+std::string ExternalDrivers();
+
 // The same problem with simulator sensitivities
 // (examples/vehicle/vehicle_sensitivity.study.textproto).
 std::string VehicleSensitivityStudy();

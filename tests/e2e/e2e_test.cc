@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <sys/stat.h>
 
+#include <chrono>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -56,14 +57,33 @@ std::string SubmitWatchAndGetResults(const std::string& address, const std::stri
   return results.stdout_text;
 }
 
-// A study (default: the vehicle) on a fresh server with `workers` plain workers.
-std::string ReferenceResult(int workers, const std::string& study = VehicleStudy()) {
+// `mbopt workers` lists `count` workers or more (polled with a deadline as
+// a failure guard: registration has no event a client could wait for).
+std::string WorkersWhenRegistered(const std::string& address, size_t count) {
+  const auto deadline = std::chrono::steady_clock::now() + kGuard;
+  while (true) {
+    auto listed = Mbopt({"workers", "--server", address});
+    EXPECT_EQ(listed.exit_code, kExitOk) << Describe(listed);
+    size_t rows = 0;
+    for (char c : listed.stdout_text) rows += c == '\n';
+    if (rows >= count + 1 || std::chrono::steady_clock::now() > deadline || listed.exit_code != kExitOk) {
+      return listed.stdout_text;
+    }
+  }
+}
+
+// A study (default: the vehicle) on a fresh server with `workers` workers
+// started with `worker_args`.
+std::string ReferenceResult(int workers, const std::string& study = VehicleStudy(),
+                            const std::vector<std::string>& worker_args = {}) {
   ScratchDir dir;
   auto server = StartServer(dir.File("ref.db"), {}, "127.0.0.1:0", dir.File("server.log"));
   EXPECT_TRUE(server.ok()) << server.status();
   if (!server.ok()) return "";
   std::vector<Subprocess> pool;
-  for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address));
+  for (int i = 0; i < workers; ++i) pool.push_back(StartWorker(server->address, worker_args));
+  // A study naming a driver is refused until a worker declaring it has registered.
+  if (!worker_args.empty()) WorkersWhenRegistered(server->address, static_cast<size_t>(workers));
   std::string json = SubmitWatchAndGetResults(server->address, study);
   for (auto& w : pool) w.Stop(kGuard);
   EXPECT_EQ(server->process->Stop(kGuard), 0) << "server did not shut down cleanly";
@@ -158,8 +178,10 @@ TEST(EndToEnd, ResultsAreIdenticalWithOneTwoAndFourWorkers) {
 // kills itself (SIGKILL) holding its third task, then a survivor; checks
 // that the job ends with the result of an undisturbed run and returns the
 // job's status text.
-std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_args) {
-  const std::string reference = Comparable(ReferenceResult(1));
+std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_args,
+                                         const std::string& study = VehicleStudy(),
+                                         const std::vector<std::string>& worker_args = {}) {
+  const std::string reference = Comparable(ReferenceResult(1, study, worker_args));
   EXPECT_FALSE(reference.empty());
   ScratchDir dir;
   auto server = StartServer(dir.File("jobs.db"), server_args, "127.0.0.1:0", dir.File("server.log"));
@@ -167,9 +189,11 @@ std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_
   if (!server.ok()) return "";
   // The doomed worker takes tasks alone first, so that it surely receives its
   // third task while the first cycle's batch is in progress.
-  Subprocess doomed = StartWorker(server->address, {"--die-after-tasks", "3", "--name", "doomed"},
-                                  dir.File("doomed.log"));
-  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  std::vector<std::string> doomed_args = {"--die-after-tasks", "3", "--name", "doomed"};
+  doomed_args.insert(doomed_args.end(), worker_args.begin(), worker_args.end());
+  Subprocess doomed = StartWorker(server->address, doomed_args, dir.File("doomed.log"));
+  if (!worker_args.empty()) WorkersWhenRegistered(server->address, 1);
+  auto submitted = Mbopt({"submit", study, "--server", server->address});
   EXPECT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto died = doomed.Wait(kGuard);
@@ -177,7 +201,9 @@ std::string RunWithAWorkerKilledMidCycle(const std::vector<std::string>& server_
   if (died.ok()) {
     EXPECT_EQ(*died, kKilledBySigkill);
   }
-  Subprocess survivor = StartWorker(server->address, {"--name", "survivor"}, dir.File("survivor.log"));
+  std::vector<std::string> survivor_args = {"--name", "survivor"};
+  survivor_args.insert(survivor_args.end(), worker_args.begin(), worker_args.end());
+  Subprocess survivor = StartWorker(server->address, survivor_args, dir.File("survivor.log"));
 
   auto watched = Mbopt({"watch", job, "--server", server->address});
   EXPECT_TRUE(IsOutcomeExitCode(watched.exit_code)) << Describe(watched);
@@ -209,8 +235,9 @@ TEST(EndToEnd, KilledWorkersTaskIsRequeuedWithoutWaitingForItsLease) {
 // the uninterrupted run's result, bit for bit.
 void ExpectServerKilledMidJobResumesBitIdentically(
     const std::string& study, const std::vector<std::string>& server_args = {},
-    const std::vector<std::string>& crash_flags = {"--crash-after-cycles", "2"}, int min_cycles_at_restart = 2) {
-  const std::string reference = Comparable(ReferenceResult(2, study));
+    const std::vector<std::string>& crash_flags = {"--crash-after-cycles", "2"}, int min_cycles_at_restart = 2,
+    const std::vector<std::string>& worker_args = {}) {
+  const std::string reference = Comparable(ReferenceResult(2, study, worker_args));
   ASSERT_FALSE(reference.empty());
 
   ScratchDir dir;
@@ -222,8 +249,9 @@ void ExpectServerKilledMidJobResumesBitIdentically(
   ASSERT_TRUE(first.ok()) << first.status();
   std::vector<Subprocess> pool;
   for (int i = 0; i < 2; ++i) {
-    pool.push_back(StartWorker(first->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
+    pool.push_back(StartWorker(first->address, worker_args, dir.File(absl::StrCat("worker", i, ".log"))));
   }
+  if (!worker_args.empty()) WorkersWhenRegistered(first->address, pool.size());
   auto submitted = Mbopt({"submit", study, "--server", first->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
@@ -326,6 +354,103 @@ TEST(EndToEnd, RunJsonStartsEverythingAndPrintsOneJsonObject) {
   EXPECT_EQ(Comparable(run.stdout_text), reference);
   const std::string database = JsonField(json, "database");
   EXPECT_NE(database.find("/mbopt/runs/vehicle-"), std::string::npos) << "where the job is kept\n" << json;
+}
+
+// A simulator mbopt did not write (examples/external: a python3 script
+// behind a declared driver) optimized through the service: `mbopt run
+// --drivers` with two local workers gives the same result, bit for bit, as
+// submit and watch to a server with two workers started with --drivers, and
+// the optimum sits on the travel limit.
+TEST(EndToEnd, ExternalSimulatorStudyRunsThroughRunAndSubmitAlike) {
+  const std::string reference = Comparable(ReferenceResult(2, ExternalStudy(), {"--drivers", ExternalDrivers()}));
+  ASSERT_FALSE(reference.empty());
+  auto run = Mbopt({"run", ExternalStudy(), "--workers", "2", "--drivers", ExternalDrivers(), "--json",
+                    "--discard-db"},
+                   {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()});
+  ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);
+  EXPECT_EQ(Comparable(run.stdout_text), reference);
+  EXPECT_EQ(JsonField(run.stdout_text, "status"), "converged") << run.stdout_text;
+  const double max_violation = std::stod(JsonField(run.stdout_text, "max_violation"));
+  EXPECT_LE(max_violation, 0.0) << "the reported design meets the travel limit";
+  EXPECT_GT(max_violation, -1e-3) << "and the limit is active at the optimum";
+}
+
+// A worker of the external study killed (SIGKILL) as it receives a task,
+// in the middle of a cycle: a worker declaring the same driver takes the
+// task over and the job ends with the undisturbed run's result, bit for bit.
+TEST(EndToEnd, ExternalSimulatorWorkerKilledMidCycleDoesNotChangeTheResult) {
+  RunWithAWorkerKilledMidCycle(kFastLeases, ExternalStudy(), {"--drivers", ExternalDrivers()});
+}
+
+// A server killed in the middle of the external study resumes it with the
+// uninterrupted run's result, bit for bit: the driver is deterministic and
+// its numbers are parsed exactly.
+TEST(EndToEnd, ExternalSimulatorJobKilledMidJobResumesBitIdentically) {
+  ExpectServerKilledMidJobResumesBitIdentically(ExternalStudy(), {}, {"--crash-after-cycles", "2"}, 2,
+                                                {"--drivers", ExternalDrivers()});
+}
+
+// Workers say what they can run: a study naming a driver no registered
+// worker declares is refused at submit, naming what the workers do declare;
+// once a worker declares it, the job runs, and only on that worker.
+TEST(EndToEnd, ExternalStudyIsRefusedWithoutItsDriverAndRunsOnlyWhereDeclared) {
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), {}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  Subprocess plain = StartWorker(server->address, {"--name", "plain"}, dir.File("plain.log"));
+  WorkersWhenRegistered(server->address, 1);
+  auto refused = Mbopt({"submit", ExternalStudy(), "--server", server->address});
+  EXPECT_EQ(refused.exit_code, kExitBadInput) << Describe(refused);
+  EXPECT_NE(refused.stderr_text.find("no registered worker declares driver \"quarter_car\"; the registered "
+                                     "workers declare no drivers"),
+            std::string::npos)
+      << Describe(refused);
+
+  Subprocess able = StartWorker(server->address, {"--name", "able", "--drivers", ExternalDrivers()},
+                                dir.File("able.log"));
+  const std::string listed = WorkersWhenRegistered(server->address, 2);
+  EXPECT_NE(listed.find("driver quarter_car"), std::string::npos) << listed;
+  auto submitted = Mbopt({"submit", ExternalStudy(), "--server", server->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto watched = Mbopt({"watch", job, "--server", server->address});
+  EXPECT_EQ(watched.exit_code, kExitOk) << Describe(watched);
+  auto after = Mbopt({"workers", "--server", server->address});
+  // Every analysis ran on the worker that declares the driver; none was
+  // handed to the other and back.
+  std::istringstream rows(after.stdout_text);
+  std::string line;
+  int checked = 0;
+  while (std::getline(rows, line)) {
+    std::istringstream fields(line);
+    std::string id, name;
+    long long slots = 0, analyses = -1;
+    fields >> id >> name >> slots >> analyses;
+    if (name == "plain") {
+      EXPECT_EQ(analyses, 0) << after.stdout_text;
+    }
+    if (name == "able") {
+      EXPECT_GT(analyses, 0) << after.stdout_text;
+    }
+    checked += name == "plain" || name == "able";
+  }
+  EXPECT_EQ(checked, 2) << after.stdout_text;
+  EXPECT_EQ(plain.Stop(kGuard), 0);
+  EXPECT_EQ(able.Stop(kGuard), 0);
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
+// A drivers file with a problem stops `mbopt run` before anything starts,
+// naming the file, the line and the field.
+TEST(BadInput, RunWithABadDriversFileNamesItsProblem) {
+  ScratchDir dir;
+  const std::string drivers = dir.Write("bad.drivers.textproto", "driver {\n  name: \"x\"\n  timeout_s: -1\n}\n");
+  auto run = Mbopt({"run", ExternalStudy(), "--drivers", drivers, "--discard-db"},
+                   {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()});
+  EXPECT_EQ(run.exit_code, kExitBadInput) << Describe(run);
+  EXPECT_NE(run.stderr_text.find("bad.drivers.textproto:"), std::string::npos) << Describe(run);
+  EXPECT_NE(run.stderr_text.find("driver[0]."), std::string::npos) << Describe(run);
+  EXPECT_EQ(run.stdout_text.find("server at"), std::string::npos) << "nothing was started";
 }
 
 // From `mbopt run` to the report page in two commands: run keeps its

@@ -75,6 +75,26 @@ TEST(TaskEvaluator, ValuesAlignWithTheStudyLayout) {
   for (double v : Unpacked(result.objective_terms_packed())) EXPECT_TRUE(std::isfinite(v));
 }
 
+// A worker that cannot run an external study's driver says so, and the task
+// goes back for another worker (retry) instead of failing the design.
+TEST(TaskEvaluator, AnExternalStudyIsRunnableOnlyWhereItsDriverIsDeclared) {
+  auto study = spec::io::LoadStudyFile(std::string(MBOPT_TEST_SOURCE_DIR) +
+                                       "/examples/external/quarter_car.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_NE(CannotRun(*study, nullptr).find("declares no drivers"), std::string::npos);
+  external::ExternalWorkerSettings settings;
+  settings.drivers.resize(1);
+  settings.drivers[0].name = "other";
+  EXPECT_NE(CannotRun(*study, &settings).find("no driver \"quarter_car\"; it declares: \"other\""),
+            std::string::npos)
+      << CannotRun(*study, &settings);
+  settings.drivers[0].name = "quarter_car";
+  EXPECT_EQ(CannotRun(*study, &settings), "");
+  auto vehicle = spec::io::LoadStudyFile(VehicleStudyPath());
+  ASSERT_TRUE(vehicle.ok());
+  EXPECT_EQ(CannotRun(*vehicle, nullptr), "") << "built-in scenes need no drivers";
+}
+
 TEST(TaskEvaluator, WrongDimensionIsAFailedResultNotACrash) {
   const v1::Study proto = VehicleStudyProto();
   auto prepared = PrepareStudy(proto, "job-1");

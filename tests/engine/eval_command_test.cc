@@ -6,6 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -39,6 +41,28 @@ TEST(EvalCommand, TextReportShowsObjectiveWorstRowOutputsAndCounters) {
   EXPECT_THAT(r.out, HasSubstr("worst row    s1@t=1.800s upper"));
   EXPECT_THAT(r.out, HasSubstr("seat_acceleration"));
   EXPECT_THAT(r.out, HasSubstr("counters     steps"));
+}
+
+// An external scene runs through the driver --drivers declares (the
+// example's python3 simulator); the per-analysis folder and the default
+// work directory are gone afterwards. Without drivers the analysis fails
+// saying why.
+TEST(EvalCommand, ExternalStudyRunsThroughTheDeclaredDriverAndLeavesNoFolders) {
+  constexpr char kStudy[] = "examples/external/quarter_car.study.textproto";
+  const EvalRun r = Eval({kStudy, "--drivers", "examples/external/quarter_car.drivers.textproto"});
+  EXPECT_EQ(r.code, kExitOk) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("formulation  external"));
+  EXPECT_THAT(r.out, HasSubstr("peak_acceleration"));
+  const std::filesystem::path default_work =
+      std::filesystem::temp_directory_path() / ("mbopt-runs-" + std::to_string(::getpid()));
+  EXPECT_FALSE(std::filesystem::exists(default_work)) << default_work;
+
+  const EvalRun without = Eval({kStudy});
+  EXPECT_EQ(without.code, kExitAnalysisFailed);
+  EXPECT_THAT(without.out, HasSubstr("runs no analysis drivers"));
+  const EvalRun keep_alone = Eval({kStudy, "--keep-runs"});
+  EXPECT_EQ(keep_alone.code, kExitBadInput);
+  EXPECT_THAT(keep_alone.err, HasSubstr("--work-dir and --keep-runs need --drivers FILE"));
 }
 
 TEST(EvalCommand, JsonIsOneObjectWithTheRequiredKeys) {

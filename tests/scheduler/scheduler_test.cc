@@ -8,6 +8,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -51,6 +52,78 @@ TEST(Scheduler, HandsOutTasksRoundRobinBetweenJobs) {
     EXPECT_EQ((*rest)[i].job_id, "job-1");
     EXPECT_EQ((*rest)[i].request_id, static_cast<std::int64_t>(i + 2));
   }
+}
+
+// A job whose scene names an analysis driver goes only to workers that
+// declared it; other jobs' tasks still go to everyone.
+TEST(Scheduler, TasksThatNeedADriverGoOnlyToWorkersThatDeclareIt) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.SetJobNeeds("job-ext", TaskNeeds{"quarter_car"});
+  for (int r = 0; r < 3; ++r) scheduler.Enqueue("job-ext", r, {1.0});
+  scheduler.Enqueue("job-plain", 0, {2.0});
+  const std::string plain = scheduler.RegisterWorker("plain", 1);
+  const std::string able = scheduler.RegisterWorker("able", 1, WorkerCapabilities{{"other", "quarter_car"}, ""});
+  auto to_plain = scheduler.Acquire(plain, 10);
+  ASSERT_TRUE(to_plain.ok());
+  ASSERT_EQ(to_plain->size(), 1u);
+  EXPECT_EQ((*to_plain)[0].job_id, "job-plain");
+  // Nothing left that the plain worker can run.
+  auto again = scheduler.Acquire(plain, 10);
+  ASSERT_TRUE(again.ok());
+  EXPECT_TRUE(again->empty());
+  // A batch is the worker's share by slots of all the work outstanding
+  // (two of four), the rest once it has answered one.
+  auto to_able = scheduler.Acquire(able, 10);
+  ASSERT_TRUE(to_able.ok());
+  ASSERT_EQ(to_able->size(), 2u);
+  ASSERT_TRUE(scheduler.Complete(able, (*to_able)[0].task_id).ok());
+  auto rest = scheduler.Acquire(able, 10);
+  ASSERT_TRUE(rest.ok());
+  ASSERT_EQ(rest->size(), 1u);
+  to_able->push_back(rest->front());
+  for (const Task& t : *to_able) EXPECT_EQ(t.job_id, "job-ext");
+  ASSERT_TRUE(scheduler.Complete(plain, (*to_plain)[0].task_id).ok());
+
+  // What `mbopt workers` shows, and what submit checks.
+  const std::vector<WorkerView> workers = scheduler.Workers();
+  ASSERT_EQ(workers.size(), 2u);
+  EXPECT_EQ(workers[0].name, "plain");
+  EXPECT_EQ(workers[0].public_id, PublicWorkerId(plain));
+  EXPECT_EQ(workers[0].analyses_done, 1);
+  EXPECT_EQ(workers[0].tasks_held, 0);
+  EXPECT_EQ(workers[1].name, "able");
+  EXPECT_EQ(workers[1].capabilities.drivers, (std::vector<std::string>{"other", "quarter_car"}));
+  EXPECT_EQ(workers[1].analyses_done, 1);
+  EXPECT_EQ(workers[1].tasks_held, 2);
+  EXPECT_EQ(scheduler.OfferedDrivers(), (std::vector<std::string>{"other", "quarter_car"}));
+  EXPECT_TRUE(scheduler.SomeWorkerCan(TaskNeeds{"quarter_car"}));
+  EXPECT_FALSE(scheduler.SomeWorkerCan(TaskNeeds{"missing"}));
+  EXPECT_TRUE(scheduler.SomeWorkerCan(TaskNeeds{}));
+}
+
+// Until a worker that declares the driver registers, the job's tasks wait;
+// dropping the job forgets what it needed.
+TEST(Scheduler, ADriversTasksWaitForAWorkerThatDeclaresIt) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.SetJobNeeds("job-ext", TaskNeeds{"quarter_car"});
+  scheduler.Enqueue("job-ext", 0, {1.0});
+  const std::string plain = scheduler.RegisterWorker("plain", 1);
+  EXPECT_FALSE(scheduler.SomeWorkerCan(TaskNeeds{"quarter_car"}));
+  auto none = scheduler.Acquire(plain, 1);
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->empty());
+  EXPECT_EQ(scheduler.QueuedCount(), 1);
+  const std::string able = scheduler.RegisterWorker("able", 1, WorkerCapabilities{{"quarter_car"}, ""});
+  auto one = scheduler.Acquire(able, 1);
+  ASSERT_TRUE(one.ok());
+  EXPECT_EQ(one->size(), 1u);
+  scheduler.DropJob("job-ext");
+  scheduler.Enqueue("job-ext", 1, {1.0});
+  auto after_drop = scheduler.Acquire(plain, 1);
+  ASSERT_TRUE(after_drop.ok());
+  EXPECT_EQ(after_drop->size(), 1u) << "a dropped job's needs are forgotten";
 }
 
 // A worker that asks for a batch gets its share, by slots, of the work

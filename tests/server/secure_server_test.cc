@@ -26,6 +26,7 @@
 #include "server/auth/certificates.h"
 #include "server/auth/token.h"
 #include "server/auth/token_table.h"
+#include "server/scheduler/scheduler.h"
 #include "server/service/server.h"
 #include "tests/server/fake_worker.h"
 #include "tests/server/test_study.h"
@@ -280,6 +281,40 @@ TEST_F(SecureServerTest, OnlyWorkerTokensActAsWorkersAndWorkerTokensCannotSubmit
   grpc::Status status = Submit(*Jobs(worker_), &ignored);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
   EXPECT_THAT(status.error_message(), HasSubstr("a worker token may only acquire tasks and report results"));
+}
+
+// Users and admins may see which workers there are and what they can run
+// (workers belong to the server, not to a job); what they see lets nobody
+// act as a worker: the id's secret part is not shown. A worker token may
+// not list them: it only acquires tasks and reports results.
+TEST_F(SecureServerTest, WorkersAreListedToUsersAndAdminsWithTheirDriversButNotTheirSecretIds) {
+  StartSecureServer();
+  auto as_worker = v1::WorkerService::NewStub(Channel(Client(worker_, ca_.certificate_pem)));
+  v1::RegisterWorkerResponse registered;
+  {
+    grpc::ClientContext context;
+    v1::RegisterWorkerRequest request;
+    request.set_name("sim-host");
+    request.set_slots(2);
+    request.add_drivers("quarter_car");
+    ASSERT_TRUE(as_worker->Register(&context, request, &registered).ok());
+  }
+  for (const std::string* token : {&alice_, &admin_}) {
+    grpc::ClientContext context;
+    v1::ListWorkersResponse listed;
+    ASSERT_TRUE(Jobs(*token)->ListWorkers(&context, v1::ListWorkersRequest(), &listed).ok());
+    ASSERT_EQ(listed.workers_size(), 1);
+    EXPECT_EQ(listed.workers(0).name(), "sim-host");
+    EXPECT_EQ(listed.workers(0).slots(), 2);
+    ASSERT_EQ(listed.workers(0).drivers_size(), 1);
+    EXPECT_EQ(listed.workers(0).drivers(0), "quarter_car");
+    EXPECT_EQ(listed.workers(0).id(), scheduler::PublicWorkerId(registered.worker_id()));
+    EXPECT_NE(listed.workers(0).id(), registered.worker_id()) << "the secret part stays with the worker";
+  }
+  grpc::ClientContext context;
+  v1::ListWorkersResponse listed;
+  grpc::Status status = Jobs(worker_)->ListWorkers(&context, v1::ListWorkersRequest(), &listed);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
 }
 
 TEST_F(SecureServerTest, MissingOrWrongTokensAreRefusedAndReloadingTheTableRevokes) {

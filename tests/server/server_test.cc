@@ -640,6 +640,75 @@ TEST_F(ServerTest, WorkerForgottenByARestartIsAskedToRegisterAgain) {
   EXPECT_EQ(stub->AcquireTasks(&context, request, &response).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
+// The oscillator study as an external scene naming driver "oscillator-sim".
+v1::Study ExternalOscillatorStudy() {
+  v1::Study study = OscillatorStudy("external oscillator");
+  v1::Scene* scene = study.mutable_scene();
+  scene->clear_lumped();
+  v1::ExternalModel* model = scene->mutable_external();
+  model->set_driver("oscillator-sim");
+  for (const char* parameter : {"k", "c"}) {
+    v1::ExternalInput* input = model->add_inputs();
+    input->set_name(parameter);
+    input->mutable_value()->set_param(parameter);
+  }
+  for (v1::Output& output : *scene->mutable_outputs()) {
+    const std::string name = output.name();
+    output.Clear();
+    output.set_name(name);
+    output.mutable_external_series()->set_name(name);
+  }
+  return study;
+}
+
+// A study naming a driver no registered worker declares is refused at
+// submit with the drivers that exist; once its workers are gone (here, a
+// restart forgets every worker) the job says what it waits for.
+TEST_F(ServerTest, ADriverNoWorkerDeclaresIsRefusedAtSubmitAndNamedWhileTheJobWaits) {
+  std::string id;
+  {
+    auto server = StartServer("drivers.db");
+    auto jobs = v1::JobService::NewStub(server->InProcessChannel());
+    v1::SubmitJobRequest request;
+    *request.mutable_study() = ExternalOscillatorStudy();
+    request.set_source_name("external.study.textproto");
+    {
+      grpc::ClientContext context;
+      v1::SubmitJobResponse response;
+      grpc::Status status = jobs->Submit(&context, request, &response);
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+      EXPECT_NE(status.error_message().find("external.study.textproto: scene.external.driver: no registered worker "
+                                            "declares driver \"oscillator-sim\"; the registered workers declare "
+                                            "no drivers"),
+                std::string::npos)
+          << status.error_message();
+    }
+    auto workers = v1::WorkerService::NewStub(server->InProcessChannel());
+    {
+      grpc::ClientContext context;
+      v1::RegisterWorkerRequest registration;
+      registration.set_name("sim");
+      registration.set_slots(1);
+      registration.add_drivers("oscillator-sim");
+      v1::RegisterWorkerResponse registered;
+      ASSERT_TRUE(workers->Register(&context, registration, &registered).ok());
+    }
+    grpc::ClientContext context;
+    v1::SubmitJobResponse response;
+    grpc::Status status = jobs->Submit(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    id = response.job_id();
+    EXPECT_EQ(Get(*server, id).summary().waiting_for(), "");
+    server->Shutdown();
+  }
+  auto server = StartServer("drivers.db");
+  const v1::GetJobResponse resumed = Get(*server, id);
+  EXPECT_EQ(resumed.summary().state(), v1::JOB_STATE_RUNNING);
+  EXPECT_NE(resumed.summary().waiting_for().find("no registered worker declares driver \"oscillator-sim\""),
+            std::string::npos)
+      << resumed.summary().waiting_for();
+}
+
 TEST(ListenAddress, OnlyLoopbackAndLocalSocketsAreLoopback) {
   for (const char* local : {"127.0.0.1:50051", "127.1.2.3:0", "localhost:50051", "[::1]:50051", "unix:/tmp/mbopt.sock"}) {
     EXPECT_TRUE(IsLoopbackAddress(local)) << local;

@@ -11,10 +11,22 @@
 
 namespace mbopt::engine {
 
-spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si) {
+spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                             const ExternalAnalyzer* external) {
   const auto start = std::chrono::steady_clock::now();
   spec::AnalysisReport report;
-  if (std::holds_alternative<spec::LumpedModel>(scene.model)) {
+  if (std::holds_alternative<spec::ExternalModel>(scene.model)) {
+    if (external != nullptr) {
+      report = external->AnalyzeExternal(scene, parameter_values_si);
+    } else {
+      report.formulation = spec::Formulation::kExternal;
+      report.times_s = scene.time_grid.Instants();
+      report.Fail(spec::FailureKind::kInvalidModel,
+                  "external scene (driver \"" + std::get<spec::ExternalModel>(scene.model).driver +
+                      "\"): this program runs no analysis drivers; run it on a worker that declares them "
+                      "(mbopt-worker --drivers FILE)");
+    }
+  } else if (std::holds_alternative<spec::LumpedModel>(scene.model)) {
     report = solve::SimulateLumped(scene, parameter_values_si);
   } else if (std::holds_alternative<spec::MultibodyModel>(scene.model)) {
     report = multibody::AnalyzeMultibodyScene(scene, parameter_values_si);
@@ -49,11 +61,12 @@ bool AppendCaseReport(const spec::Study& study, int c, spec::AnalysisReport repo
   return true;
 }
 
-spec::AnalysisReport AnalyzeCases(const spec::Study& study, const std::vector<double>& parameter_values_si) {
-  if (study.cases.empty()) return Analyze(study.scene, parameter_values_si);
+spec::AnalysisReport AnalyzeCases(const spec::Study& study, const std::vector<double>& parameter_values_si,
+                                  const ExternalAnalyzer* external) {
+  if (study.cases.empty()) return Analyze(study.scene, parameter_values_si, external);
   spec::AnalysisReport combined;
   for (int c = 0; c < study.num_cases(); ++c) {
-    if (!AppendCaseReport(study, c, Analyze(study.scene, study.CaseParameterValues(c, parameter_values_si)),
+    if (!AppendCaseReport(study, c, Analyze(study.scene, study.CaseParameterValues(c, parameter_values_si), external),
                           &combined)) {
       break;
     }

@@ -10,19 +10,23 @@
 #include "spec/analysis_report.h"
 #include "spec/scene.h"
 #include "spec/study.h"
+#include "worker/engine/external_analyzer.h"
 
 namespace mbopt::engine {
 
 // Runs one analysis. `parameter_values_si` has one SI value per scene
-// parameter. The report's counters include the wall time.
-spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si);
+// parameter. The report's counters include the wall time. `external` runs an
+// external scene (external_analyzer.h); none: such a scene fails.
+spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                             const ExternalAnalyzer* external = nullptr);
 
 // Every load case of `study` (Study::cases; the scene as it is when there
 // are none) at the design's SI parameter values: one report whose outputs
 // are the cases' outputs in signal order, named as Study::SignalName names
 // them, with the counters (wall time included) summed over the cases. The
 // first case that fails fails the report, its reason naming the case.
-spec::AnalysisReport AnalyzeCases(const spec::Study& study, const std::vector<double>& parameter_values_si);
+spec::AnalysisReport AnalyzeCases(const spec::Study& study, const std::vector<double>& parameter_values_si,
+                                  const ExternalAnalyzer* external = nullptr);
 
 // Adds load case `c`'s report to `combined` as AnalyzeCases does; false (and
 // `combined` failed) when the case failed.

@@ -24,6 +24,7 @@
 #include "spec/layout.h"
 #include "spec/study.h"
 #include "spec/study_gradients.h"
+#include "worker/engine/external_analyzer.h"
 
 namespace mbopt::engine {
 
@@ -47,7 +48,9 @@ struct StudyEvaluation {
 // does not fit the study (x_scaled of the wrong size or not finite) or the
 // engine's outputs do not have the layout's shape (an engine defect, not a
 // numerical outcome).
+// `external` runs external scenes (external_analyzer.h).
 absl::StatusOr<StudyEvaluation> EvaluateStudy(const spec::Study& study, const spec::StudyLayout& layout,
-                                              const std::vector<double>& x_scaled, bool want_gradients);
+                                              const std::vector<double>& x_scaled, bool want_gradients,
+                                              const ExternalAnalyzer* external = nullptr);
 
 }  // namespace mbopt::engine

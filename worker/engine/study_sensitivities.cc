@@ -11,7 +11,8 @@ namespace mbopt::engine {
 
 StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
-                                                     const std::vector<double>& x_scaled) {
+                                                     const std::vector<double>& x_scaled,
+                                                     const ExternalAnalyzer* external) {
   const auto start = std::chrono::steady_clock::now();
   StudyAnalysisWithGradients out;
   const std::vector<double> parameters_si = study.ParameterValuesAt(x_scaled);
@@ -28,6 +29,11 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
       parameters.push_back(also);
       variable_of.push_back(i);
     }
+  }
+  if (std::holds_alternative<spec::ExternalModel>(study.scene.model)) {
+    out.report = AnalyzeCases(study, parameters_si, external);
+    out.gradients_unavailable = "an external driver's gradients are not read yet";
+    return out;
   }
   const bool multibody = std::holds_alternative<spec::MultibodyModel>(study.scene.model);
   out.gradients_unavailable = multibody ? multibody::MultibodySensitivityUnavailable(study.scene)

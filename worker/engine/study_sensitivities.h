@@ -19,6 +19,7 @@
 #include "spec/layout.h"
 #include "spec/study.h"
 #include "spec/study_gradients.h"
+#include "worker/engine/external_analyzer.h"
 #include "worker/engine/analysis.h"
 
 namespace mbopt::engine {
@@ -30,9 +31,11 @@ struct StudyAnalysisWithGradients {
 };
 
 // `x_scaled` has one entry per study variable; `layout` is
-// MakeStudyLayout(study).
+// MakeStudyLayout(study). An external scene has no gradients here: it is
+// analysed by `external` and gradients_unavailable says so.
 StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
-                                                     const std::vector<double>& x_scaled);
+                                                     const std::vector<double>& x_scaled,
+                                                     const ExternalAnalyzer* external = nullptr);
 
 }  // namespace mbopt::engine

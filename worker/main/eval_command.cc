@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <ostream>
 
 #include "absl/strings/str_cat.h"
@@ -14,12 +15,14 @@
 #include "spec/layout.h"
 #include "worker/engine/analysis.h"
 #include "worker/engine/study_values.h"
+#include "worker/external/worker_settings.h"
 
 namespace mbopt::worker {
 namespace {
 
 const char kUsage[] =
     "usage: mbopt-worker eval STUDY [--set NAME=VALUE ...] [--json] [--series-out FILE]\n"
+    "                          [--drivers FILE [--work-dir DIR] [--keep-runs]]\n"
     "  Runs one analysis of STUDY (a .study.textproto) at its initial design and\n"
     "  prints the objective, the worst constraint row, per-output summaries,\n"
     "  the formulation and the counters.\n"
@@ -30,6 +33,8 @@ const char kUsage[] =
     "  --series-out FILE also write every output (per load case) and response\n"
     "                    series, SI, to FILE (binary mbopt.v1.AnalysisSeries,\n"
     "                    proto/mbopt/v1/series.proto): what `mbopt report` plots\n"
+    "  --drivers FILE, --work-dir DIR, --keep-runs  analysis drivers for an external\n"
+    "                    scene, as for `mbopt-worker serve`\n"
     "  exit status: 0 ok, 1 analysis failed, 2 bad input\n";
 
 std::string JsonString(const std::string& s) {
@@ -175,9 +180,20 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   std::vector<std::string> sets;
   std::string series_out;
   bool json = false;
+  external::ExternalOptions external_options;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--json") {
+    bool takes_value = false;
+    if (external::IsExternalOption(a, &takes_value)) {
+      if (takes_value && i + 1 >= args.size()) {
+        err << "mbopt-worker eval: " << a << " needs a value\n" << kUsage;
+        return kExitBadInput;
+      }
+      if (!external::SetExternalOption(a, takes_value ? args[++i] : "", &external_options)) {
+        err << "mbopt-worker eval: bad value for " << a << "\n" << kUsage;
+        return kExitBadInput;
+      }
+    } else if (a == "--json") {
       json = true;
     } else if (a == "--set") {
       if (i + 1 >= args.size()) {
@@ -211,6 +227,12 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return kExitBadInput;
   }
 
+  absl::StatusOr<std::unique_ptr<external::ExternalWorkerSettings>> external_settings =
+      external::LoadExternalSettings(external_options);
+  if (!external_settings.ok()) {
+    err << "mbopt-worker eval: " << external_settings.status().message() << "\n";
+    return kExitBadInput;
+  }
   absl::StatusOr<spec::Study> loaded = spec::io::LoadStudyFile(study_path);
   if (!loaded.ok()) {
     err << loaded.status().message() << "\n";
@@ -243,7 +265,12 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
   }
 
-  const spec::AnalysisReport report = engine::AnalyzeCases(study, parameters);
+  std::unique_ptr<external::ExternalSceneAnalyzer> analyzer;
+  if (*external_settings != nullptr) {
+    analyzer = std::make_unique<external::ExternalSceneAnalyzer>(**external_settings, "eval");
+  }
+  const spec::AnalysisReport report = engine::AnalyzeCases(study, parameters, analyzer.get());
+  external::RemoveDefaultWorkDirectoryIfEmpty(external_options, external_settings->get());
   const bool ok = report.ok();
   if (!series_out.empty()) {
     if (absl::Status written = WriteSeries(study, *layout, report, parameters, series_out); !written.ok()) {

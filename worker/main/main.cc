@@ -1,6 +1,7 @@
 // mbopt-worker: the analysis worker. Subcommands:
 //   eval STUDY [--set NAME=VALUE ...] [--json]   one analysis, for debugging
 //   serve --server ADDRESS [--slots N] [--name NAME]   work for a server
+//   drivers FILE                                 check a drivers file
 //     (`mbopt-worker --server ADDRESS ...` is short for `serve`)
 // Each subcommand lives in its own file; this file only dispatches.
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "worker/main/drivers_command.h"
 #include "worker/main/eval_command.h"
 #include "worker/service/serve_command.h"
 
@@ -23,15 +25,21 @@ int Eval(const std::vector<std::string>& args) {
   return mbopt::worker::RunEval(args, std::cout, std::cerr);
 }
 
+int Drivers(const std::vector<std::string>& args) {
+  return mbopt::worker::RunDrivers(args, std::cout, std::cerr);
+}
+
 const Subcommand kSubcommands[] = {
     {"eval", "run one analysis of a study and print its values", &Eval},
     {"serve", "connect to a server and run its analyses", &mbopt::worker::ServeMain},
+    {"drivers", "check a drivers file and list its drivers", &Drivers},
 };
 
 void PrintUsage(std::ostream& os) {
   os << "usage: mbopt-worker <subcommand> [arguments]\n\nsubcommands:\n";
   for (const Subcommand& s : kSubcommands) os << "  " << s.name << "  " << s.summary << "\n";
-  os << "\n" << mbopt::worker::EvalUsage() << "\n" << mbopt::worker::ServeUsage();
+  os << "\n" << mbopt::worker::EvalUsage() << "\n" << mbopt::worker::ServeUsage() << "\n"
+     << mbopt::worker::DriversUsage();
 }
 
 }  // namespace

@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "worker/external/worker_settings.h"
 #include "worker/service/stop_signal.h"
 #include "worker/service/worker_service.h"
 
@@ -24,8 +26,10 @@ bool ParseInt(const std::string& text, int min, int* out) {
 }  // namespace
 
 const char* ServeUsage() {
-  return "usage: mbopt-worker serve --server HOST:PORT [--slots N] [--name NAME]\n"
+  static const std::string usage = std::string(
+         "usage: mbopt-worker serve --server HOST:PORT [--slots N] [--name NAME]\n"
          "                          [--tls-ca FILE [--tls-cert FILE --tls-key FILE]] [--token-file FILE]\n"
+         "                          [--drivers FILE [--work-dir DIR] [--keep-runs]]\n"
          "       mbopt-worker --server HOST:PORT ... (the same)\n"
          "  --slots N            analyses run at once (default 1)\n"
          "  --name NAME          name shown by the server (default host:pid)\n"
@@ -43,14 +47,17 @@ const char* ServeUsage() {
          "                       holding the token); never on the command line\n"
          "  Exit status: 0 stopped by a signal, 2 bad options, 3 the server refused the\n"
          "  token or the first connection failed for a reason of this configuration.\n"
-         "  --verbose            one line on stderr per task\n"
+         "  --verbose            one line on stderr per task\n") +
+      external::ExternalOptionsUsage() +
          "  --task-delay-ms N    testing only: hold each result N ms before reporting it\n"
          "  --die-after-tasks N  testing only: SIGKILL this process on receiving the\n"
          "                       N-th task, before reporting it\n";
+  return usage.c_str();
 }
 
 int ServeMain(const std::vector<std::string>& args) {
   WorkerOptions options;
+  external::ExternalOptions external_options;
   secure_channel::ClientSecurityFlags security_flags;
   for (size_t i = 0; i < args.size(); ++i) {
     std::string name = args[i], value;
@@ -67,7 +74,10 @@ int ServeMain(const std::vector<std::string>& args) {
       return true;
     };
     bool ok = true;
-    if (name == "--server") {
+    bool external_takes_value = false;
+    if (external::IsExternalOption(name, &external_takes_value)) {
+      ok = (!external_takes_value || need_value()) && external::SetExternalOption(name, value, &external_options);
+    } else if (name == "--server") {
       ok = need_value();
       options.server_address = value;
     } else if (name == "--slots") {
@@ -103,6 +113,17 @@ int ServeMain(const std::vector<std::string>& args) {
     std::fprintf(stderr, "mbopt-worker: --server HOST:PORT is required\n%s", ServeUsage());
     return 2;
   }
+  // Read before connecting: a drivers file with a problem stops the worker
+  // here, with every problem named, not at its first analysis.
+  absl::StatusOr<std::unique_ptr<external::ExternalWorkerSettings>> external_settings =
+      external::LoadExternalSettings(external_options);
+  if (!external_settings.ok()) {
+    std::fprintf(stderr, "mbopt-worker: %s\n", std::string(external_settings.status().message()).c_str());
+    return 2;
+  }
+  // Never freed, like the stop signals below: worker threads may use them
+  // until the process exits.
+  options.external = external_settings->release();
   secure_channel::QuietGrpcLogUnlessAsked();
   absl::StatusOr<secure_channel::ClientSecurity> security = secure_channel::LoadClientSecurity(security_flags);
   if (!security.ok()) {
@@ -117,6 +138,7 @@ int ServeMain(const std::vector<std::string>& args) {
   StopSignal* stop = stop_signals->emplace_back(std::make_unique<StopSignal>()).get();
   StopOnTerminationSignals(stop);
   absl::Status status = RunWorker(options, *stop);
+  external::RemoveDefaultWorkDirectoryIfEmpty(external_options, options.external);
   if (!status.ok()) {
     std::fprintf(stderr, "mbopt-worker: %s\n", std::string(status.message()).c_str());
     return absl::IsPermissionDenied(status) ? 3 : 2;

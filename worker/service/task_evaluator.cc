@@ -1,6 +1,7 @@
 #include "worker/service/task_evaluator.h"
 
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "common/packed_doubles/packed_doubles.h"
@@ -30,6 +31,19 @@ void AppendRowMajor(const std::vector<std::vector<double>>& rows, google::protob
 
 }  // namespace
 
+std::string CannotRun(const spec::Study& study, const external::ExternalWorkerSettings* external) {
+  const auto* model = std::get_if<spec::ExternalModel>(&study.scene.model);
+  if (model == nullptr) return "";
+  if (external == nullptr) {
+    return "the study's scene is external (driver \"" + model->driver +
+           "\") and this worker declares no drivers (mbopt-worker --drivers FILE)";
+  }
+  if (external::FindDriver(external->drivers, model->driver) != nullptr) return "";
+  std::string names;
+  for (const external::DriverDeclaration& d : external->drivers) names += (names.empty() ? "\"" : ", \"") + d.name + "\"";
+  return "this worker declares no driver \"" + model->driver + "\"; it declares: " + names;
+}
+
 absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Study& study,
                                                                   const std::string& job_id) {
   auto prepared = std::make_shared<PreparedStudy>();
@@ -43,10 +57,10 @@ absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Stud
 }
 
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
-                  v1::TaskResult* result) {
+                  v1::TaskResult* result, const engine::ExternalAnalyzer* external) {
   const std::vector<double> x(task.x_scaled().begin(), task.x_scaled().end());
   absl::StatusOr<engine::StudyEvaluation> evaluation =
-      engine::EvaluateStudy(prepared.study, prepared.layout, x, task.want_gradients());
+      engine::EvaluateStudy(prepared.study, prepared.layout, x, task.want_gradients(), external);
   if (!evaluation.ok()) {
     // The task does not fit the study (or the engine's outputs do not fit
     // the layout): nothing about the design point, so the service's kind.

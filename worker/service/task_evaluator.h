@@ -20,6 +20,8 @@
 #include "mbopt/v1/service.pb.h"
 #include "spec/layout.h"
 #include "spec/study.h"
+#include "worker/engine/external_analyzer.h"
+#include "worker/external/scene_analyzer.h"
 
 namespace mbopt::worker {
 
@@ -33,14 +35,18 @@ struct PreparedStudy {
 absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Study& study,
                                                                   const std::string& job_id);
 
+// Why this worker cannot run any task of `study` (an external scene whose
+// driver `external` does not declare, or no drivers at all); "" when it can.
+std::string CannotRun(const spec::Study& study, const external::ExternalWorkerSettings* external);
+
 // How a result carries its values: packed (common/packed_doubles) for a
 // server that reads them, as repeated doubles for an older one
 // (RegisterWorkerResponse.takes_packed_values).
 enum class ValueEncoding { kPacked, kUnpacked };
 
 // Fills everything of `result` except worker_id, task_id, job_id and
-// request_id.
+// request_id. `external` runs external scenes (null: they fail).
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
-                  v1::TaskResult* result);
+                  v1::TaskResult* result, const engine::ExternalAnalyzer* external = nullptr);
 
 }  // namespace mbopt::worker

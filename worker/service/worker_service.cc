@@ -10,6 +10,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <mutex>
 #include <set>
 #include <string>
@@ -180,6 +181,11 @@ class Worker : public std::enable_shared_from_this<Worker> {
     v1::RegisterWorkerRequest request;
     request.set_name(options_.name);
     request.set_slots(options_.slots);
+    // What it can run, so the server hands it only tasks it can run. No
+    // FMU platform yet: this worker loads no FMUs.
+    if (options_.external != nullptr) {
+      for (const external::DriverDeclaration& driver : options_.external->drivers) request.add_drivers(driver.name);
+    }
     v1::RegisterWorkerResponse response;
     grpc::ClientContext context;
     context.set_deadline(Clock::now() + kShortCallDeadline);
@@ -336,8 +342,18 @@ class Worker : public std::enable_shared_from_this<Worker> {
         takes_packed_values = takes_packed_values_;
       }
       const auto started = std::chrono::steady_clock::now();
-      if (study != nullptr) {
-        EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result);
+      const std::string cannot_run = study != nullptr ? CannotRun(study->study, options_.external) : "";
+      if (!cannot_run.empty()) {
+        // Not the design point's fault: another worker may declare the
+        // driver (the server prefers one that has not failed the task).
+        result.set_ok(false);
+        result.set_retry(true);
+        result.set_failure_reason(cannot_run);
+      } else if (study != nullptr) {
+        std::optional<external::ExternalSceneAnalyzer> analyzer;
+        if (options_.external != nullptr) analyzer.emplace(*options_.external, task.task_id());
+        EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result,
+                     analyzer.has_value() ? &*analyzer : nullptr);
         FitResultToServerLimit(max_message_bytes, max_result_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.

@@ -17,6 +17,7 @@
 #include "common/secure_channel/client_security.h"
 #include "worker/service/backoff.h"
 #include "worker/service/stop_signal.h"
+#include "worker/external/scene_analyzer.h"
 
 namespace mbopt::worker {
 
@@ -47,6 +48,9 @@ struct WorkerOptions {
   // The multi-host test uses it to cut links in the middle of a job.
   int task_delay_ms = 0;
   bool verbose = false;  // a line on stderr per task
+  // The analysis drivers this worker offers (--drivers) and where their
+  // analyses run; null: none. Outlives the worker.
+  const external::ExternalWorkerSettings* external = nullptr;
 };
 
 // Runs until `stop` is requested; then lets running analyses finish, reports

@@ -5,6 +5,7 @@
 #include <deque>
 #include <iostream>
 #include <utility>
+#include <variant>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -63,6 +64,13 @@ void LogError(const std::string& job_id, const absl::Status& status) {
 }
 
 bool Running(JobState state) { return state == JobState::kRunning || state == JobState::kQueued; }
+
+// What a worker must be able to do to run the study's analyses.
+scheduler::TaskNeeds NeedsOf(const spec::Study& study) {
+  scheduler::TaskNeeds needs;
+  if (const auto* external = std::get_if<spec::ExternalModel>(&study.scene.model)) needs.driver = external->driver;
+  return needs;
+}
 
 }  // namespace
 
@@ -331,6 +339,14 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
   MBOPT_ASSIGN_OR_RETURN(spec::Study study, decoder_(study_bytes, source_name));
+  if (const scheduler::TaskNeeds needs = NeedsOf(study); !scheduler_->SomeWorkerCan(needs)) {
+    const std::vector<std::string> offered = scheduler_->OfferedDrivers();
+    return absl::FailedPreconditionError(absl::StrCat(
+        source_name, ": scene.external.driver: no registered worker declares ", needs.Describe(),
+        "; the registered workers declare ",
+        offered.empty() ? "no drivers" : absl::StrCat("\"", absl::StrJoin(offered, "\", \""), "\""),
+        " (a worker offers drivers with mbopt-worker serve --drivers FILE)"));
+  }
   MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study, options_.make_lp_solver()));
   bool room = false;
   {
@@ -467,6 +483,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why, cons
 
 void JobManager::ScheduleLocked(Entry& entry) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
+  scheduler_->SetJobNeeds(entry.row.id, NeedsOf(entry.study));
   std::vector<scheduler::Scheduler::NewTask> tasks;
   for (const slp::AnalysisRequest& request : entry.job->PendingRequests()) {
     tasks.push_back({request.id, std::vector<double>(request.x.data(), request.x.data() + request.x.size()),
@@ -815,6 +832,12 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
     }
   }
   s.failed_analyses_by_kind = entry.failed_analyses_by_kind;
+  if (entry.state == JobState::kRunning && entry.study_ok) {
+    if (const scheduler::TaskNeeds needs = NeedsOf(entry.study); !scheduler_->SomeWorkerCan(needs)) {
+      s.waiting_for = absl::StrCat("no registered worker declares ", needs.Describe(),
+                                   ": its analyses wait for one (mbopt workers)");
+    }
+  }
   // The optimizer minimizes; a maximized value is reported as itself.
   const double sign = entry.study_ok ? entry.study.objective.ReportedSign() : 1.0;
   if (entry.job != nullptr) {

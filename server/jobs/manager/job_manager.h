@@ -97,6 +97,9 @@ struct JobSummaryData {
   int max_cycles = 0;
   // Failed analyses so far by failure kind name (spec::FailureKindName).
   std::map<std::string, std::int64_t> failed_analyses_by_kind;
+  // A running job whose analyses no registered worker can run: why
+  // (e.g. the driver its scene names); "" otherwise.
+  std::string waiting_for;
 };
 
 // What a client needs to show a job's records with names and units.
@@ -160,6 +163,8 @@ class JobManager {
   absl::StatusOr<JobView> Get(const std::string& job_id, std::size_t first_record = 0,
                               JobViewFor view_for = JobViewFor::kReader);
   absl::StatusOr<std::vector<JobSummaryData>> List();
+  // The registered workers (`mbopt workers`).
+  std::vector<scheduler::WorkerView> Workers() const { return scheduler_->Workers(); }
   // FailedPrecondition when the job has already ended.
   absl::StatusOr<JobSummaryData> Cancel(const std::string& job_id, const std::string& actor = "");
   // Continues an interrupted or cancelled job (replaying its log), or queues
