@@ -111,6 +111,9 @@ function(mbopt_declare_modules)
   mbopt_module(solve DIRS worker/solve USES model spec common PURE
     LIBS mbopt_cvodes mbopt_lumped mbopt_lumped_sensitivity mbopt_linkage
     SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities, linkage solvers")
+  mbopt_module(fmu DIRS worker/fmu USES solve PURE
+    LIBS mbopt_fmu
+    SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped")
   mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
