@@ -74,6 +74,18 @@ TEST(FmuCoSimulation, TimeEventInsideACommunicationStep) {
   }
 }
 
+TEST(FmuCoSimulation, WallTimeLimitEndsTheRun) {
+  const Fmu fmu = OpenCoSimulation("van_der_pol");
+  RunOptions options;
+  options.outputs = {"x0"};
+  options.output_times_s = Grid(0.0, 40.0, 40);  // 40,000 steps of 1 ms
+  options.max_wall_seconds = 1e-6;
+  auto result = Simulate(fmu, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->outcome, RunOutcome::kTimeLimit);
+  EXPECT_LT(result->integrator_steps, 40000);
+}
+
 TEST(FmuCoSimulation, OutputTimesOffTheCommunicationPointsAreRefused) {
   const Fmu fmu = OpenCoSimulation("damped_oscillator");
   RunOptions options;

@@ -133,6 +133,16 @@ TEST(FmuModelExchange, SameRunTwiceIsBitIdentical) {
   EXPECT_EQ(first->state_event_times_s, second->state_event_times_s);
 }
 
+TEST(FmuModelExchange, WallTimeLimitEndsTheRun) {
+  const Fmu fmu = OpenModelExchange("van_der_pol");
+  RunOptions options = Tight({}, {"x0"}, Grid(0.0, 40.0, 4000));
+  options.max_wall_seconds = 1e-6;  // the whole run takes milliseconds
+  auto result = Simulate(fmu, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->outcome, RunOutcome::kTimeLimit);
+  EXPECT_THAT(result->reason, ::testing::HasSubstr("the wall-time limit of 1e-06 s was reached at t = "));
+}
+
 TEST(FmuModelExchange, OutputAtTheStartTimeIsTheInitialValue) {
   const Fmu fmu = OpenModelExchange("damped_oscillator");
   auto result = Simulate(fmu, Tight({{"x0_m", 0.3}}, {"x_m"}, {0.0, 0.0, 0.5}));

@@ -2,6 +2,7 @@
 // and the Model Exchange loop (model_exchange.cc). Internal to worker/fmu.
 #pragma once
 
+#include <chrono>
 #include <vector>
 
 #include "worker/fmu/fmi2_instance.h"
@@ -15,6 +16,18 @@ struct CheckedRun {
   std::vector<fmi2ValueReference> parameter_references;
   std::vector<double> parameter_values;
   double stop_time_s = 0.0;
+};
+
+// The run's wall-time limit (RunOptions::max_wall_seconds).
+class WallClock {
+ public:
+  explicit WallClock(double max_seconds) : max_seconds_(max_seconds), start_(std::chrono::steady_clock::now()) {}
+  // False (and `result` failed with kTimeLimit) once the limit is passed.
+  bool Within(double time_s, RunResult* result) const;
+
+ private:
+  double max_seconds_;
+  std::chrono::steady_clock::time_point start_;
 };
 
 // Marks `result` failed with `outcome` and `reason`; returns false.
