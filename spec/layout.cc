@@ -263,6 +263,8 @@ Dimension OutputDimension(const Output& output) {
                         [](const BendingStressOutput&) { return Dimension::kPressure; },
                         [](const DriveTorqueOutput&) { return Dimension::kTorque; },
                         [](const MassOutput&) { return Dimension::kMass; },
+                        // The FMU's own units, unknown here: a limit is written in SI.
+                        [](const FmuVariableOutput&) { return Dimension::kAny; },
                         [](const MultibodyOutput& m) {
                           using Q = MultibodyOutput::Quantity;
                           switch (m.quantity) {

@@ -208,6 +208,20 @@ struct MultibodyModel {
   std::vector<MultibodyTorque> torques;
 };
 
+// ---- FMU
+// An FMI 2.0 FMU run by the worker (worker/fmu). Its variables are checked
+// against the FMU's model description when an analysis opens it.
+struct FmuParameterBinding {
+  std::string variable;  // the FMU's Real parameter
+  Number value;          // SI
+};
+struct FmuModel {
+  std::string path;  // the .fmu archive, absolute once the scene file was read
+  bool co_simulation = false;
+  std::vector<FmuParameterBinding> parameters;
+  double communication_step_s = 0.0;  // co-simulation; 0: the FMU's default
+};
+
 // ---- outputs
 enum class Axis { kX, kY };
 struct PointPositionOutput { int link = -1; int point = -1; int joint = -1; Axis axis = Axis::kX; };  // link point, or joint if joint >= 0
@@ -225,6 +239,8 @@ struct BodyAccelerationOutput {
 struct BendingStressOutput { int link = -1; };
 struct DriveTorqueOutput {};
 struct MassOutput {};
+// An FMU scene's output: one of the FMU's Real variables.
+struct FmuVariableOutput { std::string variable; };
 // An output of a multibody scene. Reactions are the force body a's side of
 // the joint exerts on body b; a driver's effort is the torque (revolute) or
 // force (prismatic) it applies to body b.
@@ -244,7 +260,8 @@ struct MultibodyOutput {
 struct Output {
   std::string name;
   std::variant<PointPositionOutput, LinkRotationOutput, ElementDeflectionOutput,
-               BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput>
+               BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput,
+               FmuVariableOutput>
       kind;
 };
 
@@ -268,7 +285,7 @@ struct Scene {
   std::string source_file;  // for messages
   std::vector<Parameter> parameters;
   Effects effects;
-  std::variant<LinkageModel, LumpedModel, MultibodyModel> model;
+  std::variant<LinkageModel, LumpedModel, MultibodyModel, FmuModel> model;
   std::vector<Output> outputs;
   TimeGrid time_grid;
   // The parameters the time grid's start_expr / end_expr read (sorted): the

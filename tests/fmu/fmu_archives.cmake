@@ -1,7 +1,7 @@
 # mbopt_test_fmu(NAME): builds models/NAME.c (with models/model_frame.c) into
 # binaries/<platform>/NAME.so next to models/NAME.xml as modelDescription.xml
 # and zips both into ${MBOPT_TEST_FMU_DIR}/NAME.fmu. Every test FMU is part of
-# the target mbopt_test_fmus. Used by tests/fmu and examples.
+# the target mbopt_test_fmus (examples/fmu runs one of them).
 if(CMAKE_SYSTEM_NAME STREQUAL "Linux" AND CMAKE_SIZEOF_VOID_P EQUAL 8)
   set(MBOPT_FMU_PLATFORM linux64)
 else()
