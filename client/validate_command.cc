@@ -22,6 +22,7 @@ const char* ModelName(const spec::Scene& scene) {
   if (std::holds_alternative<spec::LinkageModel>(scene.model)) return "linkage";
   if (std::holds_alternative<spec::LumpedModel>(scene.model)) return "lumped";
   if (std::holds_alternative<spec::ExternalModel>(scene.model)) return "external";
+  if (std::holds_alternative<spec::FmuModel>(scene.model)) return "fmu";
   return "multibody";
 }
 

@@ -111,10 +111,13 @@ function(mbopt_declare_modules)
   mbopt_module(solve DIRS worker/solve USES model spec common PURE
     LIBS mbopt_cvodes mbopt_lumped mbopt_lumped_sensitivity mbopt_linkage
     SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities, linkage solvers")
+  mbopt_module(fmu DIRS worker/fmu USES solve spec PURE
+    LIBS mbopt_fmu mbopt_fmu_scene
+    SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
   mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
-  mbopt_module(engine DIRS worker/engine USES multibody solve model spec common PURE
+  mbopt_module(engine DIRS worker/engine USES fmu multibody solve model spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
     SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")
   mbopt_module(local_run DIRS worker/local_run USES jobs slp lp engine spec common PURE BRIDGE

@@ -10,6 +10,7 @@ packages=(
   libabsl-dev
   libeigen3-dev
   libsundials-dev
+  libzip-dev libpugixml-dev
   libsqlite3-dev sqlite3
   libssl-dev
   iproute2

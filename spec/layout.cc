@@ -266,6 +266,8 @@ Dimension OutputDimension(const Output& output) {
                         [](const MassOutput&) { return Dimension::kMass; },
                         // The driver's own SI quantity, unknown here.
                         [](const ExternalResultOutput&) { return Dimension::kAny; },
+                        // The FMU's own units, unknown here: a limit is written in SI.
+                        [](const FmuVariableOutput&) { return Dimension::kAny; },
                         [](const MultibodyOutput& m) {
                           using Q = MultibodyOutput::Quantity;
                           switch (m.quantity) {

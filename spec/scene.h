@@ -222,6 +222,20 @@ struct ExternalModel {
   std::vector<ExternalInput> inputs;  // names unique
 };
 
+// ---- FMU
+// An FMI 2.0 FMU run by the worker (worker/fmu). Its variables are checked
+// against the FMU's model description when an analysis opens it.
+struct FmuParameterBinding {
+  std::string variable;  // the FMU's Real parameter
+  Number value;          // SI
+};
+struct FmuModel {
+  std::string path;  // the .fmu archive, absolute once the scene file was read
+  bool co_simulation = false;
+  std::vector<FmuParameterBinding> parameters;
+  double communication_step_s = 0.0;  // co-simulation; 0: the FMU's default
+};
+
 // ---- outputs
 enum class Axis { kX, kY };
 struct PointPositionOutput { int link = -1; int point = -1; int joint = -1; Axis axis = Axis::kX; };  // link point, or joint if joint >= 0
@@ -245,6 +259,8 @@ struct ExternalResultOutput {
   std::string name;  // as written in the results file
   bool series = false;
 };
+// An FMU scene's output: one of the FMU's Real variables.
+struct FmuVariableOutput { std::string variable; };
 // An output of a multibody scene. Reactions are the force body a's side of
 // the joint exerts on body b; a driver's effort is the torque (revolute) or
 // force (prismatic) it applies to body b.
@@ -265,7 +281,7 @@ struct Output {
   std::string name;
   std::variant<PointPositionOutput, LinkRotationOutput, ElementDeflectionOutput,
                BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput,
-               ExternalResultOutput>
+               ExternalResultOutput, FmuVariableOutput>
       kind;
 };
 
@@ -289,7 +305,7 @@ struct Scene {
   std::string source_file;  // for messages
   std::vector<Parameter> parameters;
   Effects effects;
-  std::variant<LinkageModel, LumpedModel, MultibodyModel, ExternalModel> model;
+  std::variant<LinkageModel, LumpedModel, MultibodyModel, ExternalModel, FmuModel> model;
   std::vector<Output> outputs;
   TimeGrid time_grid;
   // The parameters the time grid's start_expr / end_expr read (sorted): the

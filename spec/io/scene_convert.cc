@@ -40,11 +40,13 @@ class SceneConverter {
         break;
       case v1::Scene::kExternal:
         scene_.model = ConvertExternal(msg_.external(), where_.Child("external"));
+      case v1::Scene::kFmu:
+        scene_.model = ConvertFmu(msg_.fmu(), where_.Child("fmu"));
         break;
       case v1::Scene::MODEL_NOT_SET:
         errors_.Add(where_, "",
                     "the scene has no model: expected `linkage { ... }`, `lumped { ... }`, "
-                    "`multibody { ... }` or `external { ... }`");
+                    "`multibody { ... }`, `external { ... }` or `fmu { ... }`");
         return scene_;
     }
     if (msg_.model_case() == v1::Scene::kLumped && msg_.has_effects()) {
@@ -68,6 +70,10 @@ class SceneConverter {
       errors_.Add(where_, "effects",
                   "an external scene's effects are its driver's: declare gravity or damping in the "
                   "simulator's own input, through the driver's parameters");
+    }
+    if (msg_.model_case() == v1::Scene::kFmu && msg_.has_effects()) {
+      errors_.Add(where_.Child("effects"), "",
+                  "an FMU scene's physics is the FMU's: it takes no effects (set them as FMU parameters)");
     }
     if (const auto* mb = std::get_if<MultibodyModel>(&scene_.model);
         mb != nullptr && mb->flexible_links.empty() && msg_.effects().has_structural_damping()) {
@@ -1080,6 +1086,41 @@ class SceneConverter {
   }
 
   // ------------------------------------------------------------ outputs --
+  FmuModel ConvertFmu(const v1::FmuModel& m, const Where& w) {
+    FmuModel out;
+    out.path = m.path();
+    if (out.path.empty()) errors_.Add(w, "path", "missing: expected the .fmu file, e.g. `path: \"model.fmu\"`");
+    switch (m.interface()) {
+      case v1::FMU_INTERFACE_UNSPECIFIED:
+      case v1::FMU_MODEL_EXCHANGE:
+        out.co_simulation = false;
+        break;
+      case v1::FMU_CO_SIMULATION:
+        out.co_simulation = true;
+        break;
+      default:
+        errors_.Add(w, "interface", "expected FMU_MODEL_EXCHANGE or FMU_CO_SIMULATION");
+    }
+    if (m.communication_step_s() < 0.0 || !std::isfinite(m.communication_step_s())) {
+      errors_.Add(w, "communication_step_s",
+                  absl::StrFormat("must be > 0 s (0 for the FMU's default step), got %g", m.communication_step_s()));
+    } else if (m.communication_step_s() > 0.0 && !out.co_simulation) {
+      errors_.Add(w, "communication_step_s", "applies to `interface: FMU_CO_SIMULATION` only");
+    }
+    out.communication_step_s = m.communication_step_s();
+    std::set<std::string> seen;
+    for (int i = 0; i < m.parameters_size(); ++i) {
+      const v1::FmuParameter& p = m.parameters(i);
+      const Where pw = w.Child("parameters", i);
+      if (p.variable().empty()) errors_.Add(pw, "variable", "missing: expected the FMU parameter's name");
+      if (!seen.insert(p.variable()).second) {
+        errors_.Add(pw, "variable", absl::StrCat("FMU parameter \"", p.variable(), "\" is set twice"));
+      }
+      out.parameters.push_back({p.variable(), Num(pw, "value", p.has_value(), p.value(), Dimension::kAny)});
+    }
+    return out;
+  }
+
   void ConvertOutputs() {
     std::set<std::string> names;
     const bool lumped = std::holds_alternative<LumpedModel>(scene_.model);
@@ -1212,11 +1253,22 @@ class SceneConverter {
           out.kind = ExternalResultOutput{r.name(), series};
           break;
         }
+        case v1::Output::kFmuVariable:
+          needs = "fmu";
+          if (o.fmu_variable().variable().empty()) {
+            errors_.Add(ow.Child("fmu_variable"), "variable", "missing: expected the FMU variable's name");
+          }
+          out.kind = FmuVariableOutput{o.fmu_variable().variable()};
+          break;
         case v1::Output::KIND_NOT_SET:
           errors_.Add(ow, "", "the output has no kind (e.g. `element_deflection { ... }`)");
           break;
       }
-      const char* model_kind = lumped ? "lumped" : linkage ? "linkage" : external ? "external" : "multibody";
+      const char* model_kind = lumped      ? "lumped"
+                               : linkage   ? "linkage"
+                               : multibody ? "multibody"
+                               : external  ? "external"
+                                           : "fmu";
       if (needs != nullptr && std::string(needs) != model_kind) {
         errors_.Add(ow, "",
                     absl::StrCat("output \"", o.name(), "\" needs ", needs[0] == 'e' ? "an " : "a ", needs,

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
@@ -22,6 +23,10 @@
 
 namespace mbopt::spec::io {
 namespace {
+
+// ParseSceneText, with a relative FMU path taken from `fmu_folder` if set.
+absl::StatusOr<Scene> ParseSceneTextFrom(const std::string& text, const std::string& source_name,
+                                         const std::optional<std::filesystem::path>& fmu_folder);
 
 using google::protobuf::TextFormat;
 
@@ -113,6 +118,25 @@ struct ParsedStudy {
   std::string scene_file;  // resolved path, empty if inline
 };
 
+// An FMU scene's relative `fmu.path` made absolute from `folder` (the scene
+// file's), so that the scene means the same file once it is inlined into a
+// study and sent on; and the file checked to exist here, where a mistake is
+// still the user's to fix (`scene_source` names the file in the message).
+absl::Status AnchorFmuPath(const std::filesystem::path& folder, const std::string& scene_source, v1::Scene* scene) {
+  if (!scene->has_fmu() || scene->fmu().path().empty()) return absl::OkStatus();
+  std::filesystem::path fmu_path(scene->fmu().path());
+  if (fmu_path.is_relative()) fmu_path = folder / fmu_path;
+  fmu_path = fmu_path.lexically_normal();
+  std::error_code code;
+  if (!std::filesystem::is_regular_file(fmu_path, code)) {
+    return absl::InvalidArgumentError(absl::StrCat(scene_source, ": fmu.path: no FMU file \"", fmu_path.string(),
+                                                   "\" (", scene->fmu().path(),
+                                                   " is taken from the scene file's folder)"));
+  }
+  scene->mutable_fmu()->set_path(fmu_path.string());
+  return absl::OkStatus();
+}
+
 // Takes the scene of a parsed study: from its scene_file (resolved against
 // the study's directory) unless `inline_only`, or inline.
 absl::Status ResolveScene(const std::string& path, bool inline_only, ParsedStudy* parsed) {
@@ -133,11 +157,13 @@ absl::Status ResolveScene(const std::string& path, bool inline_only, ParsedStudy
         return absl::InvalidArgumentError(absl::StrCat(
             where.Describe("scene_file"), ": cannot open scene file \"", parsed->scene_file, "\""));
       }
-      return s;
+      MBOPT_RETURN_IF_ERROR(s);
+      return AnchorFmuPath(scene_path.parent_path(), parsed->scene_file, &parsed->scene);
     }
     case v1::Study::kScene:
       parsed->scene = parsed->study.scene();
-      return absl::OkStatus();
+      if (inline_only) return absl::OkStatus();
+      return AnchorFmuPath(std::filesystem::path(path).parent_path(), path, &parsed->scene);
     case v1::Study::SCENE_SOURCE_NOT_SET:
       return absl::InvalidArgumentError(
           absl::StrCat(path,
@@ -177,7 +203,7 @@ absl::StatusOr<Study> ConvertParsed(const std::string& path, const ParsedStudy& 
 
 absl::StatusOr<Scene> LoadSceneFile(const std::string& path) {
   MBOPT_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
-  return ParseSceneText(text, path);
+  return ParseSceneTextFrom(text, path, std::filesystem::path(path).parent_path());
 }
 
 absl::StatusOr<Study> LoadStudyFile(const std::string& path) {
@@ -211,9 +237,17 @@ absl::StatusOr<v1::Study> ParseStudyText(const std::string& text, const std::str
 }
 
 absl::StatusOr<Scene> ParseSceneText(const std::string& text, const std::string& source_name) {
+  return ParseSceneTextFrom(text, source_name, std::nullopt);
+}
+
+namespace {
+
+absl::StatusOr<Scene> ParseSceneTextFrom(const std::string& text, const std::string& source_name,
+                                         const std::optional<std::filesystem::path>& fmu_folder) {
   v1::Scene message;
   TextFormat::ParseInfoTree tree;
   MBOPT_RETURN_IF_ERROR(ParseText(text, source_name, &message, &tree));
+  if (fmu_folder.has_value()) MBOPT_RETURN_IF_ERROR(AnchorFmuPath(*fmu_folder, source_name, &message));
   Errors errors;
   const Where where(source_name, v1::Scene::descriptor(), &tree);
   CheckUtf8Strings(message, where, &errors);
@@ -223,6 +257,8 @@ absl::StatusOr<Scene> ParseSceneText(const std::string& text, const std::string&
   MBOPT_RETURN_IF_ERROR(errors.ToStatus());
   return scene;
 }
+
+}  // namespace
 
 absl::StatusOr<Scene> SceneFromProto(const v1::Scene& message, const std::string& source_name) {
   Errors errors;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <variant>
 
+#include "worker/fmu/scene_analysis.h"
 #include "worker/multibody/scene_analysis.h"
 #include "worker/solve/lumped_dynamics.h"
 #ifdef MBOPT_HAVE_LINKAGE
@@ -30,6 +31,8 @@ spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>
     report = solve::SimulateLumped(scene, parameter_values_si);
   } else if (std::holds_alternative<spec::MultibodyModel>(scene.model)) {
     report = multibody::AnalyzeMultibodyScene(scene, parameter_values_si);
+  } else if (std::holds_alternative<spec::FmuModel>(scene.model)) {
+    report = fmu::AnalyzeFmuScene(scene, parameter_values_si);
   } else {
 #ifdef MBOPT_HAVE_LINKAGE
     report = solve::AnalyzeLinkage(scene, parameter_values_si);

@@ -1,0 +1,146 @@
+// The `fmu` scene kind: read from files (the FMU path taken from the scene
+// file's folder), checked, and analysed through the engine.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <variant>
+
+#include "spec/io/study_io.h"
+#include "tests/fmu/closed_forms.h"
+#include "worker/engine/analysis.h"
+
+namespace mbopt::fmu {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::DampedOscillator;
+using testing::TestFmu;
+
+class FmuScene : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-fmu-scene-XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    folder_ = pattern;
+    std::filesystem::create_directory(folder_ / "models");
+    std::filesystem::copy_file(TestFmu("damped_oscillator"), folder_ / "models" / "oscillator.fmu");
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::filesystem::path path = folder_ / name;
+    std::ofstream(path) << text;
+    return path.string();
+  }
+
+  static std::string Scene(const std::string& fmu_body, const std::string& outputs) {
+    return R"pb(
+name: "s"
+parameters { name: "stiffness" value: 9 unit: "N/m" }
+fmu {
+)pb" + fmu_body + R"pb(
+}
+)pb" + outputs + R"pb(
+time_grid { start_s: 0 end_s: 3 points: 31 }
+integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-12 }
+)pb";
+  }
+
+  static constexpr char kOscillator[] = R"pb(
+  path: "models/oscillator.fmu"
+  parameters { variable: "stiffness_n_per_m" value { param: "stiffness" } }
+  parameters { variable: "damping_n_s_per_m" value { value: 0.5 } })pb";
+  static constexpr char kPositionAndForce[] = R"pb(
+outputs { name: "position" fmu_variable { variable: "x_m" } }
+outputs { name: "force" fmu_variable { variable: "spring_force_n" } })pb";
+
+  std::filesystem::path folder_;
+};
+
+TEST_F(FmuScene, ARelativeFmuPathIsTakenFromTheSceneFilesFolder) {
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(kOscillator, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const auto* model = std::get_if<spec::FmuModel>(&scene->model);
+  ASSERT_NE(model, nullptr);
+  EXPECT_EQ(model->path, (folder_ / "models" / "oscillator.fmu").string());
+  EXPECT_FALSE(model->co_simulation);
+  ASSERT_EQ(model->parameters.size(), 2u);
+  EXPECT_EQ(model->parameters[0].variable, "stiffness_n_per_m");
+  EXPECT_EQ(model->parameters[0].value.param, 0);
+}
+
+TEST_F(FmuScene, AMissingFmuFileIsNamedWhenTheSceneIsRead) {
+  const std::string body = R"pb(path: "models/nothing.fmu")pb";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(scene.status().message(), HasSubstr("s.scene.textproto: fmu.path: no FMU file"));
+  EXPECT_THAT(scene.status().message(), HasSubstr("models/nothing.fmu"));
+}
+
+TEST_F(FmuScene, OutputsOfOtherModelKindsAndFmuOutputsElsewhereAreRefused) {
+  auto scene = spec::io::LoadSceneFile(
+      Write("s.scene.textproto", Scene(kOscillator, R"pb(outputs { name: "m" mass {} })pb")));
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(scene.status().message(), HasSubstr("output \"m\" needs a linkage model; this scene's model is fmu"));
+}
+
+TEST_F(FmuScene, ACommunicationStepNeedsCoSimulation) {
+  const std::string body = std::string(kOscillator) + "\n  communication_step_s: 0.01";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(scene.status().message(), HasSubstr("applies to `interface: FMU_CO_SIMULATION` only"));
+}
+
+TEST_F(FmuScene, AnalysisReportsTheFmuVariablesOnTheGridAtTheDesignsValues) {
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(kOscillator, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const spec::AnalysisReport report = engine::Analyze(*scene, {16.0});  // stiffness 16 N/m, not the scene's 9
+  ASSERT_TRUE(report.ok()) << report.failure.reason;
+  const DampedOscillator exact{1.0, 0.5, 16.0, 0.1};
+  ASSERT_EQ(report.outputs.size(), 2u);
+  EXPECT_EQ(report.outputs[0].name, "position");
+  ASSERT_EQ(report.times_s.size(), 31u);
+  for (std::size_t i = 0; i < report.times_s.size(); ++i) {
+    EXPECT_NEAR(report.outputs[0].series[0][i], exact.X(report.times_s[i]), 1e-8);
+    EXPECT_NEAR(report.outputs[1].series[0][i], -16.0 * exact.X(report.times_s[i]), 16e-8);
+  }
+  EXPECT_GT(report.counters.time_steps, 0);
+}
+
+TEST_F(FmuScene, CoSimulationSceneSteppedAtItsCommunicationStep) {
+  const std::string body = std::string(kOscillator) + "\n  interface: FMU_CO_SIMULATION communication_step_s: 0.005";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const spec::AnalysisReport report = engine::Analyze(*scene, {9.0});
+  ASSERT_TRUE(report.ok()) << report.failure.reason;
+  EXPECT_EQ(report.counters.time_steps, 600);  // 3 s in 5 ms steps
+  const DampedOscillator exact{1.0, 0.5, 9.0, 0.1};
+  EXPECT_NEAR(report.outputs[0].series[0].back(), exact.X(3.0), 1e-9);
+}
+
+TEST_F(FmuScene, AnFmuVariableThatDoesNotExistFailsTheAnalysisNamingThoseThatDo) {
+  auto scene = spec::io::LoadSceneFile(Write(
+      "s.scene.textproto", Scene(kOscillator, R"pb(outputs { name: "p" fmu_variable { variable: "x" } })pb")));
+  ASSERT_TRUE(scene.ok()) << scene.status();  // the FMU's names are checked when it is opened
+  const spec::AnalysisReport report = engine::Analyze(*scene, {9.0});
+  ASSERT_FALSE(report.ok());
+  EXPECT_EQ(report.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(report.failure.reason, HasSubstr("named \"x\" to output; its Real variables are: x_m, v_m_per_s"));
+}
+
+TEST_F(FmuScene, TheFmusOwnErrorFailsTheAnalysisAsAnInvalidModel) {
+  const std::string body = std::string(kOscillator) + "\n  parameters { variable: \"mass_kg\" value { value: 0 } }";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const spec::AnalysisReport report = engine::Analyze(*scene, {9.0});
+  ASSERT_FALSE(report.ok());
+  EXPECT_EQ(report.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(report.failure.reason, HasSubstr("mass_kg must be > 0, got 0"));
+}
+
+}  // namespace
+}  // namespace mbopt::fmu

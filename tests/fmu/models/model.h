@@ -1,0 +1,46 @@
+/* The test models' side of the FMI 2.0 interface: model_frame.c implements
+ * the fmi2 functions once, over a model that keeps all its Real variables in
+ * one array indexed by value reference and supplies the functions below.
+ * Each test FMU is model_frame.c plus one model file. */
+#ifndef MBOPT_TESTS_FMU_MODELS_MODEL_H_
+#define MBOPT_TESTS_FMU_MODELS_MODEL_H_
+
+#include "worker/fmu/fmi2_api.h"
+
+#define MODEL_MAX_REALS 16
+
+typedef struct {
+  fmi2Real time;
+  fmi2Real r[MODEL_MAX_REALS];
+  fmi2Boolean next_event_time_defined;
+  fmi2Real next_event_time;
+  fmi2Boolean terminate;
+  fmi2CallbackFunctions callbacks;
+  fmi2Type type;
+  char instance_name[64];
+} Model;
+
+/* Supplied by each model. */
+extern const char* const kModelGuid;
+extern const int kModelNumReals;
+extern const int kModelNumStates;
+extern const fmi2ValueReference kModelStates[];
+extern const fmi2ValueReference kModelDerivatives[];
+extern const int kModelNumEventIndicators;
+/* Runge-Kutta steps per communication step of fmi2DoStep. */
+extern const int kModelSubstepsPerStep;
+
+void ModelSetStartValues(Model* m);
+/* At the end of initialization: states from parameters, the first time
+ * event; fmi2Error (with a message logged) for parameters out of range. */
+fmi2Status ModelInitialize(Model* m);
+/* Derivatives and other dependent variables from time, states, parameters. */
+void ModelEvaluate(Model* m);
+void ModelEventIndicators(const Model* m, fmi2Real* indicators);
+/* At an event: discrete changes and state jumps, the next time event.
+ * Returns whether a continuous state changed. */
+fmi2Boolean ModelEvent(Model* m);
+
+void ModelLog(const Model* m, fmi2Status status, const char* message, double value);
+
+#endif /* MBOPT_TESTS_FMU_MODELS_MODEL_H_ */

@@ -1,0 +1,70 @@
+// The parts of an FMI 2.0 modelDescription.xml that mbopt uses to run an
+// FMU: its identity, which interface types it offers, its scalar variables
+// and its default experiment. Parsed from text (the archive reader passes
+// the file's contents), so the parser is tested without an archive.
+//
+// Errors are InvalidArgument naming the file (as the caller labels it), the
+// element and the attribute, and what was expected. FMI 3.0 descriptions are
+// recognized and refused with that reason: mbopt runs FMI 2.0 FMUs only.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/statusor.h"
+
+namespace mbopt::fmu {
+
+enum class Causality { kParameter, kCalculatedParameter, kInput, kOutput, kLocal, kIndependent };
+enum class Variability { kConstant, kFixed, kTunable, kDiscrete, kContinuous };
+enum class VariableType { kReal, kInteger, kBoolean, kString, kEnumeration };
+
+struct ScalarVariable {
+  std::string name;
+  unsigned int value_reference = 0;
+  Causality causality = Causality::kLocal;
+  Variability variability = Variability::kContinuous;
+  VariableType type = VariableType::kReal;
+  std::optional<double> start;  // Real, Integer, Boolean and Enumeration starts as numbers
+};
+
+// One interface type (<ModelExchange> or <CoSimulation>) the FMU offers.
+struct InterfaceType {
+  std::string model_identifier;  // the binary's base name
+  bool provides_directional_derivative = false;
+  bool can_handle_variable_communication_step_size = false;  // co-simulation only
+};
+
+struct DefaultExperiment {
+  std::optional<double> start_time_s;
+  std::optional<double> stop_time_s;
+  std::optional<double> tolerance;
+  std::optional<double> step_size_s;
+};
+
+struct ModelDescription {
+  std::string fmi_version;  // "2.0"
+  std::string model_name;
+  std::string guid;
+  std::optional<InterfaceType> model_exchange;
+  std::optional<InterfaceType> co_simulation;
+  int number_of_event_indicators = 0;
+  std::vector<ScalarVariable> variables;  // in file order; index i is the file's index i + 1
+  // Indices into `variables` of the continuous states (in the order of
+  // fmi2GetContinuousStates) and of their derivatives, from <ModelStructure>.
+  std::vector<int> state_indices;
+  std::vector<int> derivative_indices;
+  DefaultExperiment default_experiment;
+
+  // The variable named `name`, or nullptr.
+  const ScalarVariable* Find(std::string_view name) const;
+};
+
+const char* CausalityName(Causality causality);
+
+// Parses the text of a modelDescription.xml; `file_label` names it in errors.
+absl::StatusOr<ModelDescription> ParseModelDescription(std::string_view xml_text, std::string_view file_label);
+
+}  // namespace mbopt::fmu

@@ -1,0 +1,233 @@
+#include "worker/fmu/simulation.h"
+
+#include <cmath>
+#include <set>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "worker/fmu/run_steps.h"
+
+namespace mbopt::fmu {
+namespace {
+
+using internal::CheckedRun;
+using internal::Fail;
+
+// How far an output time may be from a whole number of communication steps,
+// in steps: output times written in decimal (0.1 s with a 0.01 s step) are
+// not exact multiples in binary.
+constexpr double kGridAlignmentSteps = 1e-9;
+
+bool IsSettableParameter(const ScalarVariable& variable) {
+  return variable.type == VariableType::kReal && variable.causality == Causality::kParameter &&
+         (variable.variability == Variability::kFixed || variable.variability == Variability::kTunable);
+}
+
+std::string NamesOf(const ModelDescription& description, bool (*keep)(const ScalarVariable&)) {
+  std::vector<std::string> names;
+  for (const ScalarVariable& variable : description.variables) {
+    if (keep(variable)) names.push_back(variable.name);
+  }
+  return names.empty() ? "none" : absl::StrJoin(names, ", ");
+}
+
+absl::StatusOr<CheckedRun> Check(const Fmu& fmu, const RunOptions& options) {
+  const ModelDescription& description = fmu.description();
+  const std::string where = fmu.archive_path().string();
+  CheckedRun run;
+  std::set<std::string> seen;
+  for (const auto& [name, value] : options.parameters) {
+    const ScalarVariable* variable = description.Find(name);
+    if (variable == nullptr || !IsSettableParameter(*variable)) {
+      const std::string what =
+          variable == nullptr
+              ? "has no variable"
+              : absl::StrCat("has a variable (causality ", CausalityName(variable->causality),
+                             ") that is not a Real parameter of variability fixed or tunable,");
+      return absl::InvalidArgumentError(absl::StrCat(where, " ", what, " named \"", name,
+                                                     "\"; its Real parameters are: ",
+                                                     NamesOf(description, IsSettableParameter)));
+    }
+    if (!seen.insert(name).second) {
+      return absl::InvalidArgumentError(absl::StrCat(where, ": parameter \"", name, "\" is set twice"));
+    }
+    if (!std::isfinite(value)) {
+      return absl::InvalidArgumentError(absl::StrCat(where, ": parameter \"", name, "\" set to ", value,
+                                                     "; expected a finite value"));
+    }
+    run.parameter_references.push_back(variable->value_reference);
+    run.parameter_values.push_back(value);
+  }
+  for (const std::string& name : options.outputs) {
+    const ScalarVariable* variable = description.Find(name);
+    if (variable == nullptr || variable->type != VariableType::kReal) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          where, variable == nullptr ? " has no variable" : " has a variable that is not Real", " named \"", name,
+          "\" to output; its Real variables are: ",
+          NamesOf(description, [](const ScalarVariable& v) { return v.type == VariableType::kReal; })));
+    }
+    run.output_references.push_back(variable->value_reference);
+  }
+  if (!std::isfinite(options.start_time_s)) {
+    return absl::InvalidArgumentError(absl::StrCat("start time ", options.start_time_s, " s is not finite"));
+  }
+  if (options.output_times_s.empty()) return absl::InvalidArgumentError("no output times");
+  double previous = options.start_time_s;
+  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
+    const double t = options.output_times_s[i];
+    if (!std::isfinite(t) || t < previous) {
+      return absl::InvalidArgumentError(absl::StrCat("output time ", i, " (", t, " s) is before ",
+                                                     i == 0 ? "the start time" : "the one before it", " (",
+                                                     previous, " s) or not finite"));
+    }
+    previous = t;
+  }
+  run.stop_time_s = options.output_times_s.back();
+  if (!(options.relative_tolerance > 0.0) || !(options.absolute_tolerance > 0.0) || options.max_steps <= 0 ||
+      options.max_events < 0 || options.max_event_iterations <= 0) {
+    return absl::InvalidArgumentError(
+        "run options: tolerances must be > 0, max_steps and max_event_iterations > 0, max_events >= 0");
+  }
+  return run;
+}
+
+absl::StatusOr<double> CommunicationStep(const Fmu& fmu, const RunOptions& options) {
+  const std::optional<double> step =
+      options.communication_step_s ? options.communication_step_s : fmu.description().default_experiment.step_size_s;
+  if (!step.has_value()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        fmu.archive_path().string(), ": no communication step: the model description's <DefaultExperiment> has no "
+        "stepSize and the run gives none"));
+  }
+  if (!(*step > 0.0) || !std::isfinite(*step)) {
+    return absl::InvalidArgumentError(absl::StrCat("communication step ", *step, " s; expected a step > 0 s"));
+  }
+  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
+    const double steps = (options.output_times_s[i] - options.start_time_s) / *step;
+    if (std::abs(steps - std::round(steps)) > kGridAlignmentSteps * std::max(1.0, steps)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "output time ", i, " (", options.output_times_s[i], " s) is not a whole number of communication steps (",
+          *step, " s) after the start time (", options.start_time_s,
+          " s); a co-simulation FMU is sampled only at its communication points"));
+    }
+  }
+  return *step;
+}
+
+RunResult RunCoSimulation(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double step_s) {
+  RunResult result;
+  result.values.assign(run.output_references.size(), std::vector<double>(options.output_times_s.size()));
+  const double tolerance = options.relative_tolerance;
+  if (!internal::Initialize(instance, options, run, tolerance, &result)) return result;
+  const Fmi2Functions& f = instance.f();
+  const internal::WallClock clock(options.max_wall_seconds);
+  // Communication points are start + m * step, computed from m each time so
+  // that no rounding accumulates over many steps.
+  std::int64_t m = 0;
+  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
+    const auto target = static_cast<std::int64_t>(std::llround((options.output_times_s[i] - options.start_time_s) / step_s));
+    for (; m < target; ++m) {
+      const double point = options.start_time_s + static_cast<double>(m) * step_s;
+      const fmi2Status status = f.do_step(instance.component(), point, step_s, fmi2True);
+      ++result.integrator_steps;
+      if (status != fmi2OK && status != fmi2Warning) {
+        Fail(&result, RunOutcome::kModelError, instance.Failure("fmi2DoStep", status, point));
+        return result;
+      }
+      if (!clock.Within(point + step_s, &result)) return result;
+    }
+    if (!internal::ReadOutputs(instance, run, static_cast<int>(i), options.output_times_s[i], &result)) return result;
+  }
+  f.terminate(instance.component());
+  return result;
+}
+
+}  // namespace
+
+const char* RunOutcomeName(RunOutcome outcome) {
+  switch (outcome) {
+    case RunOutcome::kOk: return "ok";
+    case RunOutcome::kModelError: return "model error";
+    case RunOutcome::kIntegratorFailure: return "integrator failure";
+    case RunOutcome::kTerminated: return "terminated by the FMU";
+    case RunOutcome::kTimeLimit: return "time limit";
+  }
+  return "?";
+}
+
+namespace internal {
+
+bool WallClock::Within(double time_s, RunResult* result) const {
+  if (max_seconds_ <= 0.0 ||
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() <= max_seconds_) {
+    return true;
+  }
+  return Fail(result, RunOutcome::kTimeLimit,
+              absl::StrCat("the wall-time limit of ", max_seconds_, " s was reached at t = ", time_s, " s"));
+}
+
+bool Fail(RunResult* result, RunOutcome outcome, std::string reason) {
+  result->outcome = outcome;
+  result->reason = std::move(reason);
+  return false;
+}
+
+bool Initialize(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
+                RunResult* result) {
+  const Fmi2Functions& f = instance.f();
+  const double t0 = options.start_time_s;
+  fmi2Status status = f.setup_experiment(instance.component(), fmi2True, tolerance, t0, fmi2True, run.stop_time_s);
+  if (status > fmi2Warning) return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2SetupExperiment", status, t0));
+  if (!run.parameter_references.empty()) {
+    status = f.set_real(instance.component(), run.parameter_references.data(), run.parameter_references.size(),
+                        run.parameter_values.data());
+    if (status > fmi2Warning) return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2SetReal (parameters)", status, t0));
+  }
+  status = f.enter_initialization_mode(instance.component());
+  if (status > fmi2Warning) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2EnterInitializationMode", status, t0));
+  }
+  status = f.exit_initialization_mode(instance.component());
+  if (status > fmi2Warning) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2ExitInitializationMode", status, t0));
+  }
+  return true;
+}
+
+bool ReadOutputs(Fmi2Instance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result) {
+  if (run.output_references.empty()) return true;
+  std::vector<double> values(run.output_references.size());
+  const fmi2Status status =
+      instance.f().get_real(instance.component(), run.output_references.data(), values.size(), values.data());
+  if (status > fmi2Warning) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2GetReal (outputs)", status, time_s));
+  }
+  for (std::size_t k = 0; k < values.size(); ++k) result->values[k][time_index] = values[k];
+  return true;
+}
+
+}  // namespace internal
+
+absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options) {
+  auto run = Check(fmu, options);
+  if (!run.ok()) return run.status();
+  std::optional<double> step;
+  if (fmu.interface() == Interface::kCoSimulation) {
+    auto checked_step = CommunicationStep(fmu, options);
+    if (!checked_step.ok()) return checked_step.status();
+    step = *checked_step;
+  }
+  std::unique_ptr<Fmi2Instance> instance = Fmi2Instance::Create(fmu);
+  if (instance->component() == nullptr) {
+    RunResult result;
+    const std::string messages = instance->RecentMessages();
+    Fail(&result, RunOutcome::kModelError,
+         absl::StrCat("fmi2Instantiate refused to make an instance", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
+    return result;
+  }
+  if (step.has_value()) return RunCoSimulation(*instance, options, *run, *step);
+  return internal::RunModelExchange(fmu, *instance, options, *run);
+}
+
+}  // namespace mbopt::fmu
