@@ -20,6 +20,7 @@ packages=(
   libnlopt-cxx-dev
   libsimbody-dev
   nlohmann-json3-dev
+  python3
   chromium zlib1g-dev
   clang libclang-rt-14-dev
   slurmctld slurmd slurm-client munge

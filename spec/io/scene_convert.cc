@@ -40,6 +40,7 @@ class SceneConverter {
         break;
       case v1::Scene::kExternal:
         scene_.model = ConvertExternal(msg_.external(), where_.Child("external"));
+        break;
       case v1::Scene::kFmu:
         scene_.model = ConvertFmu(msg_.fmu(), where_.Child("fmu"));
         break;
