@@ -333,7 +333,6 @@ absl::Status JobManager::NoSuchJob(const std::string& job_id) {
 
 absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, const std::string& source_name,
                                                const std::string& owner, const std::string& actor) {
-  std::lock_guard<std::mutex> admit_lock(admit_mutex_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
@@ -348,6 +347,9 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
         " (a worker offers drivers with mbopt-worker serve --drivers FILE)"));
   }
   MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study, options_.make_lp_solver()));
+  // Decoding a large study takes a while: the admission decision waits for
+  // it outside the lock that admissions after every result batch take too.
+  std::lock_guard<std::mutex> admit_lock(admit_mutex_);
   bool room = false;
   {
     std::lock_guard<std::mutex> admission_lock(admission_mutex_);
@@ -396,6 +398,12 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
 }
 
 void JobManager::AdmitWaiting() {
+  {
+    // The common case, nothing waiting, costs one short lock: this runs
+    // after every batch of results.
+    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
+    if (admission_.queued() == 0) return;
+  }
   std::lock_guard<std::mutex> admit_lock(admit_mutex_);
   while (true) {
     std::optional<std::string> next;
