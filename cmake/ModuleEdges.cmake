@@ -146,7 +146,7 @@ function(mbopt_declare_modules)
   mbopt_module(external DIRS worker/external USES engine spec_io spec proto common
     LIBS mbopt_external mbopt_external_drivers_file
     SUMMARY "analyses run by external simulation codes: declared drivers (their file), per-analysis folders, process groups with a time limit, results files, external scenes mapped onto the engine's reports")
-  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine spec spec_io proto packed_doubles common
+  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine fmu spec spec_io proto packed_doubles common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
   mbopt_module(worker_main DIRS worker/main USES worker_service external engine spec spec_io proto common

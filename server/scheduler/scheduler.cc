@@ -44,11 +44,15 @@ Scheduler::Scheduler(const Clock* clock, SchedulerOptions options)
     : clock_(clock), options_(std::move(options)) {}
 
 bool TaskNeeds::RunnableBy(const WorkerCapabilities& capabilities) const {
+  if (loads_fmus && capabilities.fmu_platform.empty()) return false;
   return driver.empty() ||
          std::find(capabilities.drivers.begin(), capabilities.drivers.end(), driver) != capabilities.drivers.end();
 }
 
-std::string TaskNeeds::Describe() const { return driver.empty() ? "" : absl::StrCat("driver \"", driver, "\""); }
+std::string TaskNeeds::Describe() const {
+  if (!driver.empty()) return absl::StrCat("driver \"", driver, "\"");
+  return loads_fmus ? "FMU support (a platform it loads FMUs for)" : "";
+}
 
 std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -66,7 +70,7 @@ std::string Scheduler::RegisterWorker(const std::string& name, int slots, Worker
 void Scheduler::SetJobNeeds(const std::string& job_id, TaskNeeds needs) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (needs.driver.empty()) {
+    if (needs.driver.empty() && !needs.loads_fmus) {
       job_needs_.erase(job_id);
     } else {
       job_needs_[job_id] = std::move(needs);
@@ -78,7 +82,7 @@ void Scheduler::SetJobNeeds(const std::string& job_id, TaskNeeds needs) {
 bool Scheduler::SomeWorkerCan(const TaskNeeds& needs) const {
   // Built-in scenes need no particular worker, and none registered yet is
   // no reason to refuse them: every worker runs them.
-  if (needs.driver.empty()) return true;
+  if (needs.driver.empty() && !needs.loads_fmus) return true;
   std::lock_guard<std::mutex> lock(mutex_);
   for (const auto& [id, worker] : workers_) {
     if (needs.RunnableBy(worker.capabilities)) return true;

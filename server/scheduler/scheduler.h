@@ -67,6 +67,9 @@ struct WorkerCapabilities {
 // What every task of a job needs of its worker; default: any worker.
 struct TaskNeeds {
   std::string driver;  // non-empty: a worker declaring this driver
+  // A worker that loads FMUs (a non-empty fmu_platform): which platforms an
+  // FMU carries binaries for is known only where it is opened.
+  bool loads_fmus = false;
   bool RunnableBy(const WorkerCapabilities& capabilities) const;
   // "driver \"x\"", for messages; "" when any worker will do.
   std::string Describe() const;

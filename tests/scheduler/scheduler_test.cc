@@ -56,6 +56,31 @@ TEST(Scheduler, HandsOutTasksRoundRobinBetweenJobs) {
 
 // A job whose scene names an analysis driver goes only to workers that
 // declared it; other jobs' tasks still go to everyone.
+// An FMU study's tasks go only to workers that load FMUs (a platform at
+// registration); with none registered the study is not refused (every
+// worker build loads them), its tasks wait.
+TEST(Scheduler, FmuTasksGoOnlyToWorkersThatLoadFmus) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  TaskNeeds fmu_needs;
+  fmu_needs.loads_fmus = true;
+  EXPECT_FALSE(scheduler.SomeWorkerCan(fmu_needs));
+  EXPECT_EQ(fmu_needs.Describe(), "FMU support (a platform it loads FMUs for)");
+  scheduler.SetJobNeeds("job-fmu", fmu_needs);
+  scheduler.Enqueue("job-fmu", 0, {1.0});
+  const std::string without = scheduler.RegisterWorker("no-fmu", 1);
+  auto none = scheduler.Acquire(without, 10);
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->empty());
+  EXPECT_FALSE(scheduler.SomeWorkerCan(fmu_needs));
+  const std::string with = scheduler.RegisterWorker("fmu", 1, WorkerCapabilities{{}, "linux64"});
+  EXPECT_TRUE(scheduler.SomeWorkerCan(fmu_needs));
+  auto tasks = scheduler.Acquire(with, 10);
+  ASSERT_TRUE(tasks.ok());
+  ASSERT_EQ(tasks->size(), 1u);
+  EXPECT_EQ((*tasks)[0].job_id, "job-fmu");
+}
+
 TEST(Scheduler, TasksThatNeedADriverGoOnlyToWorkersThatDeclareIt) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());

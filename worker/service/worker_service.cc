@@ -22,6 +22,7 @@
 #include "absl/strings/str_cat.h"
 #include "common/secure_channel/connection_diagnosis.h"
 #include "mbopt/v1/service.grpc.pb.h"
+#include "worker/fmu/fmu.h"
 #include "worker/service/result_size.h"
 #include "worker/service/task_evaluator.h"
 
@@ -181,8 +182,8 @@ class Worker : public std::enable_shared_from_this<Worker> {
     v1::RegisterWorkerRequest request;
     request.set_name(options_.name);
     request.set_slots(options_.slots);
-    // What it can run, so the server hands it only tasks it can run. No
-    // FMU platform yet: this worker loads no FMUs.
+    // What it can run, so the server hands it only tasks it can run.
+    request.set_fmu_platform(fmu::ThisPlatform());
     if (options_.external != nullptr) {
       for (const external::DriverDeclaration& driver : options_.external->drivers) request.add_drivers(driver.name);
     }

@@ -69,6 +69,7 @@ bool Running(JobState state) { return state == JobState::kRunning || state == Jo
 scheduler::TaskNeeds NeedsOf(const spec::Study& study) {
   scheduler::TaskNeeds needs;
   if (const auto* external = std::get_if<spec::ExternalModel>(&study.scene.model)) needs.driver = external->driver;
+  needs.loads_fmus = std::holds_alternative<spec::FmuModel>(study.scene.model);
   return needs;
 }
 
@@ -338,7 +339,10 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
   MBOPT_ASSIGN_OR_RETURN(spec::Study study, decoder_(study_bytes, source_name));
-  if (const scheduler::TaskNeeds needs = NeedsOf(study); !scheduler_->SomeWorkerCan(needs)) {
+  // A driver is the workers' to declare, and one no worker declares is a
+  // mistake to say at once; FMU support comes with a worker's build, so an
+  // FMU study waits for such a worker (its status says so) instead.
+  if (const scheduler::TaskNeeds needs = NeedsOf(study); !needs.driver.empty() && !scheduler_->SomeWorkerCan(needs)) {
     const std::vector<std::string> offered = scheduler_->OfferedDrivers();
     return absl::FailedPreconditionError(absl::StrCat(
         source_name, ": scene.external.driver: no registered worker declares ", needs.Describe(),
