@@ -36,6 +36,7 @@ constexpr const char* kUsage =
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N] [--max-result-mb N]\n"
     "                    [--durability full|cycles|normal]\n"
     "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
+    "                    [--max-calls-per-second-per-user N]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
@@ -74,6 +75,9 @@ constexpr const char* kUsage =
     "  --max-running-jobs-per-user N  the same per user (default 16)\n"
     "  --max-queued-jobs-per-user N   waiting jobs a user may have; more are refused\n"
     "                         at submit (default 1000)\n"
+    "  --max-calls-per-second-per-user N  job calls a user token may make per\n"
+    "                         second, in bursts of twice that (default 100; 0: no\n"
+    "                         limit; admins and workers are not limited)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -195,6 +199,14 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
       if (!ParseInt(name, value, 0, &number)) return false;
       flags->server.manager.admission.max_queued_jobs_per_user =
           static_cast<int>(std::min<std::int64_t>(number, 1 << 30));
+    } else if (name == "--max-calls-per-second-per-user") {
+      double rate = 0;
+      if (!absl::SimpleAtod(value, &rate) || !(rate >= 0) || rate > 1e6) {
+        std::cerr << "mbopt-server: --max-calls-per-second-per-user is a number from 0 to 1e6, got '" << value
+                  << "'\n";
+        return false;
+      }
+      flags->server.max_calls_per_second_per_user = rate;
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;
@@ -256,6 +268,7 @@ int main(int argc, char** argv) {
   flags.server.manager.admission.max_running_jobs = 64;
   flags.server.manager.admission.max_running_jobs_per_user = 16;
   flags.server.manager.admission.max_queued_jobs_per_user = 1000;
+  flags.server.max_calls_per_second_per_user = 100;
   if (!ParseFlags(argc, argv, &flags)) return 2;
   if (flags.server.heartbeat_ms >= flags.server.lease_ms) {
     // Keep the default heartbeat sensible for short test leases.

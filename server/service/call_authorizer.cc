@@ -2,6 +2,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "server/service/audit_log.h"
 
 namespace mbopt::service {
@@ -75,7 +76,20 @@ absl::StatusOr<auth::Principal> CallAuthorizer::ForJobs(const grpc::ServerContex
                   absl::PermissionDeniedError(absl::StrCat("a worker token may only acquire tasks and report results; ",
                                                            method, " needs a user or admin token")));
   }
+  if (user_calls_ != nullptr && needs_tokens_ && principal->role == auth::Role::kUser &&
+      !user_calls_->Allow(principal->name, now_ms_())) {
+    // Not written to the audit log: a caller over the rate would fill it.
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "user '%s' makes more than %g calls per second (the server's --max-calls-per-second-per-user): slow down "
+        "(`mbopt watch` follows a job with one call)",
+        principal->name, user_calls_->calls_per_second()));
+  }
   return principal;
+}
+
+void CallAuthorizer::LimitUserCalls(double calls_per_second, std::function<std::int64_t()> now_ms) {
+  user_calls_ = std::make_unique<CallRateLimiter>(calls_per_second);
+  now_ms_ = std::move(now_ms);
 }
 
 absl::StatusOr<auth::Principal> CallAuthorizer::ForWorkers(const grpc::ServerContext& context,

@@ -9,6 +9,7 @@
 //     and with a worker CA also a client certificate signed by it.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "absl/status/statusor.h"
 #include "server/auth/principal.h"
 #include "server/auth/token_table.h"
+#include "server/service/call_rate_limiter.h"
 
 namespace mbopt::service {
 
@@ -42,8 +44,14 @@ class CallAuthorizer {
   // Only for an authorizer made with a table.
   void ReplaceTokens(auth::TokenTable tokens);
 
+  // At most `calls_per_second` JobService calls per second (bursts of twice
+  // that) from each user-role token holder, on the clock `now_ms`; admins
+  // and workers are not limited, nor anyone on a server without tokens.
+  void LimitUserCalls(double calls_per_second, std::function<std::int64_t()> now_ms);
+
   // The caller of a JobService method (`method` names it in messages).
-  // Unauthenticated without a known token; PermissionDenied for a worker.
+  // Unauthenticated without a known token; PermissionDenied for a worker;
+  // ResourceExhausted for a user over the call rate (LimitUserCalls).
   // Every refusal is written to the audit log (audit_log.h).
   absl::StatusOr<auth::Principal> ForJobs(const grpc::ServerContext& context, const char* method) const;
   // The caller of a WorkerService method: a worker, else as above.
@@ -67,6 +75,8 @@ class CallAuthorizer {
   const bool workers_need_certificate_;
   mutable std::mutex mutex_;
   std::shared_ptr<const auth::TokenTable> tokens_;  // null without tokens
+  std::unique_ptr<CallRateLimiter> user_calls_;     // null: no limit
+  std::function<std::int64_t()> now_ms_;
 };
 
 }  // namespace mbopt::service

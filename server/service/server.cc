@@ -64,6 +64,9 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecuri
                                       "--tls-key (or --tls-dir)");
   }
   authorizer_ = std::make_unique<CallAuthorizer>(std::move(tokens), !options_.worker_ca_file.empty());
+  if (options_.max_calls_per_second_per_user > 0) {
+    authorizer_->LimitUserCalls(options_.max_calls_per_second_per_user, [this] { return clock_->NowMs(); });
+  }
   if (!tls) return grpc::InsecureServerCredentials();
   if (options_.tls_cert_file.empty() || options_.tls_key_file.empty()) {
     return absl::InvalidArgumentError("TLS needs both the certificate (--tls-cert) and its key (--tls-key)");

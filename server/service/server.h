@@ -62,6 +62,9 @@ struct ServerOptions {
   // connections from anyone who reaches the port would otherwise hold a
   // descriptor each for gRPC's default of 120 s.
   std::int64_t handshake_timeout_ms = 10'000;
+  // JobService calls per second a user-role token may make (bursts of
+  // twice that); 0: no limit. Admins and workers are not limited.
+  double max_calls_per_second_per_user = 0;
   // What a machine crash may take from the job database (store.h).
   store::Durability durability = store::Durability::kCycles;
   JobManagerOptions manager;

@@ -26,6 +26,7 @@
 #include "server/auth/certificates.h"
 #include "server/auth/token.h"
 #include "server/auth/token_table.h"
+#include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
 #include "server/service/server.h"
 #include "tests/server/fake_worker.h"
@@ -248,6 +249,33 @@ TEST_F(SecureServerTest, JobActionsNameWhoDidThemInTheJobsEventsAndTheAuditLog) 
     EXPECT_THAT(log, ::testing::Not(HasSubstr(token))) << "a token in the log";
     EXPECT_THAT(log, ::testing::Not(HasSubstr(auth::HashToken(token)))) << "a token's hash in the log";
   }
+}
+
+// A user polling in a tight loop is slowed down: after a burst of twice the
+// rate, calls are RESOURCE_EXHAUSTED until the bucket refills; another user
+// and an admin are not affected.
+TEST_F(SecureServerTest, AUserOverTheCallRateIsSlowedDownAndNobodyElseIs) {
+  scheduler::FakeClock clock;
+  ServerOptions options = SecureOptions(server_certificate_);
+  options.clock = &clock;
+  options.max_calls_per_second_per_user = 2;
+  StartServer(std::move(options));
+  auto alice = Jobs(alice_);
+  auto list = [](v1::JobService::Stub& jobs) {
+    grpc::ClientContext context;
+    v1::ListJobsResponse response;
+    return jobs.List(&context, v1::ListJobsRequest(), &response);
+  };
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(list(*alice).ok()) << i;  // the burst: twice the rate
+  const grpc::Status over = list(*alice);
+  EXPECT_EQ(over.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(over.error_message(), HasSubstr("user 'alice' makes more than 2 calls per second"));
+  EXPECT_TRUE(list(*Jobs(bob_)).ok());
+  for (int i = 0; i < 10; ++i) EXPECT_TRUE(list(*Jobs(admin_)).ok()) << i;
+  clock.Advance(1000);  // two calls' worth
+  EXPECT_TRUE(list(*alice).ok());
+  EXPECT_TRUE(list(*alice).ok());
+  EXPECT_EQ(list(*alice).error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
 }
 
 TEST_F(SecureServerTest, OnlyWorkerTokensActAsWorkersAndWorkerTokensCannotSubmit) {
