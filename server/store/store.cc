@@ -365,7 +365,7 @@ absl::StatusOr<JobRow> Store::CreateJob(const JobRow& job, const std::optional<N
                                          "(SELECT coalesce(max(last_seq), 0) FROM job_sequence))"));
     stored.seq = last + 1;
     MBOPT_RETURN_IF_ERROR(Exec(db_, absl::StrCat("UPDATE job_sequence SET last_seq = ", stored.seq)));
-    stored.id = absl::StrCat("job-", stored.seq);
+    if (stored.id.empty()) stored.id = absl::StrCat("job-", stored.seq);
     MBOPT_ASSIGN_OR_RETURN(Statement stmt,
                            Statement::Prepare(db_, absl::StrCat("INSERT INTO jobs(", kJobColumns,
                                                                 ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?)")));

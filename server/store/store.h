@@ -98,8 +98,8 @@ class Store {
 
   const std::string& path() const { return path_; }
 
-  // Inserts a job, and `event` with it; `id` and `seq` of `job` are ignored
-  // and assigned. Returns the row as stored.
+  // Inserts a job, and `event` with it; `seq` of `job` is assigned, and so
+  // is `id` ("job-<seq>") when it is empty. Returns the row as stored.
   absl::StatusOr<JobRow> CreateJob(const JobRow& job, const std::optional<NewEvent>& event = std::nullopt);
   absl::StatusOr<JobRow> GetJob(const std::string& job_id);  // NotFound
   absl::StatusOr<std::vector<JobRow>> ListJobs();             // by seq

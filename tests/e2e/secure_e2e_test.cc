@@ -87,7 +87,13 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
 
   auto submitted = Mbopt({"submit", VehicleStudy(), "--watch", "--server", addr}, alice);
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
-  auto secure = Mbopt({"results", "job-1", "--json", "--server", addr}, alice);
+  // The first line is the job's id: random on a server with tokens, so that
+  // it says nothing of how many jobs exist.
+  const std::string job = submitted.stdout_text.substr(0, submitted.stdout_text.find('\n'));
+  EXPECT_EQ(job.size(), 16u) << job;
+  EXPECT_EQ(job.rfind("job-", 0), 0u) << job;
+  EXPECT_EQ(job.find_first_not_of("0123456789abcdef", 4), std::string::npos) << job;
+  auto secure = Mbopt({"results", job, "--json", "--server", addr}, alice);
   ASSERT_EQ(secure.exit_code, kExitOk) << Describe(secure);
   // The same result as the private server of `mbopt run`, which has neither
   // TLS nor tokens; the settings in the environment do not reach it.
@@ -101,7 +107,7 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   // Options instead of the environment; the admin sees the job.
   auto listed = Mbopt({"list", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file", pki + "/admin.token"});
   EXPECT_EQ(listed.exit_code, kExitOk) << Describe(listed);
-  EXPECT_THAT(listed.stdout_text, HasSubstr("job-1"));
+  EXPECT_THAT(listed.stdout_text, HasSubstr(job));
   EXPECT_THAT(listed.stdout_text, HasSubstr(" alice\n")) << "the OWNER column";
 
   // Refusals: one line each, with the exit code that says which.
@@ -116,7 +122,7 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
                                                      std::filesystem::perms::owner_write |
                                                      std::filesystem::perms::group_read |
                                                      std::filesystem::perms::others_read);
-  auto readable_token = Mbopt({"status", "job-1", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
+  auto readable_token = Mbopt({"status", job, "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
                                wrong_token_file});
   EXPECT_EQ(readable_token.exit_code, kExitBadInput) << Describe(readable_token);
   EXPECT_THAT(readable_token.stderr_text, HasSubstr("has mode 0644: readable by every user of this machine"));
@@ -126,7 +132,7 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   EXPECT_THAT(readable_token_worker.stderr_text, HasSubstr("chmod 600 " + wrong_token_file));
   std::filesystem::permissions(wrong_token_file, std::filesystem::perms::owner_read |
                                                      std::filesystem::perms::owner_write);
-  auto wrong_token = Mbopt({"status", "job-1", "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
+  auto wrong_token = Mbopt({"status", job, "--server", addr, "--tls-ca", pki + "/ca.pem", "--token-file",
                             wrong_token_file});
   EXPECT_EQ(wrong_token.exit_code, kExitDenied) << Describe(wrong_token);
   EXPECT_THAT(wrong_token.stderr_text, HasSubstr("not one this server accepts"));
@@ -167,13 +173,13 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
     bobs_list = Mbopt({"list", "--server", addr}, bob);
   } while (bobs_list.exit_code == kExitDenied && std::chrono::steady_clock::now() < deadline);
   EXPECT_EQ(bobs_list.exit_code, kExitOk) << Describe(bobs_list);
-  EXPECT_THAT(bobs_list.stdout_text, Not(HasSubstr("job-1"))) << "Bob sees only his own jobs";
+  EXPECT_THAT(bobs_list.stdout_text, Not(HasSubstr(job))) << "Bob sees only his own jobs";
   // Alice's job is answered to Bob as one that does not exist.
-  auto bob_reads_alices = Mbopt({"status", "job-1", "--server", addr}, bob);
+  auto bob_reads_alices = Mbopt({"status", job, "--server", addr}, bob);
   auto bob_reads_none = Mbopt({"status", "job-99", "--server", addr}, bob);
   EXPECT_EQ(bob_reads_alices.exit_code, kExitBadInput) << Describe(bob_reads_alices);
   EXPECT_EQ(bob_reads_none.exit_code, kExitBadInput) << Describe(bob_reads_none);
-  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("no job with id 'job-1'"));
+  EXPECT_THAT(bob_reads_alices.stderr_text, HasSubstr("no job with id '" + job + "'"));
   EXPECT_THAT(bob_reads_none.stderr_text, HasSubstr("no job with id 'job-99'"));
 
   EXPECT_EQ(worker.Stop(kGuard), 0);
@@ -189,7 +195,7 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
   EXPECT_EQ(Mode(pki + "/server.key"), 0600u);
   auto restarted = StartServer(dir.File("jobs.db"), {"--tls-dir", pki}, "127.0.0.1:0", dir.File("server2.log"));
   ASSERT_TRUE(restarted.ok()) << restarted.status();
-  auto after_renewal = Mbopt({"status", "job-1", "--server", restarted->address}, alice);
+  auto after_renewal = Mbopt({"status", job, "--server", restarted->address}, alice);
   EXPECT_EQ(after_renewal.exit_code, kExitOk) << Describe(after_renewal);
   EXPECT_EQ(restarted->process->Stop(kGuard), 0);
   // It expires within 30 days: the server says so at every start.

@@ -4,11 +4,13 @@
 #include <chrono>
 #include <deque>
 #include <iostream>
+#include <random>
 #include <utility>
 #include <variant>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_format.h"
 #include "common/status_macros.h"
 #include "server/jobs/job_result.h"
 #include "server/jobs/problem_from_study.h"
@@ -64,6 +66,13 @@ void LogError(const std::string& job_id, const absl::Status& status) {
 }
 
 bool Running(JobState state) { return state == JobState::kRunning || state == JobState::kQueued; }
+
+// "job-" and 12 hex digits from the system's random source.
+std::string RandomJobId() {
+  std::random_device device;
+  const std::uint64_t bits = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  return absl::StrFormat("job-%012x", bits & 0xffffffffffffULL);
+}
 
 // What a worker must be able to do to run the study's analyses.
 scheduler::TaskNeeds NeedsOf(const spec::Study& study) {
@@ -365,6 +374,9 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   if (!room) job.reset();
   const JobState state = room ? JobState::kRunning : JobState::kQueued;
   store::JobRow row;
+  // On a server with tokens (owners) an id says nothing of how many jobs
+  // exist; alone on a server without tokens, job-<n> is the friendlier name.
+  if (!owner.empty()) row.id = RandomJobId();
   row.study_name = study.name;
   row.source_name = source_name;
   row.owner = owner;
