@@ -2,12 +2,12 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/external/temp_dir.h"
+#include "tests/testing/temp_dir.h"
 
 namespace mbopt::external {
 namespace {
 
-using testing::TempDir;
+using ::mbopt::testing::TempDir;
 
 bool Mentions(const absl::Status& status, const std::string& text) {
   return std::string(status.message()).find(text) != std::string::npos;

@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/external/temp_dir.h"
+#include "tests/testing/temp_dir.h"
 
 namespace mbopt::external {
 namespace {
 
-using testing::TempDir;
+using ::mbopt::testing::TempDir;
 
 // A driver whose program is the script `script` of `base`, run by /bin/sh,
 // reading parameter `a` from its input and writing results.json.

@@ -11,7 +11,7 @@
 
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
-#include "tests/external/temp_dir.h"
+#include "tests/testing/temp_dir.h"
 #include "worker/engine/evaluate_study.h"
 
 namespace mbopt::external {
@@ -19,7 +19,7 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
-using testing::TempDir;
+using ::mbopt::testing::TempDir;
 
 // Design variable "a" sets the driver's parameter "a"; the driver echoes it
 // back as the value "f" and in the series "y", and writes "b" too.

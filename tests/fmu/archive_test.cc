@@ -3,7 +3,6 @@
 // a failed run's reason, and the private folder removed.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <stdlib.h>
 #include <sys/stat.h>
 #include <zip.h>
 
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "tests/fmu/closed_forms.h"
+#include "tests/testing/temp_dir.h"
 #include "worker/fmu/fmu.h"
 #include "worker/fmu/simulation.h"
 
@@ -27,14 +27,11 @@ using testing::TestFmu;
 class FmuArchive : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-fmu-test-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    folder_ = pattern;
+    folder_ = dir_.path();
     // Unpacked FMUs go into their own folder, so that a test can see what is left.
     unpack_parent_ = folder_ / "unpacked";
     std::filesystem::create_directory(unpack_parent_);
   }
-  void TearDown() override { std::filesystem::remove_all(folder_); }
 
   // Writes a zip of (entry name, contents); `link_entry` is stored as a
   // symbolic link when not empty.
@@ -69,6 +66,7 @@ class FmuArchive : public ::testing::Test {
     return ReadFile(std::filesystem::path(MBOPT_TEST_FMU_DIR) / "damped_oscillator" / "modelDescription.xml");
   }
 
+  ::mbopt::testing::TempDir dir_;
   std::filesystem::path folder_;
   std::filesystem::path unpack_parent_;
 };

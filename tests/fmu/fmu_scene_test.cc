@@ -2,7 +2,6 @@
 // file's folder), checked, and analysed through the engine.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <filesystem>
 #include <fstream>
@@ -11,6 +10,7 @@
 
 #include "spec/io/study_io.h"
 #include "tests/fmu/closed_forms.h"
+#include "tests/testing/temp_dir.h"
 #include "worker/engine/analysis.h"
 
 namespace mbopt::fmu {
@@ -23,13 +23,10 @@ using testing::TestFmu;
 class FmuScene : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-fmu-scene-XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    folder_ = pattern;
+    folder_ = dir_.path();
     std::filesystem::create_directory(folder_ / "models");
     std::filesystem::copy_file(TestFmu("damped_oscillator"), folder_ / "models" / "oscillator.fmu");
   }
-  void TearDown() override { std::filesystem::remove_all(folder_); }
 
   std::string Write(const std::string& name, const std::string& text) {
     const std::filesystem::path path = folder_ / name;
@@ -58,6 +55,7 @@ integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-12 }
 outputs { name: "position" fmu_variable { variable: "x_m" } }
 outputs { name: "force" fmu_variable { variable: "spring_force_n" } })pb";
 
+  ::mbopt::testing::TempDir dir_;
   std::filesystem::path folder_;
 };
 

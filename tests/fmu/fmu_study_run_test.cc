@@ -1,7 +1,6 @@
 // examples/fmu's study optimized in this process (local_run: the service's
 // job code with the engine in-process), against its closed-form optimum.
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +11,7 @@
 
 #include "spec/io/study_io.h"
 #include "tests/fmu/closed_forms.h"
+#include "tests/testing/temp_dir.h"
 #include "worker/local_run/local_run.h"
 
 namespace mbopt::fmu {
@@ -38,13 +38,10 @@ std::string CopyExample(const std::filesystem::path& folder) {
 }
 
 TEST(FmuStudy, OscillatorExampleReachesItsClosedFormOptimum) {
-  std::string pattern = (std::filesystem::temp_directory_path() / "mbopt-fmu-study-XXXXXX").string();
-  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-  const std::filesystem::path folder = pattern;
-  auto study = spec::io::LoadStudyFile(CopyExample(folder));
+  const ::mbopt::testing::TempDir dir;
+  auto study = spec::io::LoadStudyFile(CopyExample(dir.path()));
   ASSERT_TRUE(study.ok()) << study.status();
   auto run = local_run::RunStudyLocally(*study);
-  std::filesystem::remove_all(folder);
   ASSERT_TRUE(run.ok()) << run.status();
   EXPECT_EQ(run->outcome.state, slp::RunState::kConverged) << run->end_reason;
   ASSERT_EQ(run->design_si.size(), 2u);

@@ -71,7 +71,8 @@ class ServerTest : public ::testing::Test {
     return server.ok() ? *std::move(server) : nullptr;
   }
 
-  static std::string Submit(MboptServer& server, const v1::Study& study) {
+  // The call's status; the new job's id in *job_id when it succeeds.
+  static grpc::Status TrySubmit(MboptServer& server, const v1::Study& study, std::string* job_id = nullptr) {
     auto stub = v1::JobService::NewStub(server.InProcessChannel());
     grpc::ClientContext context;
     v1::SubmitJobRequest request;
@@ -79,8 +80,14 @@ class ServerTest : public ::testing::Test {
     request.set_source_name(study.name() + ".study.textproto");
     v1::SubmitJobResponse response;
     grpc::Status status = stub->Submit(&context, request, &response);
+    if (job_id != nullptr) *job_id = response.job_id();
+    return status;
+  }
+  static std::string Submit(MboptServer& server, const v1::Study& study) {
+    std::string job_id;
+    grpc::Status status = TrySubmit(server, study, &job_id);
     EXPECT_TRUE(status.ok()) << status.error_message();
-    return response.job_id();
+    return job_id;
   }
 
   static v1::GetJobResponse Get(MboptServer& server, const std::string& job_id) {
@@ -460,13 +467,7 @@ TEST_F(ServerTest, AUserWithTooManyWaitingJobsIsRefusedSayingTheLimit) {
   auto server = StartServer("quota.db", OneRunningJob(/*max_queued_per_user=*/1));
   Submit(*server, OscillatorStudy());  // runs
   Submit(*server, OscillatorStudy());  // waits
-  auto stub = v1::JobService::NewStub(server->InProcessChannel());
-  grpc::ClientContext context;
-  v1::SubmitJobRequest request;
-  *request.mutable_study() = OscillatorStudy();
-  request.set_source_name("third.study.textproto");
-  v1::SubmitJobResponse response;
-  grpc::Status status = stub->Submit(&context, request, &response);
+  grpc::Status status = TrySubmit(*server, OscillatorStudy());
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("already has 1 jobs waiting to run (the server's "
                                                 "--max-queued-jobs-per-user)"));

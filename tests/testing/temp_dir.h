@@ -1,4 +1,5 @@
-// A fresh directory for one test, removed with it.
+// A fresh directory for one test (under the test's temporary directory),
+// removed with it, whatever the test's assertions did.
 #pragma once
 
 #include <stdlib.h>
@@ -9,14 +10,14 @@
 
 #include <gtest/gtest.h>
 
-namespace mbopt::external::testing {
+namespace mbopt::testing {
 
 class TempDir {
  public:
   TempDir() {
-    std::string pattern = (std::filesystem::path(::testing::TempDir()) / "mbopt-external-XXXXXX").string();
+    std::string pattern = (std::filesystem::path(::testing::TempDir()) / "mbopt-test-XXXXXX").string();
     const char* made = mkdtemp(pattern.data());
-    EXPECT_NE(made, nullptr);
+    EXPECT_NE(made, nullptr) << pattern;
     path_ = std::filesystem::canonical(pattern);
   }
   ~TempDir() {
@@ -40,4 +41,4 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-}  // namespace mbopt::external::testing
+}  // namespace mbopt::testing
