@@ -105,24 +105,30 @@ function(mbopt_declare_modules)
     SUMMARY "a job: the one driver of the SLP core, with intake, replay, record codec and the analysis record")
 
   # The analysis engine's numerical core, bottom up.
+  mbopt_module(sundials DIRS worker/sundials USES spec common PURE
+    LIBS mbopt_cvodes
+    SUMMARY "the SUNDIALS layer: owned handles, the CVODES integrator wrapper, integrator failures in words, integration across kinks")
+  mbopt_module(lumped DIRS worker/lumped USES sundials spec common PURE
+    LIBS mbopt_lumped_model mbopt_lumped mbopt_lumped_sensitivity
+    SUMMARY "lumped scenes (small motion, linear): the model's M, K, C and inputs, dynamics with CVODES, forward sensitivities")
   mbopt_module(model DIRS worker/model USES spec common PURE
-    LIBS mbopt_lumped_model mbopt_linkage_model
-    SUMMARY "model building blocks: lumped model, resolved linkage, beam element")
-  mbopt_module(solve DIRS worker/solve USES model spec common PURE
-    LIBS mbopt_cvodes mbopt_lumped mbopt_lumped_sensitivity mbopt_linkage
-    SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities, linkage solvers")
-  mbopt_module(fmu DIRS worker/fmu USES solve spec PURE
+    LIBS mbopt_linkage_model
+    SUMMARY "the resolved linkage and its beam element (the linkage engine's model)")
+  mbopt_module(solve DIRS worker/solve USES sundials model spec common PURE
+    LIBS mbopt_linkage
+    SUMMARY "the linkage engine's solvers: kinematic, kinetostatic, elastodynamic")
+  mbopt_module(fmu DIRS worker/fmu USES sundials spec PURE
     LIBS mbopt_fmu mbopt_fmu_scene
     SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
-  mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
+  mbopt_module(multibody DIRS worker/multibody USES sundials solve spec common PURE
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
-  mbopt_module(engine DIRS worker/engine USES fmu multibody solve model spec common PURE
+  mbopt_module(engine DIRS worker/engine USES fmu multibody lumped solve model spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
     SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")
-  mbopt_module(local_run DIRS worker/local_run USES jobs slp lp engine spec common PURE BRIDGE
+  mbopt_module(local_run DIRS tests/testing/local_run USES jobs slp lp engine spec common PURE BRIDGE
     LIBS mbopt_local_run
-    SUMMARY "a study optimized in this process: a job with an in-process evaluator (tests, tools)")
+    SUMMARY "test and benchmark support: a study optimized in this process, a job with an in-process evaluator")
 
   # Plumbing and boundaries.
   mbopt_module(store DIRS server/store USES jobs spec packed_doubles common

@@ -18,7 +18,7 @@
 #include "bench/accuracy/sweep_plan.h"
 #include "bench/accuracy/sweep_run.h"
 #include "common/status_macros.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::accuracy {

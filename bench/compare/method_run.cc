@@ -4,7 +4,7 @@
 
 #include "common/status_macros.h"
 #include "server/slp/finite_difference.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 namespace mbopt::compare {
 

@@ -15,7 +15,7 @@
 #include "absl/status/statusor.h"
 #include "bench/compare/method_run.h"
 #include "server/slp/options.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 #include "spec/study.h"
 
 namespace mbopt::compare {

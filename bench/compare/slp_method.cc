@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "common/status_macros.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 namespace mbopt::compare {
 

@@ -14,7 +14,7 @@
 #include "spec/layout.h"
 #include "worker/engine/analysis.h"
 #include "worker/engine/study_values.h"
-#include "worker/solve/lumped_dynamics.h"
+#include "worker/lumped/lumped_dynamics.h"
 
 namespace {
 

@@ -24,7 +24,7 @@
 #include "worker/engine/analysis.h"
 #include "worker/engine/study_sensitivities.h"
 #include "worker/engine/study_values.h"
-#include "worker/solve/lumped_sensitivity.h"
+#include "worker/lumped/lumped_sensitivity.h"
 
 namespace {
 

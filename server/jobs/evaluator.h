@@ -2,7 +2,7 @@
 // the end (Job::Run): one candidate record per request. The service does not
 // use this interface: there, the job manager hands requests to the scheduler
 // and feeds the workers' results back through the same Job::Intake and
-// Job::Apply as Run does. In-process runs (worker/local_run) and tests of
+// Job::Apply as Run does. In-process runs (tests/testing/local_run) and tests of
 // the optimizer implement it.
 #pragma once
 

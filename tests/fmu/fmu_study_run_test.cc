@@ -12,7 +12,7 @@
 #include "spec/io/study_io.h"
 #include "tests/fmu/closed_forms.h"
 #include "tests/testing/temp_dir.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 namespace mbopt::fmu {
 namespace {

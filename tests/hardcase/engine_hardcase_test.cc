@@ -1,5 +1,5 @@
 // Hard cases where the physics is the point: studies run through the
-// analysis engine with RunStudyLocally (worker/local_run). Each test says
+// analysis engine with RunStudyLocally (tests/testing/local_run). Each test says
 // what it checks and with what tolerance. Every run must end in a named
 // state with finite numbers; a design that cannot be analysed must come back
 // as a failed analysis with a reason, never as a crash or a NaN result.
@@ -15,10 +15,10 @@
 #include <gtest/gtest.h>
 
 #include "worker/engine/analysis.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 #include "spec/io/study_io.h"
 #include "tests/hardcase/analytic_problems.h"
-#include "worker/solve/lumped_dynamics.h"
+#include "worker/lumped/lumped_dynamics.h"
 
 namespace mbopt::hardcase {
 namespace {

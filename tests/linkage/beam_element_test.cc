@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "worker/model/beam_element.h"
-#include "worker/solve/cvodes_integrator.h"
+#include "worker/sundials/cvodes_integrator.h"
 
 namespace mbopt {
 namespace {

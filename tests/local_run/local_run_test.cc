@@ -1,6 +1,6 @@
 // RunStudyLocally and EvaluateDesign on the vehicle suspension study
 // (examples/vehicle, METHOD.md section 4.1).
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 #include <cmath>
 #include <iostream>

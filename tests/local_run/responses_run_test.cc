@@ -13,7 +13,7 @@
 #include "tests/local_run/carrier_study_fixture.h"
 #include "tests/spec/oscillator_scene.h"
 #include "worker/engine/analysis.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 namespace mbopt::local_run {
 namespace {

@@ -1,7 +1,7 @@
 // CvodesIntegrator against closed-form solutions, and its failure paths:
 // every failure is a status with a reason, never a crash or a message on
 // stderr.
-#include "worker/solve/cvodes_integrator.h"
+#include "worker/sundials/cvodes_integrator.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

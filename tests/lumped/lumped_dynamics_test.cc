@@ -1,14 +1,14 @@
 // The lumped dynamic formulation against analytic solutions of a single
 // degree of freedom (free response; base excitation by a cosine bump), an
 // energy invariant of an undamped multi-body system, and its failure paths.
-#include "worker/solve/lumped_dynamics.h"
+#include "worker/lumped/lumped_dynamics.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "worker/model/lumped_model.h"
+#include "worker/lumped/lumped_model.h"
 
 namespace mbopt::solve {
 namespace {

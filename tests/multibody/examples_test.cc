@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 namespace mbopt {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "mbopt/v1/study.pb.h"
 #include "server/jobs/problem_from_study.h"
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::local_run {

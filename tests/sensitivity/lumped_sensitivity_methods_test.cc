@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
-#include "worker/solve/lumped_sensitivity.h"
+#include "worker/lumped/lumped_sensitivity.h"
 
 namespace mbopt::solve {
 namespace {

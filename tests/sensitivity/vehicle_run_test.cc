@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 #include "spec/io/study_io.h"
 
 namespace mbopt::local_run {

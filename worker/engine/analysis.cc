@@ -5,7 +5,7 @@
 
 #include "worker/fmu/scene_analysis.h"
 #include "worker/multibody/scene_analysis.h"
-#include "worker/solve/lumped_dynamics.h"
+#include "worker/lumped/lumped_dynamics.h"
 #ifdef MBOPT_HAVE_LINKAGE
 #include "worker/solve/linkage_analysis.h"
 #endif

@@ -4,7 +4,7 @@
 // caller wants the simulator's gradients), and the study layout turns the
 // outputs into the values the optimizer asked for (objective terms and
 // constraint rows, spec/layout.h). The worker service translates this to and
-// from its wire messages; in-process runs (worker/local_run) call it
+// from its wire messages; in-process runs (tests/testing/local_run) call it
 // directly; `mbopt-worker eval` prints it.
 //
 // Everything that can go wrong with the analysis is data: a failed

@@ -5,7 +5,7 @@
 
 #include "spec/responses.h"
 #include "worker/multibody/scene_analysis.h"
-#include "worker/solve/lumped_sensitivity.h"
+#include "worker/lumped/lumped_sensitivity.h"
 
 namespace mbopt::engine {
 

@@ -1,7 +1,7 @@
 // One analysis of a study at a scaled design point that also yields the
 // gradients of the study values with respect to the scaled design variables,
 // from the simulator's forward sensitivity analysis (lumped scenes:
-// worker/solve/lumped_sensitivity.h; multibody scenes:
+// worker/lumped/lumped_sensitivity.h; multibody scenes:
 // worker/multibody/scene_analysis.h) and the layout's chain rule
 // (spec/study_gradients.h). Pure: no threads, no I/O.
 //

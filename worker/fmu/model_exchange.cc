@@ -12,7 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "worker/fmu/run_steps.h"
-#include "worker/solve/sundials_handles.h"
+#include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::fmu::internal {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
-#include "worker/solve/sundials_handles.h"
+#include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "worker/model/beam_element.h"
-#include "worker/solve/integrator_failure.h"
+#include "worker/sundials/integrator_failure.h"
 
 namespace mbopt::solve {
 

@@ -31,7 +31,7 @@
 
 #include "spec/scene.h"
 #include "worker/model/linkage_model.h"
-#include "worker/solve/cvodes_integrator.h"
+#include "worker/sundials/cvodes_integrator.h"
 #include "worker/solve/kinematic_solver.h"
 
 namespace mbopt::solve {

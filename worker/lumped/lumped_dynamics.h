@@ -1,5 +1,5 @@
 // The dynamic formulation of a lumped scene: integrates the small-motion
-// linear equations M q'' + C q' + K q = f(t) (worker/model/lumped_model.h)
+// linear equations M q'' + C q' + K q = f(t) (worker/lumped/lumped_model.h)
 // from rest at t = 0 with CVODES and reports the requested outputs at the
 // scene's grid instants. Only what the outputs need is evaluated: element
 // deflections from the state, body accelerations from the equations of
@@ -27,7 +27,7 @@
 
 #include "spec/scene.h"
 #include "spec/analysis_report.h"
-#include "worker/model/lumped_model.h"
+#include "worker/lumped/lumped_model.h"
 
 namespace mbopt::solve {
 

@@ -1,4 +1,4 @@
-#include "worker/solve/cvodes_integrator.h"
+#include "worker/sundials/cvodes_integrator.h"
 
 #include <cvodes/cvodes.h>
 #include <nvector/nvector_serial.h>
@@ -16,7 +16,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "common/status_macros.h"
-#include "worker/solve/sundials_handles.h"
+#include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::solve {
 

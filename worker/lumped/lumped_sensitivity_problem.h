@@ -1,5 +1,5 @@
 // The lumped model's forward-sensitivity problem as both integration paths
-// see it (worker/solve/lumped_sensitivity.h is the public entry): the model's
+// see it (worker/lumped/lumped_sensitivity.h is the public entry): the model's
 // derivatives per parameter, the scratch the right-hand sides share, and the
 // two integrations that carry the sensitivities. Internal to worker/solve.
 #pragma once
@@ -13,8 +13,8 @@
 
 #include "spec/scene.h"
 #include "spec/analysis_report.h"
-#include "worker/model/lumped_model.h"
-#include "worker/solve/lumped_sensitivity.h"
+#include "worker/lumped/lumped_model.h"
+#include "worker/lumped/lumped_sensitivity.h"
 
 namespace mbopt::solve::sensitivity_internal {
 

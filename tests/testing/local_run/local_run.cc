@@ -1,4 +1,4 @@
-#include "worker/local_run/local_run.h"
+#include "tests/testing/local_run/local_run.h"
 
 #include <chrono>
 #include <memory>

@@ -14,8 +14,8 @@
 
 #include "absl/status/status.h"
 #include "spec/analysis_outcome.h"
-#include "worker/solve/cvodes_integrator.h"
-#include "worker/solve/integrator_failure.h"
+#include "worker/sundials/cvodes_integrator.h"
+#include "worker/sundials/integrator_failure.h"
 
 namespace mbopt::solve {
 

@@ -33,7 +33,7 @@
 #include "spec/layout.h"
 #include "spec/study.h"
 #include "worker/engine/evaluate_study.h"
-#include "worker/local_run/in_process_evaluator.h"
+#include "tests/testing/local_run/in_process_evaluator.h"
 
 namespace mbopt::local_run {
 

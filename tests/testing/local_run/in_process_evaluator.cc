@@ -1,4 +1,4 @@
-#include "worker/local_run/in_process_evaluator.h"
+#include "tests/testing/local_run/in_process_evaluator.h"
 
 #include <utility>
 

@@ -11,7 +11,7 @@
 
 #include <Eigen/Dense>
 
-#include "worker/model/lumped_model.h"
+#include "worker/lumped/lumped_model.h"
 
 namespace mbopt::solve {
 

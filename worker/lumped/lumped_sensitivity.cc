@@ -1,4 +1,4 @@
-#include "worker/solve/lumped_sensitivity.h"
+#include "worker/lumped/lumped_sensitivity.h"
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
@@ -9,8 +9,8 @@
 #include <variant>
 
 #include "absl/strings/str_cat.h"
-#include "worker/model/lumped_model.h"
-#include "worker/solve/lumped_sensitivity_problem.h"
+#include "worker/lumped/lumped_model.h"
+#include "worker/lumped/lumped_sensitivity_problem.h"
 
 namespace mbopt::solve {
 namespace {

@@ -1,4 +1,4 @@
-#include "worker/solve/lumped_dynamics.h"
+#include "worker/lumped/lumped_dynamics.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -9,9 +9,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "worker/solve/cvodes_integrator.h"
-#include "worker/solve/integrate_across_kinks.h"
-#include "worker/solve/lumped_newton_operator.h"
+#include "worker/sundials/cvodes_integrator.h"
+#include "worker/sundials/integrate_across_kinks.h"
+#include "worker/lumped/lumped_newton_operator.h"
 
 namespace mbopt::solve {
 namespace {

@@ -6,10 +6,10 @@
 #include <memory>
 
 #include "absl/strings/str_cat.h"
-#include "worker/solve/cvodes_integrator.h"
-#include "worker/solve/integrate_across_kinks.h"
-#include "worker/solve/lumped_newton_operator.h"
-#include "worker/solve/lumped_sensitivity_problem.h"
+#include "worker/sundials/cvodes_integrator.h"
+#include "worker/sundials/integrate_across_kinks.h"
+#include "worker/lumped/lumped_newton_operator.h"
+#include "worker/lumped/lumped_sensitivity_problem.h"
 
 namespace mbopt::solve::sensitivity_internal {
 

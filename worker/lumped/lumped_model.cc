@@ -1,4 +1,4 @@
-#include "worker/model/lumped_model.h"
+#include "worker/lumped/lumped_model.h"
 
 #include <algorithm>
 #include <cmath>

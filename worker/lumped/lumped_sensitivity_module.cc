@@ -14,9 +14,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "worker/solve/integrator_failure.h"
-#include "worker/solve/lumped_sensitivity_problem.h"
-#include "worker/solve/sundials_handles.h"
+#include "worker/sundials/integrator_failure.h"
+#include "worker/lumped/lumped_sensitivity_problem.h"
+#include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::solve::sensitivity_internal {
 namespace {
