@@ -3,12 +3,15 @@
 
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "client/command_help.h"
 #include "client/commands.h"
 #include "client/exit_codes.h"
 #include "common/secure_channel/client_security.h"
+#include "common/version/version.h"
 
 namespace {
 
@@ -34,6 +37,7 @@ constexpr char kUsage[] =
     "  report JOB [-o FILE]  write a self-contained HTML page of the job's history\n"
     "                        (default FILE: JOB.html)\n"
     "\n"
+    "`mbopt COMMAND --help` describes a command and its options; `mbopt --version` the build.\n"
     "every command but run and validate takes --server HOST:PORT (default $MBOPT_SERVER,\n"
     "else 127.0.0.1:50051); watch, status, list, results, report and resume take\n"
     "--db PATH instead to read a database `mbopt run` kept.\n"
@@ -53,7 +57,17 @@ int main(int argc, char** argv) {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);
     return argc < 2 ? kExitBadInput : kExitOk;
   }
+  if (std::strcmp(argv[1], "--version") == 0 || std::strcmp(argv[1], "version") == 0) {
+    std::fputs(mbopt::version::VersionText("mbopt").c_str(), stdout);
+    return kExitOk;
+  }
   const std::string command = argv[1];
+  if (AsksForHelp(argc - 2, argv + 2)) {
+    if (const std::optional<std::string> help = CommandHelp(command)) {
+      std::fputs(help->c_str(), stdout);
+      return kExitOk;
+    }
+  }
   const Args args(argv + 2, argv + argc);
   if (command == "run") return RunCommandMain(args);
   if (command == "submit") return SubmitCommand(args);

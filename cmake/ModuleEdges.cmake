@@ -73,6 +73,9 @@ function(mbopt_declare_modules)
   mbopt_module(common DIRS common PURE
     LIBS mbopt_common
     SUMMARY "status macros and checks (Abseil status only)")
+  mbopt_module(version DIRS common/version USES common PURE
+    LIBS mbopt_version
+    SUMMARY "the release, the commit a program was built from, the schema versions (`--version`)")
   mbopt_module(packed_doubles DIRS common/packed_doubles USES common PURE
     LIBS mbopt_packed_doubles
     SUMMARY "vectors of doubles packed losslessly (prediction, zlib) for results on the wire and in the log")
@@ -146,7 +149,7 @@ function(mbopt_declare_modules)
   mbopt_module(service DIRS server/service USES auth job_manager jobs lp scheduler store spec spec_io proto common
     LIBS mbopt_service
     SUMMARY "boundary: the gRPC services and the server object")
-  mbopt_module(server_main DIRS server/main USES service auth store jobs common
+  mbopt_module(server_main DIRS server/main USES version service auth store jobs common
     LIBS mbopt-server
     SUMMARY "the `mbopt-server` program")
   mbopt_module(external DIRS worker/external USES engine spec_io spec proto common
@@ -155,7 +158,7 @@ function(mbopt_declare_modules)
   mbopt_module(worker_service DIRS worker/service USES secure_channel external engine fmu spec spec_io proto packed_doubles common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(worker_main DIRS worker/main USES worker_service external engine spec spec_io proto common
+  mbopt_module(worker_main DIRS worker/main USES version worker_service external engine spec spec_io proto common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE
@@ -166,7 +169,7 @@ function(mbopt_declare_modules)
     USES report proto common
     LIBS mbopt_report_proto
     SUMMARY "boundary: `GetJobResponse` to `ReportData`")
-  mbopt_module(client DIRS client USES secure_channel report report_proto spec_io spec proto common
+  mbopt_module(client DIRS client USES version secure_channel report report_proto spec_io spec proto common
     LIBS mbopt_client mbopt
     SUMMARY "the `mbopt` CLI")
 

@@ -1,30 +1,52 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package mbopt needs to build, test and run.
-# Idempotent; run as root (or with sudo) on a fresh machine. This script is the
-# only way dependencies arrive: CI and the README call it.
+# Installs the Debian 12 packages mbopt needs. Idempotent; run as root (or
+# with sudo) on a fresh machine. This script is the only way dependencies
+# arrive: CI and the README call it.
+#
+#   install-deps.sh             everything: build, run, test, benchmark
+#   install-deps.sh --programs  only what building and running the three
+#                               programs needs (the README's main command)
 set -euo pipefail
 
+mode=all
+case "${1:-}" in
+  "") ;;
+  --programs) mode=programs ;;
+  *) echo "usage: install-deps.sh [--programs]" >&2; exit 2 ;;
+esac
+
+# Building and running mbopt, mbopt-server and mbopt-worker.
 packages=(
   build-essential cmake pkg-config ninja-build
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev
   libeigen3-dev
   libsundials-dev
-  libzip-dev libpugixml-dev
-  libsqlite3-dev sqlite3
+  libzip-dev libpugixml-dev zlib1g-dev
+  libsqlite3-dev
   libssl-dev
-  iproute2
   coinor-libclp-dev
-  libgtest-dev libgmock-dev
-  libbenchmark-dev
-  libnlopt-cxx-dev
-  libsimbody-dev
   nlohmann-json3-dev
-  python3
-  chromium zlib1g-dev
-  clang libclang-rt-14-dev
-  slurmctld slurmd slurm-client munge
 )
+# Tests, benchmarks and the examples that need more: GoogleTest, Google
+# Benchmark, NLopt (the peer), Simbody (the multibody oracle), python3 (the
+# external-code example's driver), Chromium (report screenshots), clang (the
+# fuzzers), Slurm and munge (the Slurm test), iproute2 and the sqlite3 shell
+# (the multi-host test).
+if [ "$mode" = all ]; then
+  packages+=(
+    sqlite3
+    iproute2
+    libgtest-dev libgmock-dev
+    libbenchmark-dev
+    libnlopt-cxx-dev
+    libsimbody-dev
+    python3
+    chromium
+    clang libclang-rt-14-dev
+    slurmctld slurmd slurm-client munge
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -4,5 +4,5 @@
 # loopback, driven by the mbopt CLI with its embedded defaults.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-bash deploy/build.sh
+bash deploy/build.sh --programs
 exec ./build/client/mbopt run examples/vehicle/vehicle.study.textproto --workers 2 "$@"

@@ -18,6 +18,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "common/read_file.h"
+#include "common/version/version.h"
 #include "server/auth/certificates.h"
 #include "server/main/flag_value.h"
 #include "server/main/gc_command.h"
@@ -44,6 +45,7 @@ constexpr const char* kUsage =
     "       mbopt-server renew-cert DIR [--host NAME]... [--days N]\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
+    "       mbopt-server --version   (the release, the commit, the schema versions)\n"
     "  --listen ADDR          address to listen on (default 127.0.0.1:50051; port 0: any free port);\n"
     "                         an address other machines can reach needs TLS and tokens\n"
     "  --tls-dir DIR          what `init-tls DIR` made: DIR/server.pem, DIR/server.key\n"
@@ -252,6 +254,11 @@ bool WritePortFile(const std::string& path, int port) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && (std::string(argv[1]) == "--version" || std::string(argv[1]) == "version")) {
+    std::cout << mbopt::version::VersionText(
+        "mbopt-server", {{"job database schema", std::to_string(mbopt::store::kSchemaVersion)}});
+    return 0;
+  }
   if (argc >= 2 && std::string(argv[1]) == "gc") return mbopt::server_main::RunGcCommand(argc - 2, argv + 2);
   if (argc >= 2 && std::string(argv[1]) == "init-tls") {
     return mbopt::server_main::RunInitTlsCommand(argc - 2, argv + 2);

@@ -811,6 +811,39 @@ TEST(BadInput, UsageErrorsExitWithTwo) {
   EXPECT_EQ(Mbopt({"results", "j", "--csv", "--json"}).exit_code, kExitBadInput);
 }
 
+// Every command of `mbopt` answers --help with its own usage (exit 0, on
+// stdout, nothing contacted), and the three programs answer --version with
+// the release, the commit they were built from and the schema versions.
+TEST(Cli, EveryCommandHasItsHelpAndEveryProgramItsVersion) {
+  for (const char* command : {"run", "validate", "submit", "watch", "status", "list", "workers", "cancel", "resume",
+                              "results", "report"}) {
+    // The help wins over missing arguments and an unreachable server.
+    auto help = Mbopt({command, "--server", "127.0.0.1:1", "--help"});
+    EXPECT_EQ(help.exit_code, kExitOk) << command << ": " << Describe(help);
+    EXPECT_EQ(help.stdout_text.rfind(std::string("usage: mbopt ") + command + " ", 0), 0u)
+        << command << ": " << help.stdout_text;
+    EXPECT_NE(help.stdout_text.find("docs/cli.md"), std::string::npos) << command;
+    const bool talks_to_server = std::string(command) != "run" && std::string(command) != "validate";
+    EXPECT_EQ(help.stdout_text.find("--token-file") != std::string::npos, talks_to_server) << command;
+  }
+  auto short_help = Mbopt({"status", "-h"});
+  EXPECT_EQ(short_help.exit_code, kExitOk);
+  EXPECT_EQ(short_help.stdout_text.rfind("usage: mbopt status JOB", 0), 0u) << short_help.stdout_text;
+
+  for (const std::string& program : {MboptBinary(), ServerBinary(), WorkerBinary()}) {
+    auto version = client::RunCommand({program, "--version"}, kGuard);
+    ASSERT_TRUE(version.ok()) << version.status();
+    EXPECT_EQ(version->exit_code, 0) << program;
+    const std::string name = program.substr(program.rfind('/') + 1);
+    // "NAME 0.1.0 (commit <hash or unknown>)"
+    EXPECT_EQ(version->stdout_text.rfind(name + " " + MBOPT_TEST_RELEASE + " (commit ", 0), 0u)
+        << version->stdout_text;
+    const size_t commit = version->stdout_text.find("(commit ") + 8;
+    EXPECT_GE(version->stdout_text.find(')', commit) - commit, 7u) << version->stdout_text;
+    EXPECT_NE(version->stdout_text.find("mbopt.v1"), std::string::npos) << version->stdout_text;
+  }
+}
+
 // A worker that reports wrong-size vectors: the server refuses the result or
 // treats it as a failed analysis, and keeps serving; a job run by real
 // workers next to it completes with the undisturbed result.

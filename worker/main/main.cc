@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/version/version.h"
 #include "worker/main/drivers_command.h"
 #include "worker/main/eval_command.h"
 #include "worker/service/serve_command.h"
@@ -36,7 +37,7 @@ const Subcommand kSubcommands[] = {
 };
 
 void PrintUsage(std::ostream& os) {
-  os << "usage: mbopt-worker <subcommand> [arguments]\n\nsubcommands:\n";
+  os << "usage: mbopt-worker <subcommand> [arguments]   (--version: the build)\n\nsubcommands:\n";
   for (const Subcommand& s : kSubcommands) os << "  " << s.name << "  " << s.summary << "\n";
   os << "\n" << mbopt::worker::EvalUsage() << "\n" << mbopt::worker::ServeUsage() << "\n"
      << mbopt::worker::DriversUsage();
@@ -49,6 +50,10 @@ int main(int argc, char** argv) {
       std::strcmp(argv[1], "help") == 0) {
     PrintUsage(argc < 2 ? std::cerr : std::cout);
     return argc < 2 ? mbopt::worker::kExitBadInput : mbopt::worker::kExitOk;
+  }
+  if (std::strcmp(argv[1], "--version") == 0 || std::strcmp(argv[1], "version") == 0) {
+    std::cout << mbopt::version::VersionText("mbopt-worker", {{"FMI", "2.0 (Model Exchange, Co-Simulation)"}});
+    return mbopt::worker::kExitOk;
   }
   if (std::strncmp(argv[1], "--server", 8) == 0) {  // shorthand for `serve`
     return mbopt::worker::ServeMain(std::vector<std::string>(argv + 1, argv + argc));

@@ -1,0 +1,130 @@
+#include "client/command_help.h"
+
+#include <cstring>
+
+namespace mbopt::client {
+
+namespace {
+
+struct Help {
+  const char* command;
+  const char* text;
+};
+
+// Options every command that talks to a server takes.
+constexpr char kServerOptions[] =
+    "  --server HOST:PORT    the server (default $MBOPT_SERVER, else 127.0.0.1:50051)\n"
+    "  --tls-ca FILE         the server's CA certificate (or $MBOPT_TLS_CA)\n"
+    "  --token-file FILE     a file holding your token (or $MBOPT_TOKEN_FILE; never on the command line)\n"
+    "  --tls-cert FILE, --tls-key FILE, --tls-server-name NAME\n"
+    "                        a client certificate, and the name the server's certificate must carry\n";
+constexpr char kDbOption[] = "  --db PATH             read a database `mbopt run` kept instead of asking a server\n";
+
+constexpr Help kHelp[] = {
+    {"run",
+     "usage: mbopt run FILE [--workers N] [--db PATH | --discard-db] [--json | --quiet]\n"
+     "                [--drivers FILE [--keep-runs]]\n"
+     "\n"
+     "Optimizes the study in FILE on this machine: starts a server on loopback and N workers,\n"
+     "submits the study, prints the cycles as they finish and the result, then stops them.\n"
+     "The job database is kept (its path is printed, with the command that writes its report).\n"
+     "\n"
+     "options:\n"
+     "  --workers N           local worker processes (default: the number of cores)\n"
+     "  --db PATH             the job database at PATH (default: $XDG_STATE_HOME/mbopt/runs/)\n"
+     "  --discard-db          a temporary database, removed when run ends\n"
+     "  --json                print only the result, as one JSON object\n"
+     "  --quiet               print nothing but errors (the exit code tells the outcome)\n"
+     "  --drivers FILE        the analysis drivers the workers offer (external scenes)\n"
+     "  --keep-runs           with --drivers: keep every analysis folder\n"},
+    {"validate",
+     "usage: mbopt validate FILE\n"
+     "\n"
+     "Checks a study and its scene as a submission would, without a server, and prints the\n"
+     "optimization problem's layout: variables, load cases, responses, objective, constraints.\n"
+     "Exit 0 when valid, else 2 with each error's file, line, field and what was expected.\n"},
+    {"submit",
+     "usage: mbopt submit FILE [--watch] [--server HOST:PORT]\n"
+     "\n"
+     "Validates the study in FILE, sends it (with its scene) to the server and prints the job id.\n"
+     "\n"
+     "options:\n"
+     "  --watch               then follow the job as `mbopt watch` does\n"},
+    {"watch",
+     "usage: mbopt watch JOB [--server HOST:PORT | --db PATH]\n"
+     "\n"
+     "Prints one line per LP solve of the job (cycles already done first) until the job ends,\n"
+     "then its outcome. Ctrl-C stops watching; the job goes on.\n"},
+    {"status",
+     "usage: mbopt status JOB [--server HOST:PORT | --db PATH]\n"
+     "\n"
+     "The job's state, cycles, analyses, objective, largest constraint violation, wall time,\n"
+     "message, failed analyses by kind, and the best design analysed.\n"},
+    {"list",
+     "usage: mbopt list [--server HOST:PORT | --db PATH]\n"
+     "\n"
+     "One line per job: id, study, state, cycles, analyses, objective, owner.\n"},
+    {"workers",
+     "usage: mbopt workers [--server HOST:PORT]\n"
+     "\n"
+     "One line per worker registered now: id, name, slots, analyses done, tasks held, time since\n"
+     "last heard from, and what it can run (built-in scenes, declared drivers, FMU platform).\n"},
+    {"cancel",
+     "usage: mbopt cancel JOB [--server HOST:PORT]\n"
+     "\n"
+     "Stops a queued or running job; its tasks are withdrawn from the workers.\n"},
+    {"resume",
+     "usage: mbopt resume JOB [--server HOST:PORT | --db PATH [--workers N]]\n"
+     "\n"
+     "Continues an interrupted job from its last durable record; the result is bit for bit the\n"
+     "one an uninterrupted run gives. With --db, starts a local server and N workers on it.\n"},
+    {"results",
+     "usage: mbopt results JOB [--csv | --json] [--server HOST:PORT | --db PATH]\n"
+     "\n"
+     "The job's result (outcome, objective, design) and its cycle history.\n"
+     "\n"
+     "options:\n"
+     "  --csv                 the cycle history as CSV\n"
+     "  --json                result and history as one JSON object\n"},
+    {"report",
+     "usage: mbopt report JOB [-o FILE] [--no-responses] [--server HOST:PORT | --db PATH]\n"
+     "\n"
+     "Writes a self-contained HTML page of the job: history plots, tables, the responses of the\n"
+     "initial and final designs.\n"
+     "\n"
+     "options:\n"
+     "  -o, --output FILE     the page (default: JOB.html)\n"
+     "  --no-responses        leave out the response plots (no analyses are run for them)\n"},
+};
+
+bool TalksToServer(std::string_view command) { return command != "run" && command != "validate"; }
+bool ReadsDatabases(std::string_view command) {
+  return command == "watch" || command == "status" || command == "list" || command == "results" ||
+         command == "report" || command == "resume";
+}
+
+}  // namespace
+
+std::optional<std::string> CommandHelp(std::string_view command) {
+  for (const Help& h : kHelp) {
+    if (command != h.command) continue;
+    std::string text = h.text;
+    if (TalksToServer(command)) {
+      text += "\nconnection options:\n";
+      text += kServerOptions;
+      if (ReadsDatabases(command)) text += kDbOption;
+    }
+    text += "\nmore: docs/cli.md\n";
+    return text;
+  }
+  return std::nullopt;
+}
+
+bool AsksForHelp(int argc, const char* const* argv) {
+  for (int i = 0; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace mbopt::client
