@@ -150,7 +150,7 @@ function(mbopt_declare_modules)
     LIBS mbopt_service
     SUMMARY "boundary: the gRPC services and the server object")
   mbopt_module(server_main DIRS server/main USES version service auth store jobs common
-    LIBS mbopt-server
+    LIBS mbopt_refused_connection mbopt-server
     SUMMARY "the `mbopt-server` program")
   mbopt_module(external DIRS worker/external USES engine spec_io spec proto common
     LIBS mbopt_external mbopt_external_drivers_file

@@ -4,15 +4,23 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <optional>
 
 #include <grpc/support/log.h>
+
+#include "server/main/refused_connection.h"
 
 namespace mbopt::server_main {
 namespace {
 
 constexpr const char kAcceptFailed[] = "Failed accept4";
+
+// Whether gRPC's own lines were asked for (GRPC_VERBOSITY): then they are
+// written as they come, refused connections included.
+bool raw_grpc_lines = false;
 
 std::mutex failure_mutex;
 std::string failure;  // guarded by failure_mutex
@@ -32,6 +40,12 @@ const char* SeverityLetter(gpr_log_severity severity) {
 // Runs on gRPC's threads, some holding gRPC's locks: it only writes a line,
 // takes its own lock and sends a signal.
 void OnGrpcLog(gpr_log_func_args* args) {
+  if (!raw_grpc_lines && args->message != nullptr) {
+    if (const std::optional<std::string> line = RefusedConnectionLine(args->message)) {
+      std::fprintf(stderr, "mbopt-server: %s\n", line->c_str());
+      return;
+    }
+  }
   const char* file = args->file != nullptr ? std::strrchr(args->file, '/') : nullptr;
   std::fprintf(stderr, "mbopt-server: grpc %s %s:%d: %s\n", SeverityLetter(args->severity),
                file != nullptr ? file + 1 : (args->file != nullptr ? args->file : "?"), args->line,
@@ -47,7 +61,11 @@ void OnGrpcLog(gpr_log_func_args* args) {
 
 }  // namespace
 
-void WatchForListenerFailure() { gpr_set_log_function(&OnGrpcLog); }
+void WatchForListenerFailure() {
+  const char* verbosity = std::getenv("GRPC_VERBOSITY");
+  raw_grpc_lines = verbosity != nullptr && verbosity[0] != '\0';
+  gpr_set_log_function(&OnGrpcLog);
+}
 
 std::string ListenerFailure() {
   std::lock_guard<std::mutex> lock(failure_mutex);

@@ -14,7 +14,9 @@
 namespace mbopt::server_main {
 
 // Routes gRPC's log lines through a function that passes them on to
-// stderr ("mbopt-server: grpc: ...") and, on a failed accept4, records the
+// stderr ("mbopt-server: grpc: ..."; a refused TLS connection as one
+// readable line unless GRPC_VERBOSITY is set, refused_connection.h) and, on
+// a failed accept4, records the
 // message and sends SIGTERM to this process (whose main thread waits for
 // it). Call once, before the server starts.
 void WatchForListenerFailure();

@@ -184,6 +184,11 @@ TEST(Secure, InitTlsServerWorkerAndClientRunAJobWithTokens) {
 
   EXPECT_EQ(worker.Stop(kGuard), 0);
   EXPECT_EQ(server->process->Stop(kGuard), 0);
+  // The plain-text attempts above are one readable line each in the
+  // server's log, without OpenSSL's words (those come with GRPC_VERBOSITY).
+  const std::string server_log = ReadFile(dir.File("server.log"));
+  EXPECT_THAT(server_log, HasSubstr("mbopt-server: refused a connection: the client does not speak TLS"));
+  EXPECT_THAT(server_log, Not(HasSubstr("ssl_transport_security"))) << server_log;
 
   // A renewed certificate, from the same CA: clients keep their ca.pem.
   absl::StatusOr<Subprocess::Output> renewed =
