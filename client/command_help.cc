@@ -76,8 +76,9 @@ constexpr Help kHelp[] = {
     {"resume",
      "usage: mbopt resume JOB [--server HOST:PORT | --db PATH [--workers N]]\n"
      "\n"
-     "Continues an interrupted job from its last durable record; the result is bit for bit the\n"
-     "one an uninterrupted run gives. With --db, starts a local server and N workers on it.\n"},
+     "Continues an interrupted or cancelled job from its last durable record; the result is bit\n"
+     "for bit the one an uninterrupted run gives (a running job is left alone). With --db,\n"
+     "starts a local server and N workers on that database.\n"},
     {"results",
      "usage: mbopt results JOB [--csv | --json] [--server HOST:PORT | --db PATH]\n"
      "\n"

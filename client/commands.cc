@@ -238,6 +238,19 @@ int CancelOrResume(const ParsedArgs& parsed, bool cancel, int workers) {
   if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
   Connection& c = std::get<Connection>(connected);
   const std::string job_id = parsed.positional[0];
+  if (!cancel && c.local == nullptr) {
+    // The server answers a resume of a live job with its summary and does
+    // nothing; say so, rather than print a state that looks like a resume.
+    v1::GetJobResponse current;
+    grpc::Status got = GetJob(c, job_id, &current);
+    if (!got.ok()) return FailRpc(got, c.address, &c.security);
+    const v1::JobState state = current.summary().state();
+    if (state == v1::JOB_STATE_RUNNING || state == v1::JOB_STATE_QUEUED) {
+      std::printf("%s: %s already; nothing to resume (`mbopt watch %s` follows it)\n", job_id.c_str(),
+                  StateName(state).c_str(), job_id.c_str());
+      return kExitOk;
+    }
+  }
   v1::JobRef ref;
   ref.set_job_id(job_id);
   v1::JobSummary summary;

@@ -844,6 +844,27 @@ TEST(Cli, EveryCommandHasItsHelpAndEveryProgramItsVersion) {
   }
 }
 
+// `resume` of a job that is running (here: waiting for a worker) says there
+// is nothing to resume instead of printing a state that reads as a resume.
+TEST(Cli, ResumeOfARunningJobSaysThereIsNothingToResume) {
+  ScratchDir dir;
+  auto server = StartServer(dir.File("jobs.db"), {}, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto resumed = Mbopt({"resume", job, "--server", server->address});
+  EXPECT_EQ(resumed.exit_code, kExitOk) << Describe(resumed);
+  EXPECT_EQ(resumed.stdout_text, job + ": running already; nothing to resume (`mbopt watch " + job + "` follows it)\n");
+  auto cancelled = Mbopt({"cancel", job, "--server", server->address});
+  EXPECT_EQ(cancelled.exit_code, kExitOk) << Describe(cancelled);
+  // A cancelled job may be resumed: that one is a real resume.
+  auto resumed_cancelled = Mbopt({"resume", job, "--server", server->address});
+  EXPECT_EQ(resumed_cancelled.exit_code, kExitOk) << Describe(resumed_cancelled);
+  EXPECT_EQ(resumed_cancelled.stdout_text, job + ": running\n");
+  EXPECT_EQ(server->process->Stop(kGuard), 0);
+}
+
 // A worker that reports wrong-size vectors: the server refuses the result or
 // treats it as a failed analysis, and keeps serving; a job run by real
 // workers next to it completes with the undisturbed result.
