@@ -13,6 +13,7 @@ import shutil
 import subprocess
 import tempfile
 import unittest
+from unittest import mock
 
 import mbopt
 
@@ -23,16 +24,23 @@ SOURCE_DIR = os.environ["MBOPT_TEST_SOURCE_DIR"]
 VEHICLE_STUDY = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle.study.textproto")
 VEHICLE_SCENE = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle.scene.textproto")
 
+# The tests' servers are their own: settings for another in the caller's
+# environment must not reach the clients here.
+for variable in ("MBOPT_SERVER", "MBOPT_TLS_CA", "MBOPT_TLS_CERT", "MBOPT_TLS_KEY", "MBOPT_TLS_SERVER_NAME",
+                 "MBOPT_TOKEN_FILE", "MBOPT_TOKEN"):
+    os.environ.pop(variable, None)
+
 
 class Server:
     """An mbopt-server on a loopback port the system chooses, with `workers`
     workers; its address from its readiness line (docs/server.md)."""
 
-    def __init__(self, folder, workers):
+    def __init__(self, folder, workers, server_args=(), worker_args=()):
         self._log = open(os.path.join(folder, "server.log"), "wb")
         self.process = subprocess.Popen(
-            [SERVER, "--listen", "127.0.0.1:0", "--db", os.path.join(folder, "jobs.db")],
+            [SERVER, "--listen", "127.0.0.1:0", "--db", os.path.join(folder, "jobs.db"), *server_args],
             stdout=subprocess.PIPE, stderr=self._log)
+        self._worker_args = list(worker_args)
         line = self.process.stdout.readline().decode()
         if "listening on " not in line:
             self.stop()
@@ -45,7 +53,7 @@ class Server:
 
     def add_worker(self):
         log = open(os.path.join(self._folder, f"worker{len(self.workers)}.log"), "wb")
-        self.workers.append((subprocess.Popen([WORKER, "serve", "--server", self.address],
+        self.workers.append((subprocess.Popen([WORKER, "serve", "--server", self.address, *self._worker_args],
                                               stdout=subprocess.DEVNULL, stderr=log), log))
 
     def stop(self):
@@ -201,8 +209,9 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(max(abs(v) for v in acceleration), evaluated["objective"])
 
     def test_eval_with_an_unknown_name_raises_the_workers_message(self):
-        with self.assertRaises(mbopt.BadInput) as raised:
-            mbopt.evaluate(VEHICLE_STUDY, overrides={"no_such": 1}, worker_program=WORKER)
+        # The worker program as `mbopt report` finds it, from $MBOPT_WORKER_BIN.
+        with mock.patch.dict(os.environ, {"MBOPT_WORKER_BIN": WORKER}), self.assertRaises(mbopt.BadInput) as raised:
+            mbopt.evaluate(VEHICLE_STUDY, overrides={"no_such": 1})
         self.assertIn('"no_such" is neither a design variable', str(raised.exception))
 
     def test_token_file_others_can_read_is_refused(self):
@@ -212,6 +221,48 @@ class PythonClientTest(unittest.TestCase):
             mbopt.Client(self.server.address, token_file=token)
         self.assertIn("has mode 0644: readable by every user of this machine", str(raised.exception))
         self.assertIn(f"chmod 600 {token}", str(raised.exception))
+
+
+class SecureServerTest(unittest.TestCase):
+    """A server with TLS and tokens (`mbopt-server init-tls`, docs/server.md
+    "Security"): the client takes the address, the CA and the token file
+    from the environment, as the CLI does."""
+
+    def setUp(self):
+        self.folder = tempfile.mkdtemp(prefix="mbopt-python-secure-test-")
+        self.pki = os.path.join(self.folder, "pki")
+        made = subprocess.run([SERVER, "init-tls", self.pki, "--host", "127.0.0.1", "--user", "alice"],
+                              capture_output=True, text=True, check=False)
+        self.assertEqual(made.returncode, 0, made.stderr)
+        self.server = Server(self.folder, workers=1, server_args=["--tls-dir", self.pki],
+                             worker_args=["--tls-ca", f"{self.pki}/ca.pem",
+                                          "--token-file", f"{self.pki}/worker.token"])
+
+    def tearDown(self):
+        self.server.stop()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def test_user_with_ca_and_token_from_the_environment_runs_a_study(self):
+        env = {"MBOPT_SERVER": self.server.address, "MBOPT_TLS_CA": f"{self.pki}/ca.pem",
+               "MBOPT_TOKEN_FILE": f"{self.pki}/alice.token"}
+        with mock.patch.dict(os.environ, env), mbopt.Client() as client:
+            self.assertEqual(client.address, self.server.address)
+            job = client.submit(VEHICLE_STUDY)
+            final = client.wait(job)
+            self.assertEqual((final.status, final.owner), ("converged", "alice"))
+            self.assertEqual([s.job_id for s in client.list()], [job])
+
+    def test_call_without_a_token_is_refused(self):
+        with mbopt.Client(self.server.address, tls_ca=f"{self.pki}/ca.pem") as client, \
+                self.assertRaises(mbopt.AccessDenied) as raised:
+            client.list()
+        self.assertIn(f"server at {self.server.address} refused", str(raised.exception))
+        self.assertIn("needs a token", str(raised.exception))
+
+    def test_plaintext_call_to_a_tls_server_fails_as_unreachable(self):
+        with mbopt.Client(self.server.address) as client, self.assertRaises(mbopt.ServerUnreachable) as raised:
+            client.list()
+        self.assertIn(f"cannot reach server at {self.server.address}", str(raised.exception))
 
 
 if __name__ == "__main__":

@@ -13,12 +13,17 @@ from mbopt.errors import BadInput, MboptError
 
 
 def find_worker_program(program=None):
-    """`program`, else $MBOPT_WORKER_PROGRAM, else mbopt-worker on PATH."""
-    program = program or os.environ.get("MBOPT_WORKER_PROGRAM") or shutil.which("mbopt-worker")
-    if not program:
-        raise MboptError("cannot find mbopt-worker: put it on PATH, set MBOPT_WORKER_PROGRAM, "
-                         "or pass worker_program=")
-    return program
+    """`program`, else $MBOPT_WORKER_BIN (as `mbopt run` and `mbopt report`
+    read it), else mbopt-worker on PATH, else the one of the build tree this
+    package was built in (build/python beside build/worker/main)."""
+    program = program or os.environ.get("MBOPT_WORKER_BIN") or shutil.which("mbopt-worker")
+    if program:
+        return program
+    built = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                         "worker", "main", "mbopt-worker")
+    if os.access(built, os.X_OK):
+        return built
+    raise MboptError("cannot find mbopt-worker: put it on PATH, set MBOPT_WORKER_BIN, or pass worker_program=")
 
 
 def evaluate(study_path, overrides=None, series_out=None, drivers=None, worker_program=None):
