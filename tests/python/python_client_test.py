@@ -195,6 +195,15 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(evaluated["design"]["x1"], 20)
         series = mbopt.read_series(series_path, use_numpy=False)
         self.assertEqual(series.failure, "")
+        self.assertIsInstance(series.times_s, list)
+        # By default arrays when numpy is installed, the same values either way.
+        default = mbopt.read_series(series_path)
+        try:
+            import numpy
+        except ImportError:
+            numpy = None
+        self.assertIsInstance(default.times_s, numpy.ndarray if numpy is not None else list)
+        self.assertEqual(list(default.times_s), series.times_s)
         self.assertEqual(series.names(), [o["name"] for o in evaluated["outputs"]])
         for output in evaluated["outputs"]:
             for summary in output["series"]:

@@ -3,8 +3,8 @@ column (1-based) of its name, keyed by its path as mbopt's messages write
 it ("variables[0].upper", "objective"), so that a message the server gives
 for a submitted study can name the line as `mbopt validate` does
 (spec/io/locator.cc). A repeated field without an index is where its first
-element is; a field the file does not set is where its nearest enclosing
-field is, and a top-level one has no line.
+element is; a field the file does not set is where the message holding it
+is, and a top-level one has no line.
 """
 
 import re
@@ -13,7 +13,7 @@ _TOKEN = re.compile(r"""
     (?P<space>\s+)
   | (?P<comment>\#[^\n]*)
   | (?P<string>"(?:[^"\\\n]|\\.)*"|'(?:[^'\\\n]|\\.)*')
-  | (?P<word>[-+]?[A-Za-z0-9_.]+)
+  | (?P<word>[-+]?(?:0[xX][0-9A-Fa-f]+|[0-9.]+(?:[eE][-+]?[0-9]+)?[fF]?|[A-Za-z_][A-Za-z0-9_.]*))
   | (?P<punct>.)
 """, re.VERBOSE)
 
@@ -50,7 +50,7 @@ class FieldLocations:
         while path:
             if path in self._at:
                 return self._at[path]
-            path = re.sub(r"(\[\d+\]|\.?[^.\[\]]+)$", "", path)
+            path = re.sub(r"\.?[^.\[\]]+(\[\d+\])?$", "", path)
         return None
 
     def token_after(self, line, column):
@@ -85,17 +85,18 @@ class FieldLocations:
             if field is not None and field.label == field.LABEL_REPEATED:
                 base = prefix + text
                 if self._peek() == ":" and self._tokens[self._i + 1][1] == "[":
+                    # protoc's parser records one location for the whole
+                    # list, the name's, as that of its first element.
                     self._next()
                     self._next()
+                    self._at.setdefault(base, (line, column))
+                    self._at.setdefault(f"{base}[{counts.get(text, 0)}]", (line, column))
                     while self._peek() != "]":
                         if self._peek() == ",":
                             self._next()
                             continue
                         k = counts.get(text, 0)
                         counts[text] = k + 1
-                        start = self._tokens[self._i][2:]
-                        self._at.setdefault(base, start)
-                        self._at[f"{base}[{k}]"] = start
                         self._value(field, f"{base}[{k}].", element=True)
                     self._next()
                     continue
