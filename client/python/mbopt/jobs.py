@@ -67,7 +67,7 @@ class JobStatus:
             job_id=s.job_id, study=s.study_name, status=state_name(s.state), cycles=s.cycles,
             max_cycles=s.max_cycles, analyses=s.analyses, objective=_number(s.objective),
             objective_unit=s.objective_unit, max_violation=_number(s.max_violation),
-            design={n: v for n, v in zip(names, s.design)},
+            design={n: _number(v) for n, v in zip(names, s.design)},
             design_units={n: u for n, u in zip(names, s.design_units)},
             wall_seconds=s.wall_seconds, message=s.message, waiting_for=s.waiting_for, owner=s.owner,
             failed_analyses=dict(sorted(s.failed_analyses_by_kind.items())))
