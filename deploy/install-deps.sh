@@ -30,7 +30,8 @@ packages=(
 )
 # Tests, benchmarks and the examples that need more: GoogleTest, Google
 # Benchmark, NLopt (the peer), Simbody (the multibody oracle), python3 (the
-# external-code example's driver), Chromium (report screenshots), clang (the
+# external-code example's driver; with python3-grpcio and python3-protobuf
+# the Python client, client/python, and its tests), Chromium (report screenshots), clang (the
 # fuzzers), Slurm and munge (the Slurm test), iproute2 and the sqlite3 shell
 # (the multi-host test).
 if [ "$mode" = all ]; then
@@ -41,7 +42,7 @@ if [ "$mode" = all ]; then
     libbenchmark-dev
     libnlopt-cxx-dev
     libsimbody-dev
-    python3
+    python3 python3-grpcio python3-protobuf
     chromium
     clang libclang-rt-14-dev
     slurmctld slurmd slurm-client munge
