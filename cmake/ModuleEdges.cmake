@@ -105,22 +105,25 @@ function(mbopt_declare_modules)
     SUMMARY "a job: the one driver of the SLP core, with intake, replay, record codec and the analysis record")
 
   # The analysis engine's numerical core, bottom up.
+  mbopt_module(budget DIRS worker/budget USES spec common PURE
+    LIBS mbopt_analysis_budget
+    SUMMARY "the budget of one analysis: a deadline on the caller's clock, a step budget, a cancel flag")
   mbopt_module(model DIRS worker/model USES spec common PURE
     LIBS mbopt_lumped_model mbopt_linkage_model
     SUMMARY "model building blocks: lumped model, resolved linkage, beam element")
-  mbopt_module(solve DIRS worker/solve USES model spec common PURE
+  mbopt_module(solve DIRS worker/solve USES budget model spec common PURE
     LIBS mbopt_cvodes mbopt_lumped mbopt_lumped_sensitivity mbopt_linkage
     SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities, linkage solvers")
-  mbopt_module(fmu DIRS worker/fmu USES solve spec PURE
+  mbopt_module(fmu DIRS worker/fmu USES budget solve spec PURE
     LIBS mbopt_fmu mbopt_fmu_scene
     SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
-  mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
+  mbopt_module(multibody DIRS worker/multibody USES budget solve model spec common PURE
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
-  mbopt_module(engine DIRS worker/engine USES fmu multibody solve model spec common PURE
+  mbopt_module(engine DIRS worker/engine USES budget fmu multibody solve model spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
-    SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")
-  mbopt_module(local_run DIRS worker/local_run USES jobs slp lp engine spec common PURE BRIDGE
+    SUMMARY "one analysis of a scene (the table of model kinds) and the one evaluation of a study at a design point")
+  mbopt_module(local_run DIRS worker/local_run USES jobs slp lp engine budget spec common PURE BRIDGE
     LIBS mbopt_local_run
     SUMMARY "a study optimized in this process: a job with an in-process evaluator (tests, tools)")
 
@@ -146,10 +149,10 @@ function(mbopt_declare_modules)
   mbopt_module(external DIRS worker/external USES engine spec_io spec proto common
     LIBS mbopt_external mbopt_external_drivers_file
     SUMMARY "analyses run by external simulation codes: declared drivers (their file), per-analysis folders, process groups with a time limit, results files, external scenes mapped onto the engine's reports")
-  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine fmu spec spec_io proto packed_doubles common
+  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine budget fmu spec spec_io proto packed_doubles common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(worker_main DIRS worker/main USES worker_service external engine spec spec_io proto common
+  mbopt_module(worker_main DIRS worker/main USES worker_service external engine budget spec spec_io proto common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE
