@@ -89,8 +89,8 @@ TEST(AnalysisBudget, DeadlineIsTheEarlierOfTheCallersAndTheScenes) {
   EXPECT_TRUE(scene.Check(1.0).ok());                                  // reading 3
   EXPECT_TRUE(scene.Check(1.0).ok());
   EXPECT_TRUE(scene.Check(1.0).ok());
-  const spec::AnalysisFailure over = scene.Check(2.5);  // reading 6 is not past 6; 7 is
-  EXPECT_TRUE(over.ok());
+  const spec::AnalysisFailure at_deadline = scene.Check(2.5);  // reading 6 is not past 6; 7 is
+  EXPECT_TRUE(at_deadline.ok());
   const spec::AnalysisFailure late = scene.Check(2.5);
   EXPECT_EQ(late.kind, spec::FailureKind::kTimeLimit);
   EXPECT_THAT(late.reason, AllOf(HasSubstr("wall-time limit of 5 s"), HasSubstr("t = 2.5 s")));
