@@ -108,28 +108,31 @@ function(mbopt_declare_modules)
     SUMMARY "a job: the one driver of the SLP core, with intake, replay, record codec and the analysis record")
 
   # The analysis engine's numerical core, bottom up.
-  mbopt_module(sundials DIRS worker/sundials USES spec common PURE
+  mbopt_module(budget DIRS worker/budget USES spec common PURE
+    LIBS mbopt_analysis_budget
+    SUMMARY "the budget of one analysis: a deadline on the caller's clock, a step budget, a cancel flag")
+  mbopt_module(sundials DIRS worker/sundials USES budget spec common PURE
     LIBS mbopt_cvodes
     SUMMARY "the SUNDIALS layer: owned handles, the CVODES integrator wrapper, integrator failures in words, integration across kinks")
-  mbopt_module(lumped DIRS worker/lumped USES sundials spec common PURE
+  mbopt_module(lumped DIRS worker/lumped USES budget sundials spec common PURE
     LIBS mbopt_lumped_model mbopt_lumped mbopt_lumped_sensitivity
     SUMMARY "lumped scenes (small motion, linear): the model's M, K, C and inputs, dynamics with CVODES, forward sensitivities")
   mbopt_module(model DIRS worker/model USES spec common PURE
     LIBS mbopt_linkage_model
     SUMMARY "the resolved linkage and its beam element (the linkage engine's model)")
-  mbopt_module(solve DIRS worker/solve USES sundials model spec common PURE
+  mbopt_module(solve DIRS worker/solve USES budget sundials model spec common PURE
     LIBS mbopt_linkage
     SUMMARY "the linkage engine's solvers: kinematic, kinetostatic, elastodynamic")
-  mbopt_module(fmu DIRS worker/fmu USES sundials spec PURE
+  mbopt_module(fmu DIRS worker/fmu USES budget sundials spec PURE
     LIBS mbopt_fmu mbopt_fmu_scene
     SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
-  mbopt_module(multibody DIRS worker/multibody USES sundials solve spec common PURE
+  mbopt_module(multibody DIRS worker/multibody USES budget sundials solve spec common PURE
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
-  mbopt_module(engine DIRS worker/engine USES fmu multibody lumped solve model spec common PURE
+  mbopt_module(engine DIRS worker/engine USES budget fmu multibody lumped solve model spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
-    SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")
-  mbopt_module(local_run DIRS tests/testing/local_run USES jobs slp lp engine spec common PURE BRIDGE
+    SUMMARY "one analysis of a scene (the table of model kinds) and the one evaluation of a study at a design point")
+  mbopt_module(local_run DIRS tests/testing/local_run USES jobs slp lp engine budget spec common PURE BRIDGE
     LIBS mbopt_local_run
     SUMMARY "test and benchmark support: a study optimized in this process, a job with an in-process evaluator")
 
@@ -155,10 +158,10 @@ function(mbopt_declare_modules)
   mbopt_module(external DIRS worker/external USES engine spec_io spec proto common
     LIBS mbopt_external mbopt_external_drivers_file
     SUMMARY "analyses run by external simulation codes: declared drivers (their file), per-analysis folders, process groups with a time limit, results files, external scenes mapped onto the engine's reports")
-  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine fmu spec spec_io proto packed_doubles common
+  mbopt_module(worker_service DIRS worker/service USES secure_channel external engine budget fmu spec spec_io proto packed_doubles common
     LIBS mbopt_worker_service
     SUMMARY "boundary: the worker's server connection and task evaluation")
-  mbopt_module(worker_main DIRS worker/main USES version worker_service external engine spec spec_io proto common
+  mbopt_module(worker_main DIRS worker/main USES version worker_service external engine budget spec spec_io proto common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
   mbopt_module(report DIRS client/report USES common PURE

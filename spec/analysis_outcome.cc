@@ -8,7 +8,7 @@
 namespace mbopt::spec {
 namespace {
 
-constexpr std::array<std::pair<FailureKind, const char*>, 10> kNames = {{
+constexpr std::array<std::pair<FailureKind, const char*>, 11> kNames = {{
     {FailureKind::kNone, "ok"},
     {FailureKind::kInvalidModel, "invalid_model"},
     {FailureKind::kAssembly, "assembly"},
@@ -18,6 +18,7 @@ constexpr std::array<std::pair<FailureKind, const char*>, 10> kNames = {{
     {FailureKind::kModelValidity, "model_validity"},
     {FailureKind::kService, "service"},
     {FailureKind::kInjected, "injected"},
+    {FailureKind::kCancelled, "cancelled"},
     {FailureKind::kUnclassified, "unclassified"},
 }};
 

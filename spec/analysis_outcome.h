@@ -32,6 +32,7 @@ enum class FailureKind {
   kService,         // the service could not get the analysis done: every attempt's worker was
                     // lost or its lease expired, or the worker's result did not fit the task
   kInjected,        // a failure injected by a test or a fault-injection run
+  kCancelled,       // stopped on request before it ended: its job was cancelled
   kUnclassified,    // logged before failure kinds existed
 };
 

@@ -20,6 +20,8 @@ v1::AnalysisFailureKind FailureKindToProto(FailureKind kind) {
       return v1::ANALYSIS_FAILURE_SERVICE;
     case FailureKind::kInjected:
       return v1::ANALYSIS_FAILURE_INJECTED;
+    case FailureKind::kCancelled:
+      return v1::ANALYSIS_FAILURE_CANCELLED;
     case FailureKind::kNone:
     case FailureKind::kUnclassified:
       return v1::ANALYSIS_FAILURE_KIND_UNSPECIFIED;
@@ -45,6 +47,8 @@ FailureKind FailureKindFromProto(v1::AnalysisFailureKind kind) {
       return FailureKind::kService;
     case v1::ANALYSIS_FAILURE_INJECTED:
       return FailureKind::kInjected;
+    case v1::ANALYSIS_FAILURE_CANCELLED:
+      return FailureKind::kCancelled;
     default:
       return FailureKind::kUnclassified;
   }

@@ -17,6 +17,8 @@
 
 #include "mbopt/v1/service.grpc.pb.h"
 #include "spec/io/study_io.h"
+#include "tests/testing/fake_clock.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/engine/study_sensitivities.h"
 #include "worker/service/task_evaluator.h"
 #include "worker/service/worker_service.h"
@@ -215,6 +217,22 @@ TEST(TaskEvaluator, StudyWithoutSimulatorSensitivitiesGivesValuesAndTheReason) {
   EXPECT_NE(result.gradients_unavailable().find("speed"), std::string::npos) << result.gradients_unavailable();
 }
 
+// A task whose cancel flag is up ends as a `cancelled` failure (the worker
+// then drops it), not as values or another kind of failure.
+TEST(TaskEvaluator, CancelledAnalysisIsACancelledFailure) {
+  const v1::Study proto = VehicleStudyProto();
+  auto prepared = PrepareStudy(proto, "job-1");
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  const mbopt::testing::CancelAfter cancel(50);
+  v1::TaskResult result;
+  EvaluateTask(**prepared, TaskAt(InitialDesign(proto)), ValueEncoding::kPacked, &result, nullptr,
+               budget::AnalysisBudget(nullptr, cancel.AsFlag()));
+  EXPECT_FALSE(result.ok());
+  EXPECT_EQ(result.failure_kind(), v1::ANALYSIS_FAILURE_CANCELLED) << result.failure_reason();
+  EXPECT_NE(result.failure_reason().find("cancelled at t = "), std::string::npos) << result.failure_reason();
+  EXPECT_GE(cancel.asked(), 50);
+}
+
 TEST(TaskEvaluator, StudyThatDoesNotConvertIsAnError) {
   v1::Study proto = VehicleStudyProto();
   proto.mutable_variables(0)->set_parameter("no_such_parameter");
@@ -286,6 +304,11 @@ class FakeWorkerService final : public v1::WorkerService::Service {
     ++heartbeats_;
     // The first heartbeat says "who are you?", as a restarted server would.
     response->set_known(heartbeats_ > 1);
+    // Tasks of cancelled jobs, once the worker has the study (it is then
+    // running the first of them).
+    if (study_fetches_ > 0) {
+      for (const std::string& task_id : cancel_) response->add_cancelled_task_ids(task_id);
+    }
     cv_.notify_all();
     return grpc::Status::OK;
   }
@@ -313,6 +336,7 @@ class FakeWorkerService final : public v1::WorkerService::Service {
   int heartbeats_ = 0;
   int study_fetches_ = 0;
   int slots_ = 0;
+  std::vector<std::string> cancel_;  // task ids every heartbeat says are cancelled
 };
 
 // The fake on 127.0.0.1 (any free port, in *port); nullptr if it cannot start.
@@ -415,6 +439,62 @@ TEST(WorkerService, TasksHandedOutTogetherAreReportedTogether) {
     ASSERT_EQ(fake.results_.size(), 5u);
     for (int i = 0; i < 5; ++i) EXPECT_EQ(fake.results_[static_cast<size_t>(i)].request_id(), i) << "in the order run";
   }
+}
+
+// The vehicle without any damping, over 10^7 s: CVODES follows every
+// oscillation of the wheel hop (about 10 Hz) and would spend its 10^8 steps,
+// minutes of work, before the analysis ended. A heartbeat saying the task
+// is cancelled stops it within a budget check: the worker's one slot is
+// free for the next task long before that, and the cancelled task's result
+// is not sent.
+TEST(WorkerService, CancelledTaskStopsItsRunningAnalysis) {
+  v1::Study proto = VehicleStudyProto();
+  v1::Scene& scene = *proto.mutable_scene();
+  scene.mutable_time_grid()->set_end_s(1e7);
+  scene.mutable_integrator()->set_max_steps(100'000'000);
+  scene.mutable_integrator()->set_max_wall_seconds(3600);
+  for (v1::Parameter& p : *scene.mutable_parameters()) {
+    if (p.name() == "c4" || p.name() == "c5") p.set_value(0.0);  // tyres
+  }
+  FakeWorkerService fake(proto);
+  int port = 0;
+  std::unique_ptr<grpc::Server> server = ServeOnLoopback(fake, &port);
+  ASSERT_NE(server, nullptr);
+  std::vector<double> undamped = InitialDesign(proto);
+  for (const char* damper : {"x4", "x5", "x6"}) {
+    for (int i = 0; i < proto.variables_size(); ++i) {
+      if (proto.variables(i).name() == damper) undamped[static_cast<size_t>(i)] = 0.0;
+    }
+  }
+  v1::AnalysisTask endless = TaskAt(undamped);
+  endless.set_task_id("job-1/0/0");
+  v1::AnalysisTask next = TaskAt(InitialDesign(proto));
+  next.set_task_id("job-1/0/1");
+  next.set_request_id(1);
+  fake.cancel_ = {endless.task_id()};
+  fake.Queue(endless);
+  fake.Queue(next);
+
+  WorkerOptions options;
+  options.server_address = "127.0.0.1:" + std::to_string(port);
+  options.slots = 1;
+  options.batch = 1;
+  options.acquire_wait_ms = 200;
+  StopSignal stop;
+  absl::Status run_status;
+  std::thread worker([&] { run_status = RunWorker(options, stop); });
+  const auto start = std::chrono::steady_clock::now();
+  const bool next_done = fake.WaitUntil([](FakeWorkerService& f) { return !f.results_.empty(); });
+  const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stop.Stop();
+  worker.join();
+  EXPECT_TRUE(run_status.ok()) << run_status;
+  server->Shutdown();
+  ASSERT_TRUE(next_done) << "the cancelled analysis kept the only slot for " << waited_s << " s";
+  std::lock_guard<std::mutex> lock(fake.mutex_);
+  ASSERT_EQ(fake.results_.size(), 1u);
+  EXPECT_EQ(fake.results_[0].task_id(), next.task_id()) << "the cancelled task's result is dropped";
+  EXPECT_TRUE(fake.results_[0].ok()) << fake.results_[0].failure_reason();
 }
 
 TEST(WorkerService, RejectsBadOptions) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "tests/fmu/closed_forms.h"
+#include "tests/testing/fake_clock.h"
 #include "worker/fmu/fmu.h"
 #include "worker/fmu/simulation.h"
 
@@ -79,11 +80,15 @@ TEST(FmuCoSimulation, WallTimeLimitEndsTheRun) {
   RunOptions options;
   options.outputs = {"x0"};
   options.output_times_s = Grid(0.0, 40.0, 40);  // 40,000 steps of 1 ms
-  options.max_wall_seconds = 1e-6;
+  // 1 s per reading of the clock: over the 100 s limit after 100 steps.
+  const mbopt::testing::SteppingClock clock(1.0);
+  const budget::AnalysisBudget budget =
+      budget::AnalysisBudget(clock.AsClock(), nullptr).ForAnalysis(100.0, 0);
+  options.budget = &budget;
   auto result = Simulate(fmu, options);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->outcome, RunOutcome::kTimeLimit);
-  EXPECT_LT(result->integrator_steps, 40000);
+  EXPECT_EQ(result->integrator_steps, 101);
 }
 
 TEST(FmuCoSimulation, OutputTimesOffTheCommunicationPointsAreRefused) {

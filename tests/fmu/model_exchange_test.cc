@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tests/fmu/closed_forms.h"
+#include "tests/testing/fake_clock.h"
 #include "worker/fmu/fmu.h"
 #include "worker/fmu/simulation.h"
 
@@ -133,14 +134,34 @@ TEST(FmuModelExchange, SameRunTwiceIsBitIdentical) {
   EXPECT_EQ(first->state_event_times_s, second->state_event_times_s);
 }
 
+// The budget's clock advances 1 s per reading: the 10 s limit falls after
+// ten checks, on any machine.
 TEST(FmuModelExchange, WallTimeLimitEndsTheRun) {
   const Fmu fmu = OpenModelExchange("van_der_pol");
   RunOptions options = Tight({}, {"x0"}, Grid(0.0, 40.0, 4000));
-  options.max_wall_seconds = 1e-6;  // the whole run takes milliseconds
+  const mbopt::testing::SteppingClock clock(1.0);
+  const budget::AnalysisBudget budget =
+      budget::AnalysisBudget(clock.AsClock(), nullptr).ForAnalysis(10.0, 0);
+  options.budget = &budget;
   auto result = Simulate(fmu, options);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->outcome, RunOutcome::kTimeLimit);
-  EXPECT_THAT(result->reason, ::testing::HasSubstr("the wall-time limit of 1e-06 s was reached at t = "));
+  EXPECT_THAT(result->reason, ::testing::HasSubstr("the wall-time limit of 10 s (integrator.max_wall_seconds) was "
+                                                   "reached at t = "));
+  EXPECT_EQ(clock.reads(), 12) << "one reading sets the deadline, ten pass it, the eleventh is over";
+}
+
+TEST(FmuModelExchange, CancelledRunEndsAtTheNextStep) {
+  const Fmu fmu = OpenModelExchange("van_der_pol");
+  RunOptions options = Tight({}, {"x0"}, Grid(0.0, 40.0, 4000));
+  const mbopt::testing::CancelAfter cancel(5);
+  const budget::AnalysisBudget budget(nullptr, cancel.AsFlag());
+  options.budget = &budget;
+  auto result = Simulate(fmu, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->outcome, RunOutcome::kCancelled);
+  EXPECT_THAT(result->reason, ::testing::HasSubstr("cancelled at t = "));
+  EXPECT_LT(result->integrator_steps, 20);
 }
 
 TEST(FmuModelExchange, OutputAtTheStartTimeIsTheInitialValue) {

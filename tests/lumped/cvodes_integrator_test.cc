@@ -10,6 +10,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "tests/testing/fake_clock.h"
+#include "worker/sundials/integrator_failure.h"
+
 namespace mbopt::solve {
 namespace {
 
@@ -195,13 +198,34 @@ TEST(CvodesIntegrator, StepBudgetIsEnforcedAcrossCalls) {
   EXPECT_LE((*integrator)->counters().steps, 5);
 }
 
-TEST(CvodesIntegrator, WallTimeLimitIsDeadlineExceeded) {
+// The budget's clock moves 1 s per reading: the 5 s deadline passes at a
+// known right-hand side, however fast the machine.
+TEST(CvodesIntegrator, BudgetDeadlineIsDeadlineExceeded) {
+  const mbopt::testing::SteppingClock clock(1.0);
+  const budget::AnalysisBudget budget = budget::AnalysisBudget(clock.AsClock(), nullptr).ForAnalysis(5.0, 0);
   CvodesOptions o;
-  o.max_wall_seconds = 1e-12;  // already over when the first rhs runs
+  o.budget = &budget;
   auto integrator = CvodesIntegrator::Create(1, Decay(), nullptr, o, 0.0, Eigen::VectorXd::Ones(1));
   ASSERT_TRUE(integrator.ok());
   Eigen::VectorXd y;
-  EXPECT_EQ((*integrator)->IntegrateTo(1.0, &y).code(), absl::StatusCode::kDeadlineExceeded);
+  const absl::Status s = (*integrator)->IntegrateTo(100.0, &y);
+  EXPECT_EQ(s.code(), absl::StatusCode::kDeadlineExceeded) << s;
+  EXPECT_THAT(std::string(s.message()), HasSubstr("wall-time limit of 5 s"));
+  EXPECT_EQ(IntegratorFailure(s, "x").kind, spec::FailureKind::kTimeLimit);
+}
+
+TEST(CvodesIntegrator, BudgetCancelIsCancelled) {
+  const mbopt::testing::CancelAfter cancel(3);
+  const budget::AnalysisBudget budget(nullptr, cancel.AsFlag());
+  CvodesOptions o;
+  o.budget = &budget;
+  auto integrator = CvodesIntegrator::Create(1, Decay(), nullptr, o, 0.0, Eigen::VectorXd::Ones(1));
+  ASSERT_TRUE(integrator.ok());
+  Eigen::VectorXd y;
+  const absl::Status s = (*integrator)->IntegrateTo(100.0, &y);
+  EXPECT_EQ(s.code(), absl::StatusCode::kCancelled) << s;
+  EXPECT_EQ(IntegratorFailure(s, "x").kind, spec::FailureKind::kCancelled);
+  EXPECT_LE((*integrator)->counters().rhs_evaluations, 3);
 }
 
 TEST(CvodesIntegrator, InvalidOptionsAndInputsAreRejected) {

@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "tests/testing/fake_clock.h"
 #include "worker/lumped/lumped_model.h"
 
 namespace mbopt::solve {
@@ -225,13 +226,31 @@ TEST(LumpedDynamics, StepLimitIsAFailedAnalysisWithReason) {
   EXPECT_LE(r.counters.time_steps, 5);
 }
 
+// The budget's clock moves 1 s per reading: over its 3 s after a few
+// right-hand sides.
 TEST(LumpedDynamics, WallTimeLimitIsAFailedAnalysisWithReason) {
-  spec::Scene scene = OneDofScene(OneDof(), true);
-  scene.integrator.max_wall_seconds = 1e-12;  // over before the first step
-  const spec::AnalysisReport r = SimulateLumped(scene, {800.0});
+  const spec::Scene scene = OneDofScene(OneDof(), true);
+  const mbopt::testing::SteppingClock clock(1.0);
+  budget::AnalysisBudget budget = budget::AnalysisBudget(clock.AsClock(), nullptr).ForAnalysis(3.0, 0);
+  LumpedDynamicsOptions options;
+  options.budget = &budget;
+  const spec::AnalysisReport r = SimulateLumped(scene, {800.0}, options);
   EXPECT_FALSE(r.ok());
   EXPECT_EQ(r.failure.kind, spec::FailureKind::kTimeLimit);
-  EXPECT_THAT(r.failure.reason, HasSubstr("wall-time limit"));
+  EXPECT_THAT(r.failure.reason, HasSubstr("wall-time limit of 3 s"));
+  EXPECT_LE(r.counters.rhs_evaluations, 3);
+}
+
+TEST(LumpedDynamics, CancelledAnalysisIsAFailureOfItsOwnKind) {
+  const spec::Scene scene = OneDofScene(OneDof(), true);
+  const mbopt::testing::CancelAfter cancel(10);
+  budget::AnalysisBudget budget(nullptr, cancel.AsFlag());
+  LumpedDynamicsOptions options;
+  options.budget = &budget;
+  const spec::AnalysisReport r = SimulateLumped(scene, {800.0}, options);
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kCancelled) << r.failure.reason;
+  EXPECT_THAT(r.failure.reason, HasSubstr("cancelled at t = "));
+  EXPECT_LE(r.counters.rhs_evaluations, 10);
 }
 
 TEST(LumpedDynamics, UnusableParameterValueIsAFailedAnalysisNamingTheElement) {

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/multibody/mechanisms.h"
+#include "tests/testing/fake_clock.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/mechanism.h"
 
@@ -202,15 +203,20 @@ TEST(MultibodyDynamics, WallTimeLimitIsANamedFailure) {
   const Mechanism m(model);
   const Assembly assembled = Assemble(m, 0.0);
   ASSERT_TRUE(assembled.failure.ok());
+  // 1 s per reading of the clock: over the 5 s limit at a known residual.
+  const mbopt::testing::SteppingClock clock(1.0);
+  const budget::AnalysisBudget budget = budget::AnalysisBudget(clock.AsClock(), nullptr).ForAnalysis(5.0, 0);
   ForwardDynamicsOptions options;
-  options.max_wall_seconds = 1e-12;  // over at the first residual
+  options.budget = &budget;
   ForwardDynamicsCounters counters;
   const spec::AnalysisFailure f = IntegrateForward(
       m, 0.0, assembled.q, assembled.v, Grid(1.0, 10), options,
       [](const MotionSample&) { return spec::AnalysisFailure::Ok(); }, &counters);
   ASSERT_FALSE(f.ok());
   EXPECT_EQ(f.kind, spec::FailureKind::kTimeLimit);
+  EXPECT_NE(f.reason.find("wall-time limit of 5 s"), std::string::npos) << f.reason;
   EXPECT_NE(f.reason.find("t = "), std::string::npos) << f.reason;
+  EXPECT_LE(counters.residual_evaluations, 5);
 }
 
 TEST(MultibodyDynamics, RedundantJointsAtTheStartAreANamedFailureNotACrash) {

@@ -1,48 +1,16 @@
 #include "worker/engine/analysis.h"
 
-#include <chrono>
-#include <variant>
-
-#include "worker/fmu/scene_analysis.h"
-#include "worker/multibody/scene_analysis.h"
-#include "worker/lumped/lumped_dynamics.h"
-#ifdef MBOPT_HAVE_LINKAGE
-#include "worker/solve/linkage_analysis.h"
-#endif
+#include "worker/engine/model_kinds.h"
 
 namespace mbopt::engine {
 
 spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
-                             const ExternalAnalyzer* external) {
-  const auto start = std::chrono::steady_clock::now();
-  spec::AnalysisReport report;
-  if (std::holds_alternative<spec::ExternalModel>(scene.model)) {
-    if (external != nullptr) {
-      report = external->AnalyzeExternal(scene, parameter_values_si);
-    } else {
-      report.formulation = spec::Formulation::kExternal;
-      report.times_s = scene.time_grid.Instants();
-      report.Fail(spec::FailureKind::kInvalidModel,
-                  "external scene (driver \"" + std::get<spec::ExternalModel>(scene.model).driver +
-                      "\"): this program runs no analysis drivers; run it on a worker that declares them "
-                      "(mbopt-worker --drivers FILE)");
-    }
-  } else if (std::holds_alternative<spec::LumpedModel>(scene.model)) {
-    report = solve::SimulateLumped(scene, parameter_values_si);
-  } else if (std::holds_alternative<spec::MultibodyModel>(scene.model)) {
-    report = multibody::AnalyzeMultibodyScene(scene, parameter_values_si);
-  } else if (std::holds_alternative<spec::FmuModel>(scene.model)) {
-    report = fmu::AnalyzeFmuScene(scene, parameter_values_si);
-  } else {
-#ifdef MBOPT_HAVE_LINKAGE
-    report = solve::AnalyzeLinkage(scene, parameter_values_si);
-#else
-    report.times_s = scene.time_grid.Instants();
-    report.Fail(spec::FailureKind::kInvalidModel, "linkage scenes are not available in this build");
-#endif
-  }
-  report.counters.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                             const ExternalAnalyzer* external, const budget::AnalysisBudget& budget) {
+  budget::AnalysisBudget analysis_budget =
+      budget.ForAnalysis(scene.integrator.max_wall_seconds, scene.integrator.max_steps);
+  const double start_s = budget.NowSeconds();
+  spec::AnalysisReport report = ModelKindOf(scene).analyze(scene, parameter_values_si, &analysis_budget, external);
+  report.counters.wall_seconds = budget.NowSeconds() - start_s;
   return report;
 }
 
@@ -65,11 +33,11 @@ bool AppendCaseReport(const spec::Study& study, int c, spec::AnalysisReport repo
 }
 
 spec::AnalysisReport AnalyzeCases(const spec::Study& study, const std::vector<double>& parameter_values_si,
-                                  const ExternalAnalyzer* external) {
-  if (study.cases.empty()) return Analyze(study.scene, parameter_values_si, external);
+                                  const ExternalAnalyzer* external, const budget::AnalysisBudget& budget) {
+  if (study.cases.empty()) return Analyze(study.scene, parameter_values_si, external, budget);
   spec::AnalysisReport combined;
   for (int c = 0; c < study.num_cases(); ++c) {
-    if (!AppendCaseReport(study, c, Analyze(study.scene, study.CaseParameterValues(c, parameter_values_si), external),
+    if (!AppendCaseReport(study, c, Analyze(study.scene, study.CaseParameterValues(c, parameter_values_si), external, budget),
                           &combined)) {
       break;
     }

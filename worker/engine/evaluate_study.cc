@@ -91,16 +91,17 @@ void TakeGradients(std::optional<spec::StudyGradients> gradients, std::string un
 
 absl::StatusOr<StudyEvaluation> EvaluateStudy(const spec::Study& study, const spec::StudyLayout& layout,
                                               const std::vector<double>& x_scaled, bool want_gradients,
-                                              const ExternalAnalyzer* external) {
+                                              const ExternalAnalyzer* external,
+                                              const budget::AnalysisBudget& budget) {
   MBOPT_RETURN_IF_ERROR(CheckDesign(study, x_scaled));
   // Whether gradients are computed is fixed by the request, so an
   // evaluation stays a pure function of (study, x, want_gradients).
   StudyAnalysisWithGradients analysis;
   const std::vector<double> parameters_si = study.ParameterValuesAt(x_scaled);
   if (want_gradients) {
-    analysis = AnalyzeStudyWithGradients(study, layout, x_scaled, external);
+    analysis = AnalyzeStudyWithGradients(study, layout, x_scaled, external, budget);
   } else {
-    analysis.report = AnalyzeCases(study, parameters_si, external);
+    analysis.report = AnalyzeCases(study, parameters_si, external, budget);
   }
   const spec::AnalysisReport& report = analysis.report;
   StudyEvaluation evaluation;

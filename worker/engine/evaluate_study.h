@@ -25,6 +25,7 @@
 #include "spec/study.h"
 #include "spec/study_gradients.h"
 #include "worker/engine/external_analyzer.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::engine {
 
@@ -49,8 +50,11 @@ struct StudyEvaluation {
 // engine's outputs do not have the layout's shape (an engine defect, not a
 // numerical outcome).
 // `external` runs external scenes (external_analyzer.h).
+// `budget` brings the caller's clock (for the time limit and the wall time)
+// and cancel flag (engine::Analyze).
 absl::StatusOr<StudyEvaluation> EvaluateStudy(const spec::Study& study, const spec::StudyLayout& layout,
                                               const std::vector<double>& x_scaled, bool want_gradients,
-                                              const ExternalAnalyzer* external = nullptr);
+                                              const ExternalAnalyzer* external = nullptr,
+                                              const budget::AnalysisBudget& budget = budget::AnalysisBudget());
 
 }  // namespace mbopt::engine

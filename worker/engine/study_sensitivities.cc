@@ -1,19 +1,15 @@
 #include "worker/engine/study_sensitivities.h"
 
-#include <chrono>
-#include <variant>
-
 #include "spec/responses.h"
-#include "worker/multibody/scene_analysis.h"
-#include "worker/lumped/lumped_sensitivity.h"
+#include "worker/engine/model_kinds.h"
 
 namespace mbopt::engine {
 
 StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
                                                      const std::vector<double>& x_scaled,
-                                                     const ExternalAnalyzer* external) {
-  const auto start = std::chrono::steady_clock::now();
+                                                     const ExternalAnalyzer* external,
+                                                     const budget::AnalysisBudget& budget) {
   StudyAnalysisWithGradients out;
   const std::vector<double> parameters_si = study.ParameterValuesAt(x_scaled);
   // Every parameter a variable sets (its own, then also_sets): the engine
@@ -30,16 +26,11 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
       variable_of.push_back(i);
     }
   }
-  if (std::holds_alternative<spec::ExternalModel>(study.scene.model)) {
-    out.report = AnalyzeCases(study, parameters_si, external);
-    out.gradients_unavailable = "an external driver's gradients are not read yet";
-    return out;
-  }
-  const bool multibody = std::holds_alternative<spec::MultibodyModel>(study.scene.model);
-  out.gradients_unavailable = multibody ? multibody::MultibodySensitivityUnavailable(study.scene)
-                                        : solve::LumpedSensitivityUnavailable(study.scene, parameters);
-  if (!out.gradients_unavailable.empty()) {
-    out.report = AnalyzeCases(study, parameters_si);
+  const ModelKind& kind = ModelKindOf(study.scene);
+  out.gradients_unavailable = kind.sensitivities_unavailable(study.scene, parameters);
+  if (!out.gradients_unavailable.empty() || kind.analyze_with_sensitivities == nullptr) {
+    if (out.gradients_unavailable.empty()) out.gradients_unavailable = "no simulator sensitivities";
+    out.report = AnalyzeCases(study, parameters_si, external, budget);
     return out;
   }
   // [parameter][signal]: every case's outputs in turn, as AnalyzeCases
@@ -47,19 +38,14 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
   std::vector<std::vector<std::vector<double>>> output_derivatives(parameters.size());
   for (int c = 0; c < study.num_cases(); ++c) {
     const std::vector<double> case_si = study.CaseParameterValues(c, parameters_si);
-    spec::AnalysisReport report;
-    std::vector<std::vector<std::vector<double>>> derivatives;
-    if (multibody) {
-      multibody::MultibodySensitivityResult result =
-          multibody::AnalyzeMultibodySceneWithSensitivities(study.scene, case_si, parameters);
-      report = std::move(result.report);
-      if (out.gradients_unavailable.empty()) out.gradients_unavailable = std::move(result.unavailable);
-      derivatives = std::move(result.output_derivatives);
-    } else {
-      solve::LumpedSensitivityResult result = solve::SimulateLumpedWithSensitivities(study.scene, case_si, parameters);
-      report = std::move(result.report);
-      derivatives = std::move(result.output_derivatives);
-    }
+    budget::AnalysisBudget case_budget =
+        budget.ForAnalysis(study.scene.integrator.max_wall_seconds, study.scene.integrator.max_steps);
+    const double start_s = budget.NowSeconds();
+    SensitivityAnalysis result = kind.analyze_with_sensitivities(study.scene, case_si, parameters, &case_budget);
+    spec::AnalysisReport report = std::move(result.report);
+    report.counters.wall_seconds = budget.NowSeconds() - start_s;
+    if (out.gradients_unavailable.empty()) out.gradients_unavailable = std::move(result.unavailable);
+    std::vector<std::vector<std::vector<double>>> derivatives = std::move(result.output_derivatives);
     const bool ok = report.ok();
     if (study.cases.empty()) {
       out.report = std::move(report);
@@ -71,8 +57,6 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
       for (auto& series : derivatives[k]) output_derivatives[k].push_back(std::move(series));
     }
   }
-  out.report.counters.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!out.report.ok()) {
     out.gradients_unavailable = "the analysis failed";
     return out;

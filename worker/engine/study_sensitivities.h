@@ -1,15 +1,14 @@
 // One analysis of a study at a scaled design point that also yields the
 // gradients of the study values with respect to the scaled design variables,
-// from the simulator's forward sensitivity analysis (lumped scenes:
-// worker/lumped/lumped_sensitivity.h; multibody scenes:
-// worker/multibody/scene_analysis.h) and the layout's chain rule
-// (spec/study_gradients.h). Pure: no threads, no I/O.
+// from the simulator's forward sensitivity analysis of the scene's model
+// kind (model_kinds.h) and the layout's chain rule (spec/study_gradients.h).
+// Pure: no threads, no I/O, no clock (the budget's).
 //
-// When the scene has no simulator sensitivities (a linkage scene, a static
-// multibody analysis, or a lumped design variable that sets something other
-// than a mass, inertia, stiffness or damping) the plain analysis is run and
-// `gradients` is empty with the reason: the caller then uses finite
-// differences.
+// When the scene has no simulator sensitivities (its kind has none, a
+// static multibody analysis, or a lumped design variable that sets
+// something other than a mass, inertia, stiffness or damping) the plain
+// analysis is run and `gradients` is empty with the reason: the caller then
+// uses finite differences.
 #pragma once
 
 #include <optional>
@@ -32,10 +31,12 @@ struct StudyAnalysisWithGradients {
 
 // `x_scaled` has one entry per study variable; `layout` is
 // MakeStudyLayout(study). An external scene has no gradients here: it is
-// analysed by `external` and gradients_unavailable says so.
+// analysed by `external` and gradients_unavailable says so. Each load case
+// is one analysis within `budget`, as engine::Analyze.
 StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
                                                      const spec::StudyLayout& layout,
                                                      const std::vector<double>& x_scaled,
-                                                     const ExternalAnalyzer* external = nullptr);
+                                                     const ExternalAnalyzer* external = nullptr,
+                                                     const budget::AnalysisBudget& budget = budget::AnalysisBudget());
 
 }  // namespace mbopt::engine

@@ -230,10 +230,9 @@ RunResult ModelExchangeRun::Go() {
   if (!SetUpCvodes(t0)) return result_;
   if (!OutputsUpTo(t0)) return result_;
 
-  const WallClock clock(options_.max_wall_seconds);
   double t = t0;
   while (next_output_ < options_.output_times_s.size()) {
-    if (!clock.Within(t, &result_)) return result_;
+    if (!WithinBudget(options_, t, &result_)) return result_;
     const bool time_event_ahead = info_.nextEventTimeDefined == fmi2True && info_.nextEventTime <= t_end;
     if (time_event_ahead && info_.nextEventTime <= t) {
       Fail(&result_, RunOutcome::kModelError,

@@ -2,7 +2,6 @@
 // and the Model Exchange loop (model_exchange.cc). Internal to worker/fmu.
 #pragma once
 
-#include <chrono>
 #include <vector>
 
 #include "worker/fmu/fmi2_instance.h"
@@ -18,17 +17,9 @@ struct CheckedRun {
   double stop_time_s = 0.0;
 };
 
-// The run's wall-time limit (RunOptions::max_wall_seconds).
-class WallClock {
- public:
-  explicit WallClock(double max_seconds) : max_seconds_(max_seconds), start_(std::chrono::steady_clock::now()) {}
-  // False (and `result` failed with kTimeLimit) once the limit is passed.
-  bool Within(double time_s, RunResult* result) const;
-
- private:
-  double max_seconds_;
-  std::chrono::steady_clock::time_point start_;
-};
+// The run's budget (RunOptions::budget): false, and `result` failed with
+// kTimeLimit or kCancelled, once it is spent at simulated time `time_s`.
+bool WithinBudget(const RunOptions& options, double time_s, RunResult* result);
 
 // Marks `result` failed with `outcome` and `reason`; returns false.
 bool Fail(RunResult* result, RunOutcome outcome, std::string reason);

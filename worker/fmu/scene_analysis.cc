@@ -18,13 +18,15 @@ spec::FailureKind KindOf(RunOutcome outcome) {
     case RunOutcome::kIntegratorFailure: return spec::FailureKind::kIntegrator;
     case RunOutcome::kTerminated: return spec::FailureKind::kModelValidity;
     case RunOutcome::kTimeLimit: return spec::FailureKind::kTimeLimit;
+    case RunOutcome::kCancelled: return spec::FailureKind::kCancelled;
   }
   return spec::FailureKind::kInvalidModel;
 }
 
 }  // namespace
 
-spec::AnalysisReport AnalyzeFmuScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si) {
+spec::AnalysisReport AnalyzeFmuScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                                     const budget::AnalysisBudget* budget) {
   spec::AnalysisReport report;
   report.formulation = spec::Formulation::kDynamic;
   report.times_s = scene.time_grid.Instants();
@@ -56,7 +58,7 @@ spec::AnalysisReport AnalyzeFmuScene(const spec::Scene& scene, const std::vector
   options.relative_tolerance = scene.integrator.relative_tolerance;
   options.absolute_tolerance = scene.integrator.absolute_tolerance;
   options.max_steps = scene.integrator.max_steps;
-  options.max_wall_seconds = scene.integrator.max_wall_seconds;
+  options.budget = budget;
   if (model->communication_step_s > 0.0) options.communication_step_s = model->communication_step_s;
 
   auto result = Simulate(*fmu, options);

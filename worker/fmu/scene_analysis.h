@@ -15,9 +15,13 @@
 
 #include "spec/analysis_report.h"
 #include "spec/scene.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::fmu {
 
-spec::AnalysisReport AnalyzeFmuScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si);
+// `budget` (null: none) is checked after every integrator step and every
+// fmi2DoStep.
+spec::AnalysisReport AnalyzeFmuScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                                     const budget::AnalysisBudget* budget = nullptr);
 
 }  // namespace mbopt::fmu

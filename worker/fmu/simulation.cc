@@ -121,7 +121,6 @@ RunResult RunCoSimulation(Fmi2Instance& instance, const RunOptions& options, con
   const double tolerance = options.relative_tolerance;
   if (!internal::Initialize(instance, options, run, tolerance, &result)) return result;
   const Fmi2Functions& f = instance.f();
-  const internal::WallClock clock(options.max_wall_seconds);
   // Communication points are start + m * step, computed from m each time so
   // that no rounding accumulates over many steps.
   std::int64_t m = 0;
@@ -135,7 +134,7 @@ RunResult RunCoSimulation(Fmi2Instance& instance, const RunOptions& options, con
         Fail(&result, RunOutcome::kModelError, instance.Failure("fmi2DoStep", status, point));
         return result;
       }
-      if (!clock.Within(point + step_s, &result)) return result;
+      if (!internal::WithinBudget(options, point + step_s, &result)) return result;
     }
     if (!internal::ReadOutputs(instance, run, static_cast<int>(i), options.output_times_s[i], &result)) return result;
   }
@@ -152,19 +151,19 @@ const char* RunOutcomeName(RunOutcome outcome) {
     case RunOutcome::kIntegratorFailure: return "integrator failure";
     case RunOutcome::kTerminated: return "terminated by the FMU";
     case RunOutcome::kTimeLimit: return "time limit";
+    case RunOutcome::kCancelled: return "cancelled";
   }
   return "?";
 }
 
 namespace internal {
 
-bool WallClock::Within(double time_s, RunResult* result) const {
-  if (max_seconds_ <= 0.0 ||
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() <= max_seconds_) {
-    return true;
-  }
-  return Fail(result, RunOutcome::kTimeLimit,
-              absl::StrCat("the wall-time limit of ", max_seconds_, " s was reached at t = ", time_s, " s"));
+bool WithinBudget(const RunOptions& options, double time_s, RunResult* result) {
+  if (options.budget == nullptr) return true;
+  spec::AnalysisFailure spent = options.budget->Check(time_s);
+  if (spent.ok()) return true;
+  return Fail(result, spent.kind == spec::FailureKind::kCancelled ? RunOutcome::kCancelled : RunOutcome::kTimeLimit,
+              std::move(spent.reason));
 }
 
 bool Fail(RunResult* result, RunOutcome outcome, std::string reason) {

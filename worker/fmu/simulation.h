@@ -33,6 +33,7 @@
 
 #include "absl/status/statusor.h"
 #include "worker/fmu/fmu.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::fmu {
 
@@ -53,10 +54,10 @@ struct RunOptions {
   int max_events = 100000;                  // state and time events over the whole run
   int max_event_iterations = 1000;          // fmi2NewDiscreteStates calls at one event
 
-  // Wall-time limit of the run, checked after every integrator step and
-  // every fmi2DoStep; <= 0: none. A call into the FMU that never returns is
-  // not interrupted (the service's lease covers that).
-  double max_wall_seconds = 0.0;
+  // The analysis' deadline and cancel flag, checked after every integrator
+  // step and every fmi2DoStep; null: none. A call into the FMU that never
+  // returns is not interrupted (the service's lease covers that).
+  const budget::AnalysisBudget* budget = nullptr;
 
   // Co-Simulation: the communication step; unset: DefaultExperiment stepSize.
   std::optional<double> communication_step_s;
@@ -67,7 +68,8 @@ enum class RunOutcome {
   kModelError,         // an FMI call returned fmi2Error or fmi2Fatal (or fmi2Discard where no retry exists)
   kIntegratorFailure,  // CVODES gave up (step size, error test, convergence, too many steps or events)
   kTerminated,         // the FMU ended the simulation before the last output time
-  kTimeLimit,          // max_wall_seconds ran out
+  kTimeLimit,          // the budget's deadline passed
+  kCancelled,          // the budget's cancel flag went up
 };
 
 const char* RunOutcomeName(RunOutcome outcome);

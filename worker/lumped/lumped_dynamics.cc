@@ -68,7 +68,7 @@ spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& m, const std::ve
   cv.relative_tolerance = settings.relative_tolerance;
   cv.absolute_tolerance = settings.absolute_tolerance;
   cv.max_steps = settings.max_steps;
-  cv.max_wall_seconds = settings.max_wall_seconds;
+  cv.budget = options.budget;
   // Rates are larger than coordinates by about the natural frequencies; a
   // common absolute tolerance would make the fastest mode's rates dominate
   // the error norm long after that mode has died out.

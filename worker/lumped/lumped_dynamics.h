@@ -28,6 +28,7 @@
 #include "spec/scene.h"
 #include "spec/analysis_report.h"
 #include "worker/lumped/lumped_model.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::solve {
 
@@ -37,6 +38,9 @@ struct LumpedDynamicsOptions {
   // Initial coordinates and rates (SI); empty: at rest. For tests of free
   // responses; analyses of scenes always start at rest.
   Eigen::VectorXd initial_q, initial_qdot;
+  // The analysis' deadline and cancel flag, checked in every right-hand
+  // side (null: none). The engine passes one (worker/engine).
+  const budget::AnalysisBudget* budget = nullptr;
 };
 
 // The integration itself: calls `at_instant(t, q, q')` at every instant of

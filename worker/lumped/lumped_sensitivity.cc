@@ -3,7 +3,6 @@
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <functional>
 #include <variant>
@@ -127,8 +126,7 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   problem.rhs = Eigen::VectorXd::Zero(n);
   problem.input_deflection.assign(m.elements().size(), 0.0);
   problem.input_rate.assign(m.elements().size(), 0.0);
-  problem.max_wall_seconds = scene.integrator.max_wall_seconds;
-  problem.start = std::chrono::steady_clock::now();
+  problem.budget = options.budget;
   for (int p : parameters) {
     ParameterDerivative d;
     d.mass_diagonal = Eigen::VectorXd::Zero(n);

@@ -31,6 +31,7 @@
 
 #include "spec/scene.h"
 #include "spec/analysis_report.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::solve {
 
@@ -75,6 +76,9 @@ struct LumpedSensitivityOptions {
   // N_VEnableFusedOps_Serial: CVODES updates all sensitivity vectors in one
   // call per operation instead of one call per vector.
   bool fused_vector_operations = false;
+  // The analysis' deadline and cancel flag, checked in every right-hand
+  // side (null: none).
+  const budget::AnalysisBudget* budget = nullptr;
 };
 
 // Where the integration's work went, beyond report.counters (which has the

@@ -83,7 +83,7 @@ spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::Inte
   CvodesOptions cv;
   cv.relative_tolerance = settings.relative_tolerance / norm_bound;
   cv.max_steps = settings.max_steps;
-  cv.max_wall_seconds = settings.max_wall_seconds;
+  cv.budget = options.budget;
   cv.absolute_tolerances.resize(size);
   for (int k = 0; k <= ns; ++k) {
     const double scale = (k == 0 ? 1.0 : 1.0 / pbar[static_cast<size_t>(k - 1)]) / norm_bound;

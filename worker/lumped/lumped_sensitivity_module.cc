@@ -9,7 +9,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -23,11 +22,9 @@ namespace {
 
 int Rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* p = static_cast<SensitivityProblem*>(user_data);
-  if (p->max_wall_seconds > 0 &&
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - p->start).count() >
-          p->max_wall_seconds) {
-    p->wall_time_exceeded = true;
-    return -1;
+  if (p->budget != nullptr && p->budget->Exhausted()) {
+    p->budget_failure = p->budget->Check(t);
+    if (!p->budget_failure.ok()) return -1;
   }
   const int n = p->n;
   Eigen::Map<const Eigen::VectorXd> q(N_VGetArrayPointer(y), n), v(N_VGetArrayPointer(y) + n, n);
@@ -218,9 +215,6 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
     if (flag < 0) {
       failure = absl::StrFormat("integrator failed near t = %.9g (target %.9g): flag %d", reached,
                                 t, flag);
-      if (p->wall_time_exceeded) {
-        absl::StrAppend(&failure, ": wall-time limit of ", p->max_wall_seconds, " s exceeded");
-      }
       if (!p->sundials_message.empty()) absl::StrAppend(&failure, " [", p->sundials_message, "]");
       return false;
     }
@@ -271,8 +265,8 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
   }
   if (!history_counted) accumulate_counters();
   if (!ok) {
-    return IntegratorFailure(p->wall_time_exceeded ? absl::DeadlineExceededError("") : absl::AbortedError(""),
-                             failure.empty() ? "sensitivity integration failed" : failure);
+    if (!p->budget_failure.ok()) return p->budget_failure;
+    return IntegratorFailure(absl::AbortedError(""), failure.empty() ? "sensitivity integration failed" : failure);
   }
   return spec::AnalysisFailure::Ok();
 }

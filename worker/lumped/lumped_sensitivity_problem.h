@@ -5,7 +5,6 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <chrono>
 #include <functional>
 #include <limits>
 #include <string>
@@ -14,6 +13,7 @@
 #include "spec/scene.h"
 #include "spec/analysis_report.h"
 #include "worker/lumped/lumped_model.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/lumped/lumped_sensitivity.h"
 
 namespace mbopt::solve::sensitivity_internal {
@@ -43,10 +43,10 @@ struct SensitivityProblem {
   std::vector<double> input_deflection, input_rate;
   double inputs_time = std::numeric_limits<double>::quiet_NaN();
   std::string sundials_message;
-  // IntegratorSettings::max_wall_seconds (<= 0: none), checked in Rhs.
-  double max_wall_seconds = 0;
-  std::chrono::steady_clock::time_point start;
-  bool wall_time_exceeded = false;
+  // The analysis' deadline and cancel flag (null: none), checked in Rhs;
+  // budget_failure says why it stopped the integration.
+  const budget::AnalysisBudget* budget = nullptr;
+  spec::AnalysisFailure budget_failure;
 
   void EvaluateInputs(double t) {
     if (t == inputs_time) return;

@@ -11,8 +11,10 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "mbopt/v1/series.pb.h"
+#include "common/monotonic_clock.h"
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/engine/analysis.h"
 #include "worker/engine/study_values.h"
 #include "worker/external/worker_settings.h"
@@ -269,7 +271,9 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   if (*external_settings != nullptr) {
     analyzer = std::make_unique<external::ExternalSceneAnalyzer>(**external_settings, "eval");
   }
-  const spec::AnalysisReport report = engine::AnalyzeCases(study, parameters, analyzer.get());
+  // On this process' clock: the scene's time limit applies as on a worker.
+  const spec::AnalysisReport report =
+      engine::AnalyzeCases(study, parameters, analyzer.get(), budget::AnalysisBudget(&MonotonicSeconds, nullptr));
   external::RemoveDefaultWorkDirectoryIfEmpty(external_options, external_settings->get());
   const bool ok = report.ok();
   if (!series_out.empty()) {

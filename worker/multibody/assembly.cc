@@ -68,6 +68,9 @@ spec::AnalysisFailure SolvePositions(const Mechanism& m, double t, const Assembl
   Eigen::VectorXd phi;
   Eigen::MatrixXd phi_q;
   for (*iterations = 0; *iterations <= options.max_iterations; ++*iterations) {
+    if (options.budget != nullptr) {
+      if (spec::AnalysisFailure f = options.budget->Check(t); !f.ok()) return f;
+    }
     if (m.Constraints(t, *q, &phi) != 0) break;
     if (MaxAbs(phi) <= options.position_tolerance) return spec::AnalysisFailure::Ok();
     if (*iterations == options.max_iterations) break;
@@ -95,6 +98,12 @@ Assembly Assemble(const Mechanism& m, double t, const AssemblyOptions& options) 
   bool closed = false;
   int polished = 0;
   for (int it = 0; it <= options.max_iterations + options.polish_iterations; ++it) {
+    if (options.budget != nullptr) {
+      if (spec::AnalysisFailure f = options.budget->Check(t); !f.ok()) {
+        out.failure = std::move(f);
+        return out;
+      }
+    }
     m.Constraints(t, q, &constraint_phi);
     phi.head(m.num_constraints()) = constraint_phi;
     for (size_t k = 0; k < held.size(); ++k) {

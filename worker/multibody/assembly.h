@@ -16,6 +16,7 @@
 
 #include "spec/analysis_outcome.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::multibody {
 
@@ -36,6 +37,9 @@ struct AssemblyOptions {
   // links start with rigid-body velocities (each link's nodes move as one
   // rigid body), not with the minimum-norm node velocities. Null: v free.
   const Eigen::MatrixXd* velocity_basis = nullptr;
+  // The analysis' deadline and cancel flag, checked at every Newton
+  // iteration (null: none).
+  const budget::AnalysisBudget* budget = nullptr;
 };
 
 struct Assembly {

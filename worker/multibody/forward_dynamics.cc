@@ -6,7 +6,6 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -24,9 +23,8 @@ using Eigen::VectorXd;
 struct Problem {
   const ConstrainedSystem* system = nullptr;
   int n = 0, m = 0;
-  std::chrono::steady_clock::time_point start;
-  double max_wall_seconds = 0.0;
-  bool wall_time_exceeded = false;
+  const budget::AnalysisBudget* budget = nullptr;
+  spec::AnalysisFailure budget_failure;  // why the budget stopped the integration
   std::string callback_failure;
   const std::vector<ParameterPerturbation>* parameters = nullptr;  // sensitivities, if any
   // Work space.
@@ -63,10 +61,9 @@ int EvaluateResidual(const ConstrainedSystem& s, Problem* p, double t, const Y& 
 int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
   return solve::sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
-    if (p->max_wall_seconds > 0.0 &&
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - p->start).count() > p->max_wall_seconds) {
-      p->wall_time_exceeded = true;
-      return -1;
+    if (p->budget != nullptr && p->budget->Exhausted()) {
+      p->budget_failure = p->budget->Check(t);
+      if (!p->budget_failure.ok()) return -1;
     }
     const int size = 2 * p->n + 2 * p->m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
@@ -230,8 +227,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   p.system = &system;
   p.n = system.num_coordinates();
   p.m = system.num_constraints();
-  p.start = std::chrono::steady_clock::now();
-  p.max_wall_seconds = options.max_wall_seconds;
+  p.budget = options.budget;
   const int n = p.n, m = p.m, size = 2 * n + 2 * m;
   if (q0.size() != n || v0.size() != n) {
     return Failed(spec::FailureKind::kInvalidModel, "initial coordinates of the wrong size");
@@ -397,11 +393,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
           return Failed(spec::FailureKind::kModelValidity,
                         absl::StrFormat("%s; the integrator gave up near t = %.6g s", system.FailureReason(), t_reached));
         }
-        if (p.wall_time_exceeded) {
-          return Failed(spec::FailureKind::kTimeLimit,
-                        absl::StrFormat("the wall-time limit of %g s was reached near t = %.6g s", p.max_wall_seconds,
-                                        t_reached));
-        }
+        if (!p.budget_failure.ok()) return p.budget_failure;
         return Failed(spec::FailureKind::kIntegrator,
                       absl::StrFormat("the integrator failed near t = %.6g s (target %.6g s): %s%s", t_reached, t,
                                       sundials_message, p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]"));

@@ -25,6 +25,7 @@
 #include <Eigen/Dense>
 
 #include "spec/analysis_outcome.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/multibody/constrained_system.h"
 #include "worker/multibody/motion.h"
 
@@ -34,7 +35,9 @@ struct ForwardDynamicsOptions {
   double relative_tolerance = 1e-6;
   double absolute_tolerance = 1e-9;  // on q (m, rad) and v (m/s, rad/s)
   long max_steps = 100000;           // over the whole integration
-  double max_wall_seconds = 0.0;     // 0: no limit
+  // The analysis' deadline and cancel flag, checked in every residual
+  // (null: none).
+  const budget::AnalysisBudget* budget = nullptr;
   double max_step_size = 0.0;        // 0: no limit
 };
 

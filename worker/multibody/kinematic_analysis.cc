@@ -62,6 +62,12 @@ class DrivenMotion {
 
   // Positions, velocities and accelerations at t from `q_guess`.
   spec::AnalysisFailure Solve(double t, Eigen::VectorXd q_guess, State* out) {
+    if (options_.budget != nullptr) {
+      if (spec::AnalysisFailure f = options_.budget->ChargeSteps(1, t); !f.ok()) {
+        budget_spent_ = true;
+        return f;
+      }
+    }
     int iterations = 0;
     ++counters_->position_solves;
     spec::AnalysisFailure closed = SolvePositions(m_, t, options_.assembly, &q_guess, &iterations);
@@ -95,6 +101,8 @@ class DrivenMotion {
     const double dt = t - from.t;
     const Eigen::VectorXd predicted = from.q + from.v * dt + 0.5 * dt * dt * from.a;
     spec::AnalysisFailure result = Solve(t, predicted, out);
+    // A spent budget stays spent: halving the interval would only ask again.
+    if (budget_spent_) return result;
     if (result.ok()) {
       const bool flipped = out->branch_sign != from.branch_sign;
       const double jump = Jump(out->q, predicted);
@@ -152,6 +160,7 @@ class DrivenMotion {
   Eigen::VectorXd phi_t_, gamma_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   bool locked_ = false;
+  bool budget_spent_ = false;
 };
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/mechanism.h"
 #include "worker/multibody/motion.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::multibody {
 
@@ -27,6 +28,9 @@ struct KinematicOptions {
   // as locked: round-off of the solved velocities then exceeds 1e-6 of them.
   double singular_rcond = 1e-10;
   int max_interval_halvings = 10;
+  // Charged one step per position solve (instants and halved intervals
+  // alike); also the deadline and cancel flag. Null: no limit.
+  budget::AnalysisBudget* budget = nullptr;
 };
 
 struct KinematicCounters {

@@ -17,7 +17,6 @@
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
 #include "worker/multibody/static_equilibrium.h"
-#include "worker/solve/wall_time_budget.h"
 
 namespace mbopt::multibody {
 namespace {
@@ -310,9 +309,41 @@ double OutputDerivative(const spec::MultibodyModel& sm, const spec::MultibodyOut
   return (plus - minus) / (2.0 * h);
 }
 
+// The most turns a driver may make between two instants: an analysis that
+// follows the motion needs a step per turn at least, and more than the
+// step budget's worth can never end within it.
+std::string DriverTooFast(const Model& model, const std::vector<double>& instants_s, std::int64_t max_steps) {
+  if (max_steps <= 0) return "";
+  std::vector<double> times;
+  if (instants_s.empty() || instants_s.front() > 0.0) times.push_back(0.0);
+  times.insert(times.end(), instants_s.begin(), instants_s.end());
+  for (const Driver& d : model.drivers) {
+    const Joint& joint = model.joints[static_cast<size_t>(d.joint)];
+    if (joint.kind != JointKind::kRevolute) continue;
+    for (size_t i = 1; i < times.size(); ++i) {
+      const Profile::Value from = d.profile.At(times[i - 1]), to = d.profile.At(times[i]);
+      // A harmonic driver may come back to where it was: its largest rate
+      // over the interval bounds the angle it sweeps.
+      double swept_rad = std::abs(to.q - from.q);
+      if (d.profile.kind == Profile::Kind::kHarmonic) {
+        swept_rad = std::max(swept_rad, std::abs(d.profile.amplitude * d.profile.angular_frequency_rad_per_s) *
+                                            (times[i] - times[i - 1]));
+      }
+      const double turns = swept_rad / (2.0 * std::numbers::pi);
+      if (!(turns <= static_cast<double>(max_steps))) {
+        return absl::StrFormat(
+            "driver of joint '%s' turns %.3g times between t = %.6g s and %.6g s, more than the step budget of %d "
+            "steps (integrator.max_steps) could follow",
+            joint.name, turns, times[i - 1], times[i], max_steps);
+      }
+    }
+  }
+  return "";
+}
+
 // The one analysis; with `parameters`, also the output derivatives.
 void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::vector<int>* parameters,
-             MultibodySensitivityResult* result) {
+             budget::AnalysisBudget* budget, MultibodySensitivityResult* result) {
   spec::AnalysisReport& report = result->report;
   report.times_s = scene.time_grid.Instants();
   report.formulation = spec::Formulation::kKinematic;
@@ -325,6 +356,10 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   absl::StatusOr<Model> model = CompileModel(scene, p);
   if (!model.ok()) {
     report.Fail(spec::FailureKind::kInvalidModel, std::string(model.status().message()));
+    return;
+  }
+  if (const std::string why = DriverTooFast(*model, report.times_s, scene.integrator.max_steps); !why.empty()) {
+    report.Fail(spec::FailureKind::kInvalidModel, why);
     return;
   }
   bool has_stress = false;
@@ -349,6 +384,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
 
   const bool sensitivities = parameters != nullptr && !parameters->empty();
   AssemblyOptions assembly_options;
+  assembly_options.budget = budget;
   // Variants are differenced: close every assembly to round-off.
   if (sensitivities) assembly_options.polish_iterations = 3;
   const Mechanism mechanism(*model);
@@ -431,9 +467,10 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   const bool driven = assembled.degrees_of_freedom == 0;
   std::vector<StateSensitivity> kinematic;  // work space of the driven path
-  const solve::WallTimeBudget budget(scene.integrator.max_wall_seconds);
   const MotionCallback record = [&](const MotionSample& s) {
-    if (budget.Exceeded()) return budget.Failure(s.t_s);
+    if (budget != nullptr) {
+      if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
+    }
     if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
       return spec::AnalysisFailure::Ok();
     }
@@ -483,13 +520,16 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   if (is_static) {
     report.formulation = spec::Formulation::kStatic;
     StaticCounters counters;
-    outcome = RunStaticEquilibrium(mechanism, assembled.q, times, StaticOptions{}, record, &counters);
+    StaticOptions options;
+    options.budget = budget;
+    outcome = RunStaticEquilibrium(mechanism, assembled.q, times, options, record, &counters);
     report.counters.position_solves += counters.position_solves;
     report.counters.newton_iterations += counters.newton_iterations;
     report.counters.rhs_evaluations += counters.residual_evaluations;
   } else if (driven) {
     KinematicOptions options;
     options.inverse_dynamics = NeedsMultipliers(scene);
+    options.budget = budget;
     report.formulation = options.inverse_dynamics ? spec::Formulation::kKinetostatic : spec::Formulation::kKinematic;
     KinematicCounters counters;
     outcome = RunKinematics(mechanism, assembled.q, times, options, record, &counters);
@@ -501,7 +541,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     options.relative_tolerance = scene.integrator.relative_tolerance;
     options.absolute_tolerance = scene.integrator.absolute_tolerance;
     options.max_steps = scene.integrator.max_steps;
-    options.max_wall_seconds = scene.integrator.max_wall_seconds;
+    options.budget = budget;
     ForwardDynamicsCounters counters;
     ForwardSensitivityInput input;
     if (with_derivatives) {
@@ -525,17 +565,19 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
 
 }  // namespace
 
-spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& p) {
+spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& p,
+                                           budget::AnalysisBudget* budget) {
   MultibodySensitivityResult result;
-  Analyze(scene, p, nullptr, &result);
+  Analyze(scene, p, nullptr, budget, &result);
   return std::move(result.report);
 }
 
 MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Scene& scene,
                                                                   const std::vector<double>& p,
-                                                                  const std::vector<int>& parameters) {
+                                                                  const std::vector<int>& parameters,
+                                                                  budget::AnalysisBudget* budget) {
   MultibodySensitivityResult result;
-  Analyze(scene, p, &parameters, &result);
+  Analyze(scene, p, &parameters, budget, &result);
   return result;
 }
 

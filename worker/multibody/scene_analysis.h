@@ -8,7 +8,15 @@
 //
 // Failures are data with their kind: unusable parameter values or redundant
 // joints (kInvalidModel), a mechanism that cannot assemble or locks
-// (kAssembly), the integrator giving up (kIntegrator), the wall-time limit.
+// (kAssembly), the integrator giving up (kIntegrator), the analysis budget
+// spent (kTimeLimit: its deadline or step budget; kCancelled). A driver that
+// would turn more often between two instants than the step budget has steps
+// is refused before anything is solved (kInvalidModel naming it): no
+// analysis could follow it, and the positions would be round-off.
+//
+// `budget` (null: none) is checked in every loop: assembly and position
+// Newton iterations, every position solve and continuation step (charged to
+// its step budget), every residual of the integrators.
 #pragma once
 
 #include <string>
@@ -18,10 +26,12 @@
 #include "spec/analysis_report.h"
 #include "spec/scene.h"
 #include "worker/multibody/model.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::multibody {
 
-spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si);
+spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                                           budget::AnalysisBudget* budget = nullptr);
 
 // The same analysis with the derivatives of every output with respect to
 // the chosen scene parameters, whatever they set (a stiffness, a mass, a
@@ -40,7 +50,8 @@ struct MultibodySensitivityResult {
 };
 MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Scene& scene,
                                                                   const std::vector<double>& parameter_values_si,
-                                                                  const std::vector<int>& parameters);
+                                                                  const std::vector<int>& parameters,
+                                                                  budget::AnalysisBudget* budget = nullptr);
 
 // Empty if the scene's analysis has simulator sensitivities; else why not
 // (a static-equilibrium analysis).

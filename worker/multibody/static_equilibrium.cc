@@ -218,8 +218,15 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
            (f.head(n).cwiseAbs().array() <= 10.0 * row_tolerance.array()).all() &&
            (m == 0 || MaxAbs(f.tail(m)) <= options.tolerance * 10.0);
   };
+  auto charge = [&](double t) {
+    return options.budget != nullptr ? options.budget->ChargeSteps(1, t) : spec::AnalysisFailure::Ok();
+  };
   for (const double t : times) {
     p.t = t;
+    if (spec::AnalysisFailure f = charge(t); !f.ok()) {
+      counters->residual_evaluations += p.evaluations;
+      return f;
+    }
     ++counters->position_solves;
     const VectorXd start = u_values;
     bool converged = solve(KIN_LINESEARCH);
@@ -233,6 +240,10 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
       if (Evaluate(&p, start, &f_start) == 0) {
         double s_done = 0.0, step = 0.25;
         while (s_done < 1.0 && step >= 1.0 / 4096) {
+          if (spec::AnalysisFailure f = charge(t); !f.ok()) {
+            counters->residual_evaluations += p.evaluations;
+            return f;
+          }
           const double s_next = std::min(1.0, s_done + step);
           const VectorXd before = u_values;
           p.offset = (1.0 - s_next) * f_start;

@@ -29,6 +29,7 @@
 #include "spec/analysis_outcome.h"
 #include "worker/multibody/constrained_system.h"
 #include "worker/multibody/motion.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::multibody {
 
@@ -42,6 +43,9 @@ struct StaticOptions {
   // Relative size of the most negative reduced stiffness eigenvalue (to the
   // largest in magnitude) that still counts as neutral, not unstable.
   double stability_tolerance = 1e-8;
+  // Charged one step per instant and per continuation step; also the
+  // deadline and cancel flag. Null: no limit.
+  budget::AnalysisBudget* budget = nullptr;
 };
 
 struct StaticCounters {

@@ -57,10 +57,11 @@ absl::StatusOr<std::shared_ptr<const PreparedStudy>> PrepareStudy(const v1::Stud
 }
 
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
-                  v1::TaskResult* result, const engine::ExternalAnalyzer* external) {
+                  v1::TaskResult* result, const engine::ExternalAnalyzer* external,
+                  const budget::AnalysisBudget& budget) {
   const std::vector<double> x(task.x_scaled().begin(), task.x_scaled().end());
   absl::StatusOr<engine::StudyEvaluation> evaluation =
-      engine::EvaluateStudy(prepared.study, prepared.layout, x, task.want_gradients(), external);
+      engine::EvaluateStudy(prepared.study, prepared.layout, x, task.want_gradients(), external, budget);
   if (!evaluation.ok()) {
     // The task does not fit the study (or the engine's outputs do not fit
     // the layout): nothing about the design point, so the service's kind.

@@ -20,6 +20,7 @@
 #include "mbopt/v1/service.pb.h"
 #include "spec/layout.h"
 #include "spec/study.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/engine/external_analyzer.h"
 #include "worker/external/scene_analyzer.h"
 
@@ -45,8 +46,11 @@ std::string CannotRun(const spec::Study& study, const external::ExternalWorkerSe
 enum class ValueEncoding { kPacked, kUnpacked };
 
 // Fills everything of `result` except worker_id, task_id, job_id and
-// request_id. `external` runs external scenes (null: they fail).
+// request_id. `external` runs external scenes (null: they fail). `budget`
+// brings the clock and the task's cancel flag (engine::Analyze); without a
+// clock the scene's time limit does not apply and the wall time is 0.
 void EvaluateTask(const PreparedStudy& prepared, const v1::AnalysisTask& task, ValueEncoding encoding,
-                  v1::TaskResult* result, const engine::ExternalAnalyzer* external = nullptr);
+                  v1::TaskResult* result, const engine::ExternalAnalyzer* external = nullptr,
+                  const budget::AnalysisBudget& budget = budget::AnalysisBudget());
 
 }  // namespace mbopt::worker

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -20,8 +21,10 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/strings/str_cat.h"
+#include "common/monotonic_clock.h"
 #include "common/secure_channel/connection_diagnosis.h"
 #include "mbopt/v1/service.grpc.pb.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/fmu/fmu.h"
 #include "worker/service/result_size.h"
 #include "worker/service/task_evaluator.h"
@@ -300,6 +303,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
       }
       queue_.push_back({task, worker_id});
       cancelled_[task.task_id()] = false;
+      cancel_flags_[task.task_id()] = std::make_shared<std::atomic<bool>>(false);
       ++busy_;
     }
     cv_.notify_all();
@@ -336,8 +340,12 @@ class Worker : public std::enable_shared_from_this<Worker> {
       std::int64_t max_message_bytes = 0;
       std::int64_t max_result_bytes = 0;
       bool takes_packed_values = false;
+      std::shared_ptr<std::atomic<bool>> cancel_flag;
       {
         std::lock_guard<std::mutex> lock(mutex_);
+        std::shared_ptr<std::atomic<bool>>& flag = cancel_flags_[task.task_id()];
+        if (flag == nullptr) flag = std::make_shared<std::atomic<bool>>(false);
+        cancel_flag = flag;
         max_message_bytes = max_message_bytes_;
         max_result_bytes = max_result_bytes_;
         takes_packed_values = takes_packed_values_;
@@ -353,8 +361,12 @@ class Worker : public std::enable_shared_from_this<Worker> {
       } else if (study != nullptr) {
         std::optional<external::ExternalSceneAnalyzer> analyzer;
         if (options_.external != nullptr) analyzer.emplace(*options_.external, task.task_id());
+        // The analysis runs on this process' clock and stops when the
+        // heartbeat thread raises its task's cancel flag.
+        const budget::AnalysisBudget analysis_budget(
+            &MonotonicSeconds, [cancel_flag] { return cancel_flag->load(std::memory_order_relaxed); });
         EvaluateTask(*study, task, takes_packed_values ? ValueEncoding::kPacked : ValueEncoding::kUnpacked, &result,
-                     analyzer.has_value() ? &*analyzer : nullptr);
+                     analyzer.has_value() ? &*analyzer : nullptr, analysis_budget);
         FitResultToServerLimit(max_message_bytes, max_result_bytes, &result);
       } else if (!study_error.empty()) {
         // Not the design point's fault: let another worker try.
@@ -380,6 +392,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
       int next_tasks = 0;
       {
         std::lock_guard<std::mutex> lock(mutex_);
+        cancel_flags_.erase(task.task_id());
         if (cancelled_[task.task_id()]) deliver = false;
         if (!deliver) {
           cancelled_.erase(task.task_id());
@@ -586,12 +599,17 @@ class Worker : public std::enable_shared_from_this<Worker> {
         auto it = cancelled_.find(task_id);
         if (it == cancelled_.end()) continue;
         it->second = true;
+        if (auto flag = cancel_flags_.find(task_id); flag != cancel_flags_.end()) {
+          flag->second->store(true, std::memory_order_relaxed);
+          if (options_.verbose) Log(absl::StrCat("task ", task_id, " cancelled by the server"));
+        }
         auto queued = std::find_if(queue_.begin(), queue_.end(), [&](const QueuedTask& q) {
           return q.task.task_id() == task_id;
         });
         if (queued != queue_.end()) {
           queue_.erase(queued);
           cancelled_.erase(it);
+          cancel_flags_.erase(task_id);
           --busy_;
           cv_.notify_all();
         }
@@ -667,6 +685,9 @@ class Worker : public std::enable_shared_from_this<Worker> {
   std::int64_t held_bytes_ = 0;
   std::chrono::steady_clock::time_point held_since_;  // when the oldest held result was held
   std::map<std::string, bool> cancelled_; // task id -> cancelled, for tasks in hand
+  // Task id -> the cancel flag its analysis' budget reads, for tasks queued
+  // or running (shared with the running analysis, which may outlive the entry).
+  std::map<std::string, std::shared_ptr<std::atomic<bool>>> cancel_flags_;
   std::string attached_;        // the registration the presence thread holds (or tries)
   std::string attach_settled_;  // the registration whose Attach was answered
   bool attach_unavailable_logged_ = false;  // presence thread only

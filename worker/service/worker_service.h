@@ -7,8 +7,10 @@
 // expires and the server hands it to another worker).
 //
 // Threads: one long-polling thread (the caller's), one per slot, one for
-// heartbeats. A running analysis cannot be interrupted (the engine has no
-// cancellation point); a cancelled task's result is dropped instead.
+// heartbeats. A task the server says is cancelled (its job was cancelled)
+// is dropped from the queue; if it is running, its analysis' cancel flag is
+// raised, the engine stops at its next budget check (a `cancelled` failure)
+// and the result is dropped.
 #pragma once
 
 #include <string>

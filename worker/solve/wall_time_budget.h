@@ -1,9 +1,9 @@
-// The wall-time limit of one analysis (IntegratorSettings::max_wall_seconds)
-// for the work that steps through instants without an integrator
-// (kinematic and static sweeps): checked once per instant, so a sweep over
-// a million instants or a model that makes every instant slow ends as a
-// named time-limit failure. Integrators check the same limit in their
-// right-hand sides.
+// The wall-time limit of a linkage analysis (IntegratorSettings::
+// max_wall_seconds) for its kinematic sweep, on the process' own clock. Only
+// the linkage solvers use it: they predate the analysis budget
+// (worker/budget/analysis_budget.h), which every other analysis runs
+// within, and this goes with them when the multibody front end replaces
+// them.
 #pragma once
 
 #include <chrono>

@@ -19,6 +19,16 @@
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::solve {
+namespace {
+
+// The status that carries a budget's failure out of IntegrateTo;
+// IntegratorFailure (integrator_failure.h) maps it back to its kind.
+absl::Status BudgetStatus(const spec::AnalysisFailure& failure) {
+  return failure.kind == spec::FailureKind::kCancelled ? absl::CancelledError(failure.reason)
+                                                       : absl::DeadlineExceededError(failure.reason);
+}
+
+}  // namespace
 
 // Declared in the order of creation, so destroyed CVODE memory first (it may
 // still reference the solvers) and context last (sundials_handles.h).
@@ -44,6 +54,10 @@ struct CvodesCallbacks {
         self->wall_time_exceeded_ = true;
         return -1;
       }
+    }
+    if (self->options_.budget != nullptr && self->options_.budget->Exhausted()) {
+      self->budget_failure_ = self->options_.budget->Check(t);
+      if (!self->budget_failure_.ok()) return -1;
     }
     return solve::sundials::GuardCallback(&self->callback_failure_, "right-hand side", [&]() -> int {
       const int flag = self->rhs_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
@@ -419,6 +433,9 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
     }
     return absl::OkStatus();
   }
+  if (options_.budget != nullptr) {
+    if (spec::AnalysisFailure f = options_.budget->Check(t_); !f.ok()) return BudgetStatus(f);
+  }
   const std::int64_t used = counters().steps;
   const std::int64_t remaining = options_.max_steps - used;
   if (remaining <= 0) {
@@ -429,9 +446,14 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
       Check(CVodeSetMaxNumSteps(s.cvode.get(), static_cast<long>(remaining)), "CVodeSetMaxNumSteps"));
   last_sundials_message_.clear();
   callback_failure_.clear();
+  budget_failure_ = spec::AnalysisFailure::Ok();
   double t_reached = t_;
   const int flag = CVode(s.cvode.get(), t_out, s.y.get(), &t_reached, CV_NORMAL);
   if (flag < 0) {
+    if (!budget_failure_.ok()) {
+      t_ = t_reached;
+      return BudgetStatus(budget_failure_);
+    }
     if (wall_time_exceeded_) {
       return absl::DeadlineExceededError(
           absl::StrFormat("integration exceeded its wall-time limit of %g s near t = %.9g",

@@ -14,7 +14,9 @@
 //    convergence failures, a callback returned an unrecoverable error, NaN);
 //    the message says which and at what time. Callers that treat integrator
 //    failure as data (an analysis result) convert this into their result enum.
-//  - kDeadlineExceeded: max_wall_seconds elapsed.
+//  - kDeadlineExceeded: the analysis budget's deadline passed (or the
+//    legacy max_wall_seconds elapsed); the message is the budget's reason.
+//  - kCancelled: the analysis budget's cancel flag went up.
 //  - kInvalidArgument: misuse (t_out behind the current time, wrong size).
 //
 // Not thread-safe; one integrator per analysis. Units are the caller's.
@@ -29,6 +31,8 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "spec/analysis_outcome.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::solve {
 
@@ -49,7 +53,12 @@ struct CvodesOptions {
   // Budget of internal steps over the integrator's whole life (summed over
   // every IntegrateTo and Restart), not per call.
   std::int64_t max_steps = 100000;
-  double max_wall_seconds = 0.0;   // 0: no limit; checked in the rhs
+  // The analysis' deadline and cancel flag, checked in every right-hand
+  // side (null: none). Not owned; outlives the integrator.
+  const budget::AnalysisBudget* budget = nullptr;
+  // Reads the process' clock itself: only for the linkage solvers, which
+  // predate budget::AnalysisBudget and go with the linkage engine. 0: no limit.
+  double max_wall_seconds = 0.0;
   double max_step_size = 0.0;      // 0: no limit
   double initial_step_size = 0.0;  // 0: CVODES' estimate
 
@@ -158,6 +167,7 @@ class CvodesIntegrator {
   std::string last_sundials_message_;
   std::string callback_failure_;
   bool wall_time_exceeded_ = false;
+  spec::AnalysisFailure budget_failure_;  // why the budget stopped the last IntegrateTo
   double stop_time_ = 0.0;
   bool stop_time_set_ = false;
   std::chrono::steady_clock::time_point start_;

@@ -1,5 +1,6 @@
-// The failure kind of a SUNDIALS wrapper's status: its wall-time limit is a
-// time-limit failure, anything else the integrator giving up.
+// The failure kind of a SUNDIALS wrapper's status: its analysis budget's
+// deadline is a time-limit failure, its cancel flag a cancelled analysis,
+// anything else the integrator giving up.
 #pragma once
 
 #include <string>
@@ -10,9 +11,10 @@
 namespace mbopt::solve {
 
 inline spec::AnalysisFailure IntegratorFailure(const absl::Status& status, std::string reason) {
-  return spec::AnalysisFailure::Of(absl::IsDeadlineExceeded(status) ? spec::FailureKind::kTimeLimit
-                                                                    : spec::FailureKind::kIntegrator,
-                                   std::move(reason));
+  spec::FailureKind kind = spec::FailureKind::kIntegrator;
+  if (absl::IsDeadlineExceeded(status)) kind = spec::FailureKind::kTimeLimit;
+  if (absl::IsCancelled(status)) kind = spec::FailureKind::kCancelled;
+  return spec::AnalysisFailure::Of(kind, std::move(reason));
 }
 
 }  // namespace mbopt::solve

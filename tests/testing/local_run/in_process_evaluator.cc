@@ -3,6 +3,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/monotonic_clock.h"
+#include "worker/budget/analysis_budget.h"
 #include "worker/engine/evaluate_study.h"
 
 namespace mbopt::local_run {
@@ -35,7 +37,8 @@ jobs::AnalysisRecord InProcessEvaluator::EvaluateOne(const slp::AnalysisRequest&
     }
   }
   absl::StatusOr<engine::StudyEvaluation> evaluation =
-      engine::EvaluateStudy(study_, layout_, record.x_scaled, request.want_gradients);
+      engine::EvaluateStudy(study_, layout_, record.x_scaled, request.want_gradients, nullptr,
+                            budget::AnalysisBudget(&MonotonicSeconds, nullptr));
   if (!evaluation.ok()) {
     // The request does not fit the study: the job's intake would refuse
     // nothing here, so it is reported as the service would report it.

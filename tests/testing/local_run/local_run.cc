@@ -4,16 +4,18 @@
 #include <memory>
 #include <utility>
 
+#include "common/monotonic_clock.h"
 #include "common/status_macros.h"
 #include "server/jobs/job.h"
 #include "server/lp/make_clp_lp_solver.h"
+#include "worker/budget/analysis_budget.h"
 
 namespace mbopt::local_run {
 
 absl::StatusOr<engine::StudyEvaluation> EvaluateDesign(const spec::Study& study, const spec::StudyLayout& layout,
                                                        const Eigen::VectorXd& x_scaled, bool want_gradients) {
   return engine::EvaluateStudy(study, layout, std::vector<double>(x_scaled.data(), x_scaled.data() + x_scaled.size()),
-                               want_gradients);
+                               want_gradients, nullptr, budget::AnalysisBudget(&MonotonicSeconds, nullptr));
 }
 
 absl::StatusOr<LocalRunResult> RunStudyLocally(const spec::Study& study, const LocalRunOptions& options) {

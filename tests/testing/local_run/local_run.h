@@ -81,7 +81,7 @@ struct LocalRunResult {
 // The engine's one study evaluation (engine::EvaluateStudy) of a design
 // given as the optimizer's scaled vector: for tools that re-check a design,
 // e.g. on a finer time grid (a study whose scene has a different grid, and
-// the layout made from it).
+// the layout made from it). On the process' clock, as a worker runs it.
 absl::StatusOr<engine::StudyEvaluation> EvaluateDesign(const spec::Study& study, const spec::StudyLayout& layout,
                                                        const Eigen::VectorXd& x_scaled, bool want_gradients = false);
 

@@ -1,0 +1,166 @@
+#include "worker/engine/model_kinds.h"
+
+#include <utility>
+#include <variant>
+
+#include "common/check.h"
+#include "worker/fmu/scene_analysis.h"
+#include "worker/multibody/scene_analysis.h"
+#include "worker/lumped/lumped_dynamics.h"
+#include "worker/lumped/lumped_sensitivity.h"
+#ifdef MBOPT_HAVE_LINKAGE
+#include "worker/solve/linkage_analysis.h"
+#endif
+
+namespace mbopt::engine {
+namespace {
+
+using SceneModel = decltype(spec::Scene::model);
+
+// Where alternative T sits in spec::Scene::model: the table is laid out by
+// it, so a new alternative without an entry fails at start-up, not with a
+// wrong dispatch.
+template <class T>
+size_t IndexOf() {
+  return SceneModel(std::in_place_type<T>).index();
+}
+
+spec::AnalysisReport FailedAtStart(const spec::Scene& scene, spec::AnalysisFailure failure) {
+  spec::AnalysisReport report;
+  report.times_s = scene.time_grid.Instants();
+  report.Fail(failure.kind, std::move(failure.reason));
+  return report;
+}
+
+std::string Never(const char* why) { return why; }
+
+spec::AnalysisReport AnalyzeLumped(const spec::Scene& scene, const std::vector<double>& p,
+                                   budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  solve::LumpedDynamicsOptions options;
+  options.budget = budget;
+  return solve::SimulateLumped(scene, p, options);
+}
+
+SensitivityAnalysis AnalyzeLumpedWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
+                                                   const std::vector<int>& parameters,
+                                                   budget::AnalysisBudget* budget) {
+  solve::LumpedSensitivityOptions options;
+  options.budget = budget;
+  solve::LumpedSensitivityResult result = solve::SimulateLumpedWithSensitivities(scene, p, parameters, options);
+  return {std::move(result.report), std::move(result.output_derivatives), ""};
+}
+
+spec::AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& p,
+                                         budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  // The linkage solvers keep their own wall-time limit and take no budget:
+  // a cancelled analysis is stopped before it starts, not during.
+  if (spec::AnalysisFailure spent = budget->Check(0.0); !spent.ok()) return FailedAtStart(scene, std::move(spent));
+#ifdef MBOPT_HAVE_LINKAGE
+  return solve::AnalyzeLinkage(scene, p);
+#else
+  (void)p;
+  return FailedAtStart(scene, spec::AnalysisFailure::Of(spec::FailureKind::kInvalidModel,
+                                                        "linkage scenes are not available in this build"));
+#endif
+}
+
+spec::AnalysisReport AnalyzeMultibody(const spec::Scene& scene, const std::vector<double>& p,
+                                      budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  return multibody::AnalyzeMultibodyScene(scene, p, budget);
+}
+
+SensitivityAnalysis AnalyzeMultibodyWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
+                                                      const std::vector<int>& parameters,
+                                                      budget::AnalysisBudget* budget) {
+  multibody::MultibodySensitivityResult result =
+      multibody::AnalyzeMultibodySceneWithSensitivities(scene, p, parameters, budget);
+  return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
+}
+
+spec::AnalysisReport AnalyzeFmu(const spec::Scene& scene, const std::vector<double>& p,
+                                budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  return fmu::AnalyzeFmuScene(scene, p, budget);
+}
+
+spec::AnalysisReport AnalyzeExternal(const spec::Scene& scene, const std::vector<double>& p,
+                                     budget::AnalysisBudget* budget, const ExternalAnalyzer* external) {
+  // The driver's process has its own time limit (worker/external); a
+  // cancelled analysis is stopped before it starts.
+  if (spec::AnalysisFailure spent = budget->Check(0.0); !spent.ok()) return FailedAtStart(scene, std::move(spent));
+  if (external != nullptr) return external->AnalyzeExternal(scene, p);
+  spec::AnalysisReport report = FailedAtStart(
+      scene, spec::AnalysisFailure::Of(spec::FailureKind::kInvalidModel,
+                                       "external scene (driver \"" + std::get<spec::ExternalModel>(scene.model).driver +
+                                           "\"): this program runs no analysis drivers; run it on a worker that "
+                                           "declares them (mbopt-worker --drivers FILE)"));
+  report.formulation = spec::Formulation::kExternal;
+  return report;
+}
+
+std::vector<ModelKind> MakeTable() {
+  std::vector<ModelKind> table(std::variant_size_v<SceneModel>);
+  table[IndexOf<spec::LumpedModel>()] = {
+      "lumped",
+      "small-motion linear dynamics M q'' + C q' + K q = f(t), integrated by CVODES (worker/lumped/lumped_dynamics.h)",
+      "time_steps, rhs_evaluations, jacobian_evaluations (Newton matrix factorizations) and newton_iterations "
+      "of CVODES",
+      &AnalyzeLumped,
+      [](const spec::Scene& scene, const std::vector<int>& parameters) {
+        return solve::LumpedSensitivityUnavailable(scene, parameters);
+      },
+      &AnalyzeLumpedWithSensitivities};
+  table[IndexOf<spec::LinkageModel>()] = {
+      "linkage",
+      "kinematics, kinetostatics or floating-frame elastodynamics of a linkage (worker/solve/linkage_analysis.h)",
+      "position_solves and newton_iterations of the kinematic continuation; time_steps, rhs_evaluations, "
+      "jacobian_evaluations and newton_iterations of CVODES for flexible links",
+      &AnalyzeLinkageScene,
+      [](const spec::Scene&, const std::vector<int>&) {
+        return Never("a linkage analysis has no simulator sensitivities: its continuation and floating-frame "
+                     "integration are not differentiated");
+      },
+      nullptr};
+  table[IndexOf<spec::MultibodyModel>()] = {
+      "multibody",
+      "kinematics with inverse dynamics, static equilibrium (KINSOL) or forward dynamics (IDAS) of a planar "
+      "multibody system, chosen by its degrees of freedom (worker/multibody/scene_analysis.h)",
+      "position_solves and newton_iterations of kinematic and static sweeps (rhs_evaluations: KINSOL's "
+      "residuals); time_steps, rhs_evaluations (residuals), jacobian_evaluations and newton_iterations of IDAS",
+      &AnalyzeMultibody,
+      [](const spec::Scene& scene, const std::vector<int>&) {
+        return multibody::MultibodySensitivityUnavailable(scene);
+      },
+      &AnalyzeMultibodyWithSensitivities};
+  table[IndexOf<spec::ExternalModel>()] = {
+      "external",
+      "a simulation code the worker declares, run in its own folder and process group (worker/external)",
+      "wall_seconds only: the driver's work is its own",
+      &AnalyzeExternal,
+      [](const spec::Scene&, const std::vector<int>&) {
+        return Never("an external driver's gradients are not read yet");
+      },
+      nullptr};
+  table[IndexOf<spec::FmuModel>()] = {
+      "fmu",
+      "an FMI 2.0 FMU: Model Exchange integrated by CVODES with its events, or Co-Simulation stepped "
+      "(worker/fmu/scene_analysis.h)",
+      "time_steps: CVODES steps (Model Exchange) or fmi2DoStep calls (Co-Simulation)",
+      &AnalyzeFmu,
+      [](const spec::Scene&, const std::vector<int>&) {
+        return Never("an FMU's directional derivatives are not read: its gradients are differenced");
+      },
+      nullptr};
+  for (const ModelKind& kind : table) MBOPT_CHECK(kind.analyze != nullptr, "a scene model kind has no table entry");
+  return table;
+}
+
+}  // namespace
+
+const std::vector<ModelKind>& ModelKinds() {
+  static const std::vector<ModelKind> table = MakeTable();
+  return table;
+}
+
+const ModelKind& ModelKindOf(const spec::Scene& scene) { return ModelKinds()[scene.model.index()]; }
+
+}  // namespace mbopt::engine
