@@ -138,14 +138,13 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   // that brings no record goes out at most every kSummaryIntervalMs (the
   // last one held back is sent when the interval ends), so watching does not
   // cost the server a message per batch of results. Records and the final
-  // summary go out at once.
+  // summary go out at once. The interval is on the server's clock.
   std::optional<v1::JobEvent> held_summary;
-  const auto interval = std::chrono::milliseconds(kSummaryIntervalMs);
-  auto last_summary = std::chrono::steady_clock::time_point{};
-  auto summary_due = [&] { return std::chrono::steady_clock::now() >= last_summary + interval; };
+  std::optional<std::int64_t> last_summary_ms;
+  auto summary_due = [&] { return !last_summary_ms || clock_->NowMs() >= *last_summary_ms + kSummaryIntervalMs; };
   // `event` may be the held summary itself: it is written before it is dropped.
   auto write_summary = [&](const v1::JobEvent& event) {
-    last_summary = std::chrono::steady_clock::now();
+    last_summary_ms = clock_->NowMs();
     const bool written = writer->Write(event);
     held_summary.reset();
     return written;
@@ -153,8 +152,8 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   while (!context->IsCancelled()) {
     std::int64_t wait_ms = kWatchPollMs;
     if (held_summary) {
-      const auto left = last_summary + interval - std::chrono::steady_clock::now();
-      wait_ms = std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::milliseconds>(left).count());
+      // A summary is held only after one was written.
+      wait_ms = std::clamp<std::int64_t>(*last_summary_ms + kSummaryIntervalMs - clock_->NowMs(), 0, kWatchPollMs);
     }
     absl::StatusOr<JobView> view =
         version < 0 ? manager_->Get(request->job_id(), 0, JobViewFor::kWatcher)

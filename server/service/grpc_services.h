@@ -17,8 +17,11 @@ namespace mbopt::service {
 
 class JobServiceImpl final : public v1::JobService::Service {
  public:
-  // `authorizer` is not owned and must outlive the service.
-  JobServiceImpl(JobManager* manager, const CallAuthorizer* authorizer) : manager_(manager), authorizer_(authorizer) {}
+  // `authorizer` and `clock` are not owned and must outlive the service.
+  // The clock paces Watch's progress summaries (the server's clock, so a
+  // test decides when an interval has passed).
+  JobServiceImpl(JobManager* manager, const CallAuthorizer* authorizer, const scheduler::Clock* clock)
+      : manager_(manager), authorizer_(authorizer), clock_(clock) {}
 
   // What Submit takes: a study message no larger than its two files may be
   // (spec/limits.h), and a source name of a path's length.
@@ -45,6 +48,7 @@ class JobServiceImpl final : public v1::JobService::Service {
 
   JobManager* manager_;
   const CallAuthorizer* authorizer_;
+  const scheduler::Clock* clock_;
 };
 
 class WorkerServiceImpl final : public v1::WorkerService::Service {

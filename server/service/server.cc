@@ -121,7 +121,7 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   s.manager_ = std::make_unique<JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, manager_options);
   MBOPT_RETURN_IF_ERROR(s.manager_->Start());
 
-  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get(), s.authorizer_.get());
+  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get(), s.authorizer_.get(), s.clock_);
   s.worker_service_ = std::make_unique<WorkerServiceImpl>(s.manager_.get(), s.scheduler_.get(), s.clock_,
                                                          s.options_.max_message_bytes, s.options_.max_result_bytes,
                                                          s.authorizer_.get());
