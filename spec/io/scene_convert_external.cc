@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "spec/io/declared_name.h"
 
 namespace mbopt::spec::io {
 
@@ -26,10 +27,8 @@ ExternalModel SceneConverter::ConvertExternal(const v1::ExternalModel& m, const 
   for (int i = 0; i < m.inputs_size(); ++i) {
     const v1::ExternalInput& in = m.inputs(i);
     const Where iw = w.Child("inputs", i);
-    if (in.name().empty()) errors_.Add(iw, "name", "an input needs the name of one of the driver's parameters");
-    if (!names.insert(in.name()).second) {
-      errors_.Add(iw, "name", absl::StrCat("duplicate input \"", in.name(), "\""));
-    }
+    CheckDeclaredName(iw, in.name(), names.insert(in.name()).second,
+                      {.missing = "an input needs the name of one of the driver's parameters", .duplicate = "input"}, &errors_);
     out.inputs.push_back({in.name(), Num(iw, "value", in.has_value(), in.value(), Dimension::kAny)});
   }
   return out;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "spec/io/declared_name.h"
 #include "spec/limits.h"
 
 namespace mbopt::spec::io {
@@ -20,10 +21,8 @@ LinkageModel SceneConverter::ConvertLinkage(const v1::LinkageModel& m, const Whe
     Joint joint;
     joint.name = j.name();
     joint.ground = j.ground();
-    if (j.name().empty()) errors_.Add(jw, "name", "a joint needs a name");
-    if (!joints.emplace(j.name(), i).second) {
-      errors_.Add(jw, "name", absl::StrCat("duplicate joint name \"", j.name(), "\""));
-    }
+    CheckDeclaredName(jw, j.name(), joints.emplace(j.name(), i).second,
+                      {.missing = "a joint needs a name", .duplicate = "joint name"}, &errors_);
     if (!j.has_position_m())
       errors_.Add(jw, "position_m", "missing: expected the joint's position");
     joint.position_m =
@@ -44,10 +43,8 @@ LinkageModel SceneConverter::ConvertLinkage(const v1::LinkageModel& m, const Whe
     const Where lw = w.Child("links", i);
     Link link;
     link.name = l.name();
-    if (l.name().empty()) errors_.Add(lw, "name", "a link needs a name");
-    if (!links.emplace(l.name(), i).second) {
-      errors_.Add(lw, "name", absl::StrCat("duplicate link name \"", l.name(), "\""));
-    }
+    CheckDeclaredName(lw, l.name(), links.emplace(l.name(), i).second,
+                      {.missing = "a link needs a name", .duplicate = "link name"}, &errors_);
     link.joint_a = joint_index(lw, "joint_a", l.joint_a());
     link.joint_b = joint_index(lw, "joint_b", l.joint_b());
     if (link.joint_a >= 0 && link.joint_a == link.joint_b) {
@@ -75,10 +72,8 @@ LinkageModel SceneConverter::ConvertLinkage(const v1::LinkageModel& m, const Whe
       const Where pw = lw.Child("points", p);
       LinkPoint point;
       point.name = l.points(p).name();
-      if (point.name.empty()) errors_.Add(pw, "name", "a point needs a name");
-      if (!points.insert(point.name).second) {
-        errors_.Add(pw, "name", absl::StrCat("duplicate point name \"", point.name, "\""));
-      }
+      CheckDeclaredName(pw, point.name, points.insert(point.name).second,
+                        {.missing = "a point needs a name", .duplicate = "point name"}, &errors_);
       point.position_m = Vec(pw, "position_m", l.points(p).has_position_m(),
                              l.points(p).position_m(), Dimension::kLength);
       link.points.push_back(std::move(point));

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "spec/io/declared_name.h"
 
 namespace mbopt::spec::io {
 
@@ -18,10 +19,8 @@ LumpedModel SceneConverter::ConvertLumped(const v1::LumpedModel& m, const Where&
     const Where bw = w.Child("bodies", i);
     Body body;
     body.name = b.name();
-    if (b.name().empty()) errors_.Add(bw, "name", "a body needs a name");
-    if (!bodies.emplace(b.name(), i).second) {
-      errors_.Add(bw, "name", absl::StrCat("duplicate body name \"", b.name(), "\""));
-    }
+    CheckDeclaredName(bw, b.name(), bodies.emplace(b.name(), i).second,
+                      {.missing = "a body needs a name", .duplicate = "body name"}, &errors_);
     std::set<int> dofs;
     for (int d = 0; d < b.dofs_size(); ++d) {
       if (!dofs.insert(b.dofs(d)).second) {
@@ -61,10 +60,8 @@ LumpedModel SceneConverter::ConvertLumped(const v1::LumpedModel& m, const Where&
     const Where iw = w.Child("inputs", i);
     GroundInput input;
     input.name = g.name();
-    if (g.name().empty()) errors_.Add(iw, "name", "an input needs a name");
-    if (!inputs.emplace(g.name(), i).second) {
-      errors_.Add(iw, "name", absl::StrCat("duplicate input name \"", g.name(), "\""));
-    }
+    CheckDeclaredName(iw, g.name(), inputs.emplace(g.name(), i).second,
+                      {.missing = "an input needs a name", .duplicate = "input name"}, &errors_);
     if (g.profile_case() != v1::GroundInput::kCosineBump) {
       errors_.Add(iw, "", "missing profile: expected `cosine_bump { ... }`");
     } else {
@@ -92,10 +89,8 @@ LumpedModel SceneConverter::ConvertLumped(const v1::LumpedModel& m, const Where&
     const Where ew = w.Child("elements", i);
     SpringDamper element;
     element.name = e.name();
-    if (e.name().empty()) errors_.Add(ew, "name", "an element needs a name");
-    if (!element_names.insert(e.name()).second) {
-      errors_.Add(ew, "name", absl::StrCat("duplicate element name \"", e.name(), "\""));
-    }
+    CheckDeclaredName(ew, e.name(), element_names.insert(e.name()).second,
+                      {.missing = "an element needs a name", .duplicate = "element name"}, &errors_);
     element.a = Attach(ew, "a", e.has_a(), e.a(), bodies, inputs);
     element.b = Attach(ew, "b", e.has_b(), e.b(), bodies, inputs);
     Direction(ew, "direction", e.has_direction(), e.direction(), &element.direction_x,

@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "spec/io/declared_name.h"
 #include "spec/limits.h"
 
 namespace mbopt::spec::io {
@@ -89,8 +90,8 @@ std::vector<LinkPoint> SceneConverter::Markers(const Where& w, const std::string
     const Where mw = w.Child(field, k);
     LinkPoint p;
     p.name = markers[k].name();
-    if (p.name.empty()) errors_.Add(mw, "name", "a marker needs a name");
-    if (!names.insert(p.name).second) errors_.Add(mw, "name", absl::StrCat("duplicate marker \"", p.name, "\""));
+    CheckDeclaredName(mw, p.name, names.insert(p.name).second,
+                      {.missing = "a marker needs a name", .duplicate = "marker"}, &errors_);
     p.position_m = Vec(mw, "position_m", markers[k].has_position_m(), markers[k].position_m(), Dimension::kLength);
     out.push_back(std::move(p));
   }
@@ -125,10 +126,8 @@ MultibodyModel SceneConverter::ConvertMultibody(const v1::MultibodyModel& m, con
     const Where iw = w.Child("inputs", i);
     MultibodyInput input;
     input.name = in.name();
-    if (in.name().empty()) errors_.Add(iw, "name", "an input point needs a name");
-    if (!multibody_inputs_.emplace(in.name(), i).second) {
-      errors_.Add(iw, "name", absl::StrCat("duplicate input name \"", in.name(), "\""));
-    }
+    CheckDeclaredName(iw, in.name(), multibody_inputs_.emplace(in.name(), i).second,
+                      {.missing = "an input point needs a name", .duplicate = "input name"}, &errors_);
     input.position_m = Vec(iw, "position_m", in.has_position_m(), in.position_m(), Dimension::kLength);
     Direction(iw, "direction", in.has_direction(), in.direction(), &input.direction_x, &input.direction_y);
     if (in.has_harmonic()) {
@@ -145,12 +144,11 @@ MultibodyModel SceneConverter::ConvertMultibody(const v1::MultibodyModel& m, con
     const Where bw = w.Child("bodies", i);
     RigidBody body;
     body.name = b.name();
-    if (b.name().empty() || b.name() == "ground") {
-      errors_.Add(bw, "name", "a body needs a name other than \"ground\"");
-    }
-    if (!multibody_bodies_.emplace(b.name(), i).second) {
-      errors_.Add(bw, "name", absl::StrCat("duplicate body name \"", b.name(), "\""));
-    }
+    CheckDeclaredName(bw, b.name(), multibody_bodies_.emplace(b.name(), i).second,
+                      {.missing = "a body needs a name other than \"ground\"",
+                       .duplicate = "body name",
+                       .reserved = {"ground"}},
+                      &errors_);
     body.mass_kg = Num(bw, "mass_kg", b.has_mass_kg(), b.mass_kg(), Dimension::kMass);
     RequirePositive(bw, "mass_kg", body.mass_kg);
     body.inertia_kg_m2 = Num(bw, "inertia_kg_m2", b.has_inertia_kg_m2(), b.inertia_kg_m2(), Dimension::kInertia);
@@ -165,12 +163,13 @@ MultibodyModel SceneConverter::ConvertMultibody(const v1::MultibodyModel& m, con
     const Where lw = w.Child("flexible_links", i);
     MultibodyFlexibleLink link;
     link.name = l.name();
-    if (l.name().empty() || l.name() == "ground" || l.name() == "input") {
-      errors_.Add(lw, "name", "a flexible link needs a name other than \"ground\" and \"input\"");
-    }
-    if (multibody_bodies_.count(l.name()) > 0 || !multibody_links_.emplace(l.name(), i).second) {
-      errors_.Add(lw, "name", absl::StrCat("duplicate body or link name \"", l.name(), "\""));
-    }
+    // Bodies and flexible links share one namespace (markers name either).
+    CheckDeclaredName(lw, l.name(),
+                      multibody_bodies_.count(l.name()) == 0 && multibody_links_.emplace(l.name(), i).second,
+                      {.missing = "a flexible link needs a name other than \"ground\" and \"input\"",
+                       .duplicate = "body or link name",
+                       .reserved = {"ground", "input"}},
+                      &errors_);
     link.start_m = Vec(lw, "start_m", l.has_start_m(), l.start_m(), Dimension::kLength);
     link.angle_rad = Num(lw, "angle_rad", l.has_angle_rad(), l.angle_rad(), Dimension::kAngle, 0.0);
     link.length_m = Num(lw, "length_m", l.has_length_m(), l.length_m(), Dimension::kLength);
@@ -193,10 +192,8 @@ MultibodyModel SceneConverter::ConvertMultibody(const v1::MultibodyModel& m, con
     const Where jw = w.Child("joints", i);
     MultibodyJoint joint;
     joint.name = j.name();
-    if (j.name().empty()) errors_.Add(jw, "name", "a joint needs a name");
-    if (!multibody_joints_.emplace(j.name(), i).second) {
-      errors_.Add(jw, "name", absl::StrCat("duplicate joint name \"", j.name(), "\""));
-    }
+    CheckDeclaredName(jw, j.name(), multibody_joints_.emplace(j.name(), i).second,
+                      {.missing = "a joint needs a name", .duplicate = "joint name"}, &errors_);
     switch (j.kind()) {
       case v1::JOINT_REVOLUTE: joint.kind = JointKind::kRevolute; break;
       case v1::JOINT_PRISMATIC: joint.kind = JointKind::kPrismatic; break;
@@ -269,10 +266,8 @@ MultibodyModel SceneConverter::ConvertMultibody(const v1::MultibodyModel& m, con
     const Where sw = w.Child("springs", i);
     MultibodySpring spring;
     spring.name = sp.name();
-    if (sp.name().empty()) errors_.Add(sw, "name", "a spring needs a name");
-    if (!multibody_springs_.emplace(sp.name(), i).second) {
-      errors_.Add(sw, "name", absl::StrCat("duplicate spring name \"", sp.name(), "\""));
-    }
+    CheckDeclaredName(sw, sp.name(), multibody_springs_.emplace(sp.name(), i).second,
+                      {.missing = "a spring needs a name", .duplicate = "spring name"}, &errors_);
     spring.a = Marker(sw, "a", sp.a());
     spring.b = Marker(sw, "b", sp.b());
     spring.free_length_m = Num(sw, "free_length_m", sp.has_free_length_m(), sp.free_length_m(), Dimension::kLength, 0.0);

@@ -7,6 +7,7 @@
 #include <variant>
 
 #include "absl/strings/str_cat.h"
+#include "spec/io/declared_name.h"
 
 namespace mbopt::spec::io {
 
@@ -35,10 +36,8 @@ void SceneConverter::ConvertOutputs() {
     const Where ow = where_.Child("outputs", i);
     Output out;
     out.name = o.name();
-    if (o.name().empty()) errors_.Add(ow, "name", "an output needs a name");
-    if (!names.insert(o.name()).second) {
-      errors_.Add(ow, "name", absl::StrCat("duplicate output name \"", o.name(), "\""));
-    }
+    CheckDeclaredName(ow, o.name(), names.insert(o.name()).second,
+                      {.missing = "an output needs a name", .duplicate = "output name"}, &errors_);
     const char* needs = nullptr;  // the model kind this output needs
     switch (o.kind_case()) {
       case v1::Output::kElementDeflection: {

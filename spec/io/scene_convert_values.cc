@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "spec/io/declared_name.h"
 
 namespace mbopt::spec::io {
 
@@ -23,10 +24,8 @@ void SceneConverter::ConvertParameters() {
     Parameter out;
     out.name = p.name();
     out.unit = p.unit();
-    if (p.name().empty()) errors_.Add(w, "name", "a parameter needs a name");
-    if (!seen.insert(p.name()).second) {
-      errors_.Add(w, "name", absl::StrCat("duplicate parameter name \"", p.name(), "\""));
-    }
+    CheckDeclaredName(w, p.name(), seen.insert(p.name()).second,
+                      {.missing = "a parameter needs a name", .duplicate = "parameter name"}, &errors_);
     absl::StatusOr<Unit> unit = FindUnit(p.unit());
     if (!unit.ok()) {
       errors_.Add(w, "unit", std::string(unit.status().message()));
