@@ -52,11 +52,11 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::Subm
                                     v1::SubmitJobResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "Submit");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
-  if (!request->has_study()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
+  if (request->study().empty()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
   // A study comes from files of at most kMaxInputFileBytes each (its own and
   // its scene's); a larger message did not, and is refused before it is
   // decoded, stored or sent to workers.
-  const std::size_t study_bytes = request->study().ByteSizeLong();
+  const std::size_t study_bytes = request->study().size();
   if (study_bytes > kMaxStudyMessageBytes) {
     return ToGrpcStatus(absl::InvalidArgumentError(
         absl::StrFormat("SubmitJobRequest.study is %.1f MB, more than the limit of %d MB", study_bytes / 1048576.0,
@@ -67,11 +67,11 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::Subm
                                                                 request->source_name().size(),
                                                                 " bytes, more than the limit of ", kMaxSourceNameBytes)));
   }
-  const std::string source = request->source_name().empty()
-                                 ? absl::StrCat("study '", request->study().name(), "'")
-                                 : request->source_name();
+  // The study's own name is known only once it is decoded (by the job
+  // manager); without a file name its messages say "the submitted study".
+  const std::string source = request->source_name().empty() ? "the submitted study" : request->source_name();
   const std::string who = CallAuthorizer::Caller(*context, &*caller);
-  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source, caller->name, who);
+  absl::StatusOr<std::string> id = manager_->Submit(request->study(), source, caller->name, who);
   if (!id.ok()) return ToGrpcStatus(id.status());
   AuditLog(absl::StrCat("submit ", *id, " by ", who, ": ", source));
   response->set_job_id(*id);
@@ -89,7 +89,7 @@ grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef*
   for (const slp::CycleRecord& r : view->records) {
     *response->add_cycles() = ToProto(r, view->layout.get(), view->variable_scales, view->objective_sign);
   }
-  if (!response->mutable_study()->ParseFromString(view->study_bytes)) response->clear_study();
+  SetSerializedMessageField(v1::GetJobResponse::kStudyFieldNumber, view->study_bytes, response);
   return grpc::Status::OK;
 }
 
@@ -271,10 +271,7 @@ grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext* context, const v1:
   }
   absl::StatusOr<std::string> bytes = manager_->StudyBytes(request->job_id());
   if (!bytes.ok()) return ToGrpcStatus(bytes.status());
-  if (!response->mutable_study()->ParseFromString(*bytes)) {
-    return ToGrpcStatus(absl::DataLossError(absl::StrCat("the stored study of job ", request->job_id(),
-                                                         " cannot be parsed")));
-  }
+  SetSerializedMessageField(v1::GetStudyResponse::kStudyFieldNumber, *bytes, response);
   return grpc::Status::OK;
 }
 

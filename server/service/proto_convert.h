@@ -25,6 +25,13 @@ v1::CycleRecord ToProto(const slp::CycleRecord& record, const spec::StudyLayout*
 // validates the record).
 WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
 
+// Sets the message-typed field `field_number` of `out` (left unset there) to
+// `serialized`, a message of the field's type serialized already, without
+// parsing it: protobuf writes unknown fields as they are, and the receiver
+// reads a length-delimited field of that number as the field. So a study
+// goes to workers and readers as the bytes its user sent.
+void SetSerializedMessageField(int field_number, const std::string& serialized, google::protobuf::Message* out);
+
 // The study decoder of the job manager: binary mbopt.v1.Study -> validated
 // study (spec/io), InvalidArgument with the loader's message.
 absl::StatusOr<spec::Study> DecodeStudy(const std::string& bytes, const std::string& source_name);

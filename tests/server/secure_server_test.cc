@@ -126,7 +126,7 @@ class SecureServerTest : public ::testing::Test {
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + kConnectDeadline);
     v1::SubmitJobRequest request;
-    *request.mutable_study() = OscillatorStudy();
+    request.set_study(OscillatorStudy().SerializeAsString());
     v1::SubmitJobResponse response;
     grpc::Status status = jobs.Submit(&context, request, &response);
     *job_id = response.job_id();

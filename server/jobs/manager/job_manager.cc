@@ -30,7 +30,9 @@ struct JobManager::Entry {
   std::string message;
 
   bool study_ok = false;
-  spec::Study study;
+  // Decoded once, shared with the job's optimizer (never null; empty while
+  // not resident or not decodable). The bytes as submitted are row.study.
+  std::shared_ptr<const spec::Study> study = std::make_shared<const spec::Study>();
   // While resident; shared with the job and with views, never copied.
   std::shared_ptr<const spec::StudyLayout> layout;
   std::unique_ptr<jobs::Job> job;  // the optimizer of the current run; none once it stopped
@@ -234,7 +236,7 @@ void JobManager::EvictLocked(Entry& entry) {
 
 void JobManager::DropContentLocked(Entry& entry) {
   std::vector<slp::CycleRecord>().swap(entry.records);
-  entry.study = spec::Study{};
+  entry.study = std::make_shared<const spec::Study>();
   entry.layout.reset();  // its rows' names are most of a job's memory
   std::string().swap(entry.row.study);
   entry.resident = false;
@@ -248,7 +250,7 @@ void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {
     // the layout serves the views (row names) while the job is resident.
     absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
     if (layout.ok()) {
-      entry.study = *std::move(study);
+      entry.study = std::make_shared<const spec::Study>(*std::move(study));
       entry.layout = std::make_shared<const spec::StudyLayout>(*std::move(layout));
       entry.study_ok = true;
     } else {
@@ -347,11 +349,12 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
-  MBOPT_ASSIGN_OR_RETURN(spec::Study study, decoder_(study_bytes, source_name));
+  MBOPT_ASSIGN_OR_RETURN(spec::Study decoded, decoder_(study_bytes, source_name));
+  auto study = std::make_shared<const spec::Study>(std::move(decoded));
   // A driver is the workers' to declare, and one no worker declares is a
   // mistake to say at once; FMU support comes with a worker's build, so an
   // FMU study waits for such a worker (its status says so) instead.
-  if (const scheduler::TaskNeeds needs = NeedsOf(study); !needs.driver.empty() && !scheduler_->SomeWorkerCan(needs)) {
+  if (const scheduler::TaskNeeds needs = NeedsOf(*study); !needs.driver.empty() && !scheduler_->SomeWorkerCan(needs)) {
     const std::vector<std::string> offered = scheduler_->OfferedDrivers();
     return absl::FailedPreconditionError(absl::StrCat(
         source_name, ": scene.external.driver: no registered worker declares ", needs.Describe(),
@@ -377,7 +380,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   // On a server with tokens (owners) an id says nothing of how many jobs
   // exist; alone on a server without tokens, job-<n> is the friendlier name.
   if (!owner.empty()) row.id = RandomJobId();
-  row.study_name = study.name;
+  row.study_name = study->name;
   row.source_name = source_name;
   row.owner = owner;
   row.study = study_bytes;
@@ -389,7 +392,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   if (room) {
     entry->layout = job->shared_layout();
   } else {
-    MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
+    MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(*study));
     entry->layout = std::make_shared<const spec::StudyLayout>(std::move(layout));
   }
   entry->study = std::move(study);
@@ -507,7 +510,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why, cons
 
 void JobManager::ScheduleLocked(Entry& entry) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
-  scheduler_->SetJobNeeds(entry.row.id, NeedsOf(entry.study));
+  scheduler_->SetJobNeeds(entry.row.id, NeedsOf(*entry.study));
   std::vector<scheduler::Scheduler::NewTask> tasks;
   for (const slp::AnalysisRequest& request : entry.job->PendingRequests()) {
     tasks.push_back({request.id, std::vector<double>(request.x.data(), request.x.data() + request.x.size()),
@@ -837,33 +840,33 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   Eigen::VectorXd design;
   std::optional<slp::SlpOptions> options;
   if (entry.study_ok) {
-    s.objective_unit = spec::ReportedObjectiveUnit(entry.study);
+    s.objective_unit = spec::ReportedObjectiveUnit(*entry.study);
     if (entry.job != nullptr) {
       options = entry.job->options();
-    } else if (absl::StatusOr<slp::SlpOptions> from_study = jobs::SlpOptionsFromStudy(entry.study);
+    } else if (absl::StatusOr<slp::SlpOptions> from_study = jobs::SlpOptionsFromStudy(*entry.study);
                from_study.ok()) {
       options = *from_study;
     }
     if (options.has_value()) s.max_cycles = options->max_cycles;
-    design.resize(static_cast<Eigen::Index>(entry.study.variables.size()));
-    for (size_t i = 0; i < entry.study.variables.size(); ++i) {
-      const spec::DesignVariable& v = entry.study.variables[i];
+    design.resize(static_cast<Eigen::Index>(entry.study->variables.size()));
+    for (size_t i = 0; i < entry.study->variables.size(); ++i) {
+      const spec::DesignVariable& v = entry.study->variables[i];
       s.design_names.push_back(v.name);
-      s.design_units.push_back(v.parameter >= 0 && static_cast<size_t>(v.parameter) < entry.study.scene.parameters.size()
-                                   ? entry.study.scene.parameters[static_cast<size_t>(v.parameter)].unit
+      s.design_units.push_back(v.parameter >= 0 && static_cast<size_t>(v.parameter) < entry.study->scene.parameters.size()
+                                   ? entry.study->scene.parameters[static_cast<size_t>(v.parameter)].unit
                                    : "");
       design[static_cast<Eigen::Index>(i)] = v.initial;
     }
   }
   s.failed_analyses_by_kind = entry.failed_analyses_by_kind;
   if (entry.state == JobState::kRunning && entry.study_ok) {
-    if (const scheduler::TaskNeeds needs = NeedsOf(entry.study); !scheduler_->SomeWorkerCan(needs)) {
+    if (const scheduler::TaskNeeds needs = NeedsOf(*entry.study); !scheduler_->SomeWorkerCan(needs)) {
       s.waiting_for = absl::StrCat("no registered worker declares ", needs.Describe(),
                                    ": its analyses wait for one (mbopt workers)");
     }
   }
   // The optimizer minimizes; a maximized value is reported as itself.
-  const double sign = entry.study_ok ? entry.study.objective.ReportedSign() : 1.0;
+  const double sign = entry.study_ok ? entry.study->objective.ReportedSign() : 1.0;
   if (entry.job != nullptr) {
     const slp::SlpOptimizer& optimizer = entry.job->optimizer();
     s.cycles = optimizer.cycles_completed();
@@ -885,9 +888,9 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
       s.max_violation = best->max_violation;
     }
   }
-  if (entry.study_ok && static_cast<size_t>(design.size()) == entry.study.variables.size()) {
-    for (size_t i = 0; i < entry.study.variables.size(); ++i) {
-      s.design.push_back(entry.study.variables[i].scale * design[static_cast<Eigen::Index>(i)]);
+  if (entry.study_ok && static_cast<size_t>(design.size()) == entry.study->variables.size()) {
+    for (size_t i = 0; i < entry.study->variables.size(); ++i) {
+      s.design.push_back(entry.study->variables[i].scale * design[static_cast<Eigen::Index>(i)]);
     }
   }
   return s;
@@ -902,8 +905,8 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record, Job
   view.ended = !Running(entry.state);
   if (entry.study_ok) {
     view.layout = entry.layout;
-    for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
-    view.objective_sign = entry.study.objective.ReportedSign();
+    for (const spec::DesignVariable& v : entry.study->variables) view.variable_scales.push_back(v.scale);
+    view.objective_sign = entry.study->objective.ReportedSign();
   }
   if (view_for == JobViewFor::kReader) view.study_bytes = entry.row.study;
   return view;
