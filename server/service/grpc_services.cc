@@ -43,7 +43,7 @@ absl::StatusOr<auth::Principal> JobServiceImpl::CheckJobAccess(const grpc::Serve
     // of other users' jobs. The log says what happened.
     AuditLog(absl::StrCat("refused ", method, " from ", CallAuthorizer::Caller(context, &*caller), ": job '", job_id,
                           "' is another user's (", *owner, "); answered as if it did not exist"));
-    return JobManager::NoSuchJob(job_id);
+    return jobs::manager::JobManager::NoSuchJob(job_id);
   }
   return caller;
 }
@@ -83,7 +83,7 @@ grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef*
   if (absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Get", request->job_id()); !access.ok()) {
     return ToGrpcStatus(access.status());
   }
-  absl::StatusOr<JobView> view = manager_->Get(request->job_id());
+  absl::StatusOr<jobs::manager::JobView> view = manager_->Get(request->job_id());
   if (!view.ok()) return ToGrpcStatus(view.status());
   *response->mutable_summary() = ToProto(view->summary);
   for (const slp::CycleRecord& r : view->records) {
@@ -97,9 +97,9 @@ grpc::Status JobServiceImpl::List(grpc::ServerContext* context, const v1::ListJo
                                   v1::ListJobsResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "List");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
-  absl::StatusOr<std::vector<JobSummaryData>> jobs = manager_->List();
-  if (!jobs.ok()) return ToGrpcStatus(jobs.status());
-  for (const JobSummaryData& s : *jobs) {
+  absl::StatusOr<std::vector<jobs::manager::JobSummaryData>> summaries = manager_->List();
+  if (!summaries.ok()) return ToGrpcStatus(summaries.status());
+  for (const jobs::manager::JobSummaryData& s : *summaries) {
     if (CallAuthorizer::MaySee(*caller, s.owner)) *response->add_jobs() = ToProto(s);
   }
   return grpc::Status::OK;
@@ -155,8 +155,8 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
       // A summary is held only after one was written.
       wait_ms = std::clamp<std::int64_t>(*last_summary_ms + kSummaryIntervalMs - clock_->NowMs(), 0, kWatchPollMs);
     }
-    absl::StatusOr<JobView> view =
-        version < 0 ? manager_->Get(request->job_id(), 0, JobViewFor::kWatcher)
+    absl::StatusOr<jobs::manager::JobView> view =
+        version < 0 ? manager_->Get(request->job_id(), 0, jobs::manager::JobViewFor::kWatcher)
                     : manager_->WaitForChange(request->job_id(), next_record, version, wait_ms);
     if (!view.ok()) return ToGrpcStatus(view.status());
     if (view->version == version) {
@@ -187,7 +187,7 @@ grpc::Status JobServiceImpl::Cancel(grpc::ServerContext* context, const v1::JobR
   absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Cancel", request->job_id());
   if (!access.ok()) return ToGrpcStatus(access.status());
   const std::string who = CallAuthorizer::Caller(*context, &*access);
-  absl::StatusOr<JobSummaryData> summary = manager_->Cancel(request->job_id(), who);
+  absl::StatusOr<jobs::manager::JobSummaryData> summary = manager_->Cancel(request->job_id(), who);
   AuditLog(absl::StrCat("cancel ", request->job_id(), " by ", who, ": ",
                         summary.ok() ? "done" : summary.status().message()));
   if (!summary.ok()) return ToGrpcStatus(summary.status());
@@ -200,7 +200,7 @@ grpc::Status JobServiceImpl::Resume(grpc::ServerContext* context, const v1::JobR
   absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Resume", request->job_id());
   if (!access.ok()) return ToGrpcStatus(access.status());
   const std::string who = CallAuthorizer::Caller(*context, &*access);
-  absl::StatusOr<JobSummaryData> summary = manager_->Resume(request->job_id(), who);
+  absl::StatusOr<jobs::manager::JobSummaryData> summary = manager_->Resume(request->job_id(), who);
   AuditLog(absl::StrCat("resume ", request->job_id(), " by ", who, ": ",
                         summary.ok() ? "done" : summary.status().message()));
   if (!summary.ok()) return ToGrpcStatus(summary.status());
@@ -358,7 +358,7 @@ grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* contex
 grpc::Status WorkerServiceImpl::TakeResults(const grpc::ServerContext& context, const auth::Principal& caller,
                                             const char* method, const v1::TaskResults& request,
                                             v1::ReportResultsResponse* response) {
-  std::vector<WorkerReport> reports;
+  std::vector<jobs::manager::WorkerReport> reports;
   std::vector<int> report_index;  // the answer of each report
   // Each result names the registration its task was leased under (a worker
   // that registered again may still report tasks of the old one).

@@ -13,7 +13,7 @@ namespace mbopt::service {
 
 v1::JobState ToProto(jobs::JobState state) { return static_cast<v1::JobState>(static_cast<int>(state)); }
 
-v1::JobSummary ToProto(const JobSummaryData& s) {
+v1::JobSummary ToProto(const jobs::manager::JobSummaryData& s) {
   v1::JobSummary out;
   out.set_job_id(s.job_id);
   out.set_study_name(s.study_name);
@@ -36,8 +36,8 @@ v1::JobSummary ToProto(const JobSummaryData& s) {
   return out;
 }
 
-WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
-  WorkerReport report;
+jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
+  jobs::manager::WorkerReport report;
   report.worker_id = result.worker_id();
   report.task_id = result.task_id();
   report.job_id = result.job_id();

@@ -14,7 +14,7 @@
 namespace mbopt::service {
 
 v1::JobState ToProto(jobs::JobState state);
-v1::JobSummary ToProto(const JobSummaryData& summary);
+v1::JobSummary ToProto(const jobs::manager::JobSummaryData& summary);
 // `layout` (may be null: rows go out as "row N"), `variable_scales` and
 // `objective_sign` as in JobView: the objective values go out as reported (a
 // maximized value as itself).
@@ -23,7 +23,7 @@ v1::CycleRecord ToProto(const slp::CycleRecord& record, const spec::StudyLayout*
 
 // A worker's result as the job manager takes it (the job's intake then
 // validates the record).
-WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
+jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
 
 // Sets the message-typed field `field_number` of `out` (left unset there) to
 // `serialized`, a message of the field's type serialized already, without

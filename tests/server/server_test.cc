@@ -60,7 +60,7 @@ class ServerTest : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  std::unique_ptr<MboptServer> StartServer(const std::string& db_name, JobManagerOptions manager = {}) {
+  std::unique_ptr<MboptServer> StartServer(const std::string& db_name, jobs::manager::JobManagerOptions manager = {}) {
     ServerOptions options;
     options.listen_address = "127.0.0.1:0";
     options.db_path = (dir_ / db_name).string();
@@ -257,7 +257,7 @@ TEST_F(ServerTest, RestartRightAfterACycleCommitResumesBitIdentically) {
   std::string id;
   std::int64_t records_committed = 0;
   {
-    JobManagerOptions manager;
+    jobs::manager::JobManagerOptions manager;
     manager.after_record_commit = [&records_committed](std::int64_t n) { records_committed = n; };
     auto server = StartServer("hook.db", manager);
     id = Submit(*server, OscillatorStudy());
@@ -415,8 +415,8 @@ TEST_F(ServerTest, CancelThenResumeGivesTheSameResult) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
 }
 
-JobManagerOptions OneRunningJob(int max_queued_per_user = 0) {
-  JobManagerOptions manager;
+jobs::manager::JobManagerOptions OneRunningJob(int max_queued_per_user = 0) {
+  jobs::manager::JobManagerOptions manager;
   manager.admission.max_running_jobs = 1;
   manager.admission.max_queued_jobs_per_user = max_queued_per_user;
   return manager;
@@ -1174,7 +1174,7 @@ TEST_F(ServerTest, CycleRecordsArePublishedOnlyOnceTheLogIsSynced) {
   std::condition_variable changed;
   bool release = false;
   int syncs_asked = 0;
-  JobManagerOptions manager;
+  jobs::manager::JobManagerOptions manager;
   manager.before_log_sync = [&] {
     std::unique_lock<std::mutex> lock(mutex);
     ++syncs_asked;
