@@ -824,6 +824,21 @@ TEST_F(ServerTest, BadStudyIsInvalidArgumentNamingTheField) {
   EXPECT_EQ(jobs.jobs_size(), 0);
 }
 
+TEST_F(ServerTest, AStudySentWithoutASourceNameIsTheSubmittedStudyInMessages) {
+  auto server = StartServer("a.db");
+  v1::Study study = OscillatorStudy();
+  study.mutable_variables(1)->set_parameter("no_such_parameter");
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
+  grpc::ClientContext context;
+  v1::SubmitJobRequest request;
+  request.set_study(study.SerializeAsString());
+  v1::SubmitJobResponse response;
+  grpc::Status status = stub->Submit(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("the submitted study"));
+  EXPECT_THAT(status.error_message(), HasSubstr("no_such_parameter"));
+}
+
 TEST_F(ServerTest, UnknownJobIsNotFoundNamingTheId) {
   auto server = StartServer("a.db");
   auto stub = v1::JobService::NewStub(server->InProcessChannel());
