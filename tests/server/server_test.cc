@@ -1259,10 +1259,6 @@ TEST_F(ServerTest, WatchReplaysPastRecordsThenStreamsUntilTheJobEnds) {
   EXPECT_EQ(records_before + streamed, Get(*server, id).cycles_size());
 }
 
-
-// The summary interval of Watch (server/service/grpc_services.cc).
-constexpr std::int64_t kWatchSummaryIntervalMs = 50;
-
 TEST_F(ServerTest, WatchSendsNoProgressAloneWhileTheServerClockStandsAndEndsFromMemory) {
   auto server = StartServer("a.db");
   const std::string id = Submit(*server, OscillatorStudy());
@@ -1305,41 +1301,6 @@ TEST_F(ServerTest, WatchSendsNoProgressAloneWhileTheServerClockStandsAndEndsFrom
   // The watcher's last views came from memory: the job gave up its study
   // and records once, when the stream ended, and the Get above read them back.
   EXPECT_EQ(server->manager().Evictions(), 2);
-}
-
-TEST_F(ServerTest, WatchSendsAHeldProgressSummaryOnceTheServerClockPassesTheInterval) {
-  auto server = StartServer("a.db");
-  const std::string id = Submit(*server, OscillatorStudy());
-  std::unique_ptr<v1::JobService::Stub> stub = v1::JobService::NewStub(server->InProcessChannel());
-  grpc::ClientContext context;
-  // Not a wait: a bound on a broken server that never sends what it holds.
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
-  v1::JobRef ref;
-  ref.set_job_id(id);
-  std::unique_ptr<grpc::ClientReader<v1::JobEvent>> reader = stub->Watch(&context, ref);
-  v1::JobEvent event;
-  ASSERT_TRUE(reader->Read(&event));
-  ASSERT_TRUE(event.has_summary());
-  // One result at a time, then one interval on the server's clock: the
-  // watcher hears of each result, whether it brought a record or not.
-  FakeWorker worker(server->InProcessChannel(), 13);
-  std::int64_t answered = 0;
-  v1::JobSummary last = event.summary();
-  while (worker.Run(1) == 1) {
-    ++answered;
-    clock_.Advance(kWatchSummaryIntervalMs);
-    while (last.analyses() < answered) {
-      ASSERT_TRUE(reader->Read(&event)) << "no summary after " << answered << " results";
-      if (event.has_summary()) last = event.summary();
-    }
-    EXPECT_EQ(last.analyses(), answered);
-  }
-  while (reader->Read(&event)) {
-    if (event.has_summary()) last = event.summary();
-  }
-  EXPECT_TRUE(reader->Finish().ok());
-  EXPECT_EQ(last.state(), v1::JOB_STATE_CONVERGED);
-  EXPECT_GT(answered, 2 * Get(*server, id).cycles_size());
 }
 
 // The study's serialized bytes with its fields in reverse order: the same
