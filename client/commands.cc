@@ -163,7 +163,7 @@ int SubmitCommand(const Args& args) {
   if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
   Connection& c = std::get<Connection>(connected);
   v1::SubmitJobRequest request;
-  *request.mutable_study() = *std::move(study);
+  request.set_study(study->SerializeAsString());
   request.set_source_name(path);
   v1::SubmitJobResponse response;
   grpc::ClientContext context;

@@ -175,7 +175,7 @@ int RunCommandMain(const Args& args) {
     }
   }
   v1::SubmitJobRequest request;
-  *request.mutable_study() = *std::move(study);
+  request.set_study(study->SerializeAsString());
   request.set_source_name(path);
   v1::SubmitJobResponse submitted;
   {

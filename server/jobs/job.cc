@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "common/check.h"
 #include "common/packed_doubles/packed_doubles.h"
 #include "common/status_macros.h"
 #include "server/jobs/analysis_gradients.h"
@@ -70,14 +71,21 @@ slp::AnalysisResult ResultOf(const AnalysisRecord& record, const slp::ProblemSpe
 
 absl::StatusOr<std::unique_ptr<Job>> Job::Create(spec::Study study, std::unique_ptr<lp::LpSolver> lp_solver,
                                                  std::optional<slp::SlpOptions> options) {
-  MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
-  MBOPT_ASSIGN_OR_RETURN(slp::ProblemSpec problem, ProblemSpecFromStudy(study, layout));
+  return Create(std::make_shared<const spec::Study>(std::move(study)), std::move(lp_solver), std::move(options));
+}
+
+absl::StatusOr<std::unique_ptr<Job>> Job::Create(std::shared_ptr<const spec::Study> study,
+                                                 std::unique_ptr<lp::LpSolver> lp_solver,
+                                                 std::optional<slp::SlpOptions> options) {
+  MBOPT_CHECK(study != nullptr, "Job::Create needs a study");
+  MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(*study));
+  MBOPT_ASSIGN_OR_RETURN(slp::ProblemSpec problem, ProblemSpecFromStudy(*study, layout));
   slp::SlpOptions settings;
   if (options.has_value()) {
     settings = *options;
     MBOPT_RETURN_IF_ERROR(settings.Validate());
   } else {
-    MBOPT_ASSIGN_OR_RETURN(settings, SlpOptionsFromStudy(study));
+    MBOPT_ASSIGN_OR_RETURN(settings, SlpOptionsFromStudy(*study));
   }
   auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), settings, std::move(lp_solver));
   return std::unique_ptr<Job>(new Job(std::move(study), std::make_shared<const spec::StudyLayout>(std::move(layout)),
@@ -90,11 +98,12 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateForProblem(slp::ProblemSpec prob
   MBOPT_RETURN_IF_ERROR(options.Validate());
   auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, std::move(lp_solver));
   return std::unique_ptr<Job>(
-      new Job(spec::Study{}, std::make_shared<const spec::StudyLayout>(), options, std::move(optimizer)));
+      new Job(std::make_shared<const spec::Study>(), std::make_shared<const spec::StudyLayout>(), options,
+              std::move(optimizer)));
 }
 
-Job::Job(spec::Study study, std::shared_ptr<const spec::StudyLayout> layout, slp::SlpOptions options,
-         std::unique_ptr<slp::SlpOptimizer> optimizer)
+Job::Job(std::shared_ptr<const spec::Study> study, std::shared_ptr<const spec::StudyLayout> layout,
+         slp::SlpOptions options, std::unique_ptr<slp::SlpOptimizer> optimizer)
     : study_(std::move(study)),
       layout_(std::move(layout)),
       options_(options),
@@ -108,7 +117,7 @@ absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
   }
   if (request == nullptr) {
     return absl::InvalidArgumentError(
-        absl::StrCat("request ", candidate.request_id, " is not pending in ", study_.name));
+        absl::StrCat("request ", candidate.request_id, " is not pending in ", study_->name));
   }
   AnalysisRecord record = std::move(candidate);
   record.x_scaled.assign(request->x.data(), request->x.data() + request->x.size());
@@ -121,7 +130,7 @@ absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
       return absl::InvalidArgumentError(absl::StrCat("result of request ", record.request_id, " has ",
                                                      record.objective_terms.size(), " objective terms and ",
                                                      record.constraint_values.size(), " constraint values; ",
-                                                     study_.name, " needs ", terms, " and ", rows));
+                                                     study_->name, " needs ", terms, " and ", rows));
     }
     std::string non_finite = FirstNonFinite("objective term", record.objective_terms);
     if (non_finite.empty()) non_finite = FirstNonFinite("constraint value", record.constraint_values);
@@ -195,7 +204,7 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Anal
     if (next == nullptr) break;
     if (!SameBits(request->x, next->x_scaled)) {
       return absl::DataLossError(absl::StrCat(
-          "replay of ", study_.name, ": request ", request->id,
+          "replay of ", study_->name, ": request ", request->id,
           " asks for a different design point than the logged analysis; the optimizer is not "
           "deterministic or the database comes from another build"));
     }
@@ -204,7 +213,7 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Anal
     for (slp::CycleRecord& record : records) {
       if (next_record < logged_records.size()) {
         if (EncodeCycleRecord(record) != logged_records[next_record]) {
-          return absl::DataLossError(absl::StrCat("replay of ", study_.name, ": cycle record ", next_record,
+          return absl::DataLossError(absl::StrCat("replay of ", study_->name, ": cycle record ", next_record,
                                                   " (cycle ", record.cycle, ", attempt ", record.attempt,
                                                   ") differs from the logged one; the optimizer is not "
                                                   "deterministic or the database comes from another build"));
@@ -216,11 +225,11 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Anal
     }
   }
   if (next_record < logged_records.size()) {
-    return absl::DataLossError(absl::StrCat("replay of ", study_.name, " produced ", next_record,
+    return absl::DataLossError(absl::StrCat("replay of ", study_->name, " produced ", next_record,
                                             " cycle records but the log holds ", logged_records.size()));
   }
   if (used != logged.size()) {
-    return absl::DataLossError(absl::StrCat("replay of ", study_.name, " used ", used, " of ", logged.size(),
+    return absl::DataLossError(absl::StrCat("replay of ", study_->name, " used ", used, " of ", logged.size(),
                                             " logged analyses; the others were never asked for"));
   }
   return unlogged;
@@ -232,7 +241,7 @@ absl::Status Job::Run(Evaluator& evaluator, const JobRunOptions& options) {
     if (pending.empty()) return absl::InternalError("the optimizer is running but requests no analysis");
     if (optimizer_->analyses_used() + static_cast<std::int64_t>(pending.size()) > options.max_analyses) {
       return absl::ResourceExhaustedError(
-          absl::StrCat(study_.name.empty() ? "the run" : study_.name, " needs more than ", options.max_analyses,
+          absl::StrCat(study_->name.empty() ? "the run" : study_->name, " needs more than ", options.max_analyses,
                        " analyses"));
     }
     std::vector<AnalysisRecord> batch = evaluator.Evaluate(pending);
@@ -255,8 +264,8 @@ absl::Status Job::Run(Evaluator& evaluator, const JobRunOptions& options) {
 
 std::vector<double> Job::PhysicalDesign(const Eigen::VectorXd& x_scaled) const {
   std::vector<double> design(static_cast<size_t>(x_scaled.size()));
-  for (Eigen::Index i = 0; i < x_scaled.size() && static_cast<size_t>(i) < study_.variables.size(); ++i) {
-    design[static_cast<size_t>(i)] = study_.variables[static_cast<size_t>(i)].scale * x_scaled[i];
+  for (Eigen::Index i = 0; i < x_scaled.size() && static_cast<size_t>(i) < study_->variables.size(); ++i) {
+    design[static_cast<size_t>(i)] = study_->variables[static_cast<size_t>(i)].scale * x_scaled[i];
   }
   return design;
 }

@@ -59,11 +59,16 @@ class Job {
   // the study cannot be laid out or gives an invalid problem or settings.
   static absl::StatusOr<std::unique_ptr<Job>> Create(spec::Study study, std::unique_ptr<lp::LpSolver> lp_solver,
                                                      std::optional<slp::SlpOptions> options = std::nullopt);
+  // The same for a study that its holder shares with the job (the job
+  // manager keeps one decoded copy of each study, not one per run).
+  static absl::StatusOr<std::unique_ptr<Job>> Create(std::shared_ptr<const spec::Study> study,
+                                                     std::unique_ptr<lp::LpSolver> lp_solver,
+                                                     std::optional<slp::SlpOptions> options = std::nullopt);
   // A job for a problem that has no study (analytic problems in tests).
   static absl::StatusOr<std::unique_ptr<Job>> CreateForProblem(slp::ProblemSpec problem, slp::SlpOptions options,
                                                                std::unique_ptr<lp::LpSolver> lp_solver);
 
-  const spec::Study& study() const { return study_; }
+  const spec::Study& study() const { return *study_; }
   const spec::StudyLayout& layout() const { return *layout_; }
   // The same layout, for holders that outlive the job (the job manager's
   // views): shared, never copied, since its rows' names are most of a large
@@ -119,10 +124,10 @@ class Job {
   std::vector<double> PhysicalDesign(const Eigen::VectorXd& x_scaled) const;
 
  private:
-  Job(spec::Study study, std::shared_ptr<const spec::StudyLayout> layout, slp::SlpOptions options,
-      std::unique_ptr<slp::SlpOptimizer> optimizer);
+  Job(std::shared_ptr<const spec::Study> study, std::shared_ptr<const spec::StudyLayout> layout,
+      slp::SlpOptions options, std::unique_ptr<slp::SlpOptimizer> optimizer);
 
-  spec::Study study_;
+  std::shared_ptr<const spec::Study> study_;  // never null
   std::shared_ptr<const spec::StudyLayout> layout_;
   slp::SlpOptions options_;
   std::unique_ptr<slp::SlpOptimizer> optimizer_;

@@ -43,7 +43,7 @@ absl::StatusOr<auth::Principal> JobServiceImpl::CheckJobAccess(const grpc::Serve
     // of other users' jobs. The log says what happened.
     AuditLog(absl::StrCat("refused ", method, " from ", CallAuthorizer::Caller(context, &*caller), ": job '", job_id,
                           "' is another user's (", *owner, "); answered as if it did not exist"));
-    return JobManager::NoSuchJob(job_id);
+    return jobs::manager::JobManager::NoSuchJob(job_id);
   }
   return caller;
 }
@@ -52,11 +52,11 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::Subm
                                     v1::SubmitJobResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "Submit");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
-  if (!request->has_study()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
+  if (request->study().empty()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
   // A study comes from files of at most kMaxInputFileBytes each (its own and
   // its scene's); a larger message did not, and is refused before it is
   // decoded, stored or sent to workers.
-  const std::size_t study_bytes = request->study().ByteSizeLong();
+  const std::size_t study_bytes = request->study().size();
   if (study_bytes > kMaxStudyMessageBytes) {
     return ToGrpcStatus(absl::InvalidArgumentError(
         absl::StrFormat("SubmitJobRequest.study is %.1f MB, more than the limit of %d MB", study_bytes / 1048576.0,
@@ -67,11 +67,11 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::Subm
                                                                 request->source_name().size(),
                                                                 " bytes, more than the limit of ", kMaxSourceNameBytes)));
   }
-  const std::string source = request->source_name().empty()
-                                 ? absl::StrCat("study '", request->study().name(), "'")
-                                 : request->source_name();
+  // The study's own name is known only once it is decoded (by the job
+  // manager); without a file name its messages say "the submitted study".
+  const std::string source = request->source_name().empty() ? "the submitted study" : request->source_name();
   const std::string who = CallAuthorizer::Caller(*context, &*caller);
-  absl::StatusOr<std::string> id = manager_->Submit(request->study().SerializeAsString(), source, caller->name, who);
+  absl::StatusOr<std::string> id = manager_->Submit(request->study(), source, caller->name, who);
   if (!id.ok()) return ToGrpcStatus(id.status());
   AuditLog(absl::StrCat("submit ", *id, " by ", who, ": ", source));
   response->set_job_id(*id);
@@ -83,13 +83,13 @@ grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef*
   if (absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Get", request->job_id()); !access.ok()) {
     return ToGrpcStatus(access.status());
   }
-  absl::StatusOr<JobView> view = manager_->Get(request->job_id());
+  absl::StatusOr<jobs::manager::JobView> view = manager_->Get(request->job_id());
   if (!view.ok()) return ToGrpcStatus(view.status());
   *response->mutable_summary() = ToProto(view->summary);
   for (const slp::CycleRecord& r : view->records) {
     *response->add_cycles() = ToProto(r, view->layout.get(), view->variable_scales, view->objective_sign);
   }
-  if (!response->mutable_study()->ParseFromString(view->study_bytes)) response->clear_study();
+  SetSerializedMessageField(v1::GetJobResponse::kStudyFieldNumber, view->study_bytes, response);
   return grpc::Status::OK;
 }
 
@@ -97,9 +97,9 @@ grpc::Status JobServiceImpl::List(grpc::ServerContext* context, const v1::ListJo
                                   v1::ListJobsResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForJobs(*context, "List");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
-  absl::StatusOr<std::vector<JobSummaryData>> jobs = manager_->List();
-  if (!jobs.ok()) return ToGrpcStatus(jobs.status());
-  for (const JobSummaryData& s : *jobs) {
+  absl::StatusOr<std::vector<jobs::manager::JobSummaryData>> summaries = manager_->List();
+  if (!summaries.ok()) return ToGrpcStatus(summaries.status());
+  for (const jobs::manager::JobSummaryData& s : *summaries) {
     if (CallAuthorizer::MaySee(*caller, s.owner)) *response->add_jobs() = ToProto(s);
   }
   return grpc::Status::OK;
@@ -138,14 +138,13 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   // that brings no record goes out at most every kSummaryIntervalMs (the
   // last one held back is sent when the interval ends), so watching does not
   // cost the server a message per batch of results. Records and the final
-  // summary go out at once.
+  // summary go out at once. The interval is on the server's clock.
   std::optional<v1::JobEvent> held_summary;
-  const auto interval = std::chrono::milliseconds(kSummaryIntervalMs);
-  auto last_summary = std::chrono::steady_clock::time_point{};
-  auto summary_due = [&] { return std::chrono::steady_clock::now() >= last_summary + interval; };
+  std::optional<std::int64_t> last_summary_ms;
+  auto summary_due = [&] { return !last_summary_ms || clock_->NowMs() >= *last_summary_ms + kSummaryIntervalMs; };
   // `event` may be the held summary itself: it is written before it is dropped.
   auto write_summary = [&](const v1::JobEvent& event) {
-    last_summary = std::chrono::steady_clock::now();
+    last_summary_ms = clock_->NowMs();
     const bool written = writer->Write(event);
     held_summary.reset();
     return written;
@@ -153,11 +152,11 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   while (!context->IsCancelled()) {
     std::int64_t wait_ms = kWatchPollMs;
     if (held_summary) {
-      const auto left = last_summary + interval - std::chrono::steady_clock::now();
-      wait_ms = std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::milliseconds>(left).count());
+      // A summary is held only after one was written.
+      wait_ms = std::clamp<std::int64_t>(*last_summary_ms + kSummaryIntervalMs - clock_->NowMs(), 0, kWatchPollMs);
     }
-    absl::StatusOr<JobView> view =
-        version < 0 ? manager_->Get(request->job_id(), 0, JobViewFor::kWatcher)
+    absl::StatusOr<jobs::manager::JobView> view =
+        version < 0 ? manager_->Get(request->job_id(), 0, jobs::manager::JobViewFor::kWatcher)
                     : manager_->WaitForChange(request->job_id(), next_record, version, wait_ms);
     if (!view.ok()) return ToGrpcStatus(view.status());
     if (view->version == version) {
@@ -188,7 +187,7 @@ grpc::Status JobServiceImpl::Cancel(grpc::ServerContext* context, const v1::JobR
   absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Cancel", request->job_id());
   if (!access.ok()) return ToGrpcStatus(access.status());
   const std::string who = CallAuthorizer::Caller(*context, &*access);
-  absl::StatusOr<JobSummaryData> summary = manager_->Cancel(request->job_id(), who);
+  absl::StatusOr<jobs::manager::JobSummaryData> summary = manager_->Cancel(request->job_id(), who);
   AuditLog(absl::StrCat("cancel ", request->job_id(), " by ", who, ": ",
                         summary.ok() ? "done" : summary.status().message()));
   if (!summary.ok()) return ToGrpcStatus(summary.status());
@@ -201,7 +200,7 @@ grpc::Status JobServiceImpl::Resume(grpc::ServerContext* context, const v1::JobR
   absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Resume", request->job_id());
   if (!access.ok()) return ToGrpcStatus(access.status());
   const std::string who = CallAuthorizer::Caller(*context, &*access);
-  absl::StatusOr<JobSummaryData> summary = manager_->Resume(request->job_id(), who);
+  absl::StatusOr<jobs::manager::JobSummaryData> summary = manager_->Resume(request->job_id(), who);
   AuditLog(absl::StrCat("resume ", request->job_id(), " by ", who, ": ",
                         summary.ok() ? "done" : summary.status().message()));
   if (!summary.ok()) return ToGrpcStatus(summary.status());
@@ -272,10 +271,7 @@ grpc::Status WorkerServiceImpl::GetStudy(grpc::ServerContext* context, const v1:
   }
   absl::StatusOr<std::string> bytes = manager_->StudyBytes(request->job_id());
   if (!bytes.ok()) return ToGrpcStatus(bytes.status());
-  if (!response->mutable_study()->ParseFromString(*bytes)) {
-    return ToGrpcStatus(absl::DataLossError(absl::StrCat("the stored study of job ", request->job_id(),
-                                                         " cannot be parsed")));
-  }
+  SetSerializedMessageField(v1::GetStudyResponse::kStudyFieldNumber, *bytes, response);
   return grpc::Status::OK;
 }
 
@@ -362,7 +358,7 @@ grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* contex
 grpc::Status WorkerServiceImpl::TakeResults(const grpc::ServerContext& context, const auth::Principal& caller,
                                             const char* method, const v1::TaskResults& request,
                                             v1::ReportResultsResponse* response) {
-  std::vector<WorkerReport> reports;
+  std::vector<jobs::manager::WorkerReport> reports;
   std::vector<int> report_index;  // the answer of each report
   // Each result names the registration its task was leased under (a worker
   // that registered again may still report tasks of the old one).

@@ -17,8 +17,11 @@ namespace mbopt::service {
 
 class JobServiceImpl final : public v1::JobService::Service {
  public:
-  // `authorizer` is not owned and must outlive the service.
-  JobServiceImpl(JobManager* manager, const CallAuthorizer* authorizer) : manager_(manager), authorizer_(authorizer) {}
+  // `authorizer` and `clock` are not owned and must outlive the service.
+  // The clock paces Watch's progress summaries (the server's clock, so a
+  // test decides when an interval has passed).
+  JobServiceImpl(jobs::manager::JobManager* manager, const CallAuthorizer* authorizer, const scheduler::Clock* clock)
+      : manager_(manager), authorizer_(authorizer), clock_(clock) {}
 
   // What Submit takes: a study message no larger than its two files may be
   // (spec/limits.h), and a source name of a path's length.
@@ -43,8 +46,9 @@ class JobServiceImpl final : public v1::JobService::Service {
   absl::StatusOr<auth::Principal> CheckJobAccess(const grpc::ServerContext& context, const char* method,
                                                  const std::string& job_id) const;
 
-  JobManager* manager_;
+  jobs::manager::JobManager* manager_;
   const CallAuthorizer* authorizer_;
+  const scheduler::Clock* clock_;
 };
 
 class WorkerServiceImpl final : public v1::WorkerService::Service {
@@ -52,7 +56,7 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   // The clock is the scheduler's (lease deadlines are on it).
   // `max_message_bytes` is what workers are told the server receives in
   // one message, `max_result_bytes` in pieces.
-  WorkerServiceImpl(JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock,
+  WorkerServiceImpl(jobs::manager::JobManager* manager, scheduler::Scheduler* scheduler, const scheduler::Clock* clock,
                     std::int64_t max_message_bytes, std::int64_t max_result_bytes, const CallAuthorizer* authorizer)
       : manager_(manager),
         scheduler_(scheduler),
@@ -90,7 +94,7 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   static constexpr std::int64_t kAttachPollMs = 100;
 
  private:
-  JobManager* manager_;
+  jobs::manager::JobManager* manager_;
   scheduler::Scheduler* scheduler_;
   // A worker could not run a task (TaskResult.retry): its attempt fails.
   // Whether that was taken (false: the task was not outstanding any more).

@@ -1,6 +1,11 @@
 #include "server/service/proto_convert.h"
 
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/message.h>
+#include <google/protobuf/unknown_field_set.h>
+
 #include "absl/strings/str_cat.h"
+#include "common/check.h"
 #include "spec/io/analysis_outcome_convert.h"
 #include "spec/io/study_io.h"
 
@@ -8,7 +13,7 @@ namespace mbopt::service {
 
 v1::JobState ToProto(jobs::JobState state) { return static_cast<v1::JobState>(static_cast<int>(state)); }
 
-v1::JobSummary ToProto(const JobSummaryData& s) {
+v1::JobSummary ToProto(const jobs::manager::JobSummaryData& s) {
   v1::JobSummary out;
   out.set_job_id(s.job_id);
   out.set_study_name(s.study_name);
@@ -31,8 +36,8 @@ v1::JobSummary ToProto(const JobSummaryData& s) {
   return out;
 }
 
-WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
-  WorkerReport report;
+jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
+  jobs::manager::WorkerReport report;
   report.worker_id = result.worker_id();
   report.task_id = result.task_id();
   report.job_id = result.job_id();
@@ -102,6 +107,14 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
   out.set_converged(r.converged);
   out.set_restoration(r.restoration);
   return out;
+}
+
+void SetSerializedMessageField(int field_number, const std::string& serialized, google::protobuf::Message* out) {
+  const google::protobuf::FieldDescriptor* field = out->GetDescriptor()->FindFieldByNumber(field_number);
+  MBOPT_CHECK(field != nullptr && field->type() == google::protobuf::FieldDescriptor::TYPE_MESSAGE &&
+                  !field->is_repeated() && !out->GetReflection()->HasField(*out, field),
+              "SetSerializedMessageField: not an unset singular message field");
+  out->GetReflection()->MutableUnknownFields(out)->AddLengthDelimited(field_number, serialized);
 }
 
 absl::StatusOr<spec::Study> DecodeStudy(const std::string& bytes, const std::string& source_name) {

@@ -14,7 +14,7 @@
 namespace mbopt::service {
 
 v1::JobState ToProto(jobs::JobState state);
-v1::JobSummary ToProto(const JobSummaryData& summary);
+v1::JobSummary ToProto(const jobs::manager::JobSummaryData& summary);
 // `layout` (may be null: rows go out as "row N"), `variable_scales` and
 // `objective_sign` as in JobView: the objective values go out as reported (a
 // maximized value as itself).
@@ -23,7 +23,14 @@ v1::CycleRecord ToProto(const slp::CycleRecord& record, const spec::StudyLayout*
 
 // A worker's result as the job manager takes it (the job's intake then
 // validates the record).
-WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
+jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
+
+// Sets the message-typed field `field_number` of `out` (left unset there) to
+// `serialized`, a message of the field's type serialized already, without
+// parsing it: protobuf writes unknown fields as they are, and the receiver
+// reads a length-delimited field of that number as the field. So a study
+// goes to workers and readers as the bytes its user sent.
+void SetSerializedMessageField(int field_number, const std::string& serialized, google::protobuf::Message* out);
 
 // The study decoder of the job manager: binary mbopt.v1.Study -> validated
 // study (spec/io), InvalidArgument with the loader's message.

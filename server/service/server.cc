@@ -115,13 +115,13 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   MBOPT_ASSIGN_OR_RETURN(s.store_, store::Store::Open(s.options_.db_path, s.options_.durability));
   if (s.options_.before_result_commit) s.store_->SetBeforeCommitHook(s.options_.before_result_commit);
   s.scheduler_ = std::make_unique<scheduler::Scheduler>(s.clock_, scheduler_options);
-  JobManagerOptions manager_options = s.options_.manager;
+  jobs::manager::JobManagerOptions manager_options = s.options_.manager;
   if (manager_options.clock == nullptr) manager_options.clock = s.clock_;
   if (!manager_options.make_lp_solver) manager_options.make_lp_solver = [] { return lp::MakeClpLpSolver(); };
-  s.manager_ = std::make_unique<JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, manager_options);
+  s.manager_ = std::make_unique<jobs::manager::JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, manager_options);
   MBOPT_RETURN_IF_ERROR(s.manager_->Start());
 
-  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get(), s.authorizer_.get());
+  s.job_service_ = std::make_unique<JobServiceImpl>(s.manager_.get(), s.authorizer_.get(), s.clock_);
   s.worker_service_ = std::make_unique<WorkerServiceImpl>(s.manager_.get(), s.scheduler_.get(), s.clock_,
                                                          s.options_.max_message_bytes, s.options_.max_result_bytes,
                                                          s.authorizer_.get());

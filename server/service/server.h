@@ -67,7 +67,7 @@ struct ServerOptions {
   double max_calls_per_second_per_user = 0;
   // What a machine crash may take from the job database (store.h).
   store::Durability durability = store::Durability::kCycles;
-  JobManagerOptions manager;
+  jobs::manager::JobManagerOptions manager;
   // Testing: called inside each transaction of results before its COMMIT
   // (Store::SetBeforeCommitHook); empty: nothing.
   std::function<void(std::int64_t transaction)> before_result_commit;
@@ -84,7 +84,7 @@ class MboptServer {
   // "host:port" as listening, with the port the OS picked.
   const std::string& address() const { return address_; }
   std::shared_ptr<grpc::Channel> InProcessChannel();
-  JobManager& manager() { return *manager_; }
+  jobs::manager::JobManager& manager() { return *manager_; }
   scheduler::Scheduler& scheduler() { return *scheduler_; }
   store::Store& store() { return *store_; }  // for tests
 
@@ -111,7 +111,7 @@ class MboptServer {
   const scheduler::Clock* clock_ = nullptr;
   std::unique_ptr<store::Store> store_;
   std::unique_ptr<scheduler::Scheduler> scheduler_;
-  std::unique_ptr<JobManager> manager_;
+  std::unique_ptr<jobs::manager::JobManager> manager_;
   std::unique_ptr<CallAuthorizer> authorizer_;
   std::unique_ptr<JobServiceImpl> job_service_;
   std::unique_ptr<WorkerServiceImpl> worker_service_;

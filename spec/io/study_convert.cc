@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "spec/io/declared_name.h"
 #include "spec/layout.h"
 #include "spec/limits.h"
 #include "spec/units.h"
@@ -400,10 +401,8 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     const Where w = where.Child("variables", i);
     DesignVariable out;
     out.name = v.name();
-    if (v.name().empty()) errors->Add(w, "name", "a design variable needs a name");
-    if (!names.insert(v.name()).second) {
-      errors->Add(w, "name", absl::StrCat("duplicate design variable \"", v.name(), "\""));
-    }
+    CheckDeclaredName(w, v.name(), names.insert(v.name()).second,
+                      {.missing = "a design variable needs a name", .duplicate = "design variable"}, errors);
     out.parameter = scene.FindParameter(v.parameter());
     if (out.parameter < 0) {
       errors->Add(w, "parameter", absl::StrCat("unknown scene parameter \"", v.parameter(), "\""));
@@ -635,10 +634,8 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     const Where w = where.Child("constraints", i);
     Constraint out;
     out.name = c.name();
-    if (c.name().empty()) errors->Add(w, "name", "a constraint needs a name");
-    if (!constraint_names.insert(c.name()).second) {
-      errors->Add(w, "name", absl::StrCat("duplicate constraint name \"", c.name(), "\""));
-    }
+    CheckDeclaredName(w, c.name(), constraint_names.insert(c.name()).second,
+                      {.missing = "a constraint needs a name", .duplicate = "constraint name"}, errors);
     out.output = FindOutput(study, w, "output", c.output(), errors);
     if (std::optional<Reduction> r = ToReduction(c.reduction())) {
       out.reduction = *r;

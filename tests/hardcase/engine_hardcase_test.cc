@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "absl/strings/numbers.h"
 #include "worker/engine/analysis.h"
 #include "tests/testing/local_run/local_run.h"
 #include "spec/io/study_io.h"
@@ -145,8 +146,21 @@ TEST(HardcaseLock, DesignPastTheLockFailsNamingTimeAndJoint) {
   ASSERT_TRUE(past.ok()) << past.status();
   EXPECT_FALSE(past->ok());
   EXPECT_FALSE(past->values.has_value());
-  EXPECT_NE(past->failure.reason.find("t = "), std::string::npos) << past->failure.reason;
-  EXPECT_NE(past->failure.reason.find("J"), std::string::npos) << past->failure.reason;
+  // The crank turns at theta = 1 rad/s, so it reaches the lock at
+  // t = kThetaLock / 1 rad/s; the reason prints that time to 6 digits.
+  const std::string& reason = past->failure.reason;
+  const std::size_t at = reason.find("t = ");
+  ASSERT_NE(at, std::string::npos) << reason;
+  double lock_time_s = 0;
+  ASSERT_TRUE(absl::SimpleAtod(reason.substr(at + 4, reason.find_first_of(" (", at + 4) - (at + 4)), &lock_time_s))
+      << reason;
+  constexpr double kPrintedTimeToleranceS = 5e-6;
+  EXPECT_NEAR(lock_time_s, kThetaLock / 1.0, kPrintedTimeToleranceS) << reason;
+  // J3 is where coupler and rocker stop meeting; the other joints close.
+  EXPECT_NE(reason.find("at joint 'J3'"), std::string::npos) << reason;
+  for (const char* closing : {"joint 'J1'", "joint 'J2'", "joint 'J4'"}) {
+    EXPECT_EQ(reason.find(closing), std::string::npos) << closing << " in: " << reason;
+  }
   std::cout << "[hardcase] lock: theta = 1.0 rad: " << past->failure.reason << "\n";
 }
 

@@ -5,7 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-namespace mbopt::service {
+namespace mbopt::jobs::manager {
 namespace {
 
 using ::testing::HasSubstr;
@@ -62,4 +62,4 @@ TEST(Admission, NoLimitsMeansEveryJobStarts) {
 }
 
 }  // namespace
-}  // namespace mbopt::service
+}  // namespace mbopt::jobs::manager

@@ -126,7 +126,7 @@ class SecureServerTest : public ::testing::Test {
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + kConnectDeadline);
     v1::SubmitJobRequest request;
-    *request.mutable_study() = OscillatorStudy();
+    request.set_study(OscillatorStudy().SerializeAsString());
     v1::SubmitJobResponse response;
     grpc::Status status = jobs.Submit(&context, request, &response);
     *job_id = response.job_id();
@@ -185,8 +185,8 @@ TEST_F(SecureServerTest, JobsRunOverTlsAndEachUserSeesOnlyTheirOwn) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
   const grpc::Status none = Get(*bob, "job-999", &job);
   EXPECT_EQ(none.error_code(), grpc::StatusCode::NOT_FOUND);
-  EXPECT_EQ(status.error_message(), std::string(JobManager::NoSuchJob(alices_job).message()));
-  EXPECT_EQ(none.error_message(), std::string(JobManager::NoSuchJob("job-999").message()));
+  EXPECT_EQ(status.error_message(), std::string(jobs::manager::JobManager::NoSuchJob(alices_job).message()));
+  EXPECT_EQ(none.error_message(), std::string(jobs::manager::JobManager::NoSuchJob("job-999").message()));
   EXPECT_EQ(Cancel(*bob, alices_job).error_code(), grpc::StatusCode::NOT_FOUND);
   {
     grpc::ClientContext context;

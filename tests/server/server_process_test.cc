@@ -180,7 +180,7 @@ class ServerProcessTest : public ::testing::Test {
     auto stub = v1::JobService::NewStub(channel);
     grpc::ClientContext context;
     v1::SubmitJobRequest request;
-    *request.mutable_study() = OscillatorStudy();
+    request.set_study(OscillatorStudy().SerializeAsString());
     v1::SubmitJobResponse response;
     grpc::Status status = stub->Submit(&context, request, &response);
     EXPECT_TRUE(status.ok()) << status.error_message();
@@ -351,7 +351,7 @@ TEST_F(ServerProcessTest, ALargeCallWithoutATokenIsRefusedBeforeItsMessageIsRead
   const std::int64_t before = ProcessMemoryBytes(server->pid, "VmRSS");
   ASSERT_GT(before, 0);
   v1::SubmitJobRequest request;
-  *request.mutable_study() = OscillatorStudy();
+  request.set_study(OscillatorStudy().SerializeAsString());
   request.set_source_name(std::string(static_cast<std::size_t>(kMessageBytes), 'x'));
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));

@@ -2,7 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 
-namespace mbopt::service {
+namespace mbopt::jobs::manager {
 namespace {
 
 std::string Who(const std::string& owner) { return owner.empty() ? "this server's user" : absl::StrCat("user '", owner, "'"); }
@@ -88,4 +88,4 @@ std::string Admission::WhyWaiting(const std::string& job_id) const {
   return absl::StrCat("waiting to run: ", ahead, ahead == 1 ? " job" : " jobs", " ahead in the queue; ", limit);
 }
 
-}  // namespace mbopt::service
+}  // namespace mbopt::jobs::manager

@@ -12,7 +12,7 @@
 
 #include "absl/status/status.h"
 
-namespace mbopt::service {
+namespace mbopt::jobs::manager {
 
 // 0 means no limit.
 struct AdmissionLimits {
@@ -62,4 +62,4 @@ class Admission {
   std::map<std::string, std::int64_t> seq_of_;
 };
 
-}  // namespace mbopt::service
+}  // namespace mbopt::jobs::manager

@@ -11,50 +11,17 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_format.h"
+#include "common/check.h"
 #include "common/status_macros.h"
 #include "server/jobs/job_result.h"
 #include "server/jobs/problem_from_study.h"
 #include "server/jobs/record_codec.h"
+#include "server/jobs/manager/job_entry.h"
 #include "spec/layout.h"
 
-namespace mbopt::service {
+namespace mbopt::jobs::manager {
 
 using jobs::JobState;
-
-struct JobManager::Entry {
-  std::mutex mutex;
-  std::condition_variable changed;
-
-  store::JobRow row;  // id, names, study bytes, created; progress as loaded
-  JobState state = JobState::kQueued;
-  std::string message;
-
-  bool study_ok = false;
-  spec::Study study;
-  // While resident; shared with the job and with views, never copied.
-  std::shared_ptr<const spec::StudyLayout> layout;
-  std::unique_ptr<jobs::Job> job;  // the optimizer of the current run; none once it stopped
-  // Failed analyses by kind, kept when the optimizer is released.
-  std::map<std::string, std::int64_t> failed_analyses_by_kind;
-
-  std::vector<slp::CycleRecord> records;  // published: durable as the store's level promises
-  // Committed without a sync, by the number of their commit: published once
-  // the log is synced.
-  std::deque<std::pair<std::int64_t, std::vector<slp::CycleRecord>>> unsynced;
-  std::int64_t version = 0;
-
-  // Whether the study, its bytes and the records are in memory. A stopped
-  // job keeps only its summary (stopped_summary); views read the rest from
-  // the database on demand (RestoreLocked), so the server's memory does not
-  // grow with the number of finished jobs.
-  bool resident = true;
-  JobSummaryData stopped_summary;
-  int watchers = 0;  // watch streams open on the job: it stays resident for them
-
-  double wall_before_s = 0;  // running time of earlier runs
-  bool timing = false;
-  std::int64_t run_started_ms = 0;
-};
 
 namespace {
 
@@ -65,21 +32,11 @@ void LogError(const std::string& job_id, const absl::Status& status) {
   std::cerr << "mbopt-server: job " << job_id << ": " << status << std::endl;
 }
 
-bool Running(JobState state) { return state == JobState::kRunning || state == JobState::kQueued; }
-
 // "job-" and 12 hex digits from the system's random source.
 std::string RandomJobId() {
   std::random_device device;
   const std::uint64_t bits = (static_cast<std::uint64_t>(device()) << 32) ^ device();
   return absl::StrFormat("job-%012x", bits & 0xffffffffffffULL);
-}
-
-// What a worker must be able to do to run the study's analyses.
-scheduler::TaskNeeds NeedsOf(const spec::Study& study) {
-  scheduler::TaskNeeds needs;
-  if (const auto* external = std::get_if<spec::ExternalModel>(&study.scene.model)) needs.driver = external->driver;
-  needs.loads_fmus = std::holds_alternative<spec::FmuModel>(study.scene.model);
-  return needs;
 }
 
 }  // namespace
@@ -92,53 +49,24 @@ JobManager::JobManager(store::Store* store, scheduler::Scheduler* scheduler, Stu
       options_(std::move(options)),
       clock_(options_.clock != nullptr ? options_.clock : &steady_clock_),
       admission_(options_.admission) {
-  if (store_->durability() == store::Durability::kCycles) syncer_ = std::thread([this] { SyncLoop(); });
-}
-
-JobManager::~JobManager() {
-  {
-    std::lock_guard<std::mutex> lock(sync_mutex_);
-    stop_syncing_ = true;
-  }
-  sync_wanted_.notify_all();
-  if (syncer_.joinable()) syncer_.join();
-}
-
-void JobManager::SyncLoop() {
-  std::unique_lock<std::mutex> lock(sync_mutex_);
-  while (true) {
-    sync_wanted_.wait(lock, [this] { return stop_syncing_ || !sync_waiting_.empty(); });
-    if (sync_waiting_.empty()) return;  // stopping, nothing left
-    std::set<std::string> jobs;
-    jobs.swap(sync_waiting_);
-    syncing_ = true;
-    // Every commit counted so far has returned: the sync makes it durable.
-    const std::int64_t synced = deferred_commits_;
-    lock.unlock();
-    if (options_.before_log_sync) options_.before_log_sync();
-    // A failed sync is logged; the records are committed all the same (a
-    // crash of the process loses nothing), only a power loss could take
-    // them, as at Durability::kNormal.
-    if (absl::Status status = store_->SyncLog(); !status.ok()) {
-      std::cerr << "mbopt-server: cannot sync the job log: " << status << std::endl;
-    }
-    std::vector<std::string> still_waiting;
-    for (const std::string& id : jobs) {
-      absl::StatusOr<std::shared_ptr<Entry>> entry = Find(id);
-      if (!entry.ok()) continue;
-      std::lock_guard<std::mutex> entry_lock((*entry)->mutex);
-      if (!PublishSyncedLocked(**entry, synced)) still_waiting.push_back(id);
-    }
-    lock.lock();
-    sync_waiting_.insert(still_waiting.begin(), still_waiting.end());
-    syncing_ = false;
-    sync_done_.notify_all();
+  if (store_->durability() == store::Durability::kCycles) {
+    syncer_ = std::make_unique<LogSyncer>(
+        [this] { return store_->SyncLog(); },
+        [this](const std::string& job_id, std::int64_t synced) {
+          absl::StatusOr<std::shared_ptr<Entry>> entry = Find(job_id);
+          if (!entry.ok()) return true;  // gone: nothing of it waits
+          std::lock_guard<std::mutex> entry_lock((*entry)->mutex);
+          return PublishSyncedLocked(**entry, synced);
+        },
+        options_.before_log_sync);
   }
 }
+
+// The syncing thread publishes into the entries: it stops first.
+JobManager::~JobManager() { syncer_.reset(); }
 
 void JobManager::WaitForLogSync() {
-  std::unique_lock<std::mutex> lock(sync_mutex_);
-  sync_done_.wait(lock, [this] { return stop_syncing_ || !syncer_.joinable() || (sync_waiting_.empty() && !syncing_); });
+  if (syncer_ != nullptr) syncer_->WaitUntilIdle();
 }
 
 void JobManager::PublishUnsyncedLocked(Entry& entry) {
@@ -166,12 +94,6 @@ absl::StatusOr<std::shared_ptr<JobManager::Entry>> JobManager::Find(const std::s
 void JobManager::Changed(Entry& entry) {
   entry.version += 1;
   entry.changed.notify_all();
-}
-
-double JobManager::WallSecondsLocked(const Entry& entry) const {
-  double wall = entry.wall_before_s;
-  if (entry.timing) wall += static_cast<double>(clock_->NowMs() - entry.run_started_ms) / 1000.0;
-  return wall;
 }
 
 absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string message, const std::string& event,
@@ -234,7 +156,7 @@ void JobManager::EvictLocked(Entry& entry) {
 
 void JobManager::DropContentLocked(Entry& entry) {
   std::vector<slp::CycleRecord>().swap(entry.records);
-  entry.study = spec::Study{};
+  entry.study = std::make_shared<const spec::Study>();
   entry.layout.reset();  // its rows' names are most of a job's memory
   std::string().swap(entry.row.study);
   entry.resident = false;
@@ -248,7 +170,7 @@ void JobManager::LoadContentLocked(Entry& entry, absl::Status* cycles_status) {
     // the layout serves the views (row names) while the job is resident.
     absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*study);
     if (layout.ok()) {
-      entry.study = *std::move(study);
+      entry.study = std::make_shared<const spec::Study>(*std::move(study));
       entry.layout = std::make_shared<const spec::StudyLayout>(*std::move(layout));
       entry.study_ok = true;
     } else {
@@ -347,11 +269,12 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
   }
-  MBOPT_ASSIGN_OR_RETURN(spec::Study study, decoder_(study_bytes, source_name));
+  MBOPT_ASSIGN_OR_RETURN(spec::Study decoded, decoder_(study_bytes, source_name));
+  auto study = std::make_shared<const spec::Study>(std::move(decoded));
   // A driver is the workers' to declare, and one no worker declares is a
   // mistake to say at once; FMU support comes with a worker's build, so an
   // FMU study waits for such a worker (its status says so) instead.
-  if (const scheduler::TaskNeeds needs = NeedsOf(study); !needs.driver.empty() && !scheduler_->SomeWorkerCan(needs)) {
+  if (const scheduler::TaskNeeds needs = NeedsOf(*study); !needs.driver.empty() && !scheduler_->SomeWorkerCan(needs)) {
     const std::vector<std::string> offered = scheduler_->OfferedDrivers();
     return absl::FailedPreconditionError(absl::StrCat(
         source_name, ": scene.external.driver: no registered worker declares ", needs.Describe(),
@@ -377,7 +300,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   // On a server with tokens (owners) an id says nothing of how many jobs
   // exist; alone on a server without tokens, job-<n> is the friendlier name.
   if (!owner.empty()) row.id = RandomJobId();
-  row.study_name = study.name;
+  row.study_name = study->name;
   row.source_name = source_name;
   row.owner = owner;
   row.study = study_bytes;
@@ -389,7 +312,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
   if (room) {
     entry->layout = job->shared_layout();
   } else {
-    MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(study));
+    MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(*study));
     entry->layout = std::make_shared<const spec::StudyLayout>(std::move(layout));
   }
   entry->study = std::move(study);
@@ -507,7 +430,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why, cons
 
 void JobManager::ScheduleLocked(Entry& entry) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
-  scheduler_->SetJobNeeds(entry.row.id, NeedsOf(entry.study));
+  scheduler_->SetJobNeeds(entry.row.id, NeedsOf(*entry.study));
   std::vector<scheduler::Scheduler::NewTask> tasks;
   for (const slp::AnalysisRequest& request : entry.job->PendingRequests()) {
     tasks.push_back({request.id, std::vector<double>(request.x.data(), request.x.data() + request.x.size()),
@@ -589,13 +512,8 @@ absl::Status JobManager::FinishDeliveryLocked(Entry& entry, Delivery delivery, c
   if (with_records) {
     const std::int64_t rows = static_cast<std::int64_t>(delivery.records.size());
     if (delivery.write.defer_sync) {
-      std::int64_t commit = 0;
-      {
-        std::lock_guard<std::mutex> lock(sync_mutex_);
-        commit = ++deferred_commits_;
-        sync_waiting_.insert(entry.row.id);
-      }
-      sync_wanted_.notify_one();
+      MBOPT_CHECK(syncer_ != nullptr, "records committed without a sync need the syncing thread");
+      const std::int64_t commit = syncer_->CommittedWithoutSync(entry.row.id);
       entry.unsynced.emplace_back(commit, std::move(delivery.records));
     } else {
       // This commit synced the log: the records still waiting are durable.
@@ -812,142 +730,6 @@ void JobManager::ExpireLeases() {
   AdmitWaiting();
 }
 
-JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
-  if (!entry.resident) {
-    JobSummaryData s = entry.stopped_summary;
-    s.state = entry.state;
-    s.message = entry.message;
-    s.wall_seconds = WallSecondsLocked(entry);
-    return s;
-  }
-  JobSummaryData s;
-  s.job_id = entry.row.id;
-  s.study_name = entry.row.study_name;
-  s.owner = entry.row.owner;
-  s.state = entry.state;
-  s.message = entry.message;
-  if (entry.state == JobState::kQueued) {
-    std::lock_guard<std::mutex> admission_lock(admission_mutex_);
-    s.message = admission_.WhyWaiting(entry.row.id);
-  }
-  s.created_unix_ms = entry.row.created_unix_ms;
-  s.wall_seconds = WallSecondsLocked(entry);
-  s.cycles = entry.row.cycles;
-  s.analyses = entry.row.analyses;
-  Eigen::VectorXd design;
-  std::optional<slp::SlpOptions> options;
-  if (entry.study_ok) {
-    s.objective_unit = spec::ReportedObjectiveUnit(entry.study);
-    if (entry.job != nullptr) {
-      options = entry.job->options();
-    } else if (absl::StatusOr<slp::SlpOptions> from_study = jobs::SlpOptionsFromStudy(entry.study);
-               from_study.ok()) {
-      options = *from_study;
-    }
-    if (options.has_value()) s.max_cycles = options->max_cycles;
-    design.resize(static_cast<Eigen::Index>(entry.study.variables.size()));
-    for (size_t i = 0; i < entry.study.variables.size(); ++i) {
-      const spec::DesignVariable& v = entry.study.variables[i];
-      s.design_names.push_back(v.name);
-      s.design_units.push_back(v.parameter >= 0 && static_cast<size_t>(v.parameter) < entry.study.scene.parameters.size()
-                                   ? entry.study.scene.parameters[static_cast<size_t>(v.parameter)].unit
-                                   : "");
-      design[static_cast<Eigen::Index>(i)] = v.initial;
-    }
-  }
-  s.failed_analyses_by_kind = entry.failed_analyses_by_kind;
-  if (entry.state == JobState::kRunning && entry.study_ok) {
-    if (const scheduler::TaskNeeds needs = NeedsOf(entry.study); !scheduler_->SomeWorkerCan(needs)) {
-      s.waiting_for = absl::StrCat("no registered worker declares ", needs.Describe(),
-                                   ": its analyses wait for one (mbopt workers)");
-    }
-  }
-  // The optimizer minimizes; a maximized value is reported as itself.
-  const double sign = entry.study_ok ? entry.study.objective.ReportedSign() : 1.0;
-  if (entry.job != nullptr) {
-    const slp::SlpOptimizer& optimizer = entry.job->optimizer();
-    s.cycles = optimizer.cycles_completed();
-    s.analyses = optimizer.analyses_used();
-    for (const auto& [kind, count] : entry.job->failures_by_kind()) {
-      s.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
-    }
-    if (!entry.records.empty()) {
-      const slp::DesignPoint best = optimizer.best_design();
-      design = best.x;
-      s.objective = sign * best.objective;
-      s.max_violation = best.max_violation;
-    }
-  } else if (!entry.records.empty()) {
-    // Not running in this process: the same choice from the logged records.
-    if (std::optional<slp::DesignPoint> best = jobs::BestDesignOfRecords(entry.records)) {
-      design = best->x;
-      s.objective = sign * best->objective;
-      s.max_violation = best->max_violation;
-    }
-  }
-  if (entry.study_ok && static_cast<size_t>(design.size()) == entry.study.variables.size()) {
-    for (size_t i = 0; i < entry.study.variables.size(); ++i) {
-      s.design.push_back(entry.study.variables[i].scale * design[static_cast<Eigen::Index>(i)]);
-    }
-  }
-  return s;
-}
-
-JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record, JobViewFor view_for) const {
-  JobView view;
-  view.summary = SummaryLocked(entry);
-  view.first_record = std::min(first_record, entry.records.size());
-  view.records.assign(entry.records.begin() + static_cast<std::ptrdiff_t>(view.first_record), entry.records.end());
-  view.version = entry.version;
-  view.ended = !Running(entry.state);
-  if (entry.study_ok) {
-    view.layout = entry.layout;
-    for (const spec::DesignVariable& v : entry.study.variables) view.variable_scales.push_back(v.scale);
-    view.objective_sign = entry.study.objective.ReportedSign();
-  }
-  if (view_for == JobViewFor::kReader) view.study_bytes = entry.row.study;
-  return view;
-}
-
-absl::StatusOr<JobView> JobManager::Get(const std::string& job_id, std::size_t first_record,
-                                        JobViewFor view_for) {
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
-  std::lock_guard<std::mutex> lock(entry->mutex);
-  return RestoredViewLocked(*entry, first_record, view_for);
-}
-
-absl::StatusOr<JobView> JobManager::RestoredViewLocked(Entry& entry, std::size_t first_record,
-                                                       JobViewFor view_for) {
-  MBOPT_RETURN_IF_ERROR(RestoreLocked(entry));
-  JobView view = ViewLocked(entry, first_record, view_for);
-  EvictLocked(entry);
-  return view;
-}
-
-absl::StatusOr<std::vector<JobSummaryData>> JobManager::List() {
-  std::vector<std::shared_ptr<Entry>> entries;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& [id, entry] : jobs_) entries.push_back(entry);
-  }
-  // In submission order (the store's sequence number; ids sort as text).
-  std::vector<std::pair<std::int64_t, JobSummaryData>> ordered;
-  for (const auto& entry : entries) {
-    std::lock_guard<std::mutex> lock(entry->mutex);
-    ordered.emplace_back(entry->row.seq, SummaryLocked(*entry));
-  }
-  std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<JobSummaryData> summaries;
-  for (auto& [seq, summary] : ordered) summaries.push_back(std::move(summary));
-  return summaries;
-}
-
-absl::StatusOr<std::string> JobManager::OwnerOf(const std::string& job_id) {
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
-  std::lock_guard<std::mutex> lock(entry->mutex);
-  return entry->row.owner;
-}
-
 absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id, const std::string& actor) {
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   JobSummaryData summary;
@@ -999,55 +781,6 @@ absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id, con
   return SummaryLocked(*entry);
 }
 
-absl::StatusOr<JobView> JobManager::WaitForChange(const std::string& job_id, std::size_t first_record,
-                                                  std::int64_t version_seen, std::int64_t max_wait_ms) {
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
-  std::unique_lock<std::mutex> lock(entry->mutex);
-  // A real-time wait: watchers are people, not the job's clock.
-  entry->changed.wait_for(lock, std::chrono::milliseconds(std::max<std::int64_t>(0, max_wait_ms)),
-                          [&] { return entry->version != version_seen; });
-  return RestoredViewLocked(*entry, first_record, JobViewFor::kWatcher);
-}
-
-absl::Status JobManager::StartWatching(const std::string& job_id) {
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
-  std::lock_guard<std::mutex> lock(entry->mutex);
-  entry->watchers += 1;
-  return absl::OkStatus();
-}
-
-void JobManager::StopWatching(const std::string& job_id) {
-  absl::StatusOr<std::shared_ptr<Entry>> entry = Find(job_id);
-  if (!entry.ok()) return;
-  std::lock_guard<std::mutex> lock((*entry)->mutex);
-  (*entry)->watchers -= 1;
-  EvictLocked(**entry);
-}
-
-std::size_t JobManager::ResidentJobs() {
-  std::vector<std::shared_ptr<Entry>> entries;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& [id, entry] : jobs_) entries.push_back(entry);
-  }
-  std::size_t resident = 0;
-  for (const auto& entry : entries) {
-    std::lock_guard<std::mutex> lock(entry->mutex);
-    if (entry->resident) ++resident;
-  }
-  return resident;
-}
-
-absl::StatusOr<std::string> JobManager::StudyBytes(const std::string& job_id) {
-  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
-  std::lock_guard<std::mutex> lock(entry->mutex);
-  if (!entry->resident) {
-    MBOPT_ASSIGN_OR_RETURN(store::JobRow row, store_->GetJob(job_id));
-    return row.study;
-  }
-  return entry->row.study;
-}
-
 void JobManager::Shutdown() {
   std::vector<std::shared_ptr<Entry>> entries;
   {
@@ -1066,4 +799,4 @@ void JobManager::Shutdown() {
   }
 }
 
-}  // namespace mbopt::service
+}  // namespace mbopt::jobs::manager

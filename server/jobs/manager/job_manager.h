@@ -23,11 +23,11 @@
 //
 // Thread-safe. Optimizer work is short (LP solves) and done on the calling
 // thread under the job's mutex; the store's commits and the log's syncs
-// (on a thread of the manager's own) are the only I/O.
+// (on the LogSyncer's thread, log_syncer.h) are the only I/O. Summaries and
+// views are built in job_views.cc; admission limits are admission.h's.
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -46,6 +46,8 @@
 #include "server/jobs/job.h"
 #include "server/jobs/job_state.h"
 #include "server/jobs/manager/admission.h"
+#include "server/jobs/manager/job_view.h"
+#include "server/jobs/manager/log_syncer.h"
 #include "server/lp/linear_program.h"
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
@@ -53,7 +55,7 @@
 #include "spec/layout.h"
 #include "spec/study.h"
 
-namespace mbopt::service {
+namespace mbopt::jobs::manager {
 
 // Turns a stored study (opaque bytes, the service's serialization) into a
 // validated study. InvalidArgument naming `source_name` and the field.
@@ -74,52 +76,6 @@ struct JobManagerOptions {
   // How many jobs run at once; the others wait (QUEUED) in submission order.
   AdmissionLimits admission;
 };
-
-struct JobSummaryData {
-  std::string job_id;
-  std::string study_name;
-  std::string owner;  // who submitted it; "" on a server without tokens
-  jobs::JobState state = jobs::JobState::kQueued;
-  int cycles = 0;
-  std::int64_t analyses = 0;
-  // The result's F, in objective_unit (a maximized value as itself), and
-  // maxg (normalized, > 0 violated);
-  // NaN while no design has been analysed (and for a job that failed there).
-  double objective = std::numeric_limits<double>::quiet_NaN();
-  std::string objective_unit;
-  double max_violation = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::string> design_names;
-  std::vector<double> design;     // physical: scale * x, parameter units
-  std::vector<std::string> design_units;
-  double wall_seconds = 0;
-  std::string message;
-  std::int64_t created_unix_ms = 0;
-  int max_cycles = 0;
-  // Failed analyses so far by failure kind name (spec::FailureKindName).
-  std::map<std::string, std::int64_t> failed_analyses_by_kind;
-  // A running job whose analyses no registered worker can run: why
-  // (e.g. the driver its scene names); "" otherwise.
-  std::string waiting_for;
-};
-
-// What a client needs to show a job's records with names and units.
-struct JobView {
-  JobSummaryData summary;
-  std::vector<slp::CycleRecord> records;  // from the requested index on
-  std::size_t first_record = 0;           // index of records[0] in the job's log
-  std::int64_t version = 0;               // changes with every record or state change
-  bool ended = false;                     // the job is not running (nothing more will come)
-  // The study's layout (constraint rows' names, for worst_* indices);
-  // null when the study is not usable.
-  std::shared_ptr<const spec::StudyLayout> layout;
-  std::vector<double> variable_scales;    // physical = scale * x
-  double objective_sign = 1.0;            // reported F = sign * the records' F (-1: maximized)
-  std::string study_bytes;
-};
-
-// Who a view is for: a reader (Get) gets the study's bytes as well; a
-// watcher does not need them.
-enum class JobViewFor { kReader, kWatcher };
 
 // One result from a worker: where it goes, and the candidate record the
 // job's intake validates (request_id set; x_scaled and attempts are the
@@ -305,9 +261,6 @@ class JobManager {
   // the sync numbered `synced`.
   void PublishUnsyncedLocked(Entry& entry);
   bool PublishSyncedLocked(Entry& entry, std::int64_t synced);
-  // The syncing thread (at Durability::kCycles): syncs the log whenever
-  // records wait for it, then publishes them.
-  void SyncLoop();
   // Prepare, commit (alone) and finish a batch.
   absl::Status DeliverLocked(Entry& entry, const std::vector<jobs::AnalysisRecord>& batch);
   // Commits the optimizer's new records with the job's progress in one
@@ -343,14 +296,8 @@ class JobManager {
   mutable std::mutex admission_mutex_;  // guards admission_
   Admission admission_;
 
-  std::mutex sync_mutex_;  // guards the five below
-  std::condition_variable sync_wanted_;
-  std::condition_variable sync_done_;
-  bool syncing_ = false;  // a sync round is under way
-  std::set<std::string> sync_waiting_;  // jobs with records waiting for a sync
-  std::int64_t deferred_commits_ = 0;   // commits of records without a sync so far
-  bool stop_syncing_ = false;
-  std::thread syncer_;  // runs SyncLoop at Durability::kCycles
+  // At Durability::kCycles (else null). Last: its thread reads the above.
+  std::unique_ptr<LogSyncer> syncer_;
 };
 
-}  // namespace mbopt::service
+}  // namespace mbopt::jobs::manager

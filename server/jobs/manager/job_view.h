@@ -1,0 +1,65 @@
+// What the job manager tells of a job: its summary (List, and every
+// view), and a view of its records from an index on (Get, Watch).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "server/jobs/job_state.h"
+#include "server/jobs/job.h"  // slp::CycleRecord
+#include "spec/layout.h"
+
+namespace mbopt::jobs::manager {
+
+struct JobSummaryData {
+  std::string job_id;
+  std::string study_name;
+  std::string owner;  // who submitted it; "" on a server without tokens
+  jobs::JobState state = jobs::JobState::kQueued;
+  int cycles = 0;
+  std::int64_t analyses = 0;
+  // The result's F, in objective_unit (a maximized value as itself), and
+  // maxg (normalized, > 0 violated);
+  // NaN while no design has been analysed (and for a job that failed there).
+  double objective = std::numeric_limits<double>::quiet_NaN();
+  std::string objective_unit;
+  double max_violation = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::string> design_names;
+  std::vector<double> design;     // physical: scale * x, parameter units
+  std::vector<std::string> design_units;
+  double wall_seconds = 0;
+  std::string message;
+  std::int64_t created_unix_ms = 0;
+  int max_cycles = 0;
+  // Failed analyses so far by failure kind name (spec::FailureKindName).
+  std::map<std::string, std::int64_t> failed_analyses_by_kind;
+  // A running job whose analyses no registered worker can run: why
+  // (e.g. the driver its scene names); "" otherwise.
+  std::string waiting_for;
+};
+
+// What a client needs to show a job's records with names and units.
+struct JobView {
+  JobSummaryData summary;
+  std::vector<slp::CycleRecord> records;  // from the requested index on
+  std::size_t first_record = 0;           // index of records[0] in the job's log
+  std::int64_t version = 0;               // changes with every record or state change
+  bool ended = false;                     // the job is not running (nothing more will come)
+  // The study's layout (constraint rows' names, for worst_* indices);
+  // null when the study is not usable.
+  std::shared_ptr<const spec::StudyLayout> layout;
+  std::vector<double> variable_scales;    // physical = scale * x
+  double objective_sign = 1.0;            // reported F = sign * the records' F (-1: maximized)
+  std::string study_bytes;
+};
+
+// Who a view is for: a reader (Get) gets the study's bytes as well; a
+// watcher does not need them.
+enum class JobViewFor { kReader, kWatcher };
+
+}  // namespace mbopt::jobs::manager
