@@ -4,11 +4,9 @@
 #include <variant>
 
 #include "worker/fmu/scene_analysis.h"
+#include "worker/multibody/linkage_analysis.h"
 #include "worker/multibody/scene_analysis.h"
 #include "worker/solve/lumped_dynamics.h"
-#ifdef MBOPT_HAVE_LINKAGE
-#include "worker/solve/linkage_analysis.h"
-#endif
 
 namespace mbopt::engine {
 
@@ -34,12 +32,7 @@ spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>
   } else if (std::holds_alternative<spec::FmuModel>(scene.model)) {
     report = fmu::AnalyzeFmuScene(scene, parameter_values_si);
   } else {
-#ifdef MBOPT_HAVE_LINKAGE
-    report = solve::AnalyzeLinkage(scene, parameter_values_si);
-#else
-    report.times_s = scene.time_grid.Instants();
-    report.Fail(spec::FailureKind::kInvalidModel, "linkage scenes are not available in this build");
-#endif
+    report = multibody::AnalyzeLinkageScene(scene, parameter_values_si);
   }
   report.counters.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
