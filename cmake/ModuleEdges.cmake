@@ -106,17 +106,17 @@ function(mbopt_declare_modules)
 
   # The analysis engine's numerical core, bottom up.
   mbopt_module(model DIRS worker/model USES spec common PURE
-    LIBS mbopt_lumped_model mbopt_linkage_model
-    SUMMARY "model building blocks: lumped model, resolved linkage, beam element")
+    LIBS mbopt_lumped_model
+    SUMMARY "model building blocks of lumped scenes: M, K, C and the input forcing")
   mbopt_module(solve DIRS worker/solve USES model spec common PURE
-    LIBS mbopt_cvodes mbopt_lumped mbopt_lumped_sensitivity mbopt_linkage
-    SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities, linkage solvers")
+    LIBS mbopt_cvodes mbopt_lumped mbopt_lumped_sensitivity
+    SUMMARY "solution procedures: CVODES wrapper, lumped dynamics and sensitivities")
   mbopt_module(fmu DIRS worker/fmu USES solve spec PURE
     LIBS mbopt_fmu mbopt_fmu_scene
     SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
   mbopt_module(multibody DIRS worker/multibody USES solve model spec common PURE
     LIBS mbopt_multibody
-    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
+    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")
   mbopt_module(engine DIRS worker/engine USES fmu multibody solve model spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
     SUMMARY "one analysis of a scene (formulation dispatch) and the one evaluation of a study at a design point")

@@ -28,7 +28,7 @@ using spec::OutputValues;
 // The driver turns at most this much between two instants of the kinematic
 // analysis, so that Newton starts from a close prediction and a change of
 // branch is seen where it happens (the interval is halved where needed).
-constexpr double kRigidStepRad = 2.0 * std::numbers::pi / 36.0;
+constexpr double kRigidStepRad = 2.0 * std::numbers::pi / 18.0;
 // The floating-frame integration asks for the rigid motion at every one of
 // its steps, solved from the nearest instant kept: finer, so that Newton
 // closes in one or two iterations.
@@ -255,12 +255,14 @@ AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<d
 
   KinematicOptions options;
   options.inverse_dynamics = needs_loads && !elastic;
-  // Closed to round-off, not to the engine's default 1e-11 m: the
-  // floating-frame integration reads the motion at thousands of instants,
-  // and its loads should not carry the noise of where Newton stopped.
-  double longest_m = 1.0;
-  for (const LinkageLink& l : sys.links) longest_m = std::max(longest_m, l.length_m);
-  options.assembly.position_tolerance = kPositionToleranceM * longest_m;
+  // The floating-frame integration reads the motion at thousands of
+  // instants: closed to round-off, not to the engine's default 1e-11 m, so
+  // that its loads do not carry the noise of where Newton stopped.
+  if (elastic) {
+    double longest_m = 1.0;
+    for (const LinkageLink& l : sys.links) longest_m = std::max(longest_m, l.length_m);
+    options.assembly.position_tolerance = kPositionToleranceM * longest_m;
+  }
   KinematicCounters counters;
   const solve::WallTimeBudget budget(scene.integrator.max_wall_seconds);
   LinkageState start, state;
