@@ -10,6 +10,7 @@
 #include "absl/strings/str_join.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/floating_frame.h"
+#include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/linkage_front_end.h"
 #include "worker/multibody/linkage_system.h"
@@ -162,6 +163,124 @@ void RecordLoads(const spec::Scene& scene, const LinkageSystem& sys,
   }
 }
 
+
+// Bending moment at every node of every co-rotational link (the moment a
+// node passes on: minus the end moment at a of the element after it, the
+// end moment at b of the element before it, their mean at an inner node);
+// false if an element's nodes coincide.
+bool CorotationalMoments(const LinkageSystem& sys, const Mechanism& mech, const CompiledLinkage& c,
+                         const MotionSample& s, std::vector<std::vector<double>>* moments) {
+  moments->assign(sys.links.size(), {});
+  for (size_t i = 0; i < sys.links.size(); ++i) {
+    const int elements = sys.links[i].flexible_elements;
+    std::vector<double>& out = (*moments)[i];
+    out.assign(static_cast<size_t>(StressNodes(sys.links[i])), 0.0);
+    if (c.link_first_element[i] < 0) continue;
+    std::vector<int> count(out.size(), 0);
+    for (int e = 0; e < elements; ++e) {
+      BeamLoads loads;
+      if (!mech.BeamEndLoads(c.link_first_element[i] + e, s.q, s.v, &loads)) return false;
+      out[static_cast<size_t>(e)] -= loads.moment_a_n_m;
+      out[static_cast<size_t>(e + 1)] += loads.moment_b_n_m;
+      ++count[static_cast<size_t>(e)];
+      ++count[static_cast<size_t>(e + 1)];
+    }
+    for (size_t k = 0; k < out.size(); ++k) out[k] /= count[k];
+  }
+  return true;
+}
+
+// The co-rotational formulation: forward dynamics (IDAS) of the linkage
+// whose moving links are co-rotational beams, the driver turning the driven
+// link's root. Positions and rotations are those of the deformed links'
+// ends (a link's rotation: its chord's).
+void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, AnalysisReport* report) {
+  report->formulation = Formulation::kDynamic;
+  for (size_t i = 0; i < sys.links.size(); ++i) {
+    if (!sys.links[i].both_ground && sys.links[i].flexible_elements <= 0) {
+      Fail(report, absl::StrFormat("the co-rotational formulation needs every moving link flexible; %s is rigid",
+                                   sys.LinkLabel(static_cast<int>(i))));
+      return;
+    }
+  }
+  const CompiledLinkage compiled = CompileCorotationalLinkage(sys);
+  const Mechanism mechanism(compiled.model);
+  // The links start with rigid-body velocities: v = T w, w holding per link
+  // its end a's (x', y') and its angular rate.
+  int moving = 0;
+  for (const LinkageLink& l : sys.links) moving += l.both_ground ? 0 : 1;
+  Eigen::MatrixXd velocity_basis = Eigen::MatrixXd::Zero(mechanism.num_coordinates(), 3 * moving);
+  const Eigen::VectorXd q0 = mechanism.InitialGuess();
+  int column = 0;
+  for (size_t i = 0; i < sys.links.size(); ++i) {
+    const int a = compiled.link_first_node[i];
+    if (a < 0) continue;
+    for (int k = 0; k <= sys.links[i].flexible_elements; ++k) {
+      const int node = a + k;
+      const Eigen::Vector2d arm = q0.segment<2>(3 * node) - q0.segment<2>(3 * a);
+      velocity_basis(3 * node, column) = 1.0;
+      velocity_basis(3 * node + 1, column + 1) = 1.0;
+      velocity_basis(3 * node, column + 2) = -arm.y();
+      velocity_basis(3 * node + 1, column + 2) = arm.x();
+      velocity_basis(3 * node + 2, column + 2) = 1.0;
+    }
+    column += 3;
+  }
+  AssemblyOptions assembly_options;
+  assembly_options.velocity_basis = &velocity_basis;
+  const Assembly assembled = Assemble(mechanism, 0.0, assembly_options);
+  report->counters.position_solves += 1;
+  report->counters.newton_iterations += assembled.newton_iterations;
+  if (!assembled.failure.ok()) {
+    report->Fail(FailureKind::kAssembly,
+                 absl::StrFormat("the mechanism cannot assemble at t = 0 s (driver angle %.6g rad): %s",
+                                 sys.driver.start_angle_rad, assembled.failure.reason));
+    return;
+  }
+  if (!assembled.redundant.empty()) {
+    Fail(report, absl::StrFormat("redundant constraints at joint(s) %s", absl::StrJoin(assembled.redundant, ", ")));
+    return;
+  }
+  const MotionSample at_start{0.0, assembled.q, assembled.v, Eigen::VectorXd::Zero(assembled.q.size()), {}, 0, {}};
+  LinkageState start, state;
+  ToLinkageState(mechanism, compiled, at_start, &start);
+  std::vector<double> times;
+  if (report->times_s.empty() || report->times_s.front() > 0.0) times.push_back(0.0);
+  for (double t : report->times_s) {
+    if (times.empty() || t > times.back()) times.push_back(t);
+  }
+  const size_t nt = report->times_s.size();
+  size_t next = 0;
+  std::vector<std::vector<double>> moments;
+  const MotionCallback record = [&](const MotionSample& s) {
+    if (next < nt && report->times_s[next] == s.t_s) {
+      ToLinkageState(mechanism, compiled, s, &state);
+      if (!CorotationalMoments(sys, mechanism, compiled, s, &moments)) {
+        return spec::AnalysisFailure::Of(FailureKind::kNonFiniteValue,
+                                         absl::StrFormat("flexible link nodes coincide at t = %.6g s", s.t_s));
+      }
+    }
+    for (; next < nt && report->times_s[next] == s.t_s; ++next) {
+      RecordMotion(scene, sys, start, state, next, &report->outputs);
+      RecordLoads(scene, sys, moments, -s.lambda[mechanism.row_of_driver(0)], next, &report->outputs);
+    }
+    return spec::AnalysisFailure::Ok();
+  };
+  ForwardDynamicsOptions options;
+  options.relative_tolerance = scene.integrator.relative_tolerance;
+  options.absolute_tolerance = scene.integrator.absolute_tolerance;
+  options.max_steps = scene.integrator.max_steps;
+  options.max_wall_seconds = scene.integrator.max_wall_seconds;
+  ForwardDynamicsCounters counters;
+  const spec::AnalysisFailure outcome =
+      IntegrateForward(mechanism, 0.0, assembled.q, assembled.v, times, options, record, &counters);
+  report->counters.time_steps = counters.steps;
+  report->counters.rhs_evaluations = counters.residual_evaluations;
+  report->counters.jacobian_evaluations = counters.jacobian_evaluations;
+  report->counters.newton_iterations += counters.nonlinear_iterations;
+  if (!outcome.ok()) Fail(report, outcome);
+}
+
 }  // namespace
 
 AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si) {
@@ -228,6 +347,10 @@ AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<d
 
   if (std::string why; LinkageDegreesOfFreedom(sys, &why) != 0) {
     Fail(&report, why);
+    return report;
+  }
+  if (elastic && linkage->flexible_formulation == spec::FlexibleFormulation::kCorotational) {
+    AnalyzeCorotational(scene, sys, &report);
     return report;
   }
   const CompiledLinkage compiled = CompileLinkage(sys);

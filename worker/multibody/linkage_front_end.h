@@ -38,9 +38,24 @@ struct CompiledLinkage {
     int link_a = -1, end_a = 0, link_b = -1, end_b = 0;
   };
   std::vector<PinEnds> pin_ends;
+  // Co-rotational links only: per link, its first node body (end a) and
+  // its first element in Model::beams; -1 for a bar with both pins on the
+  // ground.
+  std::vector<int> link_first_node, link_first_element;
 };
 
 CompiledLinkage CompileLinkage(const LinkageSystem& system);
+
+// The same linkage with every moving link a co-rotational flexible link
+// (flexible_link.h) of its `flexible_elements` elements: EA, EI = E A^2 /
+// (4 pi), rho A lumped at the nodes (+ rho I with rotary inertia); the pins
+// join the end nodes, the driver turns the driven link's root node (its
+// root clamped to the driver, as in the floating frame). Structural damping
+// C = beta K, beta = 2 zeta / omega_1, omega_1 the lowest first bending
+// frequency over the links alone, ends pinned or the driven root clamped
+// (closed form, as the multibody scenes' flexible links). Every moving link
+// must be flexible.
+CompiledLinkage CompileCorotationalLinkage(const LinkageSystem& system);
 
 // The number of unknowns (2 per moving pin) minus the equations (one length
 // per bar, two for the driven bar's end) of the driven linkage: it must be 0.
