@@ -182,7 +182,7 @@ spec::AnalysisFailure RunKinematics(const Mechanism& m, const Eigen::VectorXd& q
       if (spec::AnalysisFailure f = motion.Advance(state, times[i], 0, &next); !f.ok()) return f;
       state = std::move(next);
     }
-    MotionSample sample{state.t, state.q, state.v, state.a, Eigen::VectorXd(), state.branch_sign, {}};
+    MotionSample sample{state.t, state.q, state.v, state.a, Eigen::VectorXd(), {}, state.branch_sign};
     if (options.inverse_dynamics) sample.lambda = motion.Multipliers(state);
     if (spec::AnalysisFailure f = at_instant(sample); !f.ok()) return f;
   }

@@ -241,7 +241,7 @@ void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, Ana
     Fail(report, absl::StrFormat("redundant constraints at joint(s) %s", absl::StrJoin(assembled.redundant, ", ")));
     return;
   }
-  const MotionSample at_start{0.0, assembled.q, assembled.v, Eigen::VectorXd::Zero(assembled.q.size()), {}, 0, {}};
+  const MotionSample at_start{0.0, assembled.q, assembled.v, Eigen::VectorXd::Zero(assembled.q.size()), {}, {}, 0};
   LinkageState start, state;
   ToLinkageState(mechanism, compiled, at_start, &start);
   std::vector<double> times;

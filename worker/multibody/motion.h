@@ -25,11 +25,11 @@ struct MotionSample {
   double t_s = 0.0;
   Eigen::VectorXd q, v, a;
   Eigen::VectorXd lambda;  // empty when not computed
+  // One per parameter when the analysis carries sensitivities, else empty.
+  std::vector<StateSensitivity> sensitivities;
   // Driven kinematics: the sign of det(Phi_q), which changes only through a
   // locking position (0 elsewhere).
   int branch_sign = 0;
-  // One per parameter when the analysis carries sensitivities, else empty.
-  std::vector<StateSensitivity> sensitivities;
 };
 
 // A system's parameter dependence for sensitivity analysis, as central
