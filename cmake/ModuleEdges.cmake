@@ -117,19 +117,13 @@ function(mbopt_declare_modules)
   mbopt_module(lumped DIRS worker/lumped USES budget sundials spec common PURE
     LIBS mbopt_lumped_model mbopt_lumped mbopt_lumped_sensitivity
     SUMMARY "lumped scenes (small motion, linear): the model's M, K, C and inputs, dynamics with CVODES, forward sensitivities")
-  mbopt_module(model DIRS worker/model USES spec common PURE
-    LIBS mbopt_linkage_model
-    SUMMARY "the resolved linkage and its beam element (the linkage engine's model)")
-  mbopt_module(solve DIRS worker/solve USES budget sundials model spec common PURE
-    LIBS mbopt_linkage
-    SUMMARY "the linkage engine's solvers: kinematic, kinetostatic, elastodynamic")
   mbopt_module(fmu DIRS worker/fmu USES budget sundials spec PURE
     LIBS mbopt_fmu mbopt_fmu_scene
     SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
-  mbopt_module(multibody DIRS worker/multibody USES budget sundials solve spec common PURE
+  mbopt_module(multibody DIRS worker/multibody USES budget sundials spec common PURE
     LIBS mbopt_multibody
-    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities")
-  mbopt_module(engine DIRS worker/engine USES budget fmu multibody lumped solve model spec common PURE
+    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")
+  mbopt_module(engine DIRS worker/engine USES budget fmu multibody lumped spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
     SUMMARY "one analysis of a scene (the table of model kinds) and the one evaluation of a study at a design point")
   mbopt_module(local_run DIRS tests/testing/local_run USES jobs slp lp engine budget spec common PURE BRIDGE

@@ -81,10 +81,17 @@ struct Driver {
   std::optional<Number> start_angle_rad;
   Number angular_velocity_rad_per_s;
 };
+// How flexible links are analysed (docs/physics.md, section 3): small
+// elastic motion on the rigid one (floating frame, the cheap model), or
+// co-rotational beam elements whose nodes are bodies of the multibody
+// engine, integrated as forward dynamics with the driver (accurate for large
+// deflections and the frame's own rotation, many times the cost).
+enum class FlexibleFormulation { kFloatingFrame, kCorotational };
 struct LinkageModel {
   std::vector<Joint> joints;
   std::vector<Link> links;
   Driver driver;
+  FlexibleFormulation flexible_formulation = FlexibleFormulation::kFloatingFrame;
 };
 
 // ---- lumped (small motion, linear)

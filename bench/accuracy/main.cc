@@ -14,6 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "bench/accuracy/accuracy_report.h"
+#include "bench/accuracy/formulation_comparison.h"
 #include "bench/accuracy/pareto_svg.h"
 #include "bench/accuracy/sweep_plan.h"
 #include "bench/accuracy/sweep_run.h"
@@ -25,7 +26,7 @@ namespace mbopt::accuracy {
 namespace {
 
 const char kUsage[] =
-    "usage: mbopt_accuracy [--problem vehicle|fourbar_rigid|fourbar_elastic|landing_gear|all]\n"
+    "usage: mbopt_accuracy [--problem vehicle|fourbar_rigid|fourbar_elastic|landing_gear|formulations|all]\n"
     "                      [--out FILE] [--svg-dir DIR]\n"
     "  Run from the repository root. Default: all problems, Markdown to stdout, no plots.\n";
 
@@ -74,6 +75,11 @@ const char kNotMeasured[] = R"md(## Not yet measured
 - **Integrator choice and order limits**, the LP solver's tolerances and the move-limit
   thresholds of METHOD.md section 3 are not part of this sweep.
 )md";
+
+// Not a sweep: the two formulations of the elastic four-bar's flexible
+// links side by side (formulation_comparison.h).
+constexpr char kFormulations[] = "formulations";
+constexpr char kElasticFourBarStudy[] = "examples/fourbar/fourbar_elastic.study.textproto";
 
 struct Args {
   std::vector<std::string> problems;
@@ -147,6 +153,7 @@ int Main(int argc, char** argv) {
     }
   }
   args.problems = problem == "all" ? ProblemNames() : std::vector<std::string>{problem};
+  if (problem == "all") args.problems.push_back(kFormulations);
   std::vector<std::string> command(argv, argv + argc);
   command[0] = "mbopt_accuracy";
 
@@ -155,6 +162,18 @@ int Main(int argc, char** argv) {
   std::string body;
   std::vector<std::string> failed;
   for (const std::string& name : args.problems) {
+    if (name == kFormulations) {
+      absl::StatusOr<std::string> section = FormulationComparisonMarkdown(kElasticFourBarStudy);
+      if (!section.ok()) {
+        std::cerr << name << ": " << section.status() << "\n";
+        absl::StrAppend(&body, "## Flexible-link formulations\n\nCould not be run: `", section.status().ToString(),
+                        "`\n\n");
+        failed.push_back(name);
+      } else {
+        absl::StrAppend(&body, *section);
+      }
+      continue;
+    }
     SweepPlan plan;
     if (!MakeSweepPlan(name, &plan)) {
       std::cerr << "unknown problem " << name << "\n" << kUsage;

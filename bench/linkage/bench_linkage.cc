@@ -3,7 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include "tests/linkage/linkage_scenes.h"
-#include "worker/solve/linkage_analysis.h"
+#include "worker/multibody/linkage_analysis.h"
 
 namespace mbopt {
 namespace {
@@ -14,7 +14,7 @@ void BM_LandingGearKinematic(benchmark::State& state) {
   const std::vector<double> p =
       linkage_testing::LandingGearDesign({100, 110, 130, 110, 160, 155, 180, 100, -2.0});
   for (auto _ : state) {
-    spec::AnalysisReport r = solve::AnalyzeLinkage(scene, p);
+    spec::AnalysisReport r = multibody::AnalyzeLinkageScene(scene, p);
     if (!r.ok()) state.SkipWithError(r.failure.reason.c_str());
     benchmark::DoNotOptimize(r);
   }
@@ -26,7 +26,7 @@ void BM_FourBarKinetostatic(benchmark::State& state) {
   const spec::Scene scene = linkage_testing::FourBarScene();
   const std::vector<double> p = {9.65e-4, 3.92e-4, 2.69e-4};
   for (auto _ : state) {
-    spec::AnalysisReport r = solve::AnalyzeLinkage(scene, p);
+    spec::AnalysisReport r = multibody::AnalyzeLinkageScene(scene, p);
     if (!r.ok()) state.SkipWithError(r.failure.reason.c_str());
     benchmark::DoNotOptimize(r);
   }
@@ -43,7 +43,7 @@ void BM_FourBarElastodynamic(benchmark::State& state) {
   const spec::Scene scene = linkage_testing::FourBarScene(o);
   const std::vector<double> p = {9.65e-4, 3.92e-4, 2.69e-4};
   for (auto _ : state) {
-    spec::AnalysisReport r = solve::AnalyzeLinkage(scene, p);
+    spec::AnalysisReport r = multibody::AnalyzeLinkageScene(scene, p);
     if (!r.ok()) state.SkipWithError(r.failure.reason.c_str());
     state.counters["steps"] = static_cast<double>(r.counters.time_steps);
     benchmark::DoNotOptimize(r);

@@ -116,6 +116,24 @@ LinkageModel SceneConverter::ConvertLinkage(const v1::LinkageModel& m, const Whe
         Num(dw, "angular_velocity_rad_per_s", d.has_angular_velocity_rad_per_s(),
             d.angular_velocity_rad_per_s(), Dimension::kAngularVelocity);
   }
+  switch (m.flexible_formulation()) {
+    case v1::FLEXIBLE_FORMULATION_UNSPECIFIED:
+    case v1::FLEXIBLE_FORMULATION_FLOATING_FRAME:
+      out.flexible_formulation = FlexibleFormulation::kFloatingFrame;
+      break;
+    case v1::FLEXIBLE_FORMULATION_COROTATIONAL:
+      out.flexible_formulation = FlexibleFormulation::kCorotational;
+      break;
+    default:
+      errors_.Add(w, "flexible_formulation", "expected FLEXIBLE_FORMULATION_FLOATING_FRAME or "
+                                             "FLEXIBLE_FORMULATION_COROTATIONAL");
+  }
+  if (m.flexible_formulation() != v1::FLEXIBLE_FORMULATION_UNSPECIFIED &&
+      std::none_of(out.links.begin(), out.links.end(), [](const Link& l) { return l.flexible_elements > 0; })) {
+    errors_.Add(w, "flexible_formulation",
+                "chooses how flexible links are analysed, but no link is flexible: give the links a `flexible` "
+                "block or remove the field");
+  }
   linkage_links_ = links;
   linkage_joints_ = joints;
   return out;

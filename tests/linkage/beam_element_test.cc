@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "worker/model/beam_element.h"
+#include "worker/multibody/floating_frame_beam.h"
 #include "worker/sundials/cvodes_integrator.h"
 
 namespace mbopt {
@@ -22,14 +22,14 @@ constexpr double kLength = 0.9144, kArea = 4e-4, kE = 6.895e10, kRho = 2757;
 const double kI = kArea * kArea / (4 * std::numbers::pi);
 
 Beam Assemble(int n, double rotary_inertia = 0.0) {
-  model::BeamSection s;
+  multibody::floating_frame::BeamSection s;
   s.length_m = kLength / n;
   s.axial_stiffness_n = kE * kArea;
   s.bending_stiffness_n_m2 = kE * kI;
   s.mass_per_length_kg_per_m = kRho * kArea;
   s.rotary_inertia_kg_m = rotary_inertia;
-  const model::BeamMatrix ke = model::BeamStiffness(s), me = model::BeamConsistentMass(s);
-  const model::BeamMatrix kge = model::BeamGeometricStiffness(s.length_m, 1.0);
+  const multibody::floating_frame::BeamMatrix ke = multibody::floating_frame::BeamStiffness(s), me = multibody::floating_frame::BeamConsistentMass(s);
+  const multibody::floating_frame::BeamMatrix kge = multibody::floating_frame::BeamGeometricStiffness(s.length_m, 1.0);
   const int nd = 3 * (n + 1);
   Beam b{Eigen::MatrixXd::Zero(nd, nd), Eigen::MatrixXd::Zero(nd, nd), Eigen::MatrixXd::Zero(nd, nd)};
   for (int e = 0; e < n; ++e) {

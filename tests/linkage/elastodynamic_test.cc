@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/linkage/linkage_scenes.h"
-#include "worker/solve/linkage_analysis.h"
+#include "worker/multibody/linkage_analysis.h"
 
 namespace mbopt {
 namespace {
@@ -31,14 +31,14 @@ constexpr double kPointwiseFraction = 2e-3;
 constexpr double kPeakFraction = 1.5e-3;
 
 TEST(ElasticFourBar, StiffLinksApproachKinetostaticStresses) {
-  const spec::AnalysisReport rigid = solve::AnalyzeLinkage(FourBarScene(), kReportOptimum);
+  const spec::AnalysisReport rigid = multibody::AnalyzeLinkageScene(FourBarScene(), kReportOptimum);
   ASSERT_TRUE(rigid.ok()) << rigid.failure.reason;
   FourBarOptions stiff;
   stiff.elements = 6;
   stiff.youngs_modulus_pa *= 100;
   stiff.rotary_inertia = false;
   stiff.damping = true;
-  const spec::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(stiff), kReportOptimum);
+  const spec::AnalysisReport elastic = multibody::AnalyzeLinkageScene(FourBarScene(stiff), kReportOptimum);
   ASSERT_TRUE(elastic.ok()) << elastic.failure.reason;
   EXPECT_EQ(elastic.formulation, spec::Formulation::kElastodynamic);
   EXPECT_GT(elastic.counters.time_steps, 0);
@@ -83,7 +83,7 @@ TEST(ElasticFourBar, ReportOptimumHasEveryLinkNearTheAllowableStress) {
   report.elements = 6;
   report.rotary_inertia = true;
   report.damping = true;
-  const spec::AnalysisReport elastic = solve::AnalyzeLinkage(FourBarScene(report), kReportOptimum);
+  const spec::AnalysisReport elastic = multibody::AnalyzeLinkageScene(FourBarScene(report), kReportOptimum);
   ASSERT_TRUE(elastic.ok()) << elastic.failure.reason;
   for (size_t link = 0; link < 3; ++link) {
     double peak = 0.0;
@@ -102,8 +102,8 @@ TEST(ElasticFourBar, RepeatedAnalysesAreBitIdentical) {
   o.rotary_inertia = true;
   o.damping = true;
   const spec::Scene scene = FourBarScene(o);
-  const spec::AnalysisReport first = solve::AnalyzeLinkage(scene, kReportOptimum);
-  const spec::AnalysisReport second = solve::AnalyzeLinkage(scene, kReportOptimum);
+  const spec::AnalysisReport first = multibody::AnalyzeLinkageScene(scene, kReportOptimum);
+  const spec::AnalysisReport second = multibody::AnalyzeLinkageScene(scene, kReportOptimum);
   ASSERT_TRUE(first.ok()) << first.failure.reason;
   ASSERT_TRUE(second.ok()) << second.failure.reason;
   EXPECT_EQ(first.counters.time_steps, second.counters.time_steps);
@@ -118,7 +118,7 @@ TEST(ElasticFourBar, RigidLinkInFlexibleLinkageIsReported) {
   o.elements = 6;
   spec::Scene scene = FourBarScene(o);
   std::get<spec::LinkageModel>(scene.model).links[2].flexible_elements = 0;
-  const spec::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  const spec::AnalysisReport r = multibody::AnalyzeLinkageScene(scene, kReportOptimum);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.failure.kind, spec::FailureKind::kInvalidModel);
   EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("link 'rocker'"));
@@ -129,7 +129,7 @@ TEST(ElasticFourBar, IntegratorGivingUpIsAFailedAnalysisNamingTheTime) {
   o.elements = 6;
   spec::Scene scene = FourBarScene(o);
   scene.integrator.max_steps = 50;  // far too few for 0.5 s
-  const spec::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  const spec::AnalysisReport r = multibody::AnalyzeLinkageScene(scene, kReportOptimum);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.failure.kind, spec::FailureKind::kIntegrator);
   EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("elastodynamic integration failed before t = 0.3 s"));
@@ -145,7 +145,7 @@ TEST(ElasticFourBar, LinkBucklingIsAFailedAnalysisNamingTheLink) {
   o.elements = 6;
   o.rotary_inertia = true;
   o.damping = true;
-  const spec::AnalysisReport r = solve::AnalyzeLinkage(FourBarScene(o), {1e-4, 2e-5, 2e-5});
+  const spec::AnalysisReport r = multibody::AnalyzeLinkageScene(FourBarScene(o), {1e-4, 2e-5, 2e-5});
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.failure.kind, spec::FailureKind::kModelValidity);
   EXPECT_THAT(r.failure.reason, ::testing::HasSubstr("link 'coupler'"));
@@ -158,7 +158,7 @@ TEST(ElasticFourBar, KinematicOutputsOfFlexibleLinkageNeedNoIntegration) {
   o.elements = 6;
   spec::Scene scene = FourBarScene(o);
   scene.outputs = {linkage_testing::JointOutput("B_y", 2, spec::Axis::kY)};
-  const spec::AnalysisReport r = solve::AnalyzeLinkage(scene, kReportOptimum);
+  const spec::AnalysisReport r = multibody::AnalyzeLinkageScene(scene, kReportOptimum);
   ASSERT_TRUE(r.ok()) << r.failure.reason;
   EXPECT_EQ(r.formulation, spec::Formulation::kKinematic);
   EXPECT_EQ(r.counters.time_steps, 0);

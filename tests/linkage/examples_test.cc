@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
-#include "worker/solve/linkage_analysis.h"
+#include "worker/multibody/linkage_analysis.h"
 
 namespace mbopt {
 namespace {
@@ -19,7 +19,7 @@ std::string Example(const std::string& relative) {
 spec::AnalysisReport AnalyzeInitial(const spec::Study& study) {
   std::vector<double> x;
   for (const spec::DesignVariable& v : study.variables) x.push_back(v.initial);
-  return solve::AnalyzeLinkage(study.scene, study.ParameterValuesAt(x));
+  return multibody::AnalyzeLinkageScene(study.scene, study.ParameterValuesAt(x));
 }
 
 const spec::OutputValues& Output(const spec::AnalysisReport& r, const std::string& name) {

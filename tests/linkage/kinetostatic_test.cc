@@ -6,11 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/linkage/follow_linkage.h"
 #include "tests/linkage/linkage_scenes.h"
-#include "worker/model/linkage_model.h"
-#include "worker/solve/kinematic_solver.h"
-#include "worker/solve/kinetostatic_solver.h"
-#include "worker/solve/linkage_analysis.h"
+#include "worker/multibody/linkage_analysis.h"
 
 namespace mbopt {
 namespace {
@@ -26,7 +24,7 @@ struct Ratios {
 };
 
 Ratios MaxStressRatios(const std::vector<double>& areas) {
-  const spec::AnalysisReport r = solve::AnalyzeLinkage(FourBarScene(), areas);
+  const spec::AnalysisReport r = multibody::AnalyzeLinkageScene(FourBarScene(), areas);
   EXPECT_TRUE(r.ok()) << r.failure.reason;
   EXPECT_EQ(r.formulation, spec::Formulation::kKinetostatic);
   EXPECT_EQ(r.counters.time_steps, 0);
@@ -80,24 +78,19 @@ TEST(RigidFourBarStress, StressScalesAsInverseSquareRootOfUniformAreaScale) {
 void CheckEquilibriumAndPower(bool gravity) {
   spec::Scene scene = FourBarScene();
   if (gravity) scene.effects.gravity_m_per_s2 = linkage_testing::At(0.0, -9.81);
-  auto sys = model::ResolveLinkage(std::get<spec::LinkageModel>(scene.model), scene.effects,
-                                   {0.01, 0.02, 0.03});
-  ASSERT_TRUE(sys.ok());
-  solve::KinematicSolver kin(*sys);
-  ASSERT_TRUE(kin.Start().ok());
-  solve::KinetostaticSolver statics(*sys);
-  solve::KinetostaticLoads loads;
   const double omega = 10 * std::numbers::pi;
   const Eigen::Vector2d g = gravity ? Eigen::Vector2d(0.0, -9.81) : Eigen::Vector2d::Zero();
-  for (int i = 1; i <= 40; ++i) {
-    ASSERT_TRUE(kin.AdvanceTo(0.005 * i).ok());
-    const solve::LinkageState& s = kin.state();
-    ASSERT_TRUE(statics.Solve(s, &loads).ok());
+  std::vector<double> times;
+  for (int i = 0; i <= 40; ++i) times.push_back(0.005 * i);
+  int instants = 0;
+  const auto at = [&](const multibody::LinkageSystem& system, const multibody::LinkageState& s,
+                      const multibody::RigidBarLoads& loads) {
+    ++instants;
     double scale = std::abs(loads.drive_torque_n_m);
     for (size_t l = 0; l < 3; ++l) {
       for (double m : loads.node_moment_n_m[l]) scale = std::max(scale, std::abs(m));
     }
-    // Round-off of a 13x13 solve relative to the largest moment.
+    // Round-off of the 9x9 multiplier solve relative to the largest moment.
     const double tol = 1e-10 * scale;
     EXPECT_NEAR(loads.node_moment_n_m[0].back(), 0.0, tol);   // crank at A
     EXPECT_NEAR(loads.node_moment_n_m[1].front(), 0.0, tol);  // coupler at A
@@ -108,7 +101,7 @@ void CheckEquilibriumAndPower(bool gravity) {
     // Slender rods: dT/dt = m (v_a.a_a/3 + (v_a.a_b + v_b.a_a)/6 + v_b.a_b/3);
     // gravity's power m g.(v_a + v_b)/2.
     double power = 0.0;
-    for (const model::LinkageLink& l : sys->links) {
+    for (const multibody::LinkageLink& l : system.links) {
       const double mass = l.mass_per_length_kg_per_m() * l.length_m;
       const auto& va = s.velocity_m_per_s[static_cast<size_t>(l.joint_a)];
       const auto& vb = s.velocity_m_per_s[static_cast<size_t>(l.joint_b)];
@@ -118,7 +111,9 @@ void CheckEquilibriumAndPower(bool gravity) {
       power -= mass * g.dot(va + vb) / 2;
     }
     EXPECT_NEAR(loads.drive_torque_n_m * omega, power, 1e-10 * scale * omega);
-  }
+  };
+  ASSERT_TRUE(linkage_testing::FollowLinkage(scene, {0.01, 0.02, 0.03}, times, true, at));
+  EXPECT_EQ(instants, 41);
 }
 
 TEST(Kinetostatics, PinnedEndsAreMomentFreeAndPowerBalances) { CheckEquilibriumAndPower(false); }
@@ -128,8 +123,8 @@ TEST(Kinetostatics, GravityEntersOnlyWhenDeclaredAndBalancesPower) {
   // Declared gravity changes the drive torque; absent gravity does not exist.
   spec::Scene with = FourBarScene();
   with.effects.gravity_m_per_s2 = linkage_testing::At(0.0, -9.81);
-  const auto a = solve::AnalyzeLinkage(FourBarScene(), {0.01, 0.02, 0.03});
-  const auto b = solve::AnalyzeLinkage(with, {0.01, 0.02, 0.03});
+  const auto a = multibody::AnalyzeLinkageScene(FourBarScene(), {0.01, 0.02, 0.03});
+  const auto b = multibody::AnalyzeLinkageScene(with, {0.01, 0.02, 0.03});
   ASSERT_TRUE(a.ok());
   ASSERT_TRUE(b.ok());
   double diff = 0.0;

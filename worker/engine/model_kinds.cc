@@ -5,12 +5,10 @@
 
 #include "common/check.h"
 #include "worker/fmu/scene_analysis.h"
-#include "worker/multibody/scene_analysis.h"
 #include "worker/lumped/lumped_dynamics.h"
 #include "worker/lumped/lumped_sensitivity.h"
-#ifdef MBOPT_HAVE_LINKAGE
-#include "worker/solve/linkage_analysis.h"
-#endif
+#include "worker/multibody/linkage_analysis.h"
+#include "worker/multibody/scene_analysis.h"
 
 namespace mbopt::engine {
 namespace {
@@ -50,18 +48,9 @@ SensitivityAnalysis AnalyzeLumpedWithSensitivities(const spec::Scene& scene, con
   return {std::move(result.report), std::move(result.output_derivatives), ""};
 }
 
-spec::AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& p,
-                                         budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
-  // The linkage solvers keep their own wall-time limit and take no budget:
-  // a cancelled analysis is stopped before it starts, not during.
-  if (spec::AnalysisFailure spent = budget->Check(0.0); !spent.ok()) return FailedAtStart(scene, std::move(spent));
-#ifdef MBOPT_HAVE_LINKAGE
-  return solve::AnalyzeLinkage(scene, p);
-#else
-  (void)p;
-  return FailedAtStart(scene, spec::AnalysisFailure::Of(spec::FailureKind::kInvalidModel,
-                                                        "linkage scenes are not available in this build"));
-#endif
+spec::AnalysisReport AnalyzeLinkage(const spec::Scene& scene, const std::vector<double>& p,
+                                    budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  return multibody::AnalyzeLinkageScene(scene, p, budget);
 }
 
 spec::AnalysisReport AnalyzeMultibody(const spec::Scene& scene, const std::vector<double>& p,
@@ -111,12 +100,12 @@ std::vector<ModelKind> MakeTable() {
       &AnalyzeLumpedWithSensitivities};
   table[IndexOf<spec::LinkageModel>()] = {
       "linkage",
-      "kinematics, kinetostatics or floating-frame elastodynamics of a linkage (worker/solve/linkage_analysis.h)",
+      "compiled to the multibody engine: kinematics, kinetostatics (inverse dynamics), or elastodynamics of flexible links in the floating-frame or co-rotational formulation (worker/multibody/linkage_analysis.h)",
       "position_solves and newton_iterations of the kinematic continuation; time_steps, rhs_evaluations, "
       "jacobian_evaluations and newton_iterations of CVODES for flexible links",
-      &AnalyzeLinkageScene,
+      &AnalyzeLinkage,
       [](const spec::Scene&, const std::vector<int>&) {
-        return Never("a linkage analysis has no simulator sensitivities: its continuation and floating-frame "
+        return Never("a linkage analysis has no simulator sensitivities: its kinematic sweep and floating-frame "
                      "integration are not differentiated");
       },
       nullptr};

@@ -122,9 +122,15 @@ class DrivenMotion {
                             "interval between instants",
                             from.t, t, jump, scale_m_, 1 << options_.max_interval_halvings));
       }
-    } else if (locked_ || depth >= options_.max_interval_halvings) {
+    } else if (locked_) {
       // A lock is a property of the position, not of the guess: no retry.
       return result;
+    } else if (depth >= options_.max_interval_halvings) {
+      // Newton fails however close the last closed position: the loop opens
+      // there (a crank driven past a lock).
+      return spec::AnalysisFailure::Of(
+          result.kind, absl::StrFormat("the mechanism locks at t = %.6g s: no closed position beyond it; %s", from.t,
+                                       result.reason));
     }
     State middle;
     if (spec::AnalysisFailure f = Advance(from, from.t + 0.5 * dt, depth + 1, &middle); !f.ok()) return f;
@@ -185,10 +191,26 @@ spec::AnalysisFailure RunKinematics(const Mechanism& m, const Eigen::VectorXd& q
       if (spec::AnalysisFailure f = motion.Advance(state, times[i], 0, &next); !f.ok()) return f;
       state = std::move(next);
     }
-    MotionSample sample{state.t, state.q, state.v, state.a, Eigen::VectorXd(), {}};
+    MotionSample sample{state.t, state.q, state.v, state.a, Eigen::VectorXd(), {}, state.branch_sign};
     if (options.inverse_dynamics) sample.lambda = motion.Multipliers(state);
     if (spec::AnalysisFailure f = at_instant(sample); !f.ok()) return f;
   }
+  return spec::AnalysisFailure::Ok();
+}
+
+spec::AnalysisFailure SolveMotionNear(const Mechanism& m, const MotionSample& near, double t_s,
+                                      const KinematicOptions& options, MotionSample* out,
+                                      KinematicCounters* counters) {
+  DrivenMotion motion(m, options, counters);
+  const State from{near.t_s, near.q, near.v, near.a, near.branch_sign};
+  State to;
+  if (spec::AnalysisFailure f = motion.Advance(from, t_s, 0, &to); !f.ok()) return f;
+  out->t_s = to.t;
+  out->q = std::move(to.q);
+  out->v = std::move(to.v);
+  out->a = std::move(to.a);
+  out->lambda.resize(0);
+  out->branch_sign = to.branch_sign;
   return spec::AnalysisFailure::Ok();
 }
 

@@ -43,4 +43,14 @@ spec::AnalysisFailure RunKinematics(const Mechanism& mechanism, const Eigen::Vec
                                     const std::vector<double>& times_s, const KinematicOptions& options,
                                     const MotionCallback& at_instant, KinematicCounters* counters);
 
+// The driven motion at t_s solved from `near`, a sample of the same driven
+// mechanism close in time (from RunKinematics or from this function): for
+// callers that need the motion at instants of their own choosing (the
+// floating-frame elastodynamics at its integrator's steps). The same
+// predictor, interval halving and failures as RunKinematics between two
+// instants; no multipliers.
+spec::AnalysisFailure SolveMotionNear(const Mechanism& mechanism, const MotionSample& near, double t_s,
+                                      const KinematicOptions& options, MotionSample* out,
+                                      KinematicCounters* counters);
+
 }  // namespace mbopt::multibody

@@ -27,6 +27,9 @@ struct MotionSample {
   Eigen::VectorXd lambda;  // empty when not computed
   // One per parameter when the analysis carries sensitivities, else empty.
   std::vector<StateSensitivity> sensitivities;
+  // Driven kinematics: the sign of det(Phi_q), which changes only through a
+  // locking position (0 elsewhere).
+  int branch_sign = 0;
 };
 
 // A system's parameter dependence for sensitivity analysis, as central

@@ -47,14 +47,6 @@ struct CvodesIntegrator::Sundials {
 struct CvodesCallbacks {
   static int Rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) {
     auto* self = static_cast<CvodesIntegrator*>(user_data);
-    if (self->options_.max_wall_seconds > 0.0) {
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - self->start_).count();
-      if (elapsed > self->options_.max_wall_seconds) {
-        self->wall_time_exceeded_ = true;
-        return -1;
-      }
-    }
     if (self->options_.budget != nullptr && self->options_.budget->Exhausted()) {
       self->budget_failure_ = self->options_.budget->Check(t);
       if (!self->budget_failure_.ok()) return -1;
@@ -173,9 +165,8 @@ absl::Status CvodesOptions::Validate(int num_states) const {
   if (max_steps <= 0) {
     return absl::InvalidArgumentError(absl::StrCat("max_steps must be positive, got ", max_steps));
   }
-  if (max_wall_seconds < 0.0 || max_step_size < 0.0 || initial_step_size < 0.0) {
-    return absl::InvalidArgumentError(
-        "max_wall_seconds, max_step_size and initial_step_size must not be negative");
+  if (max_step_size < 0.0 || initial_step_size < 0.0) {
+    return absl::InvalidArgumentError("max_step_size and initial_step_size must not be negative");
   }
   return absl::OkStatus();
 }
@@ -186,8 +177,7 @@ CvodesIntegrator::CvodesIntegrator(int num_states, RhsFunction rhs, JacobianFunc
       rhs_(std::move(rhs)),
       jacobian_(std::move(jacobian)),
       options_(options),
-      sundials_(std::make_unique<Sundials>()),
-      start_(std::chrono::steady_clock::now()) {}
+      sundials_(std::make_unique<Sundials>()) {}
 
 CvodesIntegrator::~CvodesIntegrator() = default;
 
@@ -453,11 +443,6 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
     if (!budget_failure_.ok()) {
       t_ = t_reached;
       return BudgetStatus(budget_failure_);
-    }
-    if (wall_time_exceeded_) {
-      return absl::DeadlineExceededError(
-          absl::StrFormat("integration exceeded its wall-time limit of %g s near t = %.9g",
-                          options_.max_wall_seconds, t_reached));
     }
     std::string reason;
     switch (flag) {

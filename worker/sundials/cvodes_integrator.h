@@ -14,8 +14,8 @@
 //    convergence failures, a callback returned an unrecoverable error, NaN);
 //    the message says which and at what time. Callers that treat integrator
 //    failure as data (an analysis result) convert this into their result enum.
-//  - kDeadlineExceeded: the analysis budget's deadline passed (or the
-//    legacy max_wall_seconds elapsed); the message is the budget's reason.
+//  - kDeadlineExceeded: the analysis budget's deadline passed; the message
+//    is the budget's reason.
 //  - kCancelled: the analysis budget's cancel flag went up.
 //  - kInvalidArgument: misuse (t_out behind the current time, wrong size).
 //
@@ -23,7 +23,6 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -56,9 +55,6 @@ struct CvodesOptions {
   // The analysis' deadline and cancel flag, checked in every right-hand
   // side (null: none). Not owned; outlives the integrator.
   const budget::AnalysisBudget* budget = nullptr;
-  // Reads the process' clock itself: only for the linkage solvers, which
-  // predate budget::AnalysisBudget and go with the linkage engine. 0: no limit.
-  double max_wall_seconds = 0.0;
   double max_step_size = 0.0;      // 0: no limit
   double initial_step_size = 0.0;  // 0: CVODES' estimate
 
@@ -166,11 +162,9 @@ class CvodesIntegrator {
   double t_ = 0.0;
   std::string last_sundials_message_;
   std::string callback_failure_;
-  bool wall_time_exceeded_ = false;
   spec::AnalysisFailure budget_failure_;  // why the budget stopped the last IntegrateTo
   double stop_time_ = 0.0;
   bool stop_time_set_ = false;
-  std::chrono::steady_clock::time_point start_;
   CvodesCounters carried_;  // counters of histories ended by Restart
 };
 

@@ -1,5 +1,6 @@
-// Planar Euler-Bernoulli beam element (axial bar + cubic Hermite bending) in
-// its own local frame: x along the element, y = z x x. Local degrees of
+// The floating-frame formulation's beam element (floating_frame.h): a planar
+// Euler-Bernoulli element (axial bar + cubic Hermite bending) in its own
+// local frame, small displacements only: x along the element, y = z x x. Local degrees of
 // freedom, in this order: (u1, w1, theta1, u2, w2, theta2), with u axial and
 // w transverse displacements in m and theta rotations in rad. Stiffness in
 // N/m (N, N m per unit), consistent mass in kg (kg m, kg m^2). Uniform
@@ -8,7 +9,7 @@
 
 #include <Eigen/Dense>
 
-namespace mbopt::model {
+namespace mbopt::multibody::floating_frame {
 
 struct BeamSection {
   double length_m = 0.0;                    // element length
@@ -30,4 +31,4 @@ BeamMatrix BeamConsistentMass(const BeamSection& s);
 // P-delta moment N w); axial dofs are untouched.
 BeamMatrix BeamGeometricStiffness(double length_m, double axial_force_n);
 
-}  // namespace mbopt::model
+}  // namespace mbopt::multibody::floating_frame

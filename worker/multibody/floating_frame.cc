@@ -1,4 +1,4 @@
-#include "worker/solve/elastodynamic_solver.h"
+#include "worker/multibody/floating_frame.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,14 +6,14 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
-#include "worker/model/beam_element.h"
+#include "worker/multibody/floating_frame_beam.h"
 #include "worker/sundials/integrator_failure.h"
 
-namespace mbopt::solve {
+namespace mbopt::multibody {
 
 namespace {
 
-using model::BeamMatrix;
+using floating_frame::BeamMatrix;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 constexpr double kPi = std::numbers::pi;
 
@@ -64,9 +64,8 @@ Vector6d ToLinkFrame(double angle, const Vector6d& g) {
 
 class ElasticLinkage {
  public:
-  ElasticLinkage(const model::LinkageSystem& sys, KinematicSolver* kinematics,
-                 const std::vector<LinkageState>& trail)
-      : sys_(sys), kinematics_(kinematics), trail_(trail) {}
+  ElasticLinkage(const LinkageSystem& sys, const RigidMotionAt& rigid_motion)
+      : sys_(sys), rigid_motion_(rigid_motion) {}
 
   // Numbers the degrees of freedom and builds the element matrices.
   std::string Build() {
@@ -78,7 +77,7 @@ class ElasticLinkage {
       }
     }
     for (size_t i = 0; i < sys_.links.size(); ++i) {
-      const model::LinkageLink& l = sys_.links[i];
+      const LinkageLink& l = sys_.links[i];
       if (l.both_ground) continue;
       if (l.flexible_elements <= 0) {
         return absl::StrFormat(
@@ -89,16 +88,16 @@ class ElasticLinkage {
       mesh.link = static_cast<int>(i);
       mesh.elements = l.flexible_elements;
       mesh.element_length_m = l.length_m / l.flexible_elements;
-      model::BeamSection sec;
+      floating_frame::BeamSection sec;
       sec.length_m = mesh.element_length_m;
       sec.axial_stiffness_n = l.youngs_modulus_pa * l.area_m2;
       sec.bending_stiffness_n_m2 = l.youngs_modulus_pa * l.second_moment_m4();
       sec.mass_per_length_kg_per_m = l.mass_per_length_kg_per_m();
       sec.rotary_inertia_kg_m = l.rotary_inertia ? l.density_kg_per_m3 * l.second_moment_m4() : 0.0;
-      mesh.k = model::BeamStiffness(sec);
+      mesh.k = floating_frame::BeamStiffness(sec);
       mesh.axial_stiffness_n = sec.axial_stiffness_n;
       mesh.bending_stiffness_n_m2 = sec.bending_stiffness_n_m2;
-      mesh.m = model::BeamConsistentMass(sec);
+      mesh.m = floating_frame::BeamConsistentMass(sec);
       mesh.nodes.resize(static_cast<size_t>(mesh.elements + 1));
       const bool driven = static_cast<int>(i) == sys_.driver.link;
       for (int nd = 0; nd <= mesh.elements; ++nd) {
@@ -158,17 +157,7 @@ class ElasticLinkage {
   // Rigid motion and the assembled M, K, C, load at t (cached per t).
   bool Prepare(double t) {
     if (prepared_ && t == prepared_t_) return true;
-    auto it = std::lower_bound(trail_.begin(), trail_.end(), t,
-                               [](const LinkageState& s, double v) { return s.time_s < v; });
-    const LinkageState* near = nullptr;
-    if (it == trail_.end()) {
-      near = &trail_.back();
-    } else if (it == trail_.begin()) {
-      near = &*it;
-    } else {
-      near = (t - std::prev(it)->time_s < it->time_s - t) ? &*std::prev(it) : &*it;
-    }
-    if (KinematicOutcome o = kinematics_->SolveFrom(*near, t, &state_); !o.ok()) {
+    if (spec::AnalysisFailure o = rigid_motion_(t, &state_); !o.ok()) {
       failure_ = o;
       prepared_ = false;
       return false;
@@ -179,7 +168,7 @@ class ElasticLinkage {
     f_.setZero();
     const Eigen::Vector2d g = sys_.has_gravity ? sys_.gravity_m_per_s2 : Eigen::Vector2d::Zero();
     for (const LinkMesh& mesh : meshes_) {
-      const model::LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
+      const LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
       const double angle = state_.LinkAngle(l);
       const Eigen::Vector2d aa = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_a)];
       const Eigen::Vector2d ab = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_b)];
@@ -270,7 +259,7 @@ class ElasticLinkage {
     moments->assign(sys_.links.size(), {});
     *drive_torque = 0.0;
     for (const LinkMesh& mesh : meshes_) {
-      const model::LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
+      const LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
       const double angle = state_.LinkAngle(l);
       const Eigen::Vector2d aa = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_a)];
       const Eigen::Vector2d ab = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_b)];
@@ -313,7 +302,7 @@ class ElasticLinkage {
   static BeamMatrix GeometricStiffness(const LinkMesh& mesh, const Vector6d& local) {
     const double axial_force_n =
         mesh.axial_stiffness_n * (local(3) - local(0)) / mesh.element_length_m;
-    return model::BeamGeometricStiffness(mesh.element_length_m, axial_force_n);
+    return floating_frame::BeamGeometricStiffness(mesh.element_length_m, axial_force_n);
   }
 
   // Names the first link whose compression passed its Euler load (ends
@@ -431,9 +420,8 @@ class ElasticLinkage {
     return std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
   }
 
-  const model::LinkageSystem& sys_;
-  KinematicSolver* kinematics_;
-  const std::vector<LinkageState>& trail_;
+  const LinkageSystem& sys_;
+  const RigidMotionAt& rigid_motion_;
   std::vector<LinkMesh> meshes_;
   int n_ = 0;
   double lowest_frequency_ = 0.0;
@@ -461,43 +449,40 @@ class ElasticLinkage {
 
 }  // namespace
 
-KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
-                                  const spec::IntegratorSettings& integrator,
-                                  const std::vector<double>& times_s, KinematicSolver* kinematics,
-                                  ElastodynamicResult* result) {
-  std::vector<LinkageState> trail{kinematics->state()};
+spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::IntegratorSettings& integrator,
+                                       const std::vector<double>& times_s, const RigidMotionAt& rigid_motion,
+                                       const budget::AnalysisBudget* budget,
+                                       FloatingFrameResult* result) {
   const double t_end = times_s.empty() ? 0.0 : times_s.back();
-  if (KinematicOutcome o = kinematics->AdvanceTo(t_end, &trail); !o.ok()) return o;
-
-  ElasticLinkage elastic(system, kinematics, trail);
+  ElasticLinkage elastic(system, rigid_motion);
   if (std::string why = elastic.Build(); !why.empty()) {
-    return KinematicOutcome::Of(spec::FailureKind::kInvalidModel, why);
+    return spec::AnalysisFailure::Of(spec::FailureKind::kInvalidModel, why);
   }
   result->lowest_link_frequency_rad_per_s = elastic.lowest_frequency();
   const int n = elastic.num_dofs();
 
-  CvodesOptions options;
-  options.method = CvodesOptions::Method::kBdf;
+  solve::CvodesOptions options;
+  options.method = solve::CvodesOptions::Method::kBdf;
   options.relative_tolerance = integrator.relative_tolerance;
   options.absolute_tolerance = integrator.absolute_tolerance;
   options.max_steps = integrator.max_steps;
-  options.max_wall_seconds = integrator.max_wall_seconds;
+  options.budget = budget;
   const Eigen::VectorXd y0 = Eigen::VectorXd::Zero(2 * n);
-  auto created = CvodesIntegrator::CreateWithNewtonSolver(
+  auto created = solve::CvodesIntegrator::CreateWithNewtonSolver(
       2 * n,
       [&elastic](double t, const double* y, double* ydot) { return elastic.Rhs(t, y, ydot); },
       [&elastic](double t, double gamma, double* bx, bool* refactored) {
         return elastic.NewtonSolve(t, gamma, bx, refactored);
       },
-      CvodesIntegrator::NewtonRefresh::kEveryIteration, options, 0.0, y0);
+      solve::CvodesIntegrator::NewtonRefresh::kEveryIteration, options, 0.0, y0);
   if (!created.ok()) {
-    return KinematicOutcome::Of(spec::FailureKind::kIntegrator,
+    return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator,
         absl::StrFormat("elastodynamic integrator setup failed: %s", created.status().message()));
   }
-  CvodesIntegrator& cvodes = **created;
+  solve::CvodesIntegrator& cvodes = **created;
   if (t_end > 0.0) {
     if (absl::Status s = cvodes.SetStopTime(t_end); !s.ok()) {
-      return KinematicOutcome::Of(spec::FailureKind::kIntegrator, std::string(s.message()));
+      return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, std::string(s.message()));
     }
   }
   Eigen::VectorXd y = y0;
@@ -510,8 +495,8 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
         result->counters = cvodes.counters();
         const std::string context = absl::StrFormat("elastodynamic integration failed before t = %.6g s: ", t);
         const spec::AnalysisFailure model_failure = elastic.failure();
-        if (!model_failure.ok()) return KinematicOutcome::Of(model_failure.kind, context + model_failure.reason);
-        return IntegratorFailure(s, context + std::string(s.message()));
+        if (!model_failure.ok()) return spec::AnalysisFailure::Of(model_failure.kind, context + model_failure.reason);
+        return solve::IntegratorFailure(s, context + std::string(s.message()));
       }
     }
     std::vector<std::vector<double>> moments;
@@ -519,7 +504,7 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
     if (!elastic.Moments(t, y, &moments, &torque)) {
       result->counters = cvodes.counters();
       const spec::AnalysisFailure model_failure = elastic.failure();
-      return model_failure.ok() ? KinematicOutcome::Of(spec::FailureKind::kNonFiniteValue,
+      return model_failure.ok() ? spec::AnalysisFailure::Of(spec::FailureKind::kNonFiniteValue,
                                                        absl::StrFormat("elastic moments not finite at t = %.6g s", t))
                                 : model_failure;
     }
@@ -531,4 +516,4 @@ KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
   return {};
 }
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::multibody

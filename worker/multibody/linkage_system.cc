@@ -1,4 +1,4 @@
-#include "worker/model/linkage_model.h"
+#include "worker/multibody/linkage_system.h"
 
 #include <cmath>
 #include <numbers>
@@ -6,7 +6,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 
-namespace mbopt::model {
+namespace mbopt::multibody {
 
 double LinkageLink::second_moment_m4() const {
   return area_m2 * area_m2 / (4.0 * std::numbers::pi);
@@ -168,4 +168,34 @@ absl::StatusOr<LinkageSystem> ResolveLinkage(const spec::LinkageModel& linkage,
   return sys;
 }
 
-}  // namespace mbopt::model
+namespace {
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+}  // namespace
+
+Eigen::Vector2d LinkageState::LinkVector(const LinkageLink& link) const {
+  return position_m[static_cast<size_t>(link.joint_b)] - position_m[static_cast<size_t>(link.joint_a)];
+}
+
+double LinkageState::LinkAngle(const LinkageLink& link) const {
+  const Eigen::Vector2d d = LinkVector(link);
+  return std::atan2(d.y(), d.x());
+}
+
+double LinkageState::LinkAngularVelocity(const LinkageLink& link) const {
+  const Eigen::Vector2d d = LinkVector(link);
+  const Eigen::Vector2d v =
+      velocity_m_per_s[static_cast<size_t>(link.joint_b)] - velocity_m_per_s[static_cast<size_t>(link.joint_a)];
+  return Cross(d, v) / d.squaredNorm();
+}
+
+double LinkageState::LinkAngularAcceleration(const LinkageLink& link) const {
+  const Eigen::Vector2d d = LinkVector(link);
+  const Eigen::Vector2d v =
+      velocity_m_per_s[static_cast<size_t>(link.joint_b)] - velocity_m_per_s[static_cast<size_t>(link.joint_a)];
+  const Eigen::Vector2d a = acceleration_m_per_s2[static_cast<size_t>(link.joint_b)] -
+                            acceleration_m_per_s2[static_cast<size_t>(link.joint_a)];
+  const double d2 = d.squaredNorm();
+  return Cross(d, a) / d2 - 2.0 * d.dot(v) * Cross(d, v) / (d2 * d2);
+}
+
+}  // namespace mbopt::multibody

@@ -1,7 +1,10 @@
-// Elastodynamic analysis of a driven linkage whose moving links are planar
-// Euler-Bernoulli beams (worker/model/beam_element.h): small elastic
-// deformation superposed on the large rigid motion of the kinematic solution
-// (the kineto-elastodynamic, floating-frame approach).
+// The floating-frame formulation of flexible links (the kineto-elastodynamic
+// model): the moving links of a driven linkage as planar Euler-Bernoulli
+// beams (floating_frame_beam.h) whose small elastic deformation rides on the
+// large rigid motion the multibody kinematic analysis gives at any t
+// (RigidMotionAt). The cheap effect level: the co-rotational links of the
+// multibody engine (flexible_link.h) are the accurate one, at many times
+// the cost (docs/accuracy.md).
 //
 // Unknowns: elastic nodal displacements in the global frame. The two joints
 // of a pin share their elastic translations; each link keeps its own end
@@ -27,31 +30,34 @@
 // transmits), averaged between the two elements that meet at an inner node.
 #pragma once
 
+#include <functional>
 #include <vector>
 
+#include "spec/analysis_outcome.h"
 #include "spec/scene.h"
-#include "worker/model/linkage_model.h"
+#include "worker/budget/analysis_budget.h"
+#include "worker/multibody/linkage_system.h"
 #include "worker/sundials/cvodes_integrator.h"
-#include "worker/solve/kinematic_solver.h"
 
-namespace mbopt::solve {
+namespace mbopt::multibody {
 
-struct ElastodynamicResult {
+// The rigid reference motion at t (any t the integrator asks for).
+using RigidMotionAt = std::function<spec::AnalysisFailure(double t_s, LinkageState* state)>;
+
+struct FloatingFrameResult {
   std::vector<LinkageState> rigid_states;  // [instant]: the rigid reference motion
-  // [instant][link][node] bending moment, N m (same sign convention as the
-  // kinetostatic solver).
+  // [instant][link][node] bending moment, N m (the rigid bars' sign
+  // convention, linkage_front_end.h).
   std::vector<std::vector<std::vector<double>>> node_moment_n_m;
   std::vector<double> drive_torque_n_m;  // [instant]
-  CvodesCounters counters;
+  solve::CvodesCounters counters;
   double lowest_link_frequency_rad_per_s = 0.0;
 };
 
-// `kinematics` must have been Start()ed (t = 0); it is advanced to the last
-// instant. Fails (with a reason naming the time, or the rigid link) if a link
-// is rigid, the mechanism locks, or the integrator gives up.
-KinematicOutcome RunElastodynamic(const model::LinkageSystem& system,
-                                  const spec::IntegratorSettings& integrator,
-                                  const std::vector<double>& times_s,
-                                  KinematicSolver* kinematics, ElastodynamicResult* result);
+// Fails (with a reason naming the time, or the rigid link) if a moving link
+// is rigid, the rigid motion fails, or the integrator gives up.
+spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::IntegratorSettings& integrator,
+                                       const std::vector<double>& times_s, const RigidMotionAt& rigid_motion,
+                                       const budget::AnalysisBudget* budget, FloatingFrameResult* result);
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::multibody

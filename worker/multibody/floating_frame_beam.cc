@@ -1,6 +1,6 @@
-#include "worker/model/beam_element.h"
+#include "worker/multibody/floating_frame_beam.h"
 
-namespace mbopt::model {
+namespace mbopt::multibody::floating_frame {
 
 namespace {
 // Local index of the bending dofs (w1, theta1, w2, theta2) and axial (u1, u2).
@@ -61,4 +61,4 @@ BeamMatrix BeamGeometricStiffness(double length_m, double axial_force_n) {
   return k;
 }
 
-}  // namespace mbopt::model
+}  // namespace mbopt::multibody::floating_frame

@@ -1,11 +1,15 @@
-// LinkageSystem: a planar linkage (bars joined by revolute joints, one bar
-// driven at constant angular velocity about a ground joint) with every
-// Number resolved to SI values for one design point. It is the immutable
-// input of the kinematic, kinetostatic and elastodynamic solvers; it owns no
-// solver state. Built from spec::LinkageModel by ResolveLinkage, which
-// rejects malformed models (bad indices, non-positive lengths or section
-// data) with InvalidArgument; whether the mechanism assembles is not decided
-// here (that is a numerical outcome of the kinematic solver).
+// LinkageSystem: a planar linkage (bars joined by pins, one bar driven at
+// constant angular velocity about a ground pin) with every Number resolved
+// to SI values for one design point: the linkage scene as the multibody
+// front end (linkage_front_end.h) reads it. Built from spec::LinkageModel by
+// ResolveLinkage, which rejects malformed models (bad indices, non-positive
+// lengths or section data) with InvalidArgument; whether the mechanism
+// assembles is not decided here (that is a numerical outcome of the
+// kinematic analysis).
+//
+// LinkageState is the motion of the linkage at one instant in the scene's
+// own terms, indexed by its joints (pins): what the outputs, the rigid-bar
+// bending moments and the floating-frame elastodynamics read.
 #pragma once
 
 #include <string>
@@ -16,7 +20,7 @@
 #include "absl/status/statusor.h"
 #include "spec/scene.h"
 
-namespace mbopt::model {
+namespace mbopt::multibody {
 
 struct LinkageJoint {
   std::string name;
@@ -78,8 +82,19 @@ struct LinkageSystem {
 
 // Resolves `linkage` at one design point. `effects` supplies gravity and
 // structural damping (only where declared).
-absl::StatusOr<LinkageSystem> ResolveLinkage(const spec::LinkageModel& linkage,
-                                             const spec::Effects& effects,
+absl::StatusOr<LinkageSystem> ResolveLinkage(const spec::LinkageModel& linkage, const spec::Effects& effects,
                                              const std::vector<double>& parameter_values_si);
 
-}  // namespace mbopt::model
+// The linkage at one instant; indexed by joint (ground joints included).
+struct LinkageState {
+  double time_s = 0.0;
+  std::vector<Eigen::Vector2d> position_m, velocity_m_per_s, acceleration_m_per_s2;
+
+  // Rigid-link quantities from the joint states.
+  Eigen::Vector2d LinkVector(const LinkageLink& link) const;  // r_b - r_a
+  double LinkAngle(const LinkageLink& link) const;            // rad, atan2
+  double LinkAngularVelocity(const LinkageLink& link) const;  // rad/s
+  double LinkAngularAcceleration(const LinkageLink& link) const;  // rad/s^2
+};
+
+}  // namespace mbopt::multibody

@@ -1,0 +1,31 @@
+// Analysis of a linkage scene (spec::LinkageModel) at one design point on
+// the multibody engine: the scene resolved (linkage_system.h), compiled to a
+// Model (linkage_front_end.h), assembled at t = 0 and followed by the
+// kinematic analysis. Picks the cheapest formulation the requested outputs
+// allow:
+//  - kinematic: only positions and rotations requested;
+//  - kinetostatic: forces, stresses or drive torque of rigid links (inverse
+//    dynamics; the bending moment along each rigid bar from its pin forces
+//    and its acceleration field);
+//  - elastodynamic: the same for a linkage with flexible links, in the
+//    floating-frame formulation (floating_frame.h) on the kinematic motion.
+// A mechanism that cannot assemble, locks or changes branch, and an
+// integrator failure, give status kFailed with a reason naming the time and
+// the joint or link; never a number. Pure: no I/O, no threads.
+#pragma once
+
+#include <vector>
+
+#include "spec/analysis_report.h"
+#include "spec/scene.h"
+#include "worker/budget/analysis_budget.h"
+
+namespace mbopt::multibody {
+
+// `scene.model` must hold a LinkageModel; `parameter_values_si` has one SI
+// value per scene parameter. `budget` (none: no limit) bounds the kinematic
+// sweep, the integration and every position solve.
+spec::AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                                         budget::AnalysisBudget* budget = nullptr);
+
+}  // namespace mbopt::multibody
