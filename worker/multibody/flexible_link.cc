@@ -38,4 +38,18 @@ FlexibleLinkNodes AddFlexibleLink(const FlexibleLinkSpec& link, Model* model) {
   return nodes;
 }
 
+void SetRigidLinkVelocityColumns(const Eigen::VectorXd& q0, int first_node, int elements, int column,
+                                 Eigen::MatrixXd* velocity_basis) {
+  Eigen::MatrixXd& basis = *velocity_basis;
+  for (int k = 0; k <= elements; ++k) {
+    const int node = first_node + k;
+    const Eigen::Vector2d arm = q0.segment<2>(3 * node) - q0.segment<2>(3 * first_node);
+    basis(3 * node, column) = 1.0;
+    basis(3 * node + 1, column + 1) = 1.0;
+    basis(3 * node, column + 2) = -arm.y();
+    basis(3 * node + 1, column + 2) = arm.x();
+    basis(3 * node + 2, column + 2) = 1.0;
+  }
+}
+
 }  // namespace mbopt::multibody

@@ -44,4 +44,12 @@ struct FlexibleLinkNodes {
 };
 FlexibleLinkNodes AddFlexibleLink(const FlexibleLinkSpec& link, Model* model);
 
+// Three columns of an assembly's velocity basis (AssemblyOptions::
+// velocity_basis) from `column` on: the rigid motions (x, y, rotation about
+// node 0) of the link whose `elements` + 1 node bodies start at body
+// `first_node`, at the coordinates `q0`. Starting a flexible link with a
+// rigid-body velocity keeps its elastic modes at rest.
+void SetRigidLinkVelocityColumns(const Eigen::VectorXd& q0, int first_node, int elements, int column,
+                                 Eigen::MatrixXd* velocity_basis);
+
 }  // namespace mbopt::multibody

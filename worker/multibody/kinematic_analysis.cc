@@ -9,6 +9,11 @@
 namespace mbopt::multibody {
 namespace {
 
+// Bisections that locate a lock between the last closed position and the
+// first open one, down to this share of the time (1e-9 of 1 s).
+constexpr int kLockBisections = 60;
+constexpr double kLockTimeResolution = 1e-9;
+
 struct State {
   double t = 0.0;
   Eigen::VectorXd q, v, a;
@@ -127,10 +132,29 @@ class DrivenMotion {
       return result;
     } else if (depth >= options_.max_interval_halvings) {
       // Newton fails however close the last closed position: the loop opens
-      // there (a crank driven past a lock).
+      // between `from` and t (a crank driven past a lock). Bisect for where,
+      // so that the time printed is the lock's whatever the step between
+      // instants (a few Newton solves, once per analysis).
+      State closed = from;
+      double open_t = t;
+      spec::AnalysisFailure open_failure = std::move(result);
+      for (int k = 0; k < kLockBisections && open_t - closed.t > kLockTimeResolution * std::max(1.0, std::abs(t));
+           ++k) {
+        const double mid = 0.5 * (closed.t + open_t);
+        const double h = mid - closed.t;
+        State trial;
+        spec::AnalysisFailure f = Solve(mid, closed.q + closed.v * h + 0.5 * h * h * closed.a, &trial);
+        if (budget_spent_ || locked_) return f;
+        if (f.ok() && trial.branch_sign == closed.branch_sign) {
+          closed = std::move(trial);
+        } else {
+          open_t = mid;
+          if (!f.ok()) open_failure = std::move(f);
+        }
+      }
       return spec::AnalysisFailure::Of(
-          result.kind, absl::StrFormat("the mechanism locks at t = %.6g s: no closed position beyond it; %s", from.t,
-                                       result.reason));
+          open_failure.kind, absl::StrFormat("the mechanism locks at t = %.6g s: no closed position beyond it; %s",
+                                             closed.t, open_failure.reason));
     }
     State middle;
     if (spec::AnalysisFailure f = Advance(from, from.t + 0.5 * dt, depth + 1, &middle); !f.ok()) return f;

@@ -9,6 +9,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "worker/multibody/assembly.h"
+#include "worker/multibody/flexible_link.h"
 #include "worker/multibody/floating_frame.h"
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/kinematic_analysis.h"
@@ -215,15 +216,7 @@ void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, bud
   for (size_t i = 0; i < sys.links.size(); ++i) {
     const int a = compiled.link_first_node[i];
     if (a < 0) continue;
-    for (int k = 0; k <= sys.links[i].flexible_elements; ++k) {
-      const int node = a + k;
-      const Eigen::Vector2d arm = q0.segment<2>(3 * node) - q0.segment<2>(3 * a);
-      velocity_basis(3 * node, column) = 1.0;
-      velocity_basis(3 * node + 1, column + 1) = 1.0;
-      velocity_basis(3 * node, column + 2) = -arm.y();
-      velocity_basis(3 * node + 1, column + 2) = arm.x();
-      velocity_basis(3 * node + 2, column + 2) = 1.0;
-    }
+    SetRigidLinkVelocityColumns(q0, a, sys.links[i].flexible_elements, column, &velocity_basis);
     column += 3;
   }
   AssemblyOptions assembly_options;

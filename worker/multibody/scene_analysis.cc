@@ -399,17 +399,8 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     velocity_basis.topLeftCorner(3 * rigid, 3 * rigid).setIdentity();
     const Eigen::VectorXd q0 = mechanism.InitialGuess();
     for (size_t i = 0; i < sm.flexible_links.size(); ++i) {
-      const int column = 3 * rigid + 3 * static_cast<int>(i);
-      const int a = LinkNode(sm, static_cast<int>(i), 0);
-      for (int k = 0; k <= sm.flexible_links[i].elements; ++k) {
-        const int node = LinkNode(sm, static_cast<int>(i), k);
-        const Eigen::Vector2d arm = q0.segment<2>(3 * node) - q0.segment<2>(3 * a);
-        velocity_basis(3 * node, column) = 1.0;
-        velocity_basis(3 * node + 1, column + 1) = 1.0;
-        velocity_basis(3 * node, column + 2) = -arm.y();
-        velocity_basis(3 * node + 1, column + 2) = arm.x();
-        velocity_basis(3 * node + 2, column + 2) = 1.0;
-      }
+      SetRigidLinkVelocityColumns(q0, LinkNode(sm, static_cast<int>(i), 0), sm.flexible_links[i].elements,
+                                  3 * rigid + 3 * static_cast<int>(i), &velocity_basis);
     }
     assembly_options.velocity_basis = &velocity_basis;
   }

@@ -52,7 +52,7 @@ class Client:
         A study the server refuses raises BadInput with its message, each
         field named with its file and line as `mbopt submit` names it."""
         study_file = StudyFile(study_path)
-        request = service_pb2.SubmitJobRequest(study=study_file.study, source_name=study_file.path)
+        request = service_pb2.SubmitJobRequest(study=study_file.study.SerializeToString(), source_name=study_file.path)
         try:
             return self._call(self._jobs.Submit, request).job_id
         except BadInput as e:
