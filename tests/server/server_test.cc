@@ -75,11 +75,16 @@ class ServerTest : public ::testing::Test {
 
   // The call's status; the new job's id in *job_id when it succeeds.
   static grpc::Status TrySubmit(MboptServer& server, const v1::Study& study, std::string* job_id = nullptr) {
+    return TrySubmitFrom(server, study, study.name() + ".study.textproto", job_id);
+  }
+  // The same as sent from the file `source_name` ("": none given).
+  static grpc::Status TrySubmitFrom(MboptServer& server, const v1::Study& study, const std::string& source_name,
+                                    std::string* job_id = nullptr) {
     auto stub = v1::JobService::NewStub(server.InProcessChannel());
     grpc::ClientContext context;
     v1::SubmitJobRequest request;
     request.set_study(study.SerializeAsString());
-    request.set_source_name(study.name() + ".study.textproto");
+    if (!source_name.empty()) request.set_source_name(source_name);
     v1::SubmitJobResponse response;
     grpc::Status status = stub->Submit(&context, request, &response);
     if (job_id != nullptr) *job_id = response.job_id();
@@ -808,16 +813,11 @@ TEST_F(ServerTest, BadStudyIsInvalidArgumentNamingTheField) {
   auto server = StartServer("a.db");
   v1::Study study = OscillatorStudy();
   study.mutable_variables(1)->set_parameter("no_such_parameter");
-  auto stub = v1::JobService::NewStub(server->InProcessChannel());
-  grpc::ClientContext context;
-  v1::SubmitJobRequest request;
-  request.set_study(study.SerializeAsString());
-  request.set_source_name("bad.study.textproto");
-  v1::SubmitJobResponse response;
-  grpc::Status status = stub->Submit(&context, request, &response);
+  grpc::Status status = TrySubmitFrom(*server, study, "bad.study.textproto");
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("bad.study.textproto"));
   EXPECT_THAT(status.error_message(), HasSubstr("no_such_parameter"));
+  auto stub = v1::JobService::NewStub(server->InProcessChannel());
   grpc::ClientContext list_context;
   v1::ListJobsResponse jobs;
   ASSERT_TRUE(stub->List(&list_context, v1::ListJobsRequest(), &jobs).ok());
@@ -828,12 +828,7 @@ TEST_F(ServerTest, AStudySentWithoutASourceNameIsTheSubmittedStudyInMessages) {
   auto server = StartServer("a.db");
   v1::Study study = OscillatorStudy();
   study.mutable_variables(1)->set_parameter("no_such_parameter");
-  auto stub = v1::JobService::NewStub(server->InProcessChannel());
-  grpc::ClientContext context;
-  v1::SubmitJobRequest request;
-  request.set_study(study.SerializeAsString());
-  v1::SubmitJobResponse response;
-  grpc::Status status = stub->Submit(&context, request, &response);
+  grpc::Status status = TrySubmitFrom(*server, study, "");
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("the submitted study"));
   EXPECT_THAT(status.error_message(), HasSubstr("no_such_parameter"));

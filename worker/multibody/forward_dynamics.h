@@ -25,6 +25,7 @@
 #include <Eigen/Dense>
 
 #include "spec/analysis_outcome.h"
+#include "spec/scene.h"
 #include "worker/budget/analysis_budget.h"
 #include "worker/multibody/constrained_system.h"
 #include "worker/multibody/motion.h"
@@ -39,6 +40,16 @@ struct ForwardDynamicsOptions {
   // (null: none).
   const budget::AnalysisBudget* budget = nullptr;
   double max_step_size = 0.0;        // 0: no limit
+
+  // A scene's integrator settings (tolerances, step budget) within `budget`.
+  static ForwardDynamicsOptions Of(const spec::IntegratorSettings& integrator, const budget::AnalysisBudget* budget) {
+    ForwardDynamicsOptions options;
+    options.relative_tolerance = integrator.relative_tolerance;
+    options.absolute_tolerance = integrator.absolute_tolerance;
+    options.max_steps = integrator.max_steps;
+    options.budget = budget;
+    return options;
+  }
 };
 
 struct ForwardDynamicsCounters {

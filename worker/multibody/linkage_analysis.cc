@@ -259,11 +259,7 @@ void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, bud
     }
     return spec::AnalysisFailure::Ok();
   };
-  ForwardDynamicsOptions options;
-  options.relative_tolerance = scene.integrator.relative_tolerance;
-  options.absolute_tolerance = scene.integrator.absolute_tolerance;
-  options.max_steps = scene.integrator.max_steps;
-  options.budget = budget;
+  ForwardDynamicsOptions options = ForwardDynamicsOptions::Of(scene.integrator, budget);
   ForwardDynamicsCounters counters;
   const spec::AnalysisFailure outcome =
       IntegrateForward(mechanism, 0.0, assembled.q, assembled.v, times, options, record, &counters);

@@ -528,11 +528,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     report.counters.newton_iterations += counters.newton_iterations;
   } else {
     report.formulation = spec::Formulation::kDynamic;
-    ForwardDynamicsOptions options;
-    options.relative_tolerance = scene.integrator.relative_tolerance;
-    options.absolute_tolerance = scene.integrator.absolute_tolerance;
-    options.max_steps = scene.integrator.max_steps;
-    options.budget = budget;
+    ForwardDynamicsOptions options = ForwardDynamicsOptions::Of(scene.integrator, budget);
     ForwardDynamicsCounters counters;
     ForwardSensitivityInput input;
     if (with_derivatives) {
