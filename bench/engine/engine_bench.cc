@@ -74,11 +74,11 @@ BENCHMARK(BM_VehicleAnalysisAndValues_Rtol1e8)->Unit(benchmark::kMicrosecond);
 void BM_VehicleLumpedMethod_Rtol1e6(benchmark::State& state) {
   const mbopt::spec::Study study = LoadVehicle(1e-6);
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
-  mbopt::solve::LumpedDynamicsOptions options;
+  mbopt::lumped::LumpedDynamicsOptions options;
   options.adams = state.range(0) > 0;
   options.fixed_point = state.range(0) > 1;
   for (auto _ : state) {
-    mbopt::spec::AnalysisReport report = mbopt::solve::SimulateLumped(study.scene, p, options);
+    mbopt::spec::AnalysisReport report = mbopt::lumped::SimulateLumped(study.scene, p, options);
     benchmark::DoNotOptimize(report);
     state.counters["steps"] = static_cast<double>(report.counters.time_steps);
   }

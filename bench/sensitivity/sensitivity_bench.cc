@@ -28,7 +28,7 @@
 
 namespace {
 
-using mbopt::solve::LumpedSensitivityOptions;
+using mbopt::lumped::LumpedSensitivityOptions;
 using Derivatives = std::vector<std::vector<std::vector<double>>>;
 
 mbopt::spec::Study LoadVehicle() {
@@ -63,7 +63,7 @@ const Derivatives& Reference() {
     options.method = LumpedSensitivityOptions::Method::kCvodesSensitivities;
     options.corrector = LumpedSensitivityOptions::Corrector::kSimultaneous;
     options.error_control = true;
-    const auto result = mbopt::solve::SimulateLumpedWithSensitivities(
+    const auto result = mbopt::lumped::SimulateLumpedWithSensitivities(
         study.scene, study.ParameterValuesAt(InitialDesign(study)), SensitivityParameters(study),
         options);
     if (!result.report.ok()) {
@@ -119,9 +119,9 @@ void RunSensitivities(benchmark::State& state, const LumpedSensitivityOptions& o
   const std::vector<double> p = study.ParameterValuesAt(InitialDesign(study));
   const std::vector<int> parameters = SensitivityParameters(study);
   Reference();
-  mbopt::solve::LumpedSensitivityResult result;
+  mbopt::lumped::LumpedSensitivityResult result;
   for (auto _ : state) {
-    result = mbopt::solve::SimulateLumpedWithSensitivities(study.scene, p, parameters, options);
+    result = mbopt::lumped::SimulateLumpedWithSensitivities(study.scene, p, parameters, options);
     if (!result.report.ok()) {
       state.SkipWithError(result.report.failure.reason.c_str());
       return;

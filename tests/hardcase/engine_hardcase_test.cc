@@ -100,13 +100,13 @@ TEST(HardcaseStiffVehicle, StiffTyresAnalyseAndOptimizeToAFiniteEnd) {
   EXPECT_GT(x0->counters.jacobian_evaluations, 0);
   EXPECT_TRUE(std::isfinite(x0->values->objective));
 
-  solve::LumpedDynamicsOptions explicit_like;
+  lumped::LumpedDynamicsOptions explicit_like;
   explicit_like.adams = true;
   explicit_like.fixed_point = true;
   const Eigen::VectorXd x0_scaled = InitialDesign(study);
   const std::vector<double> x0_parameters =
       study.ParameterValuesAt(std::vector<double>(x0_scaled.data(), x0_scaled.data() + x0_scaled.size()));
-  const spec::AnalysisReport adams = solve::SimulateLumped(study.scene, x0_parameters, explicit_like);
+  const spec::AnalysisReport adams = lumped::SimulateLumped(study.scene, x0_parameters, explicit_like);
   std::cout << "[hardcase] stiff vehicle x0: F " << x0->values->objective << ", BDF time steps "
             << x0->counters.time_steps << ", jacobians " << x0->counters.jacobian_evaluations << ", wall "
             << x0->counters.wall_seconds << " s; Adams/fixed-point: "

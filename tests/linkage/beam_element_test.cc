@@ -197,11 +197,11 @@ TEST(BeamElement, UndampedFreeVibrationConservesEnergy) {
   auto energy = [&](const Eigen::VectorXd& y) {
     return 0.5 * y.head(nd).dot(k * y.head(nd)) + 0.5 * y.tail(nd).dot(m * y.tail(nd));
   };
-  solve::CvodesOptions options;
-  options.method = solve::CvodesOptions::Method::kAdams;
+  sundials::CvodesOptions options;
+  options.method = sundials::CvodesOptions::Method::kAdams;
   options.relative_tolerance = 1e-10;
   options.absolute_tolerance = 1e-14;
-  auto integrator = solve::CvodesIntegrator::Create(
+  auto integrator = sundials::CvodesIntegrator::Create(
       2 * nd,
       [&](double, const double* y, double* ydot) {
         Eigen::Map<const Eigen::VectorXd> u(y, nd), v(y + nd, nd);

@@ -13,7 +13,7 @@
 #include "tests/testing/fake_clock.h"
 #include "worker/sundials/integrator_failure.h"
 
-namespace mbopt::solve {
+namespace mbopt::sundials {
 namespace {
 
 using ::testing::HasSubstr;
@@ -264,4 +264,4 @@ TEST(CvodesIntegrator, PerStateAbsoluteTolerancesAreAccepted) {
 }
 
 }  // namespace
-}  // namespace mbopt::solve
+}  // namespace mbopt::sundials

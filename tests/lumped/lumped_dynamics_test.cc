@@ -11,7 +11,7 @@
 #include "tests/testing/fake_clock.h"
 #include "worker/lumped/lumped_model.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 namespace {
 
 using ::testing::HasSubstr;
@@ -182,7 +182,7 @@ TEST(LumpedDynamics, UndampedFreeVibrationConservesEnergy) {
   };
   spec_model.elements = {spring(0, 0.5, -1, 1000), spring(0, -0.5, -1, 1500),
                          spring(0, 0.5, 1, 300)};
-  auto model = model::LumpedModel::Assemble(spec_model, {});
+  auto model = lumped::LumpedModel::Assemble(spec_model, {});
   ASSERT_TRUE(model.ok()) << model.status();
   spec::IntegratorSettings settings;
   settings.relative_tolerance = 1e-10;
@@ -316,7 +316,7 @@ TEST(LumpedDynamics, BodyDisplacementAndVelocityMatchTheClosedForm) {
 
 TEST(LumpedModel, KinksAreTheBumpStartsAndEndsInsideTheInterval) {
   spec::Scene scene = OneDofScene(OneDof(), true);
-  auto model = model::LumpedModel::Assemble(std::get<spec::LumpedModel>(scene.model), {800.0});
+  auto model = lumped::LumpedModel::Assemble(std::get<spec::LumpedModel>(scene.model), {800.0});
   ASSERT_TRUE(model.ok());
   EXPECT_THAT(
       model->KinkTimes(0.0, 1.0),
@@ -326,4 +326,4 @@ TEST(LumpedModel, KinksAreTheBumpStartsAndEndsInsideTheInterval) {
 }
 
 }  // namespace
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

@@ -11,7 +11,7 @@
 #include "spec/io/study_io.h"
 #include "worker/lumped/lumped_sensitivity.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 namespace {
 
 using Derivatives = std::vector<std::vector<std::vector<double>>>;
@@ -151,4 +151,4 @@ TEST(LumpedSensitivityMethods, StepLimitIsAFailedAnalysisWithReasonForEitherMeth
 }
 
 }  // namespace
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

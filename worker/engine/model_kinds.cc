@@ -34,17 +34,17 @@ std::string Never(const char* why) { return why; }
 
 spec::AnalysisReport AnalyzeLumped(const spec::Scene& scene, const std::vector<double>& p,
                                    budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
-  solve::LumpedDynamicsOptions options;
+  lumped::LumpedDynamicsOptions options;
   options.budget = budget;
-  return solve::SimulateLumped(scene, p, options);
+  return lumped::SimulateLumped(scene, p, options);
 }
 
 SensitivityAnalysis AnalyzeLumpedWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
                                                    const std::vector<int>& parameters,
                                                    budget::AnalysisBudget* budget) {
-  solve::LumpedSensitivityOptions options;
+  lumped::LumpedSensitivityOptions options;
   options.budget = budget;
-  solve::LumpedSensitivityResult result = solve::SimulateLumpedWithSensitivities(scene, p, parameters, options);
+  lumped::LumpedSensitivityResult result = lumped::SimulateLumpedWithSensitivities(scene, p, parameters, options);
   return {std::move(result.report), std::move(result.output_derivatives), ""};
 }
 
@@ -95,7 +95,7 @@ std::vector<ModelKind> MakeTable() {
       "of CVODES",
       &AnalyzeLumped,
       [](const spec::Scene& scene, const std::vector<int>& parameters) {
-        return solve::LumpedSensitivityUnavailable(scene, parameters);
+        return lumped::LumpedSensitivityUnavailable(scene, parameters);
       },
       &AnalyzeLumpedWithSensitivities};
   table[IndexOf<spec::LinkageModel>()] = {

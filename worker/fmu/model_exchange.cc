@@ -17,7 +17,6 @@
 namespace mbopt::fmu::internal {
 namespace {
 
-namespace sundials = solve::sundials;
 
 // What the CVODES callbacks need, through their user data.
 struct Callbacks {

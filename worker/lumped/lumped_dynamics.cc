@@ -13,7 +13,7 @@
 #include "worker/sundials/integrate_across_kinks.h"
 #include "worker/lumped/lumped_newton_operator.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 namespace {
 
 spec::AnalysisReport Failed(spec::AnalysisReport report, spec::FailureKind kind, std::string reason) {
@@ -35,7 +35,7 @@ struct OutputPlan {
 
 }  // namespace
 
-spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& m, const std::vector<double>& instants_s,
+spec::AnalysisFailure IntegrateLumped(const LumpedModel& m, const std::vector<double>& instants_s,
                             const spec::IntegratorSettings& settings,
                             const LumpedDynamicsOptions& options,
                             const LumpedInstantCallback& at_instant,
@@ -62,9 +62,9 @@ spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& m, const std::ve
     return newton.Solve(bx) ? 0 : 1;
   };
 
-  CvodesOptions cv;
-  cv.method = options.adams ? CvodesOptions::Method::kAdams : CvodesOptions::Method::kBdf;
-  if (options.adams && options.fixed_point) cv.iteration = CvodesOptions::Iteration::kFixedPoint;
+  sundials::CvodesOptions cv;
+  cv.method = options.adams ? sundials::CvodesOptions::Method::kAdams : sundials::CvodesOptions::Method::kBdf;
+  if (options.adams && options.fixed_point) cv.iteration = sundials::CvodesOptions::Iteration::kFixedPoint;
   cv.relative_tolerance = settings.relative_tolerance;
   cv.absolute_tolerance = settings.absolute_tolerance;
   cv.max_steps = settings.max_steps;
@@ -85,22 +85,22 @@ spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& m, const std::ve
   Eigen::VectorXd y = Eigen::VectorXd::Zero(2 * n);
   if (options.initial_q.size() == n) y.head(n) = options.initial_q;
   if (options.initial_qdot.size() == n) y.tail(n) = options.initial_qdot;
-  absl::StatusOr<std::unique_ptr<CvodesIntegrator>> created =
-      cv.iteration == CvodesOptions::Iteration::kNewton
-          ? CvodesIntegrator::CreateWithNewtonSolver(
-                2 * n, rhs, newton_solve, CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv, 0.0, y)
-          : CvodesIntegrator::Create(2 * n, rhs, nullptr, cv, 0.0, y);
+  absl::StatusOr<std::unique_ptr<sundials::CvodesIntegrator>> created =
+      cv.iteration == sundials::CvodesOptions::Iteration::kNewton
+          ? sundials::CvodesIntegrator::CreateWithNewtonSolver(
+                2 * n, rhs, newton_solve, sundials::CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv, 0.0, y)
+          : sundials::CvodesIntegrator::Create(2 * n, rhs, nullptr, cv, 0.0, y);
   if (!created.ok()) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator,
                                      absl::StrCat("integrator setup: ", created.status().message()));
   }
-  CvodesIntegrator& integrator = **created;
+  sundials::CvodesIntegrator& integrator = **created;
 
   const double t_last = instants_s.empty() ? 0.0 : instants_s.back();
-  const spec::AnalysisFailure failure = IntegrateAcrossKinks(
+  const spec::AnalysisFailure failure = sundials::IntegrateAcrossKinks(
       integrator, m.KinkTimes(0.0, t_last), instants_s, &y,
       [&](double t, const Eigen::VectorXd& state) { return at_instant(t, state.head(n), state.tail(n)); });
-  const CvodesCounters c = integrator.counters();
+  const sundials::CvodesCounters c = integrator.counters();
   counters->time_steps = c.steps;
   counters->rhs_evaluations = c.rhs_evaluations;
   counters->jacobian_evaluations = c.jacobian_evaluations;
@@ -120,12 +120,12 @@ spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
     return Failed(report, spec::FailureKind::kInvalidModel, absl::StrCat("got ", parameter_values_si.size(), " parameter values for ",
                                        scene.parameters.size(), " scene parameters"));
   }
-  absl::StatusOr<model::LumpedModel> assembled =
-      model::LumpedModel::Assemble(*spec_model, parameter_values_si);
+  absl::StatusOr<LumpedModel> assembled =
+      LumpedModel::Assemble(*spec_model, parameter_values_si);
   if (!assembled.ok()) {
     return Failed(report, spec::FailureKind::kInvalidModel, std::string(assembled.status().message()));
   }
-  const model::LumpedModel& m = *assembled;
+  const LumpedModel& m = *assembled;
 
   std::vector<OutputPlan> plans;
   bool needs_acceleration = false;
@@ -188,4 +188,4 @@ spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
   return report;
 }
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

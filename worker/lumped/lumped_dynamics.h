@@ -30,7 +30,7 @@
 #include "worker/lumped/lumped_model.h"
 #include "worker/budget/analysis_budget.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 
 struct LumpedDynamicsOptions {
   bool adams = false;        // Adams-Moulton instead of BDF (non-stiff problems)
@@ -49,7 +49,7 @@ struct LumpedDynamicsOptions {
 // `counters` receives the integrator's counters either way.
 using LumpedInstantCallback =
     std::function<spec::AnalysisFailure(double t_s, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot)>;
-spec::AnalysisFailure IntegrateLumped(const model::LumpedModel& model, const std::vector<double>& instants_s,
+spec::AnalysisFailure IntegrateLumped(const LumpedModel& model, const std::vector<double>& instants_s,
                             const spec::IntegratorSettings& settings,
                             const LumpedDynamicsOptions& options,
                             const LumpedInstantCallback& at_instant,
@@ -62,4 +62,4 @@ spec::AnalysisReport SimulateLumped(const spec::Scene& scene,
                                       const std::vector<double>& parameter_values_si,
                                       const LumpedDynamicsOptions& options = {});
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

@@ -6,7 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
-namespace mbopt::model {
+namespace mbopt::lumped {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925;
@@ -199,4 +199,4 @@ std::vector<double> LumpedModel::KinkTimes(double t_begin_s, double t_end_s) con
   return kinks;
 }
 
-}  // namespace mbopt::model
+}  // namespace mbopt::lumped

@@ -22,7 +22,7 @@
 #include "absl/status/statusor.h"
 #include "spec/scene.h"
 
-namespace mbopt::model {
+namespace mbopt::lumped {
 
 // One-period cosine bump, resolved to SI numbers.
 struct CosineBumpInput {
@@ -96,4 +96,4 @@ class LumpedModel {
   std::vector<Eigen::VectorXd> force_per_velocity_;
 };
 
-}  // namespace mbopt::model
+}  // namespace mbopt::lumped

@@ -13,11 +13,11 @@
 
 #include "worker/lumped/lumped_model.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 
 class LumpedNewtonOperator {
  public:
-  explicit LumpedNewtonOperator(const model::LumpedModel& m)
+  explicit LumpedNewtonOperator(const LumpedModel& m)
       : m_(m), matrix_(m.num_coordinates(), m.num_coordinates()), rhs_map_(m.num_coordinates(), 2 * m.num_coordinates()),
         operator_(m.num_coordinates(), 2 * m.num_coordinates()), lu_(m.num_coordinates()), x_v_(m.num_coordinates()) {}
 
@@ -52,7 +52,7 @@ class LumpedNewtonOperator {
   }
 
  private:
-  const model::LumpedModel& m_;
+  const LumpedModel& m_;
   Eigen::MatrixXd matrix_, rhs_map_, operator_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   Eigen::VectorXd x_v_;
@@ -60,4 +60,4 @@ class LumpedNewtonOperator {
   bool formed_ = false;
 };
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

@@ -11,7 +11,7 @@
 #include "worker/lumped/lumped_model.h"
 #include "worker/lumped/lumped_sensitivity_problem.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 namespace {
 
 using sensitivity_internal::ParameterDerivative;
@@ -105,13 +105,13 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
                                          " sensitivity parameters"));
     return result;
   }
-  absl::StatusOr<model::LumpedModel> assembled =
-      model::LumpedModel::Assemble(*spec_model, parameter_values_si);
+  absl::StatusOr<LumpedModel> assembled =
+      LumpedModel::Assemble(*spec_model, parameter_values_si);
   if (!assembled.ok()) {
     report = Failed(report, std::string(assembled.status().message()));
     return result;
   }
-  const model::LumpedModel& m = *assembled;
+  const LumpedModel& m = *assembled;
   const int n = m.num_coordinates();
   const int ns = static_cast<int>(parameters.size());
 
@@ -271,4 +271,4 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
   return result;
 }
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

@@ -33,7 +33,7 @@
 #include "spec/analysis_report.h"
 #include "worker/budget/analysis_budget.h"
 
-namespace mbopt::solve {
+namespace mbopt::lumped {
 
 // Empty if every parameter in `parameters` (scene parameter indices) enters
 // the scene only where sensitivities are available; else why not.
@@ -107,4 +107,4 @@ LumpedSensitivityResult SimulateLumpedWithSensitivities(
     const spec::Scene& scene, const std::vector<double>& parameter_values_si,
     const std::vector<int>& parameters, const LumpedSensitivityOptions& options = {});
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::lumped

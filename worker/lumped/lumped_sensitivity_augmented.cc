@@ -11,7 +11,7 @@
 #include "worker/lumped/lumped_newton_operator.h"
 #include "worker/lumped/lumped_sensitivity_problem.h"
 
-namespace mbopt::solve::sensitivity_internal {
+namespace mbopt::lumped::sensitivity_internal {
 
 spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::IntegratorSettings& settings,
                                const LumpedSensitivityOptions& options, double omega_max,
@@ -19,7 +19,7 @@ spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::Inte
                                const std::vector<double>& instants, const SensitivityRecorder& record,
                                spec::AnalysisCounters* counters,
                                LumpedSensitivityCounters* sensitivity_counters) {
-  const model::LumpedModel& m = *p->model;
+  const LumpedModel& m = *p->model;
   const int n = p->n;
   const int ns = static_cast<int>(p->derivatives.size());
   const int block = 2 * n;
@@ -80,7 +80,7 @@ spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::Inte
   // block norms, never less than the largest: the test is at least as
   // strict as the module's.
   const double norm_bound = options.augmented_block_norm_bound ? std::sqrt(1.0 + ns) : 1.0;
-  CvodesOptions cv;
+  sundials::CvodesOptions cv;
   cv.relative_tolerance = settings.relative_tolerance / norm_bound;
   cv.max_steps = settings.max_steps;
   cv.budget = options.budget;
@@ -92,23 +92,23 @@ spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::Inte
         .setConstant(settings.absolute_tolerance * std::max(1.0, omega_max) * scale);
   }
   Eigen::VectorXd y = Eigen::VectorXd::Zero(size);
-  absl::StatusOr<std::unique_ptr<CvodesIntegrator>> created =
-      CvodesIntegrator::CreateWithNewtonSolver(size, rhs, newton_solve,
-                                               CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv,
+  absl::StatusOr<std::unique_ptr<sundials::CvodesIntegrator>> created =
+      sundials::CvodesIntegrator::CreateWithNewtonSolver(size, rhs, newton_solve,
+                                               sundials::CvodesIntegrator::NewtonRefresh::kCvodesSetups, cv,
                                                0.0, y);
   if (!created.ok()) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator,
                                      absl::StrCat("integrator setup: ", created.status().message()));
   }
-  CvodesIntegrator& integrator = **created;
+  sundials::CvodesIntegrator& integrator = **created;
 
   const double t_last = instants.empty() ? 0.0 : instants.back();
-  const spec::AnalysisFailure failure = IntegrateAcrossKinks(
+  const spec::AnalysisFailure failure = sundials::IntegrateAcrossKinks(
       integrator, m.KinkTimes(0.0, t_last), instants, &y, [&](double t, const Eigen::VectorXd& state) {
         record(t, state.head(block), [&](int k) { return state.data() + block * (1 + k); });
         return spec::AnalysisFailure::Ok();
       });
-  const CvodesCounters c = integrator.counters();
+  const sundials::CvodesCounters c = integrator.counters();
   counters->time_steps = c.steps;
   counters->rhs_evaluations = c.rhs_evaluations;
   counters->jacobian_evaluations = c.jacobian_evaluations;
@@ -122,4 +122,4 @@ spec::AnalysisFailure IntegrateAugmented(SensitivityProblem* p, const spec::Inte
   return failure;
 }
 
-}  // namespace mbopt::solve::sensitivity_internal
+}  // namespace mbopt::lumped::sensitivity_internal

@@ -17,7 +17,7 @@
 #include "worker/lumped/lumped_sensitivity_problem.h"
 #include "worker/sundials/sundials_handles.h"
 
-namespace mbopt::solve::sensitivity_internal {
+namespace mbopt::lumped::sensitivity_internal {
 namespace {
 
 int Rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) {
@@ -106,7 +106,7 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
                                            const SensitivityRecorder& record,
                                            spec::AnalysisCounters* counters,
                                            LumpedSensitivityCounters* sensitivity_counters) {
-  const model::LumpedModel& m = *p->model;
+  const LumpedModel& m = *p->model;
   const int n = p->n;
   const int ns = static_cast<int>(p->derivatives.size());
   // CVODES takes the scales as a non-const pointer.
@@ -266,9 +266,9 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
   if (!history_counted) accumulate_counters();
   if (!ok) {
     if (!p->budget_failure.ok()) return p->budget_failure;
-    return IntegratorFailure(absl::AbortedError(""), failure.empty() ? "sensitivity integration failed" : failure);
+    return sundials::IntegratorFailure(absl::AbortedError(""), failure.empty() ? "sensitivity integration failed" : failure);
   }
   return spec::AnalysisFailure::Ok();
 }
 
-}  // namespace mbopt::solve::sensitivity_internal
+}  // namespace mbopt::lumped::sensitivity_internal

@@ -16,7 +16,7 @@
 #include "worker/budget/analysis_budget.h"
 #include "worker/lumped/lumped_sensitivity.h"
 
-namespace mbopt::solve::sensitivity_internal {
+namespace mbopt::lumped::sensitivity_internal {
 
 // The model's derivatives with respect to one parameter.
 struct ParameterDerivative {
@@ -29,7 +29,7 @@ struct ParameterDerivative {
 
 // Everything the C callbacks see.
 struct SensitivityProblem {
-  const model::LumpedModel* model = nullptr;
+  const LumpedModel* model = nullptr;
   int n = 0;
   Eigen::VectorXd inverse_mass;
   Eigen::MatrixXd minv_k, minv_c;
@@ -130,4 +130,4 @@ spec::AnalysisFailure IntegrateWithSensitivityModule(SensitivityProblem* p,
                                            spec::AnalysisCounters* counters,
                                            LumpedSensitivityCounters* sensitivity_counters);
 
-}  // namespace mbopt::solve::sensitivity_internal
+}  // namespace mbopt::lumped::sensitivity_internal

@@ -461,25 +461,25 @@ spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::
   result->lowest_link_frequency_rad_per_s = elastic.lowest_frequency();
   const int n = elastic.num_dofs();
 
-  solve::CvodesOptions options;
-  options.method = solve::CvodesOptions::Method::kBdf;
+  sundials::CvodesOptions options;
+  options.method = sundials::CvodesOptions::Method::kBdf;
   options.relative_tolerance = integrator.relative_tolerance;
   options.absolute_tolerance = integrator.absolute_tolerance;
   options.max_steps = integrator.max_steps;
   options.budget = budget;
   const Eigen::VectorXd y0 = Eigen::VectorXd::Zero(2 * n);
-  auto created = solve::CvodesIntegrator::CreateWithNewtonSolver(
+  auto created = sundials::CvodesIntegrator::CreateWithNewtonSolver(
       2 * n,
       [&elastic](double t, const double* y, double* ydot) { return elastic.Rhs(t, y, ydot); },
       [&elastic](double t, double gamma, double* bx, bool* refactored) {
         return elastic.NewtonSolve(t, gamma, bx, refactored);
       },
-      solve::CvodesIntegrator::NewtonRefresh::kEveryIteration, options, 0.0, y0);
+      sundials::CvodesIntegrator::NewtonRefresh::kEveryIteration, options, 0.0, y0);
   if (!created.ok()) {
     return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator,
         absl::StrFormat("elastodynamic integrator setup failed: %s", created.status().message()));
   }
-  solve::CvodesIntegrator& cvodes = **created;
+  sundials::CvodesIntegrator& cvodes = **created;
   if (t_end > 0.0) {
     if (absl::Status s = cvodes.SetStopTime(t_end); !s.ok()) {
       return spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, std::string(s.message()));
@@ -496,7 +496,7 @@ spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::
         const std::string context = absl::StrFormat("elastodynamic integration failed before t = %.6g s: ", t);
         const spec::AnalysisFailure model_failure = elastic.failure();
         if (!model_failure.ok()) return spec::AnalysisFailure::Of(model_failure.kind, context + model_failure.reason);
-        return solve::IntegratorFailure(s, context + std::string(s.message()));
+        return sundials::IntegratorFailure(s, context + std::string(s.message()));
       }
     }
     std::vector<std::vector<double>> moments;

@@ -50,7 +50,7 @@ struct FloatingFrameResult {
   // convention, linkage_front_end.h).
   std::vector<std::vector<std::vector<double>>> node_moment_n_m;
   std::vector<double> drive_torque_n_m;  // [instant]
-  solve::CvodesCounters counters;
+  sundials::CvodesCounters counters;
   double lowest_link_frequency_rad_per_s = 0.0;
 };
 

@@ -60,7 +60,7 @@ int EvaluateResidual(const ConstrainedSystem& s, Problem* p, double t, const Y& 
 
 int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
-  return solve::sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
+  return sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
     if (p->budget != nullptr && p->budget->Exhausted()) {
       p->budget_failure = p->budget->Check(t);
       if (!p->budget_failure.ok()) return -1;
@@ -76,7 +76,7 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
 // The system's validity bounds as IDAS root functions.
 int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
-  return solve::sundials::GuardCallback(&p->callback_failure, "the validity bounds", [&]() -> int {
+  return sundials::GuardCallback(&p->callback_failure, "the validity bounds", [&]() -> int {
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), 2 * p->n + 2 * p->m);
     p->system->ValidityBounds(t, y.head(p->n), y.segment(p->n, p->n), g);
     return 0;
@@ -97,7 +97,7 @@ int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* 
 int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vector /*rr*/, N_Vector* y_s,
                         N_Vector* yp_s, N_Vector* rr_s, void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
-  return solve::sundials::GuardCallback(&p->callback_failure, "the sensitivity residual", [&]() -> int {
+  return sundials::GuardCallback(&p->callback_failure, "the sensitivity residual", [&]() -> int {
     const int n = p->n, m = p->m, size = 2 * n + 2 * m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
@@ -239,16 +239,15 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     return f;
   }
 
-  namespace sd = solve::sundials;
   struct Handles {
-    sd::Context context;
-    sd::Vector yy, yp, id, atol;
-    sd::Matrix matrix;
-    sd::LinearSolver linear_solver;
-    sd::Memory<&IDAFree> ida;
+    sundials::Context context;
+    sundials::Vector yy, yp, id, atol;
+    sundials::Matrix matrix;
+    sundials::LinearSolver linear_solver;
+    sundials::Memory<&IDAFree> ida;
   } h;
   std::string sundials_message;
-  h.context = sd::MakeContext();
+  h.context = sundials::MakeContext();
   if (!h.context) return Failed(spec::FailureKind::kIntegrator, "SUNContext_Create failed");
   h.yy.reset(N_VNew_Serial(size, h.context.get()));
   h.yp.reset(N_VNew_Serial(size, h.context.get()));
@@ -291,7 +290,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
                                        sundials_message);
     return false;
   };
-  bool ok = check(IDASetErrHandlerFn(ida, &sd::CaptureMessage, &sundials_message), "IDASetErrHandlerFn") &&
+  bool ok = check(IDASetErrHandlerFn(ida, &sundials::CaptureMessage, &sundials_message), "IDASetErrHandlerFn") &&
             check(IDAInit(ida, &Residual, t0, h.yy.get(), h.yp.get()), "IDAInit") &&
             check(IDASetUserData(ida, &p), "IDASetUserData") &&
             check(IDASVtolerances(ida, options.relative_tolerance, h.atol.get()), "IDASVtolerances") &&
@@ -334,12 +333,12 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   // Sensitivities: initial values by central differences of the consistent
   // start along (dq0/dp_k, dv0/dp_k, e_k).
   const int num_sens = sensitivities != nullptr ? static_cast<int>(sensitivities->parameters.size()) : 0;
-  sd::VectorArray y_s, yp_s, atol_s;
+  sundials::VectorArray y_s, yp_s, atol_s;
   if (num_sens > 0) {
     p.parameters = &sensitivities->parameters;
-    y_s = sd::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
-    yp_s = sd::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
-    atol_s = sd::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
+    y_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
+    yp_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
+    atol_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
     if (!y_s || !yp_s || !atol_s) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
     for (int k = 0; k < num_sens; ++k) {
       const ParameterPerturbation& dp = sensitivities->parameters[static_cast<size_t>(k)];

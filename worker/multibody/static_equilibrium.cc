@@ -54,7 +54,7 @@ int Evaluate(Problem* p, const VectorXd& x, VectorXd* f) {
 
 int Residual(N_Vector uu, N_Vector ff, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
-  return solve::sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
+  return sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
     const int size = p->n + p->m;
     const VectorXd x = Map<const VectorXd>(N_VGetArrayPointer(uu), size);
     VectorXd f;
@@ -123,7 +123,6 @@ double RelativeLeastStiffness(Problem* p, const VectorXd& x, bool* ok) {
 spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, const VectorXd& q0,
                                            const std::vector<double>& times, const StaticOptions& options,
                                            const MotionCallback& at_instant, StaticCounters* counters) {
-  namespace sd = solve::sundials;
   Problem p;
   p.system = &system;
   p.n = system.num_coordinates();
@@ -169,15 +168,15 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     }
   }
 
-  sd::Context context = sd::MakeContext();
+  sundials::Context context = sundials::MakeContext();
   if (!context) return Failed(spec::FailureKind::kIntegrator, "KINSOL: no SUNDIALS context");
-  sd::Vector u(N_VNew_Serial(size, context.get()));
-  sd::Vector u_scale(N_VNew_Serial(size, context.get()));
-  sd::Vector f_scale(N_VNew_Serial(size, context.get()));
-  sd::Matrix jacobian(SUNDenseMatrix(size, size, context.get()));
+  sundials::Vector u(N_VNew_Serial(size, context.get()));
+  sundials::Vector u_scale(N_VNew_Serial(size, context.get()));
+  sundials::Vector f_scale(N_VNew_Serial(size, context.get()));
+  sundials::Matrix jacobian(SUNDenseMatrix(size, size, context.get()));
   if (!u || !u_scale || !f_scale || !jacobian) return Failed(spec::FailureKind::kIntegrator, "KINSOL: out of memory");
-  sd::LinearSolver solver(SUNLinSol_Dense(u.get(), jacobian.get(), context.get()));
-  sd::Memory<KINFree> kinsol(KINCreate(context.get()));
+  sundials::LinearSolver solver(SUNLinSol_Dense(u.get(), jacobian.get(), context.get()));
+  sundials::Memory<KINFree> kinsol(KINCreate(context.get()));
   if (!solver || !kinsol) return Failed(spec::FailureKind::kIntegrator, "KINSOL: out of memory");
   std::string message;
   N_VConst(1.0, u_scale.get());
@@ -186,7 +185,7 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
   fs.tail(m).setConstant(1.0);
   void* mem = kinsol.get();
   if (KINInit(mem, Residual, u.get()) != KIN_SUCCESS || KINSetUserData(mem, &p) != KIN_SUCCESS ||
-      KINSetErrHandlerFn(mem, sd::CaptureMessage, &message) != KIN_SUCCESS ||
+      KINSetErrHandlerFn(mem, sundials::CaptureMessage, &message) != KIN_SUCCESS ||
       KINSetLinearSolver(mem, solver.get(), jacobian.get()) != KIN_SUCCESS ||
       // A fresh Jacobian every iteration: plain Newton, quadratic near the
       // solution; the systems are small.

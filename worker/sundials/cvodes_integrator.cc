@@ -18,7 +18,7 @@
 #include "common/status_macros.h"
 #include "worker/sundials/sundials_handles.h"
 
-namespace mbopt::solve {
+namespace mbopt::sundials {
 namespace {
 
 // The status that carries a budget's failure out of IntegrateTo;
@@ -33,13 +33,13 @@ absl::Status BudgetStatus(const spec::AnalysisFailure& failure) {
 // Declared in the order of creation, so destroyed CVODE memory first (it may
 // still reference the solvers) and context last (sundials_handles.h).
 struct CvodesIntegrator::Sundials {
-  sundials::Context context;
-  sundials::Vector y;
-  sundials::Vector abstol;
-  sundials::Matrix matrix;
-  sundials::LinearSolver linear_solver;
-  sundials::NonlinearSolver nonlinear_solver;
-  sundials::Memory<&CVodeFree> cvode;
+  Context context;
+  Vector y;
+  Vector abstol;
+  Matrix matrix;
+  LinearSolver linear_solver;
+  NonlinearSolver nonlinear_solver;
+  Memory<&CVodeFree> cvode;
 };
 
 // The C side of the callbacks: each turns an exception or a non-finite value
@@ -51,7 +51,7 @@ struct CvodesCallbacks {
       self->budget_failure_ = self->options_.budget->Check(t);
       if (!self->budget_failure_.ok()) return -1;
     }
-    return solve::sundials::GuardCallback(&self->callback_failure_, "right-hand side", [&]() -> int {
+    return GuardCallback(&self->callback_failure_, "right-hand side", [&]() -> int {
       const int flag = self->rhs_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
       if (flag != 0) {
         if (flag < 0) {
@@ -75,7 +75,7 @@ struct CvodesCallbacks {
   static int Jacobian(realtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void* user_data, N_Vector,
                       N_Vector, N_Vector) {
     auto* self = static_cast<CvodesIntegrator*>(user_data);
-    return solve::sundials::GuardCallback(&self->callback_failure_, "Jacobian", [&]() -> int {
+    return GuardCallback(&self->callback_failure_, "Jacobian", [&]() -> int {
       SUNMatZero(jac);
       const int flag = self->jacobian_(t, N_VGetArrayPointer(y), N_VGetArrayPointer(fy),
                                        SUNDenseMatrix_Data(jac));
@@ -118,7 +118,7 @@ struct CvodesCallbacks {
       self->callback_failure_ = "Newton solver could not read the step's time and gamma";
       return SUNLS_PACKAGE_FAIL_UNREC;
     }
-    return solve::sundials::GuardCallback(&self->callback_failure_, "Newton solver", [&]() -> int {
+    return GuardCallback(&self->callback_failure_, "Newton solver", [&]() -> int {
       N_VScale(1.0, b, x);
       bool refactored = false;
       const int flag = self->newton_solve_(t, gamma, N_VGetArrayPointer(x), &refactored);
@@ -240,7 +240,7 @@ absl::Status CvodesIntegrator::Check(int flag, const char* call) {
 
 absl::Status CvodesIntegrator::Init(double t0, const Eigen::VectorXd& y0) {
   Sundials& s = *sundials_;
-  s.context = sundials::MakeContext();
+  s.context = MakeContext();
   if (!s.context) {
     return absl::InternalError("SUNContext_Create failed");
   }
@@ -255,7 +255,7 @@ absl::Status CvodesIntegrator::Init(double t0, const Eigen::VectorXd& y0) {
   s.cvode.reset(CVodeCreate(options_.method == CvodesOptions::Method::kBdf ? CV_BDF : CV_ADAMS, s.context.get()));
   if (!s.cvode) return absl::InternalError("CVodeCreate failed");
   MBOPT_RETURN_IF_ERROR(
-      Check(CVodeSetErrHandlerFn(s.cvode.get(), &sundials::CaptureMessage, &last_sundials_message_),
+      Check(CVodeSetErrHandlerFn(s.cvode.get(), &CaptureMessage, &last_sundials_message_),
             "CVodeSetErrHandlerFn"));
   MBOPT_RETURN_IF_ERROR(Check(CVodeInit(s.cvode.get(), &CvodesCallbacks::Rhs, t0, s.y.get()), "CVodeInit"));
   MBOPT_RETURN_IF_ERROR(Check(CVodeSetUserData(s.cvode.get(), this), "CVodeSetUserData"));
@@ -484,4 +484,4 @@ absl::Status CvodesIntegrator::IntegrateTo(double t_out, Eigen::VectorXd* y) {
   return absl::OkStatus();
 }
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::sundials

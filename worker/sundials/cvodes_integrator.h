@@ -33,7 +33,7 @@
 #include "spec/analysis_outcome.h"
 #include "worker/budget/analysis_budget.h"
 
-namespace mbopt::solve {
+namespace mbopt::sundials {
 
 struct CvodesOptions {
   enum class Method {
@@ -168,4 +168,4 @@ class CvodesIntegrator {
   CvodesCounters carried_;  // counters of histories ended by Restart
 };
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::sundials

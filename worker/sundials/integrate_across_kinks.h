@@ -17,7 +17,7 @@
 #include "worker/sundials/cvodes_integrator.h"
 #include "worker/sundials/integrator_failure.h"
 
-namespace mbopt::solve {
+namespace mbopt::sundials {
 
 inline spec::AnalysisFailure IntegrateAcrossKinks(
     CvodesIntegrator& integrator, const std::vector<double>& kinks_s,
@@ -43,4 +43,4 @@ inline spec::AnalysisFailure IntegrateAcrossKinks(
   return failure;
 }
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::sundials

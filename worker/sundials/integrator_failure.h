@@ -8,7 +8,7 @@
 #include "absl/status/status.h"
 #include "spec/analysis_outcome.h"
 
-namespace mbopt::solve {
+namespace mbopt::sundials {
 
 inline spec::AnalysisFailure IntegratorFailure(const absl::Status& status, std::string reason) {
   spec::FailureKind kind = spec::FailureKind::kIntegrator;
@@ -17,4 +17,4 @@ inline spec::AnalysisFailure IntegratorFailure(const absl::Status& status, std::
   return spec::AnalysisFailure::Of(kind, std::move(reason));
 }
 
-}  // namespace mbopt::solve
+}  // namespace mbopt::sundials

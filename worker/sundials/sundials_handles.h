@@ -25,7 +25,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
-namespace mbopt::solve::sundials {
+namespace mbopt::sundials {
 
 struct ContextFree {
   void operator()(SUNContext context) const { SUNContext_Free(&context); }
@@ -120,4 +120,4 @@ int GuardCallback(std::string* failure, const char* name, Body&& body, int unrec
   return unrecoverable;
 }
 
-}  // namespace mbopt::solve::sundials
+}  // namespace mbopt::sundials
