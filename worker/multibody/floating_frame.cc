@@ -168,17 +168,14 @@ class ElasticLinkage {
     f_.setZero();
     const Eigen::Vector2d g = sys_.has_gravity ? sys_.gravity_m_per_s2 : Eigen::Vector2d::Zero();
     for (const LinkMesh& mesh : meshes_) {
-      const LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
-      const double angle = state_.LinkAngle(l);
-      const Eigen::Vector2d aa = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_a)];
-      const Eigen::Vector2d ab = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_b)];
-      const double alpha = state_.LinkAngularAcceleration(l);
+      const LinkFrameMotion frame = FrameMotionOf(mesh);
+      const double angle = frame.angle_rad;
       for (int e = 0; e < mesh.elements; ++e) {
         const bool at_joint = e == 0 || e + 1 == mesh.elements;
         const BeamMatrix t6 = Transform(angle, e == 0, e + 1 == mesh.elements);
         const Vector6d load =
             t6.transpose() *
-            (mesh.m * ToLinkFrame(angle, GravityVector(g) - RigidAcceleration(mesh, e, aa, ab, alpha)));
+            (mesh.m * ToLinkFrame(angle, GravityVector(g) - RigidAcceleration(mesh, e, frame)));
         int dofs[6];
         ElementDofs(mesh, e, dofs);
         for (int r = 0; r < 6; ++r) {
@@ -259,11 +256,8 @@ class ElasticLinkage {
     moments->assign(sys_.links.size(), {});
     *drive_torque = 0.0;
     for (const LinkMesh& mesh : meshes_) {
-      const LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
-      const double angle = state_.LinkAngle(l);
-      const Eigen::Vector2d aa = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_a)];
-      const Eigen::Vector2d ab = state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_b)];
-      const double alpha = state_.LinkAngularAcceleration(l);
+      const LinkFrameMotion frame = FrameMotionOf(mesh);
+      const double angle = frame.angle_rad;
       std::vector<double>& out = (*moments)[static_cast<size_t>(mesh.link)];
       out.assign(static_cast<size_t>(mesh.elements + 1), 0.0);
       std::vector<int> hits(out.size(), 0);
@@ -278,7 +272,7 @@ class ElasticLinkage {
         }
         const BeamMatrix t6 = Transform(angle, e == 0, e + 1 == mesh.elements);
         const Vector6d rigid =
-            ToLinkFrame(angle, RigidAcceleration(mesh, e, aa, ab, alpha) - GravityVector(g));
+            ToLinkFrame(angle, RigidAcceleration(mesh, e, frame) - GravityVector(g));
         const Vector6d local = t6 * d;
         const Vector6d end = mesh.k * local + GeometricStiffness(mesh, local) * local +
                              mesh.beta_s * (mesh.k * (t6 * dd)) + mesh.m * (t6 * acc + rigid);
@@ -360,8 +354,26 @@ class ElasticLinkage {
     return v;
   }
 
-  Vector6d RigidAcceleration(const LinkMesh& mesh, int e, const Eigen::Vector2d& aa,
-                             const Eigen::Vector2d& ab, double alpha) const {
+  // A link's rigid motion at the prepared instant: what the loads and the
+  // moments both read per link.
+  struct LinkFrameMotion {
+    double angle_rad = 0.0;
+    Eigen::Vector2d end_a_acceleration_m_per_s2;
+    Eigen::Vector2d end_b_acceleration_m_per_s2;
+    double angular_acceleration_rad_per_s2 = 0.0;
+  };
+
+  LinkFrameMotion FrameMotionOf(const LinkMesh& mesh) const {
+    const LinkageLink& l = sys_.links[static_cast<size_t>(mesh.link)];
+    return {state_.LinkAngle(l), state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_a)],
+            state_.acceleration_m_per_s2[static_cast<size_t>(l.joint_b)], state_.LinkAngularAcceleration(l)};
+  }
+
+  // Rigid acceleration of element e's two nodes (linear along the link).
+  static Vector6d RigidAcceleration(const LinkMesh& mesh, int e, const LinkFrameMotion& frame) {
+    const Eigen::Vector2d& aa = frame.end_a_acceleration_m_per_s2;
+    const Eigen::Vector2d& ab = frame.end_b_acceleration_m_per_s2;
+    const double alpha = frame.angular_acceleration_rad_per_s2;
     const double x1 = static_cast<double>(e) / mesh.elements;
     const double x2 = static_cast<double>(e + 1) / mesh.elements;
     const Eigen::Vector2d a1 = aa + x1 * (ab - aa), a2 = aa + x2 * (ab - aa);
