@@ -40,8 +40,8 @@ absl::StatusOr<spec::SceneDrawing> RunWorkerDraw(const std::string& worker, cons
   std::ifstream in(work_path, std::ios::binary);
   // Exit 1 writes the drawing up to where the motion stopped; 2 writes none.
   if (output->exit_code > 1 || !in || !message.ParseFromIstream(&in)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(absl::StripSuffix(output->stderr_text, "\n"), " (mbopt-worker draw, exit ", output->exit_code, ")"));
+    return absl::InvalidArgumentError(absl::StrCat(absl::StripSuffix(output->stderr_text, "\n"),
+                                                   " (mbopt-worker draw, exit ", output->exit_code, ")"));
   }
   return spec::io::DrawingFromProto(message);
 }

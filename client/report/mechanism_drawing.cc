@@ -88,7 +88,9 @@ std::vector<Px> Hull(std::vector<Px> p) {
   std::sort(p.begin(), p.end(), [](const Px& a, const Px& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   p.erase(std::unique(p.begin(), p.end(), [](const Px& a, const Px& b) { return a.x == b.x && a.y == b.y; }), p.end());
   if (p.size() < 3) return p;
-  auto cross = [](const Px& o, const Px& a, const Px& b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
+  auto cross = [](const Px& o, const Px& a, const Px& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
   std::vector<Px> h(2 * p.size());
   size_t k = 0;
   for (size_t i = 0; i < p.size(); ++i) {
@@ -192,8 +194,9 @@ std::string JointSvg(const Px& at, const SceneDrawing::Joint& joint, double axis
     case SceneDrawing::JointKind::kSlider:
       out += "<polyline class=\"axis\" points=\"" + Pair(point(-kAxisHalfLengthPx, 0)) + " " +
              Pair(point(kAxisHalfLengthPx, 0)) + "\" " + stroke + " stroke-dasharray=\"6 3\" fill=\"none\"/>";
-      out += "<polygon class=\"slider\" points=\"" + Points({point(-11, -7), point(11, -7), point(11, 7), point(-11, 7)}) +
-             "\" fill=\"" + layer.fill + "\" " + stroke + "/>";
+      out += "<polygon class=\"slider\" points=\"" +
+             Points({point(-11, -7), point(11, -7), point(11, 7), point(-11, 7)}) + "\" fill=\"" + layer.fill + "\" " +
+             stroke + "/>";
       out += "<circle cx=\"" + Num(at.x) + "\" cy=\"" + Num(at.y) + "\" r=\"2\" fill=\"" + layer.color + "\"/>";
       break;
     case SceneDrawing::JointKind::kPinInSlot:
@@ -230,8 +233,8 @@ std::string InputSvg(const Px& at, const SceneDrawing::Input& input) {
   const Px left{at.x - 7 * u.x - 4 * u.y, at.y - 7 * u.y + 4 * u.x};
   const Px right{at.x - 7 * u.x + 4 * u.y, at.y - 7 * u.y - 4 * u.x};
   return "<g class=\"input\"><title>" + EscapeHtml(input.name) + "</title><polyline points=\"" + Pair(tail) + " " +
-         Pair(at) + "\" stroke=\"#b03a2e\" stroke-width=\"1.6\" fill=\"none\"/><polygon points=\"" + Points({at, left, right}) +
-         "\" fill=\"#b03a2e\"/></g>";
+         Pair(at) + "\" stroke=\"#b03a2e\" stroke-width=\"1.6\" fill=\"none\"/><polygon points=\"" +
+         Points({at, left, right}) + "\" fill=\"#b03a2e\"/></g>";
 }
 
 // One layer at one instant.

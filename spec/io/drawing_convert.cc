@@ -87,8 +87,8 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
   d.point_names.assign(m.point_names().begin(), m.point_names().end());
   const int points = m.point_names_size();
   if (m.instants_size() != m.times_s_size()) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("drawing '%s': %d instants for %d times_s", m.scene_name(), m.instants_size(), m.times_s_size()));
+    return absl::InvalidArgumentError(absl::StrFormat("drawing '%s': %d instants for %d times_s", m.scene_name(),
+                                                      m.instants_size(), m.times_s_size()));
   }
   for (int i = 0; i < m.instants_size(); ++i) {
     const v1::DrawingInstant& instant = m.instants(i);
@@ -110,7 +110,8 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
     SceneDrawing::Body body;
     body.name = m.bodies(b).name();
     for (int k = 0; k < m.bodies(b).points_size(); ++k) {
-      if (absl::Status s = check(m.bodies(b).points(k), absl::StrFormat("bodies[%d].points[%d]", b, k)); !s.ok()) return s;
+      const absl::Status s = check(m.bodies(b).points(k), absl::StrFormat("bodies[%d].points[%d]", b, k));
+      if (!s.ok()) return s;
       body.points.push_back(m.bodies(b).points(k));
     }
     d.bodies.push_back(std::move(body));
@@ -120,10 +121,12 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
     if (absl::Status s = check(in.point(), absl::StrFormat("joints[%d].point", j)); !s.ok()) return s;
     SceneDrawing::Joint joint{in.name(), KindFromProto(in.kind()), in.point(),
                               std::vector<double>(in.axis_angle_rad().begin(), in.axis_angle_rad().end())};
-    const bool axis = joint.kind == SceneDrawing::JointKind::kSlider || joint.kind == SceneDrawing::JointKind::kPinInSlot;
+    const bool axis =
+        joint.kind == SceneDrawing::JointKind::kSlider || joint.kind == SceneDrawing::JointKind::kPinInSlot;
     if (axis && in.axis_angle_rad_size() != m.times_s_size()) {
-      return absl::InvalidArgumentError(absl::StrFormat("drawing '%s': joints[%d].axis_angle_rad has %d values, expected %d",
-                                                        m.scene_name(), j, in.axis_angle_rad_size(), m.times_s_size()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("drawing '%s': joints[%d].axis_angle_rad has %d values, expected %d", m.scene_name(), j,
+                          in.axis_angle_rad_size(), m.times_s_size()));
     }
     d.joints.push_back(std::move(joint));
   }
@@ -137,7 +140,8 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
     SceneDrawing::Line line;
     line.name = m.lines(l).name();
     for (int k = 0; k < m.lines(l).points_size(); ++k) {
-      if (absl::Status s = check(m.lines(l).points(k), absl::StrFormat("lines[%d].points[%d]", l, k)); !s.ok()) return s;
+      const absl::Status s = check(m.lines(l).points(k), absl::StrFormat("lines[%d].points[%d]", l, k));
+      if (!s.ok()) return s;
       line.points.push_back(m.lines(l).points(k));
     }
     d.lines.push_back(std::move(line));

@@ -48,7 +48,8 @@ class DrawingInBrowser : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_EQ(access(testing::ChromiumPath().c_str(), X_OK), 0)
-        << testing::ChromiumPath() << " is missing: install it with `bash deploy/install-deps.sh` (Debian package chromium)";
+        << testing::ChromiumPath()
+        << " is missing: install it with `bash deploy/install-deps.sh` (Debian package chromium)";
     std::string pattern = (fs::temp_directory_path() / "mbopt-drawing-XXXXXX").string();
     ASSERT_NE(mkdtemp(pattern.data()), nullptr);
     dir_ = pattern;
@@ -84,7 +85,8 @@ TEST_F(DrawingInBrowser, ScriptShowsTheFrameTheAddressAsksForWithoutErrors) {
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
   // The 8th frame is the one shown; the first is hidden now.
   std::vector<std::string> frames;
-  for (std::size_t p = dom.find("<g class=\"frame\""); p != std::string::npos; p = dom.find("<g class=\"frame\"", p + 1)) {
+  for (std::size_t p = dom.find("<g class=\"frame\""); p != std::string::npos;
+       p = dom.find("<g class=\"frame\"", p + 1)) {
     frames.push_back(dom.substr(p, dom.find('>', p) - p));
   }
   ASSERT_EQ(frames.size(), 20u);

@@ -36,7 +36,8 @@ spec::SceneDrawing LumpedSchematic(const spec::Scene& scene, const std::vector<d
       const bool up = e.direction_y >= 0.0;
       const int above = up ? e.a.index : e.b.index, below = up ? e.b.index : e.a.index;
       if (above < 0 || below < 0 || above >= static_cast<int>(n) || below >= static_cast<int>(n)) continue;
-      level[static_cast<size_t>(above)] = std::max(level[static_cast<size_t>(above)], level[static_cast<size_t>(below)] + 1);
+      level[static_cast<size_t>(above)] =
+          std::max(level[static_cast<size_t>(above)], level[static_cast<size_t>(below)] + 1);
     }
   }
   double x_min = 0.0, x_max = 0.0;
@@ -83,8 +84,9 @@ spec::SceneDrawing LumpedSchematic(const spec::Scene& scene, const std::vector<d
     const std::string& name = m->bodies[b].name;
     spec::SceneDrawing::Body body;
     body.name = name;
-    body.points = {add(name + " corner", left, y[b] - box_height / 2), add(name + " corner", right, y[b] - box_height / 2),
-                   add(name + " corner", right, y[b] + box_height / 2), add(name + " corner", left, y[b] + box_height / 2)};
+    body.points = {
+        add(name + " corner", left, y[b] - box_height / 2), add(name + " corner", right, y[b] - box_height / 2),
+        add(name + " corner", right, y[b] + box_height / 2), add(name + " corner", left, y[b] + box_height / 2)};
     d.bodies.push_back(std::move(body));
   }
   for (const spec::SpringDamper& e : m->elements) {

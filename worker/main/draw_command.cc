@@ -100,8 +100,9 @@ int RunDraw(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   std::vector<double> parameters = study.ParameterValuesAt(x);
   for (const auto& [p, value] : overrides) parameters[static_cast<size_t>(p)] = value;
   // On this process' clock: the scene's time limit applies as to an analysis.
-  budget::AnalysisBudget budget = budget::AnalysisBudget(&MonotonicSeconds, nullptr)
-                                      .ForAnalysis(study.scene.integrator.max_wall_seconds, study.scene.integrator.max_steps);
+  budget::AnalysisBudget budget =
+      budget::AnalysisBudget(&MonotonicSeconds, nullptr)
+          .ForAnalysis(study.scene.integrator.max_wall_seconds, study.scene.integrator.max_steps);
   absl::StatusOr<spec::SceneDrawing> drawing = engine::DrawScene(study.scene, parameters, &budget);
   if (!drawing.ok()) {
     err << "mbopt-worker draw: " << drawing.status().message() << "\n";

@@ -24,6 +24,10 @@ int FirstNodeOfLink(const spec::MultibodyModel& m, int link) {
   return first;
 }
 
+Eigen::Vector2d Resolve(const spec::Vec2& v, const std::vector<double>& p) {
+  return Eigen::Vector2d(v.x.Resolve(p), v.y.Resolve(p));
+}
+
 bool SamePoint(const Point& a, const Point& b) {
   return a.body == b.body && a.input == b.input && a.local_m == b.local_m;
 }
@@ -73,12 +77,11 @@ MultibodyDrawingLayout LayoutMultibodyDrawing(const spec::Scene& scene, const st
   // Every declared marker is drawn, used or not: a marker left where it was
   // not meant to be is what a drawing should show.
   for (const spec::LinkPoint& marker : sm.ground_markers) {
-    ground(Point{kGround, Eigen::Vector2d(marker.position_m.x.Resolve(p), marker.position_m.y.Resolve(p)), marker.name});
+    ground(Point{kGround, Resolve(marker.position_m, p), marker.name});
   }
   for (size_t b = 0; b < sm.bodies.size(); ++b) {
     for (const spec::LinkPoint& marker : sm.bodies[b].markers) {
-      add_to_body(Point{static_cast<int>(b), Eigen::Vector2d(marker.position_m.x.Resolve(p), marker.position_m.y.Resolve(p)),
-                        sm.bodies[b].name + "." + marker.name});
+      add_to_body(Point{static_cast<int>(b), Resolve(marker.position_m, p), sm.bodies[b].name + "." + marker.name});
     }
   }
 
