@@ -88,17 +88,32 @@ constexpr Help kHelp[] = {
      "  --csv                 the cycle history as CSV\n"
      "  --json                result and history as one JSON object\n"},
     {"report",
-     "usage: mbopt report JOB [-o FILE] [--no-responses] [--server HOST:PORT | --db PATH]\n"
+     "usage: mbopt report JOB [-o FILE] [--no-responses] [--no-mechanism] [--server HOST:PORT | --db PATH]\n"
      "\n"
      "Writes a self-contained HTML page of the job: history plots, tables, the responses of the\n"
-     "initial and final designs.\n"
+     "initial and final designs, the mechanism drawn at both.\n"
      "\n"
      "options:\n"
      "  -o, --output FILE     the page (default: JOB.html)\n"
-     "  --no-responses        leave out the response plots (no analyses are run for them)\n"},
+     "  --no-responses        leave out the response plots (no analyses are run for them)\n"
+     "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"},
+    {"draw",
+     "usage: mbopt draw FILE [-o OUT.html] [--set NAME=VALUE ...]\n"
+     "\n"
+     "Writes a self-contained HTML page with the drawing of a scene (FILE a .scene.textproto) or\n"
+     "of a study's scene at its initial design: multibody and linkage scenes over their time grid,\n"
+     "animated (slider and play button), lumped scenes as a schematic. No server is needed; the\n"
+     "drawing is computed by mbopt-worker (found as for `mbopt report`).\n"
+     "Exit 0 drawn, 4 drawn up to where the motion stopped (the page says why), 2 bad input.\n"
+     "\n"
+     "options:\n"
+     "  -o, --output FILE     the page (default: FILE's name with .html, in this folder)\n"
+     "  --set NAME=VALUE      a design variable (scaled) or a scene parameter (its unit); repeatable\n"},
 };
 
-bool TalksToServer(std::string_view command) { return command != "run" && command != "validate"; }
+bool TalksToServer(std::string_view command) {
+  return command != "run" && command != "validate" && command != "draw";
+}
 bool ReadsDatabases(std::string_view command) {
   return command == "watch" || command == "status" || command == "list" || command == "results" ||
          command == "report" || command == "resume";

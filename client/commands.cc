@@ -18,6 +18,7 @@
 #include "client/local_cluster.h"
 #include "client/report/job_report_html.h"
 #include "client/report/report_from_proto.h"
+#include "client/report_mechanism.h"
 #include "client/report_responses.h"
 #include "client/study_file.h"
 #include "client/temp_dir.h"
@@ -316,8 +317,9 @@ int ReportCommand(const Args& args) {
   for (std::string& a : spelled) {
     if (a == "-o") a = "--output";
   }
-  auto parsed = Parse(spelled, {{"--server", "--db", "--output"}, {"--no-responses"}}, 1,
-                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH] [--no-responses]");
+  auto parsed = Parse(spelled, {{"--server", "--db", "--output"}, {"--no-responses", "--no-mechanism"}}, 1,
+                      "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH] [--no-responses] "
+                      "[--no-mechanism]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   const std::string job_id = parsed->positional[0];
   std::string path = parsed->Value("--output");
@@ -333,6 +335,11 @@ int ReportCommand(const Args& args) {
     data.responses_note = "Not analysed (mbopt report --no-responses).";
   } else {
     AddResponsePlots(response, &data);
+  }
+  if (parsed->Has("--no-mechanism")) {
+    data.mechanism.note = "Not drawn (mbopt report --no-mechanism).";
+  } else {
+    AddMechanismDrawings(response, &data);
   }
   const std::string html = report::RenderJobReportHtml(data);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -23,6 +23,7 @@ int ResultsCommand(const Args& args);
 int ReportCommand(const Args& args);   // `mbopt report`: HTML page of a job
 int RunCommandMain(const Args& args);  // `mbopt run`
 int ValidateCommand(const Args& args);  // `mbopt validate`: a study checked offline
+int DrawCommand(const Args& args);      // `mbopt draw`: HTML drawing of a scene
 
 // Prints "mbopt: <message>" on stderr and returns `exit_code`.
 int Fail(const std::string& message, int exit_code);

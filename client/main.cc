@@ -24,6 +24,8 @@ constexpr char kUsage[] =
     "                        start a local server and N workers, optimize, print the result;\n"
     "                        keeps the job database (its path is printed) unless --discard-db\n"
     "  validate FILE         check a study and its scene offline; print its layout\n"
+    "  draw FILE [-o OUT.html]\n"
+    "                        draw a scene (or a study's scene), animated over its time grid\n"
     "  submit FILE [--watch] submit a study to a server; prints the job id\n"
     "  watch JOB             follow a job's cycles until it ends\n"
     "  status JOB            a job's state, objective and design\n"
@@ -38,7 +40,7 @@ constexpr char kUsage[] =
     "                        (default FILE: JOB.html)\n"
     "\n"
     "`mbopt COMMAND --help` describes a command and its options; `mbopt --version` the build.\n"
-    "every command but run and validate takes --server HOST:PORT (default $MBOPT_SERVER,\n"
+    "every command but run, validate and draw takes --server HOST:PORT (default $MBOPT_SERVER,\n"
     "else 127.0.0.1:50051); watch, status, list, results, report and resume take\n"
     "--db PATH instead to read a database `mbopt run` kept.\n"
     "a server with TLS and tokens needs --tls-ca FILE and --token-file FILE (or\n"
@@ -80,6 +82,7 @@ int main(int argc, char** argv) {
   if (command == "results") return ResultsCommand(args);
   if (command == "report") return ReportCommand(args);
   if (command == "validate") return ValidateCommand(args);
+  if (command == "draw") return DrawCommand(args);
   std::fprintf(stderr, "mbopt: unknown command '%s'\n\n%s", command.c_str(), kUsage);
   return kExitBadInput;
 }

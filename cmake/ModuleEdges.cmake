@@ -124,8 +124,8 @@ function(mbopt_declare_modules)
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")
   mbopt_module(engine DIRS worker/engine USES budget fmu multibody lumped spec common PURE
-    LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study
-    SUMMARY "one analysis of a scene (the table of model kinds) and the one evaluation of a study at a design point")
+    LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study mbopt_scene_drawing
+    SUMMARY "one analysis of a scene (the table of model kinds), the one evaluation of a study at a design point, and the drawing of a scene")
   mbopt_module(local_run DIRS tests/testing/local_run USES jobs slp lp engine budget spec common PURE BRIDGE
     LIBS mbopt_local_run
     SUMMARY "test and benchmark support: a study optimized in this process, a job with an in-process evaluator")
@@ -158,9 +158,9 @@ function(mbopt_declare_modules)
   mbopt_module(worker_main DIRS worker/main USES version worker_service external engine budget spec spec_io proto common
     LIBS mbopt_worker_eval mbopt-worker
     SUMMARY "the `mbopt-worker` program")
-  mbopt_module(report DIRS client/report USES common PURE
+  mbopt_module(report DIRS client/report USES spec common PURE
     LIBS mbopt_report
-    SUMMARY "the job report page, from `ReportData`")
+    SUMMARY "the job report page, from `ReportData`, and the animated drawings of scenes")
   mbopt_module(report_proto
     FILES client/report/report_from_proto.h client/report/report_from_proto.cc
     USES report proto common

@@ -5,6 +5,7 @@
 
 #include "client/report/history_plots.h"
 #include "client/report/html_escape.h"
+#include "client/report/mechanism_drawing.h"
 #include "client/report/number_format.h"
 #include "client/report/report_tables.h"
 #include "client/report/response_plots.h"
@@ -104,6 +105,7 @@ std::string RenderJobReportHtml(const ReportData& data) {
   out += "<h1>" + EscapeHtml(name) + "</h1>\n";
   if (!data.description.empty()) out += "<p class=\"description\">" + EscapeHtml(data.description) + "</p>\n";
   out += SummaryTable(data);
+  out += MechanismSectionHtml(data.mechanism);
 
   out += "<h2>Cycle history</h2>\n";
   if (data.records.empty()) {

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "client/report/mechanism_drawing.h"
+
 namespace mbopt::report {
 
 struct ReportVariable {
@@ -113,6 +115,8 @@ struct ReportData {
   // `responses_note` says why (e.g. the analyses could not be run).
   std::vector<ResponsePlot> responses;
   std::string responses_note;
+  // The scene drawn at the initial and final designs.
+  MechanismDrawings mechanism;
 
   // kAuto for the objective: logarithmic only when every value is > 0.
   ScaleChoice objective_scale = ScaleChoice::kAuto;

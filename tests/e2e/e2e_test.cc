@@ -486,7 +486,11 @@ TEST(EndToEnd, RunKeepsItsDatabaseForReportAndResults) {
   }
   int plots = 0;
   for (size_t at = text.str().find("<svg"); at != std::string::npos; at = text.str().find("<svg", at + 1)) ++plots;
-  EXPECT_EQ(plots, 5 + 6) << "five history plots, the objective's output and five constraints";
+  EXPECT_EQ(plots, 5 + 6 + 1)
+      << "five history plots, the objective's output and five constraints, the vehicle's schematic";
+  EXPECT_NE(text.str().find("<h2>Mechanism</h2>"), std::string::npos);
+  EXPECT_NE(text.str().find(">initial design</text>"), std::string::npos) << "both designs drawn";
+  EXPECT_NE(text.str().find(">final design</text>"), std::string::npos) << "both designs drawn";
   auto results = Mbopt({"results", "job-1", "--json", "--db", db}, env);
   ASSERT_EQ(results.exit_code, kExitOk) << Describe(results);
   EXPECT_EQ(Comparable(results.stdout_text), Comparable(ReferenceResult(2)));
@@ -496,6 +500,47 @@ TEST(EndToEnd, RunKeepsItsDatabaseForReportAndResults) {
   auto discarded = Mbopt({"run", VehicleStudy(), "--workers", "1", "--discard-db"}, env);
   ASSERT_EQ(discarded.exit_code, kExitOk) << Describe(discarded);
   EXPECT_EQ(discarded.stdout_text.find("database:"), std::string::npos) << Describe(discarded);
+}
+
+// `mbopt draw` writes a scene's animated drawing without a server: one
+// frame per instant of the press's grid, at a design set on the command
+// line; a scene kind without geometry and an unknown name are bad input.
+TEST(Draw, WritesTheAnimatedDrawingOfASceneOrAStudy) {
+  ScratchDir out;
+  const std::vector<std::string> env = {"MBOPT_WORKER_BIN=" + WorkerBinary()};
+  const std::string examples = std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/";
+  const std::string page = out.File("press.html");
+  auto drawn = Mbopt({"draw", examples + "press/press.scene.textproto", "-o", page}, env);
+  ASSERT_EQ(drawn.exit_code, kExitOk) << Describe(drawn);
+  EXPECT_NE(drawn.stdout_text.find("(101 instants)"), std::string::npos) << Describe(drawn);
+  std::stringstream text;
+  text << std::ifstream(page).rdbuf();
+  int frames = 0;
+  for (size_t at = text.str().find("<g class=\"frame\""); at != std::string::npos;
+       at = text.str().find("<g class=\"frame\"", at + 1)) {
+    ++frames;
+  }
+  EXPECT_EQ(frames, 101);
+  EXPECT_NE(text.str().find("<input type=\"range\""), std::string::npos);
+  EXPECT_EQ(text.str().find("http"), std::string::npos) << "nothing fetched";
+
+  // A study's scene at a design of the command line: the longer rod moves
+  // the slider's start from r + l = 0.95 m to 1.15 m.
+  const std::string longer = out.File("longer.html");
+  auto set = Mbopt({"draw", examples + "press/press.study.textproto", "--set", "rod_length=1", "-o", longer}, env);
+  ASSERT_EQ(set.exit_code, kExitOk) << Describe(set);
+  std::stringstream longer_text;
+  longer_text << std::ifstream(longer).rdbuf();
+  EXPECT_NE(longer_text.str(), text.str());
+
+  auto external = Mbopt({"draw", examples + "external/quarter_car.scene.textproto", "-o", out.File("q.html")}, env);
+  EXPECT_EQ(external.exit_code, kExitBadInput) << Describe(external);
+  EXPECT_NE(external.stderr_text.find("only multibody, linkage and lumped scenes can be drawn"), std::string::npos)
+      << Describe(external);
+  auto unknown = Mbopt({"draw", examples + "press/press.scene.textproto", "--set", "no_such=1"}, env);
+  EXPECT_EQ(unknown.exit_code, kExitBadInput) << Describe(unknown);
+  EXPECT_NE(unknown.stderr_text.find("\"no_such\" is neither a design variable"), std::string::npos)
+      << Describe(unknown);
 }
 
 // mbopt-server gc prunes finished jobs, exports them readable by --db, never
@@ -815,15 +860,16 @@ TEST(BadInput, UsageErrorsExitWithTwo) {
 // stdout, nothing contacted), and the three programs answer --version with
 // the release, the commit they were built from and the schema versions.
 TEST(Cli, EveryCommandHasItsHelpAndEveryProgramItsVersion) {
-  for (const char* command : {"run", "validate", "submit", "watch", "status", "list", "workers", "cancel", "resume",
-                              "results", "report"}) {
+  for (const char* command : {"run", "validate", "draw", "submit", "watch", "status", "list", "workers", "cancel",
+                              "resume", "results", "report"}) {
     // The help wins over missing arguments and an unreachable server.
     auto help = Mbopt({command, "--server", "127.0.0.1:1", "--help"});
     EXPECT_EQ(help.exit_code, kExitOk) << command << ": " << Describe(help);
     EXPECT_EQ(help.stdout_text.rfind(std::string("usage: mbopt ") + command + " ", 0), 0u)
         << command << ": " << help.stdout_text;
     EXPECT_NE(help.stdout_text.find("docs/cli.md"), std::string::npos) << command;
-    const bool talks_to_server = std::string(command) != "run" && std::string(command) != "validate";
+    const bool talks_to_server =
+        std::string(command) != "run" && std::string(command) != "validate" && std::string(command) != "draw";
     EXPECT_EQ(help.stdout_text.find("--token-file") != std::string::npos, talks_to_server) << command;
   }
   auto short_help = Mbopt({"status", "-h"});

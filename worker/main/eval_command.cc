@@ -125,8 +125,9 @@ SeriesSummary Summarize(const std::string& label, const std::vector<double>& val
   return s;
 }
 
-// Applies one --set: a design variable (scaled) or a parameter (its unit).
-absl::Status ApplySet(const spec::Study& study, const std::string& assignment,
+}  // namespace
+
+absl::Status ApplyDesignSet(const spec::Study& study, const std::string& assignment,
                       std::vector<double>* x,
                       std::vector<std::pair<int, double>>* parameter_overrides) {
   const size_t eq = assignment.find('=');
@@ -172,8 +173,6 @@ absl::Status ApplySet(const spec::Study& study, const std::string& assignment,
   parameter_overrides->emplace_back(p, value * study.scene.parameters[p].si_per_unit);
   return absl::OkStatus();
 }
-
-}  // namespace
 
 const char* EvalUsage() { return kUsage; }
 
@@ -251,7 +250,7 @@ int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   for (const auto& v : study.variables) x.push_back(v.initial);
   std::vector<std::pair<int, double>> overrides;
   for (const std::string& s : sets) {
-    if (absl::Status st = ApplySet(study, s, &x, &overrides); !st.ok()) {
+    if (absl::Status st = ApplyDesignSet(study, s, &x, &overrides); !st.ok()) {
       err << "mbopt-worker eval: " << st.message() << "\n";
       return kExitBadInput;
     }

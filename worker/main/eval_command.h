@@ -5,7 +5,11 @@
 
 #include <iosfwd>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "absl/status/status.h"
+#include "spec/study.h"
 
 namespace mbopt::worker {
 
@@ -17,6 +21,12 @@ inline constexpr int kExitBadInput = 2;
 // `args` are the arguments after "eval". Writes results to `out`, errors to
 // `err`; returns one of the exit codes above.
 int RunEval(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+// Applies one `--set NAME=VALUE` to the design: NAME a design variable
+// (VALUE scaled, into `x`) or a scene parameter (VALUE in its own unit,
+// appended to `parameter_overrides` in SI). InvalidArgument says why not.
+absl::Status ApplyDesignSet(const spec::Study& study, const std::string& assignment, std::vector<double>* x,
+                            std::vector<std::pair<int, double>>* parameter_overrides);
 
 // The usage text of the subcommand.
 const char* EvalUsage();

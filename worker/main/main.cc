@@ -2,6 +2,7 @@
 //   eval STUDY [--set NAME=VALUE ...] [--json]   one analysis, for debugging
 //   serve --server ADDRESS [--slots N] [--name NAME]   work for a server
 //   drivers FILE                                 check a drivers file
+//   draw FILE --out DRAWING                      the drawing of a scene
 //     (`mbopt-worker --server ADDRESS ...` is short for `serve`)
 // Each subcommand lives in its own file; this file only dispatches.
 #include <cstring>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "common/version/version.h"
+#include "worker/main/draw_command.h"
 #include "worker/main/drivers_command.h"
 #include "worker/main/eval_command.h"
 #include "worker/service/serve_command.h"
@@ -26,6 +28,10 @@ int Eval(const std::vector<std::string>& args) {
   return mbopt::worker::RunEval(args, std::cout, std::cerr);
 }
 
+int Draw(const std::vector<std::string>& args) {
+  return mbopt::worker::RunDraw(args, std::cout, std::cerr);
+}
+
 int Drivers(const std::vector<std::string>& args) {
   return mbopt::worker::RunDrivers(args, std::cout, std::cerr);
 }
@@ -34,13 +40,14 @@ const Subcommand kSubcommands[] = {
     {"eval", "run one analysis of a study and print its values", &Eval},
     {"serve", "connect to a server and run its analyses", &mbopt::worker::ServeMain},
     {"drivers", "check a drivers file and list its drivers", &Drivers},
+    {"draw", "write the drawing of a scene over its time grid", &Draw},
 };
 
 void PrintUsage(std::ostream& os) {
   os << "usage: mbopt-worker <subcommand> [arguments]   (--version: the build)\n\nsubcommands:\n";
   for (const Subcommand& s : kSubcommands) os << "  " << s.name << "  " << s.summary << "\n";
   os << "\n" << mbopt::worker::EvalUsage() << "\n" << mbopt::worker::ServeUsage() << "\n"
-     << mbopt::worker::DriversUsage();
+     << mbopt::worker::DriversUsage() << "\n" << mbopt::worker::DrawUsage();
 }
 
 }  // namespace

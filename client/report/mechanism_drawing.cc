@@ -1,0 +1,422 @@
+#include "client/report/mechanism_drawing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "client/report/html_escape.h"
+#include "client/report/number_format.h"
+
+namespace mbopt::report {
+namespace {
+
+using spec::SceneDrawing;
+
+// The figure's width and its largest height (px): the page's column.
+constexpr double kWidthPx = 720.0;
+constexpr double kMaxHeightPx = 520.0;
+constexpr double kMinHeightPx = 180.0;
+constexpr double kMarginPx = 36.0;
+// Symbols keep their size on screen whatever the scene's size.
+constexpr double kPinRadiusPx = 4.5;
+constexpr double kBodyWidthPx = 14.0;
+constexpr double kAxisHalfLengthPx = 46.0;
+constexpr double kGroundWidthPx = 22.0;
+// Frames of the animation follow one another this often (ms): about the
+// rate at which a slider's steps still read as motion.
+constexpr int kFrameIntervalMs = 60;
+
+struct Px {
+  double x = 0.0, y = 0.0;
+};
+
+// World (m, +y up) to the SVG's pixels (+y down), one scale for both axes.
+struct Mapping {
+  double scale = 1.0;  // px per m
+  double x0 = 0.0, y0 = 0.0;  // world point at the origin of the drawing area
+  double width = kWidthPx, height = kMinHeightPx;
+  double offset_x = 0.0, offset_y = 0.0;
+  Px operator()(const spec::DrawingPosition& p) const {
+    return Px{offset_x + (p.x_m - x0) * scale, offset_y + (y0 - p.y_m) * scale};
+  }
+};
+
+std::string Num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.1f", std::isfinite(v) ? v : 0.0);
+  return buffer;
+}
+
+std::string Pair(const Px& p) { return Num(p.x) + "," + Num(p.y); }
+
+bool Finite(const spec::DrawingPosition& p) { return std::isfinite(p.x_m) && std::isfinite(p.y_m); }
+
+Mapping MapOf(const std::vector<DrawingLayer>& layers) {
+  double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min, y_min = x_min, y_max = -x_min;
+  for (const DrawingLayer& layer : layers) {
+    for (const std::vector<spec::DrawingPosition>& instant : layer.drawing->points_m) {
+      for (const spec::DrawingPosition& p : instant) {
+        if (!Finite(p)) continue;
+        x_min = std::min(x_min, p.x_m);
+        x_max = std::max(x_max, p.x_m);
+        y_min = std::min(y_min, p.y_m);
+        y_max = std::max(y_max, p.y_m);
+      }
+    }
+  }
+  Mapping m;
+  if (!std::isfinite(x_min)) return m;
+  // A drawing of one point, or of points on a line, still gets an area.
+  const double size = std::max({x_max - x_min, y_max - y_min, 1e-6});
+  const double dx = std::max(x_max - x_min, 0.05 * size), dy = std::max(y_max - y_min, 0.05 * size);
+  const double inner_width = kWidthPx - 2 * kMarginPx;
+  m.scale = std::min(inner_width / dx, (kMaxHeightPx - 2 * kMarginPx) / dy);
+  m.height = std::max(kMinHeightPx, dy * m.scale + 2 * kMarginPx);
+  m.x0 = 0.5 * (x_min + x_max) - dx / 2;
+  m.y0 = 0.5 * (y_min + y_max) + dy / 2;
+  m.offset_x = kMarginPx + 0.5 * (inner_width - dx * m.scale);
+  m.offset_y = 0.5 * (m.height - dy * m.scale);
+  return m;
+}
+
+// The convex hull (Andrew's monotone chain), counter-clockwise.
+std::vector<Px> Hull(std::vector<Px> p) {
+  std::sort(p.begin(), p.end(), [](const Px& a, const Px& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  p.erase(std::unique(p.begin(), p.end(), [](const Px& a, const Px& b) { return a.x == b.x && a.y == b.y; }), p.end());
+  if (p.size() < 3) return p;
+  auto cross = [](const Px& o, const Px& a, const Px& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
+  std::vector<Px> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(h[k - 2], h[k - 1], p[i - 1]) <= 0) --k;
+    h[k++] = p[i - 1];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+std::string Points(const std::vector<Px>& points) {
+  std::string out;
+  for (const Px& p : points) out += (out.empty() ? "" : " ") + Pair(p);
+  return out;
+}
+
+// A body: its points' hull drawn with a wide round stroke in the fill
+// colour (so two points make a bar, one a disc), then its outline.
+std::string BodySvg(const std::vector<Px>& points, const DrawingLayer& layer) {
+  const std::vector<Px> hull = Hull(points);
+  if (hull.empty()) return "";
+  if (hull.size() == 1) {
+    return "<circle cx=\"" + Num(hull[0].x) + "\" cy=\"" + Num(hull[0].y) + "\" r=\"" + Num(kBodyWidthPx / 2) +
+           "\" fill=\"" + layer.fill + "\" stroke=\"" + layer.color + "\" stroke-width=\"1.2\"/>";
+  }
+  const std::string shape = hull.size() == 2 ? "polyline" : "polygon";
+  return "<" + shape + " points=\"" + Points(hull) + "\" fill=\"" + layer.fill + "\" stroke=\"" + layer.fill +
+         "\" stroke-width=\"" + Num(kBodyWidthPx) + "\" stroke-linejoin=\"round\" stroke-linecap=\"round\"/>" + "<" +
+         shape + " points=\"" + Points(hull) + "\" fill=\"none\" stroke=\"" + layer.color +
+         "\" stroke-width=\"1.2\" stroke-linejoin=\"round\"/>";
+}
+
+Px Along(const Px& a, const Px& b, double f) { return Px{a.x + f * (b.x - a.x), a.y + f * (b.y - a.y)}; }
+
+// A spring (zigzag), a damper (a pot and its piston) or both side by side
+// between a and b; neither: a dashed line (an actuator).
+std::string ElementSvg(Px a, Px b, const SceneDrawing::Element& e, const DrawingLayer& layer) {
+  const double length = std::hypot(b.x - a.x, b.y - a.y);
+  if (!(length > 1e-9)) return "";
+  const Px u{(b.x - a.x) / length, (b.y - a.y) / length};
+  const Px n{-u.y, u.x};
+  const std::string stroke = "stroke=\"" + layer.color + "\" stroke-width=\"1.4\" fill=\"none\"";
+  auto shifted = [&](const Px& p, double s) { return Px{p.x + s * n.x, p.y + s * n.y}; };
+  auto spring = [&](double side) {
+    std::vector<Px> zig{shifted(a, side), shifted(Along(a, b, 0.2), side)};
+    constexpr int kTurns = 8;
+    const double amplitude = std::min(6.0, 0.25 * length);
+    for (int k = 1; k < 2 * kTurns; ++k) {
+      zig.push_back(shifted(Along(a, b, 0.2 + 0.6 * k / (2.0 * kTurns)), side + (k % 2 == 1 ? amplitude : -amplitude)));
+    }
+    zig.push_back(shifted(Along(a, b, 0.8), side));
+    zig.push_back(shifted(b, side));
+    return "<polyline points=\"" + Points(zig) + "\" " + stroke + "/>";
+  };
+  auto damper = [&](double side) {
+    const double w = 5.0;
+    const Px pot_bottom = shifted(Along(a, b, 0.35), side), pot_top = shifted(Along(a, b, 0.7), side);
+    const Px piston = shifted(Along(a, b, 0.55), side);
+    std::string out = "<polyline points=\"" + Pair(shifted(a, side)) + " " + Pair(pot_bottom) + "\" " + stroke + "/>";
+    out += "<polyline points=\"" + Pair(shifted(pot_top, w)) + " " + Pair(shifted(pot_bottom, w)) + " " +
+           Pair(shifted(pot_bottom, -w)) + " " + Pair(shifted(pot_top, -w)) + "\" " + stroke + "/>";
+    out += "<polyline points=\"" + Pair(shifted(piston, 0.7 * w)) + " " + Pair(shifted(piston, -0.7 * w)) + "\" " +
+           stroke + "/>";
+    out += "<polyline points=\"" + Pair(piston) + " " + Pair(shifted(b, side)) + "\" " + stroke + "/>";
+    return out;
+  };
+  std::string out = "<g class=\"element\"><title>" + EscapeHtml(e.name) + "</title>";
+  if (e.spring && e.damper) {
+    out += spring(-8.0) + damper(8.0);
+  } else if (e.spring) {
+    out += spring(0.0);
+  } else if (e.damper) {
+    out += damper(0.0);
+  } else {
+    out += "<polyline points=\"" + Pair(a) + " " + Pair(b) + "\" " + stroke + " stroke-dasharray=\"5 3\"/>";
+  }
+  return out + "</g>";
+}
+
+std::string JointSvg(const Px& at, const SceneDrawing::Joint& joint, double axis_angle_rad, const DrawingLayer& layer) {
+  std::string out = "<g class=\"joint\"><title>" + EscapeHtml(joint.name) + "</title>";
+  const std::string stroke = "stroke=\"" + layer.color + "\" stroke-width=\"1.4\"";
+  // The axis in pixels: +y is down on screen.
+  const Px u{std::cos(axis_angle_rad), -std::sin(axis_angle_rad)};
+  auto point = [&](double along, double across) {
+    return Px{at.x + along * u.x - across * u.y, at.y + along * u.y + across * u.x};
+  };
+  switch (joint.kind) {
+    case SceneDrawing::JointKind::kPin:
+      out += "<circle class=\"pin\" cx=\"" + Num(at.x) + "\" cy=\"" + Num(at.y) + "\" r=\"" + Num(kPinRadiusPx) +
+             "\" fill=\"#ffffff\" " + stroke + "/>";
+      break;
+    case SceneDrawing::JointKind::kFixed:
+      out += "<rect class=\"fixed\" x=\"" + Num(at.x - 4) + "\" y=\"" + Num(at.y - 4) +
+             "\" width=\"8\" height=\"8\" fill=\"" + layer.color + "\"/>";
+      break;
+    case SceneDrawing::JointKind::kSlider:
+      out += "<polyline class=\"axis\" points=\"" + Pair(point(-kAxisHalfLengthPx, 0)) + " " +
+             Pair(point(kAxisHalfLengthPx, 0)) + "\" " + stroke + " stroke-dasharray=\"6 3\" fill=\"none\"/>";
+      out += "<polygon class=\"slider\" points=\"" +
+             Points({point(-11, -7), point(11, -7), point(11, 7), point(-11, 7)}) + "\" fill=\"" + layer.fill + "\" " +
+             stroke + "/>";
+      out += "<circle cx=\"" + Num(at.x) + "\" cy=\"" + Num(at.y) + "\" r=\"2\" fill=\"" + layer.color + "\"/>";
+      break;
+    case SceneDrawing::JointKind::kPinInSlot:
+      for (const double side : {-kPinRadiusPx - 1.5, kPinRadiusPx + 1.5}) {
+        out += "<polyline class=\"slot\" points=\"" + Pair(point(-kAxisHalfLengthPx, side)) + " " +
+               Pair(point(kAxisHalfLengthPx, side)) + "\" " + stroke + " fill=\"none\"/>";
+      }
+      out += "<circle class=\"pin\" cx=\"" + Num(at.x) + "\" cy=\"" + Num(at.y) + "\" r=\"" + Num(kPinRadiusPx) +
+             "\" fill=\"#ffffff\" " + stroke + "/>";
+      break;
+  }
+  return out + "</g>";
+}
+
+// A ground point: a short base line under it, hatched.
+std::string GroundSvg(const Px& at, const DrawingLayer& layer) {
+  const double y = at.y + kPinRadiusPx + 3.0, half = kGroundWidthPx / 2;
+  std::string out = "<g class=\"ground\"><polyline points=\"" + Pair(at) + " " + Pair(Px{at.x, y}) + "\" stroke=\"" +
+                    layer.color + "\" stroke-width=\"1.2\" fill=\"none\"/>";
+  out += "<polyline points=\"" + Pair(Px{at.x - half, y}) + " " + Pair(Px{at.x + half, y}) + "\" stroke=\"" +
+         layer.color + "\" stroke-width=\"1.6\" fill=\"none\"/>";
+  for (double x = at.x - half + 4; x <= at.x + half + 0.1; x += 5) {
+    out += "<polyline points=\"" + Pair(Px{x, y}) + " " + Pair(Px{x - 5, y + 6}) + "\" stroke=\"" + layer.color +
+           "\" stroke-width=\"1\" fill=\"none\"/>";
+  }
+  return out + "</g>";
+}
+
+// An input point: an arrow along its direction, ending at it.
+std::string InputSvg(const Px& at, const SceneDrawing::Input& input) {
+  const double norm = std::hypot(input.direction_x, input.direction_y);
+  const Px u = norm > 0 ? Px{input.direction_x / norm, -input.direction_y / norm} : Px{0, -1};
+  const Px tail{at.x - 28 * u.x, at.y - 28 * u.y};
+  const Px left{at.x - 7 * u.x - 4 * u.y, at.y - 7 * u.y + 4 * u.x};
+  const Px right{at.x - 7 * u.x + 4 * u.y, at.y - 7 * u.y - 4 * u.x};
+  return "<g class=\"input\"><title>" + EscapeHtml(input.name) + "</title><polyline points=\"" + Pair(tail) + " " +
+         Pair(at) + "\" stroke=\"#b03a2e\" stroke-width=\"1.6\" fill=\"none\"/><polygon points=\"" +
+         Points({at, left, right}) + "\" fill=\"#b03a2e\"/></g>";
+}
+
+// One layer at one instant.
+std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mapping& map) {
+  const SceneDrawing& d = *layer.drawing;
+  const std::vector<spec::DrawingPosition>& at = d.points_m[instant];
+  auto px = [&](int point) { return map(at[static_cast<size_t>(point)]); };
+  std::string out = "<g class=\"layer\"";
+  if (layer.opacity < 1.0) out += " opacity=\"" + FormatValue(layer.opacity, 3) + "\"";
+  out += ">";
+  for (const SceneDrawing::Body& body : d.bodies) {
+    std::vector<Px> points;
+    for (const int p : body.points) {
+      if (Finite(at[static_cast<size_t>(p)])) points.push_back(px(p));
+    }
+    out += "<g class=\"body\"><title>" + EscapeHtml(body.name) + "</title>" + BodySvg(points, layer) + "</g>";
+  }
+  for (const SceneDrawing::Line& line : d.lines) {
+    std::vector<Px> points;
+    for (const int p : line.points) points.push_back(px(p));
+    out += "<g class=\"flexible\"><title>" + EscapeHtml(line.name) + "</title><polyline points=\"" + Points(points) +
+           "\" stroke=\"" + layer.color + "\" stroke-width=\"3\" fill=\"none\" stroke-linejoin=\"round\"/></g>";
+  }
+  for (const SceneDrawing::Element& e : d.elements) out += ElementSvg(px(e.a), px(e.b), e, layer);
+  for (const SceneDrawing::Input& input : d.inputs) out += InputSvg(px(input.point), input);
+  // The points themselves, small, under the joints.
+  for (size_t p = 0; p < at.size(); ++p) {
+    const Px c = px(static_cast<int>(p));
+    out += "<circle cx=\"" + Num(c.x) + "\" cy=\"" + Num(c.y) + "\" r=\"1.6\" fill=\"" + layer.color +
+           "\"><title>" + EscapeHtml(d.point_names[p]) + "</title></circle>";
+  }
+  for (const SceneDrawing::Joint& joint : d.joints) {
+    const double axis = instant < joint.axis_angle_rad.size() ? joint.axis_angle_rad[instant] : 0.0;
+    out += JointSvg(px(joint.point), joint, axis, layer);
+  }
+  return out + "</g>";
+}
+
+// The instants shown: all, or kMaxDrawingFrames picked evenly.
+std::vector<size_t> FrameInstants(size_t instants) {
+  std::vector<size_t> picked;
+  if (instants <= static_cast<size_t>(kMaxDrawingFrames)) {
+    for (size_t i = 0; i < instants; ++i) picked.push_back(i);
+    return picked;
+  }
+  for (int k = 0; k < kMaxDrawingFrames; ++k) {
+    picked.push_back(static_cast<size_t>(std::llround(static_cast<double>(k) * static_cast<double>(instants - 1) /
+                                                      (kMaxDrawingFrames - 1))));
+  }
+  return picked;
+}
+
+}  // namespace
+
+std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, const std::string& id) {
+  std::vector<DrawingLayer> layers;
+  for (const DrawingLayer& layer : layers_in) {
+    if (layer.drawing != nullptr && !layer.drawing->points_m.empty()) layers.push_back(layer);
+  }
+  std::string out = "<div class=\"mechanism\" id=\"" + EscapeHtml(id) + "\">\n";
+  if (layers.empty()) return out + "<p class=\"note\">Nothing to draw.</p>\n</div>\n";
+  const Mapping map = MapOf(layers);
+  size_t instants = 0;
+  const std::vector<double>* times = nullptr;
+  for (const DrawingLayer& layer : layers) {
+    if (layer.drawing->points_m.size() > instants) {
+      instants = layer.drawing->points_m.size();
+      times = &layer.drawing->times_s;
+    }
+  }
+  const std::vector<size_t> frames = FrameInstants(instants);
+  out += "<svg class=\"drawing\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) + "\" viewBox=\"0 0 " +
+         Num(map.width) + " " + Num(map.height) + "\" role=\"img\">\n";
+  out += "<rect x=\"0\" y=\"0\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) +
+         "\" fill=\"#fcfcfc\" stroke=\"#dddddd\"/>\n";
+  // Ground does not move: drawn once per layer, under the frames.
+  for (const DrawingLayer& layer : layers) {
+    for (const int p : layer.drawing->ground_points) {
+      out += GroundSvg(map(layer.drawing->points_m[0][static_cast<size_t>(p)]), layer);
+    }
+  }
+  out += "\n";
+  for (size_t f = 0; f < frames.size(); ++f) {
+    out += "<g class=\"frame\"" + std::string(f == 0 ? "" : " display=\"none\"") + ">";
+    for (const DrawingLayer& layer : layers) {
+      out += LayerFrameSvg(layer, std::min(frames[f], layer.drawing->points_m.size() - 1), map);
+    }
+    out += "</g>\n";
+  }
+  // The legend: one line per layer.
+  double y = 16;
+  for (const DrawingLayer& layer : layers) {
+    if (layer.label.empty()) continue;
+    out += "<rect x=\"10\" y=\"" + Num(y - 9) + "\" width=\"14\" height=\"9\" fill=\"" + layer.fill + "\" stroke=\"" +
+           layer.color + "\"/><text x=\"30\" y=\"" + Num(y) + "\" font-size=\"12\">" + EscapeHtml(layer.label) +
+           "</text>\n";
+    y += 16;
+  }
+  out += "</svg>\n";
+  std::string time_list;
+  for (const size_t f : frames) {
+    time_list += (time_list.empty() ? "" : ",") + std::string("\"") +
+                 FormatValue(f < times->size() ? (*times)[f] : 0.0, 6) + "\"";
+  }
+  const std::string first_time = FormatValue(times->empty() ? 0.0 : (*times)[frames[0]], 6);
+  // One frame (a schematic, a grid of one instant) has nothing to animate.
+  const bool animated = frames.size() > 1;
+  out += "<div class=\"controls\">";
+  if (animated) {
+    out += "<button type=\"button\">Play</button> <input type=\"range\" min=\"0\" max=\"" +
+           std::to_string(frames.size() - 1) +
+           "\" value=\"0\" step=\"1\" style=\"width: 420px; vertical-align: middle\"> ";
+  }
+  out += "<span class=\"time\">t = " + first_time + " s</span>";
+  if (frames.size() < instants) {
+    out += " <span class=\"note\">(" + std::to_string(frames.size()) + " of " + std::to_string(instants) +
+           " instants shown)</span>";
+  }
+  out += "</div>\n";
+  for (const DrawingLayer& layer : layers) {
+    if (!layer.drawing->failure.empty()) {
+      out += "<p class=\"note\">" + EscapeHtml(layer.label.empty() ? std::string("The drawing") : layer.label) +
+             ": the motion stops at t = " +
+             FormatValue(layer.drawing->times_s.empty() ? 0.0 : layer.drawing->times_s.back(), 6) +
+             " s: " + EscapeHtml(layer.drawing->failure) + "</p>\n";
+    }
+  }
+  if (!animated) return out + "</div>\n";
+  // One frame shown at a time; the slider picks it, the button steps
+  // through them in a loop, and "#frame=N" in the page's address opens it
+  // at frame N (a link to an instant, a screenshot of one).
+  out += "<script>(function(){var root=document.getElementById(\"" + EscapeHtml(id) +
+         "\");var frames=root.querySelectorAll(\"g.frame\");var slider=root.querySelector(\"input\");"
+         "var button=root.querySelector(\"button\");var label=root.querySelector(\".time\");var times=[" +
+         time_list +
+         "];var shown=0,timer=null;function show(i){frames[shown].setAttribute(\"display\",\"none\");shown=i;"
+         "frames[i].removeAttribute(\"display\");slider.value=i;label.textContent=\"t = \"+times[i]+\" s\";}"
+         "slider.addEventListener(\"input\",function(){show(Number(slider.value));});"
+         "button.addEventListener(\"click\",function(){if(timer!==null){clearInterval(timer);timer=null;"
+         "button.textContent=\"Play\";return;}button.textContent=\"Pause\";timer=setInterval(function(){"
+         "show((shown+1)%frames.length);}," +
+         std::to_string(kFrameIntervalMs) +
+         ");});var asked=/frame=([0-9]+)/.exec(location.hash);"
+         "if(asked)show(Math.min(Number(asked[1]),frames.length-1));})();</script>\n";
+  return out + "</div>\n";
+}
+
+std::string MechanismSectionHtml(const MechanismDrawings& mechanism) {
+  if (!mechanism.initial && !mechanism.final && mechanism.note.empty()) return "";
+  std::string out = "<h2>Mechanism</h2>\n";
+  std::vector<DrawingLayer> layers;
+  if (mechanism.initial) {
+    layers.push_back(DrawingLayer{&*mechanism.initial, "initial design", "#7a7a7a", "#e6e6e6", 0.75});
+  }
+  if (mechanism.final) layers.push_back(DrawingLayer{&*mechanism.final, "final design", "#1f4e9a", "#c9d8f0", 1.0});
+  if (!layers.empty()) {
+    const bool schematic = layers.front().drawing->schematic;
+    out += std::string("<p class=\"note\">The scene ") +
+           (schematic ? "as a schematic (a lumped scene: its layout, not a motion)"
+                      : "over its time grid (the slider or the play button moves it)") +
+           " at the initial design (grey) and at the final design (blue), overlaid on the same axes.</p>\n";
+    out += MechanismFigureHtml(layers, "mechanism");
+  }
+  if (!mechanism.note.empty()) out += "<p class=\"note\">" + EscapeHtml(mechanism.note) + "</p>\n";
+  return out;
+}
+
+std::string SceneDrawingPageHtml(const spec::SceneDrawing& drawing, const std::string& source) {
+  std::string out =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
+      EscapeHtml(drawing.scene_name) +
+      "</title>\n<style>\nbody { font-family: sans-serif; margin: 1.5em; color: #222; }\n"
+      "p.note { color: #555; }\n.controls { margin: 0.4em 0; }\n.controls input { width: 420px; vertical-align: middle; }\n"
+      "</style>\n</head>\n<body>\n<h1>" +
+      EscapeHtml(drawing.scene_name) + "</h1>\n<p class=\"note\">" + EscapeHtml(source) + ": " +
+      (drawing.schematic ? std::string("schematic (a lumped scene: its layout, not a motion)")
+                         : std::to_string(drawing.times_s.size()) + " instants of the time grid") +
+      "</p>\n";
+  DrawingLayer layer;
+  layer.drawing = &drawing;
+  out += MechanismFigureHtml({layer}, "drawing");
+  return out + "</body>\n</html>\n";
+}
+
+}  // namespace mbopt::report

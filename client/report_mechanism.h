@@ -1,0 +1,16 @@
+// The report page's "Mechanism" section for one job: `mbopt-worker draw`
+// draws the job's study (its scene inlined) at the initial and at the final
+// design, as `mbopt report` analyses them for the responses.
+#pragma once
+
+#include "client/report/report_data.h"
+#include "mbopt/v1/service.pb.h"
+
+namespace mbopt::client {
+
+// Fills data->mechanism: both drawings, or a note saying why not (no
+// design yet, a scene kind without a drawing, the worker program not
+// found, a motion that stops early). Prints a line on stderr while it runs.
+void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data);
+
+}  // namespace mbopt::client

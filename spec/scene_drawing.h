@@ -1,0 +1,79 @@
+// The picture of a scene: where its parts are at every instant drawn, as
+// plain data. The worker computes it only when asked (`mbopt-worker draw`),
+// the file schema carries it (proto/mbopt/v1/drawing.proto), and the report
+// draws it (client/report/mechanism_drawing.h); nothing here draws.
+//
+// Every part names points of one table, `point_names`, whose positions are
+// given per instant (`points_m[instant]`, world axes, m). A schematic (a
+// lumped scene: small motion about a layout that means nothing physically)
+// has one instant, t = 0.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace mbopt::spec {
+
+struct DrawingPosition {
+  double x_m = 0.0, y_m = 0.0;
+};
+
+struct SceneDrawing {
+  // A rigid body (or a lumped body) drawn as the outline around its points.
+  struct Body {
+    std::string name;
+    std::vector<int> points;
+  };
+  enum class JointKind { kPin, kSlider, kFixed, kPinInSlot };
+  // A joint drawn at `point`; a slider's and a pin-in-slot's axis through it
+  // at `axis_angle_rad[instant]` (world axes; empty for the others).
+  struct Joint {
+    std::string name;
+    JointKind kind = JointKind::kPin;
+    int point = -1;
+    std::vector<double> axis_angle_rad;
+  };
+  // A translational element between two points: spring zigzag, damper pot,
+  // or both side by side.
+  struct Element {
+    std::string name;
+    int a = -1, b = -1;
+    bool spring = false, damper = false;
+  };
+  // A flexible link's centre line through its nodes, in order.
+  struct Line {
+    std::string name;
+    std::vector<int> points;
+  };
+  // A point that moves by a prescribed input (a road under a wheel): drawn
+  // with an arrow along `direction` (unit).
+  struct Input {
+    std::string name;
+    int point = -1;
+    double direction_x = 0.0, direction_y = 1.0;
+  };
+
+  std::string scene_name;
+  bool schematic = false;
+  std::vector<double> times_s;
+  std::vector<std::string> point_names;
+  std::vector<std::vector<DrawingPosition>> points_m;  // [instant][point]
+  std::vector<Body> bodies;
+  std::vector<Joint> joints;
+  std::vector<Element> elements;
+  std::vector<Line> lines;
+  std::vector<Input> inputs;
+  std::vector<int> ground_points;  // hatched: fixed to the world
+  // Empty when every instant of the grid was drawn; else why the motion
+  // stopped (the instants before are kept).
+  std::string failure;
+
+  // Appends a point (its positions are filled per instant) and returns its index.
+  int AddPoint(std::string name) {
+    point_names.push_back(std::move(name));
+    return static_cast<int>(point_names.size()) - 1;
+  }
+};
+
+}  // namespace mbopt::spec

@@ -1,0 +1,125 @@
+#include "worker/multibody/linkage_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <variant>
+
+#include "absl/strings/str_format.h"
+#include "worker/multibody/assembly.h"
+#include "worker/multibody/kinematic_analysis.h"
+#include "worker/multibody/linkage_front_end.h"
+#include "worker/multibody/linkage_system.h"
+#include "worker/multibody/mechanism.h"
+
+namespace mbopt::multibody {
+namespace {
+
+// Small enough that Newton, started from the previous instant, stays on the
+// assembly branch between two drawn instants however coarse the grid.
+constexpr double kDrawStepRad = std::numbers::pi / 18.0;
+// A grid that needs more solved instants than this is drawn only up to
+// there: a drawing has no use for millions of frames.
+constexpr int kMaxSolvedInstants = 200000;
+
+}  // namespace
+
+spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<double>& p,
+                                    budget::AnalysisBudget* budget) {
+  spec::SceneDrawing d;
+  d.scene_name = scene.name;
+  const auto* linkage = std::get_if<spec::LinkageModel>(&scene.model);
+  if (linkage == nullptr) {
+    d.failure = "expected a linkage scene";
+    return d;
+  }
+  absl::StatusOr<LinkageSystem> resolved = ResolveLinkage(*linkage, scene.effects, p);
+  if (!resolved.ok()) {
+    d.failure = std::string(resolved.status().message());
+    return d;
+  }
+  const LinkageSystem& sys = *resolved;
+  if (std::string why; LinkageDegreesOfFreedom(sys, &why) != 0) {
+    d.failure = why;
+    return d;
+  }
+  // Points: the pins, then every link's own points.
+  for (const LinkageJoint& j : sys.joints) {
+    const int point = d.AddPoint(j.name);
+    d.joints.push_back(spec::SceneDrawing::Joint{j.name, spec::SceneDrawing::JointKind::kPin, point, {}});
+    if (j.ground) d.ground_points.push_back(point);
+  }
+  for (const LinkageLink& l : sys.links) {
+    spec::SceneDrawing::Body body;
+    body.name = l.name;
+    body.points = {l.joint_a, l.joint_b};
+    for (const LinkagePoint& point : l.points) body.points.push_back(d.AddPoint(l.name + "." + point.name));
+    d.bodies.push_back(std::move(body));
+  }
+
+  const CompiledLinkage compiled = CompileLinkage(sys);
+  const Mechanism mechanism(compiled.model);
+  AssemblyOptions assembly_options;
+  assembly_options.budget = budget;
+  const Assembly assembled = Assemble(mechanism, 0.0, assembly_options);
+  const auto append = [&](double t_s, const Eigen::VectorXd& q) {
+    d.times_s.push_back(t_s);
+    std::vector<spec::DrawingPosition>& at = d.points_m.emplace_back();
+    std::vector<Eigen::Vector2d> pins;
+    for (size_t j = 0; j < sys.joints.size(); ++j) {
+      pins.push_back(mechanism.PointPosition(compiled.joint_point[j], q, t_s));
+      at.push_back(spec::DrawingPosition{pins.back().x(), pins.back().y()});
+    }
+    // A link point is carried in the link's frame: origin at joint a, x
+    // towards joint b.
+    for (const LinkageLink& l : sys.links) {
+      const Eigen::Vector2d a = pins[static_cast<size_t>(l.joint_a)];
+      const Eigen::Vector2d e = (pins[static_cast<size_t>(l.joint_b)] - a).normalized();
+      const Eigen::Vector2d n(-e.y(), e.x());
+      for (const LinkagePoint& point : l.points) {
+        const Eigen::Vector2d r = a + point.local_m.x() * e + point.local_m.y() * n;
+        at.push_back(spec::DrawingPosition{r.x(), r.y()});
+      }
+    }
+  };
+  if (!assembled.failure.ok()) {
+    append(0.0, mechanism.InitialGuess());
+    d.failure = "does not assemble (the pins as given are drawn): " + assembled.failure.reason;
+    return d;
+  }
+  const std::vector<double> grid = scene.time_grid.Instants();
+  const double omega = std::abs(sys.driver.angular_velocity_rad_per_s);
+  std::vector<double> instants{0.0};
+  for (const double t : grid) {
+    const double from = instants.back();
+    if (t <= from) continue;
+    const int steps = std::max(1, static_cast<int>(std::ceil(omega * (t - from) / kDrawStepRad)));
+    if (static_cast<double>(instants.size()) + steps > kMaxSolvedInstants) break;
+    for (int k = 1; k < steps; ++k) instants.push_back(from + (t - from) * k / steps);
+    instants.push_back(t);
+  }
+  size_t next = 0;
+  const MotionCallback record = [&](const MotionSample& s) {
+    if (budget != nullptr) {
+      if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
+    }
+    for (; next < grid.size() && grid[next] <= s.t_s; ++next) {
+      if (grid[next] == s.t_s) append(s.t_s, s.q);
+    }
+    return spec::AnalysisFailure::Ok();
+  };
+  KinematicOptions options;
+  options.budget = budget;
+  KinematicCounters counters;
+  const spec::AnalysisFailure outcome = RunKinematics(mechanism, assembled.q, instants, options, record, &counters);
+  if (!outcome.ok()) {
+    d.failure = outcome.reason;
+  } else if (d.times_s.size() < grid.size()) {
+    d.failure = absl::StrFormat("drawn up to t = %.6g s: the driver turns too often over the time grid to follow",
+                                d.times_s.empty() ? 0.0 : d.times_s.back());
+  }
+  return d;
+}
+
+}  // namespace mbopt::multibody
