@@ -129,7 +129,7 @@ TEST(DesignSetEndToEnd, EveryDesignIsTheWorkersEvaluationOfIt) {
   const std::string json = SweepResults(2);
   const std::vector<std::string> objectives = AllFields(json, "objective");
   const std::vector<std::string> violations = AllFields(json, "max_violation");
-  // Design k's x2 value, scaled as in the study: 7.5 + 2.8125 (k - 1).
+  // Design k + 1 (k from 0) has x2 = 7.5 + 2.8125 k, scaled as in the study.
   ASSERT_EQ(objectives.size(), static_cast<size_t>(kDesigns)) << json;
   ASSERT_EQ(violations.size(), static_cast<size_t>(kDesigns)) << json;
   for (int k : {0, 4, 8}) {
