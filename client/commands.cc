@@ -12,10 +12,13 @@
 
 #include "client/args.h"
 #include "client/connection.h"
+#include "client/design_set_format.h"
+#include "client/design_set_report_from_job.h"
 #include "client/exit_codes.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
 #include "client/local_cluster.h"
+#include "client/report/design_set_report.h"
 #include "client/report/job_report_html.h"
 #include "client/report/report_from_proto.h"
 #include "client/report_mechanism.h"
@@ -133,8 +136,8 @@ int Follow(Connection& c, const std::string& job_id) {
   }
   if (!outcome.ok) return Fail(outcome.failure.message, outcome.failure.exit_code);
   const auto& s = outcome.summary;
-  std::printf("%s: %s after %d cycles, %lld analyses", job_id.c_str(), StateName(s.state()).c_str(),
-              s.cycles(), static_cast<long long>(s.analyses()));
+  std::printf("%s: %s after %d %s, %lld analyses", job_id.c_str(), StateName(s.state()).c_str(),
+              s.cycles(), s.design_set() ? "designs" : "cycles", static_cast<long long>(s.analyses()));
   if (std::isfinite(s.objective())) {
     std::printf(", F = %.10g %s, max violation %.4g\n", s.objective(), s.objective_unit().c_str(),
                 s.max_violation());
@@ -311,6 +314,20 @@ int ResultsCommand(const Args& args) {
   return ExitCodeForState(response.summary().state());
 }
 
+namespace {
+
+// Writes a report page to `path` and says where.
+int WriteReport(const std::string& path, const std::string& html) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << html;
+  out.close();
+  if (!out) return Fail("cannot write the report to " + path, kExitBadInput);
+  std::printf("wrote %s\n", path.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
 int ReportCommand(const Args& args) {
   // `-o` is the one short option mbopt takes: the usual spelling for an output file.
   Args spelled = args;
@@ -330,6 +347,11 @@ int ReportCommand(const Args& args) {
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, job_id, &response);
   if (!status.ok()) return FailRpc(status, c.address, &c.security);
+  if (IsDesignSetJob(response)) {
+    // A sweep or sample has no optimization history: its page plots the
+    // objective and constraints against the design.
+    return WriteReport(path, report::RenderDesignSetReportHtml(DesignSetReportFromJob(response)));
+  }
   report::ReportData data = report::ReportDataFromJob(response);
   if (parsed->Has("--no-responses")) {
     data.responses_note = "Not analysed (mbopt report --no-responses).";
@@ -341,13 +363,7 @@ int ReportCommand(const Args& args) {
   } else {
     AddMechanismDrawings(response, &data);
   }
-  const std::string html = report::RenderJobReportHtml(data);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << html;
-  out.close();
-  if (!out) return Fail("cannot write the report to " + path, kExitBadInput);
-  std::printf("wrote %s\n", path.c_str());
-  return kExitOk;
+  return WriteReport(path, report::RenderJobReportHtml(data));
 }
 
 }  // namespace mbopt::client

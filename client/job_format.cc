@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "client/design_set_format.h"
 #include "client/exit_codes.h"
 #include "client/json_writer.h"
 #include "client/report/report_from_proto.h"
@@ -73,6 +74,7 @@ std::string StateName(v1::JobState state) { return report::JobStateName(state); 
 bool IsTerminal(v1::JobState state) {
   switch (state) {
     case v1::JOB_STATE_CONVERGED:
+    case v1::JOB_STATE_COMPLETED:
     case v1::JOB_STATE_MAX_CYCLES:
     case v1::JOB_STATE_STALLED:
     case v1::JOB_STATE_FAILED:
@@ -87,6 +89,7 @@ bool IsTerminal(v1::JobState state) {
 int ExitCodeForState(v1::JobState state) {
   switch (state) {
     case v1::JOB_STATE_CONVERGED: return kExitOk;
+    case v1::JOB_STATE_COMPLETED: return kExitOk;
     case v1::JOB_STATE_FAILED: return kExitJobFailed;
     case v1::JOB_STATE_QUEUED:
     case v1::JOB_STATE_RUNNING: return kExitOk;
@@ -134,8 +137,12 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   out += "study:         " + s.study_name() + "\n";
   if (!s.owner().empty()) out += "submitted by:  " + s.owner() + "\n";
   out += "status:        " + StateName(s.state()) + "\n";
-  out += "cycles:        " + std::to_string(s.cycles()) +
-         (s.max_cycles() > 0 ? " (of at most " + std::to_string(s.max_cycles()) + ")" : "") + "\n";
+  if (s.design_set()) {
+    out += "designs:       " + std::to_string(s.cycles()) + " of " + std::to_string(s.max_cycles()) + " analysed\n";
+  } else {
+    out += "cycles:        " + std::to_string(s.cycles()) +
+           (s.max_cycles() > 0 ? " (of at most " + std::to_string(s.max_cycles()) + ")" : "") + "\n";
+  }
   out += "analyses:      " + std::to_string(s.analyses()) + "\n";
   if (std::isfinite(s.objective())) {
     out += "objective:     " + Format("%.10g", s.objective()) +
@@ -148,7 +155,8 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   if (!s.message().empty()) out += "message:       " + s.message() + "\n";
   if (!s.waiting_for().empty()) out += "waiting:       " + s.waiting_for() + "\n";
   if (!s.failed_analyses_by_kind().empty()) out += "failed:        " + FailedAnalysesText(s) + "\n";
-  if (s.design_size() > 0) out += "design:\n" + DesignLines(s, study);
+  // A design set's summary design is its best analysed design.
+  if (s.design_size() > 0) out += (s.design_set() ? "best design:\n" : "design:\n") + DesignLines(s, study);
   return out;
 }
 
@@ -185,6 +193,7 @@ std::string WorkersRow(const v1::WorkerSummary& w) {
 }
 
 std::string ResultsTable(const v1::GetJobResponse& job) {
+  if (IsDesignSetJob(job)) return DesignSetTable(job);
   std::string out = SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr);
   // Appended piece by piece: GCC 12 at -O3 reports a false -Wrestrict for
   // "\n" + std::string temporaries here.
@@ -199,6 +208,7 @@ std::string ResultsTable(const v1::GetJobResponse& job) {
 }
 
 std::string ResultsCsv(const v1::GetJobResponse& job) {
+  if (IsDesignSetJob(job)) return DesignSetCsv(job);
   const auto& s = job.summary();
   std::string out = "cycle,attempt,accepted,objective,max_violation,max_approximation_error,"
                     "optimality_residual,lp_feasible,move_limit_min,move_limit_max,analyses,restoration";
@@ -224,6 +234,7 @@ std::string ResultsCsv(const v1::GetJobResponse& job) {
 }
 
 std::string ResultsJson(const v1::GetJobResponse& job, const std::string& database) {
+  if (IsDesignSetJob(job)) return DesignSetJson(job, database);
   const auto& s = job.summary();
   JsonWriter w;
   w.BeginObject();

@@ -11,6 +11,7 @@
 #include "client/commands.h"
 #include "client/exit_codes.h"
 #include "client/study_text.h"
+#include "spec/io/design_set_convert.h"
 #include "spec/io/study_io.h"
 #include "spec/layout.h"
 #include "spec/study.h"
@@ -96,6 +97,7 @@ int ValidateCommand(const Args& args) {
 
   const spec::Scene& scene = study->scene;
   std::printf("study:       %s (%s)\n", study->name.c_str(), path.c_str());
+  std::printf("form:        %s\n", spec::io::DescribeStudyForm(*study).c_str());
   std::printf("scene:       %s, %s model, %d instants from %g s to %g s, %zu outputs\n",
               scene.name.c_str(), ModelName(scene), scene.time_grid.points, scene.time_grid.start_s,
               scene.time_grid.end_s, scene.outputs.size());

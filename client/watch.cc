@@ -1,5 +1,6 @@
 #include "client/watch.h"
 
+#include "client/design_set_format.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
 
@@ -14,6 +15,13 @@ void DrawProgress(const WatchOptions& options, const v1::JobSummary& s) {
   if (!options.progress_line) return;
   char objective[64] = "";
   if (s.cycles() > 0) std::snprintf(objective, sizeof objective, ", F = %.7g", s.objective());
+  if (s.design_set()) {
+    std::fprintf(options.table_out, "\r\033[K  %s: %d of %d designs, %lld analyses, %.1f s",
+                 StateName(s.state()).c_str(), s.cycles(), s.max_cycles(), static_cast<long long>(s.analyses()),
+                 s.wall_seconds());
+    std::fflush(options.table_out);
+    return;
+  }
   std::fprintf(options.table_out, "\r\033[K  %s: %d cycles, %lld analyses%s, %.1f s",
                StateName(s.state()).c_str(), s.cycles(), static_cast<long long>(s.analyses()),
                objective, s.wall_seconds());
@@ -36,11 +44,13 @@ WatchOutcome WatchJob(v1::JobService::Stub& job_service, const std::string& addr
     if (event.has_cycle()) {
       if (options.table_out == nullptr) continue;
       ClearProgress(options);
+      const bool design = event.cycle().design_set();
       if (!header_printed) {
-        std::fprintf(options.table_out, "%s\n", CycleTableHeader().c_str());
+        std::fprintf(options.table_out, "%s\n", (design ? DesignWatchHeader() : CycleTableHeader()).c_str());
         header_printed = true;
       }
-      std::fprintf(options.table_out, "%s\n", CycleTableRow(event.cycle()).c_str());
+      std::fprintf(options.table_out, "%s\n",
+                   (design ? DesignWatchRow(event.cycle()) : CycleTableRow(event.cycle())).c_str());
       std::fflush(options.table_out);
     } else if (event.has_summary()) {
       outcome.summary = event.summary();

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "spec/design_set.h"
 #include "spec/expression.h"
 #include "spec/scene.h"
 #include "spec/units.h"
@@ -170,6 +171,8 @@ struct Study {
   std::vector<Constraint> constraints;
   OptimizerSettings optimizer;
   AnalysisOverrides analysis;
+  // Analyses at these designs instead of an optimization (empty: optimize).
+  DesignSet design_set;
 
   // SI parameter values of the scene at scaled design x (others at default).
   std::vector<double> ParameterValuesAt(const std::vector<double>& x_scaled) const;

@@ -17,6 +17,7 @@ std::string JobStateName(v1::JobState state) {
     case v1::JOB_STATE_FAILED: return "failed";
     case v1::JOB_STATE_CANCELLED: return "cancelled";
     case v1::JOB_STATE_INTERRUPTED: return "interrupted";
+    case v1::JOB_STATE_COMPLETED: return "completed";
     default: return "unknown";
   }
 }

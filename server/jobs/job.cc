@@ -87,9 +87,48 @@ absl::StatusOr<std::unique_ptr<Job>> Job::Create(std::shared_ptr<const spec::Stu
   } else {
     MBOPT_ASSIGN_OR_RETURN(settings, SlpOptionsFromStudy(*study));
   }
+  std::unique_ptr<DesignSetRun> design_set;
+  if (!study->design_set.empty()) {
+    std::vector<Eigen::VectorXd> designs;
+    for (const std::vector<double>& x : spec::DesignSetPoints(*study)) designs.push_back(ToEigen(x));
+    std::vector<int> row_constraints;
+    row_constraints.reserve(layout.rows.size());
+    for (const spec::ConstraintRow& row : layout.rows) row_constraints.push_back(row.constraint);
+    design_set = std::make_unique<DesignSetRun>(problem, std::move(designs), std::move(row_constraints),
+                                                static_cast<int>(study->constraints.size()));
+  }
   auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), settings, std::move(lp_solver));
-  return std::unique_ptr<Job>(new Job(std::move(study), std::make_shared<const spec::StudyLayout>(std::move(layout)),
-                                      settings, std::move(optimizer)));
+  std::unique_ptr<Job> job(new Job(std::move(study), std::make_shared<const spec::StudyLayout>(std::move(layout)),
+                                   settings, std::move(optimizer)));
+  job->design_set_ = std::move(design_set);
+  return job;
+}
+
+JobState Job::state() const {
+  if (design_set_ == nullptr) return JobStateOf(optimizer_->state());
+  return design_set_->done() ? JobState::kCompleted : JobState::kRunning;
+}
+
+int Job::cycles_completed() const {
+  return design_set_ == nullptr ? optimizer_->cycles_completed() : static_cast<int>(design_set_->designs_done());
+}
+
+std::int64_t Job::analyses_used() const {
+  return design_set_ == nullptr ? optimizer_->analyses_used() : design_set_->analyses_used();
+}
+
+std::string Job::end_reason() const { return design_set_ == nullptr ? optimizer_->end_reason() : ""; }
+
+std::vector<std::string> Job::result_notes() const {
+  return design_set_ == nullptr ? optimizer_->result_notes() : std::vector<std::string>{};
+}
+
+std::vector<slp::AnalysisRequest> Job::PendingRequests() const {
+  return design_set_ == nullptr ? optimizer_->PendingRequests() : design_set_->PendingRequests();
+}
+
+bool Job::IsPending(std::int64_t request_id) const {
+  return design_set_ == nullptr ? optimizer_->IsPending(request_id) : design_set_->IsPending(request_id);
 }
 
 absl::StatusOr<std::unique_ptr<Job>> Job::CreateForProblem(slp::ProblemSpec problem, slp::SlpOptions options,
@@ -110,7 +149,7 @@ Job::Job(std::shared_ptr<const spec::Study> study, std::shared_ptr<const spec::S
       optimizer_(std::move(optimizer)) {}
 
 absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
-  const std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
+  const std::vector<slp::AnalysisRequest> pending = PendingRequests();
   const slp::AnalysisRequest* request = nullptr;
   for (const slp::AnalysisRequest& r : pending) {
     if (r.id == candidate.request_id) request = &r;
@@ -172,12 +211,16 @@ absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
 }
 
 absl::StatusOr<std::vector<slp::CycleRecord>> Job::Apply(const AnalysisRecord& record) {
-  MBOPT_RETURN_IF_ERROR(optimizer_->SubmitResult(ResultOf(record, optimizer_->spec())));
+  if (design_set_ != nullptr) {
+    MBOPT_RETURN_IF_ERROR(design_set_->Submit(record));
+  } else {
+    MBOPT_RETURN_IF_ERROR(optimizer_->SubmitResult(ResultOf(record, optimizer_->spec())));
+  }
   if (!record.ok()) {
     ++failures_by_kind_[record.failure.kind];
     last_failure_ = record.failure;
   }
-  return optimizer_->TakeNewRecords();
+  return design_set_ != nullptr ? design_set_->TakeNewRecords() : optimizer_->TakeNewRecords();
 }
 
 absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<AnalysisRecord>& logged,
@@ -191,7 +234,7 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Anal
   // completes a batch changes what is pending.
   while (true) {
     const AnalysisRecord* next = nullptr;
-    const std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
+    const std::vector<slp::AnalysisRequest> pending = PendingRequests();
     const slp::AnalysisRequest* request = nullptr;
     for (const slp::AnalysisRequest& r : pending) {
       auto found = by_id.find(r.id);
@@ -237,9 +280,9 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<Anal
 
 absl::Status Job::Run(Evaluator& evaluator, const JobRunOptions& options) {
   while (running()) {
-    const std::vector<slp::AnalysisRequest> pending = optimizer_->PendingRequests();
+    const std::vector<slp::AnalysisRequest> pending = PendingRequests();
     if (pending.empty()) return absl::InternalError("the optimizer is running but requests no analysis");
-    if (optimizer_->analyses_used() + static_cast<std::int64_t>(pending.size()) > options.max_analyses) {
+    if (analyses_used() + static_cast<std::int64_t>(pending.size()) > options.max_analyses) {
       return absl::ResourceExhaustedError(
           absl::StrCat(study_->name.empty() ? "the run" : study_->name, " needs more than ", options.max_analyses,
                        " analyses"));

@@ -1,7 +1,9 @@
 // One optimization: a study (or, for analytic test problems, a bare
-// problem), its layout, and the SLP optimizer that runs it. The Job is the
-// only thing that drives the SLP core, in one of two ways that share every
-// step that matters:
+// problem), its layout, and the SLP optimizer that runs it; or, for a study
+// with a design set (a sweep or sample), the DesignSetRun that analyses its
+// designs in the optimizer's place (design_set_run.h), behind the same
+// calls. The Job is the only thing that drives the SLP core, in one of two
+// ways that share every step that matters:
 //  - Run(evaluator): the job asks, the evaluator answers each batch, and the
 //    job goes on until the optimizer ends (in-process runs, tests, tools);
 //  - the service's job manager asks PendingRequests(), hands them to the
@@ -31,7 +33,9 @@
 
 #include "absl/status/statusor.h"
 #include "server/jobs/analysis_record.h"
+#include "server/jobs/design_set_run.h"
 #include "server/jobs/evaluator.h"
+#include "server/jobs/job_state.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/slp_optimizer.h"
 #include "spec/layout.h"
@@ -76,11 +80,22 @@ class Job {
   std::shared_ptr<const spec::StudyLayout> shared_layout() const { return layout_; }
   const slp::ProblemSpec& problem() const { return optimizer_->spec(); }
   const slp::SlpOptions& options() const { return options_; }
+  // The SLP core; for a design set it is made but never driven (what the
+  // job tells goes through the calls below, which know both).
   const slp::SlpOptimizer& optimizer() const { return *optimizer_; }
-  bool running() const { return optimizer_->state() == slp::RunState::kRunning; }
+  bool is_design_set() const { return design_set_ != nullptr; }
+  bool running() const { return state() == JobState::kRunning; }
+  // kRunning, or how the run ended (a design set: kCompleted).
+  JobState state() const;
+  // SLP cycles completed; a design set's designs whose records are out.
+  int cycles_completed() const;
+  std::int64_t analyses_used() const;
+  // Why a stalled run stopped, and what the user should know of its result.
+  std::string end_reason() const;
+  std::vector<std::string> result_notes() const;
 
-  std::vector<slp::AnalysisRequest> PendingRequests() const { return optimizer_->PendingRequests(); }
-  bool IsPending(std::int64_t request_id) const { return optimizer_->IsPending(request_id); }
+  std::vector<slp::AnalysisRequest> PendingRequests() const;
+  bool IsPending(std::int64_t request_id) const;
 
   // Validates a candidate record for a pending request into the record to
   // log and apply: x_scaled is the request's; a failed record loses its
@@ -131,6 +146,7 @@ class Job {
   std::shared_ptr<const spec::StudyLayout> layout_;
   slp::SlpOptions options_;
   std::unique_ptr<slp::SlpOptimizer> optimizer_;
+  std::unique_ptr<DesignSetRun> design_set_;  // null: an optimization
   std::map<spec::FailureKind, std::int64_t> failures_by_kind_;
   spec::AnalysisFailure last_failure_;
 };

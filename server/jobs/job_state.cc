@@ -12,12 +12,13 @@ const char* JobStateName(JobState state) {
     case JobState::kFailed: return "FAILED";
     case JobState::kCancelled: return "CANCELLED";
     case JobState::kInterrupted: return "INTERRUPTED";
+    case JobState::kCompleted: return "COMPLETED";
   }
   return "UNKNOWN";
 }
 
 std::optional<JobState> ParseJobState(const std::string& name) {
-  for (int s = 1; s <= 8; ++s) {
+  for (int s = 1; s <= 9; ++s) {
     if (name == JobStateName(static_cast<JobState>(s))) return static_cast<JobState>(s);
   }
   return std::nullopt;
@@ -25,7 +26,7 @@ std::optional<JobState> ParseJobState(const std::string& name) {
 
 bool IsFinished(JobState state) {
   return state == JobState::kConverged || state == JobState::kMaxCycles || state == JobState::kStalled ||
-         state == JobState::kFailed;
+         state == JobState::kFailed || state == JobState::kCompleted;
 }
 
 bool IsResumable(JobState state) { return state == JobState::kInterrupted || state == JobState::kCancelled; }

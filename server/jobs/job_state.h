@@ -18,12 +18,14 @@ enum class JobState {
   kFailed = 6,
   kCancelled = 7,
   kInterrupted = 8,  // the server stopped while it ran; it resumes on the next start
+  kCompleted = 9,    // every design of a design set (sweep or sample) was analysed
 };
 
 const char* JobStateName(JobState state);  // "RUNNING", ...
 std::optional<JobState> ParseJobState(const std::string& name);
 
-// The optimizer ended the run (converged, max cycles, stalled, failed).
+// The run ended by itself (converged, max cycles, stalled, failed; a
+// design set completed).
 bool IsFinished(JobState state);
 // Resume may continue the job (interrupted or cancelled).
 bool IsResumable(JobState state);

@@ -11,7 +11,12 @@ namespace {
 // 2: optimality_residual after max_approximation_error's row.
 // 3: restoration after converged. Records of version 2 are still read
 // (restoration false): a database written before it resumes as it was.
-constexpr unsigned char kVersion = 3;
+// 4: the records of a design set, with their constraint_violations and
+// failure_kind after restoration. Only such records are written as 4: an optimization's records
+// stay version 3 byte for byte, so a job logged before resumes (its replay
+// compares the bytes).
+constexpr unsigned char kVersion = 4;
+constexpr unsigned char kOptimizationVersion = 3;
 constexpr unsigned char kOldestReadVersion = 2;
 
 class Writer {
@@ -109,7 +114,7 @@ class Reader {
 
 std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   Writer w;
-  w.out().push_back(static_cast<char>(kVersion));
+  w.out().push_back(static_cast<char>(r.design_set ? kVersion : kOptimizationVersion));
   w.Int(r.cycle);
   w.Int(r.attempt);
   w.Bool(r.accepted);
@@ -138,6 +143,11 @@ std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   w.Int64(r.analyses_total);
   w.Bool(r.converged);
   w.Bool(r.restoration);
+  if (r.design_set) {
+    w.U32(static_cast<std::uint32_t>(r.constraint_violations.size()));
+    for (double v : r.constraint_violations) w.Double(v);
+    w.String(r.failure_kind);
+  }
   return std::move(w.out());
 }
 
@@ -179,6 +189,12 @@ absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
   c.analyses_total = r.Int64();
   c.converged = r.Bool();
   if (version >= 3) c.restoration = r.Bool();
+  if (version >= 4) {
+    c.design_set = true;
+    const Eigen::VectorXd violations = r.Vector();
+    c.constraint_violations.assign(violations.data(), violations.data() + violations.size());
+    c.failure_kind = r.String();
+  }
   if (!r.ok() || !r.at_end()) {
     return absl::DataLossError(absl::StrCat("a cycle record of ", bytes.size(), " bytes is truncated or too long"));
   }

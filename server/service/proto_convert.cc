@@ -32,6 +32,7 @@ v1::JobSummary ToProto(const jobs::manager::JobSummaryData& s) {
   out.set_message(s.message);
   out.set_created_unix_ms(s.created_unix_ms);
   out.set_max_cycles(s.max_cycles);
+  out.set_design_set(s.design_set);
   for (const auto& [kind, count] : s.failed_analyses_by_kind) (*out.mutable_failed_analyses_by_kind())[kind] = count;
   return out;
 }
@@ -106,6 +107,9 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
   out.set_analyses_total(r.analyses_total);
   out.set_converged(r.converged);
   out.set_restoration(r.restoration);
+  for (double v : r.constraint_violations) out.add_constraint_violations(v);
+  out.set_failure_kind(r.failure_kind);
+  out.set_design_set(r.design_set);
   return out;
 }
 

@@ -135,6 +135,14 @@ struct CycleRecord {
   // Such a record belongs to the cycle that converged and changes neither
   // the move limits nor the cycle count.
   bool restoration = false;
+  // Set only in the records of a design set (a sweep or sample, which the
+  // job runs without this core: server/jobs/design_set_run.h), one record
+  // per design: the largest normalized value (g_h - c_h) / scale_h of each
+  // of the study's constraints (NaN when the analysis failed), and the
+  // failure kind's name of a failed analysis ("" when it succeeded).
+  bool design_set = false;  // the record of one design of a design set
+  std::vector<double> constraint_violations;
+  std::string failure_kind;
 };
 
 class SlpOptimizer {

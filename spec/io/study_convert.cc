@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "spec/io/declared_name.h"
+#include "spec/io/design_set_convert.h"
 #include "spec/layout.h"
 #include "spec/limits.h"
 #include "spec/units.h"
@@ -803,6 +804,8 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "finite differences");
     }
   }
+
+  study.design_set = ConvertDesignSet(m, study, where, errors);
 
   if (errors->empty()) {
     // Catch what only the layout sees (e.g. minimize on a multi-series output).

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "client/args.h"
+#include "client/design_set_format.h"
 #include "client/job_format.h"
 #include "client/json_writer.h"
 #include "client/local_cluster.h"
@@ -157,6 +158,80 @@ TEST(JobState, ExitCodesFollowTheOutcome) {
   EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_MAX_CYCLES), 1);
   EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_FAILED), 4);
   EXPECT_EQ(client::StateName(v1::JOB_STATE_INTERRUPTED), "interrupted");
+  EXPECT_EQ(client::ExitCodeForState(v1::JOB_STATE_COMPLETED), 0);
+  EXPECT_EQ(client::StateName(v1::JOB_STATE_COMPLETED), "completed");
+  EXPECT_TRUE(client::IsTerminal(v1::JOB_STATE_COMPLETED));
+}
+
+// A sweep of k over two designs, the second failed: every format lists both,
+// the failed one without values and with its kind and reason.
+v1::GetJobResponse TwoDesignSweep() {
+  v1::GetJobResponse job;
+  v1::SweepAxis* axis = job.mutable_study()->mutable_sweep()->add_axis();
+  axis->set_variable("x1");
+  job.mutable_study()->add_constraints()->set_name("travel");
+  v1::DesignVariable* v = job.mutable_study()->add_variables();
+  v->set_name("x1");
+  v->set_parameter("k");
+  v->set_scale(10);
+  v1::JobSummary* s = job.mutable_summary();
+  s->set_job_id("job-4");
+  s->set_state(v1::JOB_STATE_COMPLETED);
+  s->set_design_set(true);
+  s->set_cycles(2);
+  s->set_max_cycles(2);
+  s->set_objective(1.5);
+  s->set_objective_unit("m/s^2");
+  s->add_design_names("x1");
+  s->add_design_units("N/m");
+  s->add_design(20);
+  v1::CycleRecord* ok = job.add_cycles();
+  ok->set_cycle(1);
+  ok->set_design_set(true);
+  ok->add_x_trial_scaled(2);
+  ok->add_x_trial_physical(20);
+  ok->set_objective_trial(1.5);
+  ok->set_max_violation_trial(-0.25);
+  ok->add_constraint_violations(-0.25);
+  v1::CycleRecord* failed = job.add_cycles();
+  failed->set_cycle(2);
+  failed->set_design_set(true);
+  failed->add_x_trial_scaled(3);
+  failed->add_x_trial_physical(30);
+  failed->set_objective_trial(std::numeric_limits<double>::quiet_NaN());
+  failed->set_max_violation_trial(std::numeric_limits<double>::quiet_NaN());
+  failed->add_constraint_violations(std::numeric_limits<double>::quiet_NaN());
+  failed->set_failure_kind("integrator");
+  failed->set_rejection_reason("step \"too\" small");
+  return job;
+}
+
+TEST(DesignSetFormat, CsvHasOneRowPerDesignWithEmptyCellsForAFailure) {
+  const v1::GetJobResponse job = TwoDesignSweep();
+  ASSERT_TRUE(client::IsDesignSetJob(job));
+  EXPECT_EQ(client::ResultsCsv(job),
+            "design,x1,objective,max_violation,travel,status,failure_reason\n"
+            "1,20,1.5,-0.25,-0.25,ok,\n"
+            "2,30,,,,integrator,\"step \"\"too\"\" small\"\n");
+}
+
+TEST(DesignSetFormat, TableAndJsonListEveryDesign) {
+  const v1::GetJobResponse job = TwoDesignSweep();
+  const std::string table = client::ResultsTable(job);
+  EXPECT_NE(table.find("designs:       2 of 2 analysed"), std::string::npos) << table;
+  EXPECT_NE(table.find("best design:"), std::string::npos) << table;
+  EXPECT_NE(table.find("x1 [N/m]"), std::string::npos) << table;
+  EXPECT_NE(table.find("F [m/s^2]"), std::string::npos) << table;
+  EXPECT_NE(table.find("-0.25   ok\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("-   integrator\n"), std::string::npos) << table;
+  const std::string json = client::ResultsJson(job);
+  EXPECT_NE(json.find("\"form\": \"sweep\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"designs_total\": 2"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"travel\": -0.25"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"travel\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"status\": \"integrator\""), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"history\""), std::string::npos) << "a sweep has no optimization history\n" << json;
+  EXPECT_NE(client::DesignWatchRow(job.cycles(1)).find("integrator"), std::string::npos);
 }
 
 TEST(Backoff, GrowsGeometricallyUpToTheCapWithBoundedJitter) {

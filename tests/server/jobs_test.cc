@@ -85,7 +85,7 @@ TEST(RecordCodec, TruncatedOrForeignBytesAreDataLoss) {
 }
 
 TEST(JobState, NamesRoundTrip) {
-  for (int s = 1; s <= 8; ++s) {
+  for (int s = 1; s <= 9; ++s) {
     const JobState state = static_cast<JobState>(s);
     EXPECT_EQ(ParseJobState(JobStateName(state)), state);
   }

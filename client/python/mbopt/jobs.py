@@ -15,6 +15,7 @@ _STATE_NAMES = {
     service_pb2.JOB_STATE_QUEUED: "queued",
     service_pb2.JOB_STATE_RUNNING: "running",
     service_pb2.JOB_STATE_CONVERGED: "converged",
+    service_pb2.JOB_STATE_COMPLETED: "completed",
     service_pb2.JOB_STATE_MAX_CYCLES: "max_cycles",
     service_pb2.JOB_STATE_STALLED: "stalled",
     service_pb2.JOB_STATE_FAILED: "failed",
@@ -23,7 +24,7 @@ _STATE_NAMES = {
 }
 
 # The job will not change by itself (client/job_format.cc, IsTerminal).
-TERMINAL_STATES = frozenset(("converged", "max_cycles", "stalled", "failed", "cancelled", "interrupted"))
+TERMINAL_STATES = frozenset(("converged", "completed", "max_cycles", "stalled", "failed", "cancelled", "interrupted"))
 
 
 def state_name(state):

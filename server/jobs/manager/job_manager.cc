@@ -120,9 +120,8 @@ absl::Status JobManager::EnterStateLocked(Entry& entry, JobState to, std::string
       // here and the study and records by EvictLocked below, so a server's
       // memory does not grow with every finished job. A resume rebuilds
       // them from the log.
-      const slp::SlpOptimizer& optimizer = entry.job->optimizer();
-      entry.row.cycles = optimizer.cycles_completed();
-      entry.row.analyses = optimizer.analyses_used();
+      entry.row.cycles = entry.job->cycles_completed();
+      entry.row.analyses = entry.job->analyses_used();
       entry.failed_analyses_by_kind.clear();
       for (const auto& [kind, count] : entry.job->failures_by_kind()) {
         entry.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
@@ -455,30 +454,30 @@ absl::Status JobManager::CommitRecordsLocked(Entry& entry, std::vector<slp::Cycl
 
 JobManager::Delivery JobManager::RecordsDeliveryLocked(Entry& entry, std::vector<slp::CycleRecord> records,
                                                        std::vector<const jobs::AnalysisRecord*> analyses) {
-  const slp::SlpOptimizer& optimizer = entry.job->optimizer();
+  const jobs::Job& job = *entry.job;
   Delivery delivery;
   delivery.needs_commit = true;
-  delivery.state = jobs::JobStateOf(optimizer.state());
+  delivery.state = job.state();
   if (delivery.state == JobState::kFailed) {
     const spec::AnalysisFailure& last = entry.job->last_failure();
     delivery.message = absl::StrCat("the initial design could not be analysed (", spec::FailureKindName(last.kind),
                                     "): ", last.reason);
   } else if (delivery.state == JobState::kStalled) {
-    delivery.message = optimizer.end_reason();
+    delivery.message = job.end_reason();
     if (!records.empty() && !records.back().rejection_reason.empty()) {
       absl::StrAppend(&delivery.message, "; last rejection: ", records.back().rejection_reason);
     }
   }
   // What the user should know about the result (no feasible design, flat
   // directions) goes with the state that ends the job.
-  for (const std::string& note : optimizer.result_notes()) {
+  for (const std::string& note : job.result_notes()) {
     absl::StrAppend(&delivery.message, delivery.message.empty() ? "" : "; ", note);
   }
   store::JobProgress progress;
   progress.state = jobs::JobStateName(delivery.state);
   progress.message = delivery.message;
-  progress.cycles = optimizer.cycles_completed();
-  progress.analyses = optimizer.analyses_used();
+  progress.cycles = job.cycles_completed();
+  progress.analyses = job.analyses_used();
   progress.wall_seconds = WallSecondsLocked(entry);
   delivery.write.job_id = entry.row.id;
   delivery.write.analyses = std::move(analyses);

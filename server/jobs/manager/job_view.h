@@ -41,6 +41,9 @@ struct JobSummaryData {
   // A running job whose analyses no registered worker can run: why
   // (e.g. the driver its scene names); "" otherwise.
   std::string waiting_for;
+  // A design set (sweep or sample): cycles are its designs done and
+  // max_cycles all of them.
+  bool design_set = false;
 };
 
 // What a client needs to show a job's records with names and units.

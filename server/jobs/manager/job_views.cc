@@ -56,6 +56,11 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
       options = *from_study;
     }
     if (options.has_value()) s.max_cycles = options->max_cycles;
+    // A design set's records are its designs: progress is designs done of all.
+    if (!entry.study->design_set.empty()) {
+      s.design_set = true;
+      s.max_cycles = static_cast<int>(entry.study->design_set.size());
+    }
     design.resize(static_cast<Eigen::Index>(entry.study->variables.size()));
     for (size_t i = 0; i < entry.study->variables.size(); ++i) {
       const spec::DesignVariable& v = entry.study->variables[i];
@@ -76,17 +81,21 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
   // The optimizer minimizes; a maximized value is reported as itself.
   const double sign = entry.study_ok ? entry.study->objective.ReportedSign() : 1.0;
   if (entry.job != nullptr) {
-    const slp::SlpOptimizer& optimizer = entry.job->optimizer();
-    s.cycles = optimizer.cycles_completed();
-    s.analyses = optimizer.analyses_used();
+    const jobs::Job& job = *entry.job;
+    s.cycles = job.cycles_completed();
+    s.analyses = job.analyses_used();
     for (const auto& [kind, count] : entry.job->failures_by_kind()) {
       s.failed_analyses_by_kind[spec::FailureKindName(kind)] = count;
     }
     if (!entry.records.empty()) {
-      const slp::DesignPoint best = optimizer.best_design();
-      design = best.x;
-      s.objective = sign * best.objective;
-      s.max_violation = best.max_violation;
+      // A design set's best design is the best of its analysed designs.
+      const std::optional<slp::DesignPoint> best =
+          job.is_design_set() ? jobs::BestDesignOfRecords(entry.records) : job.optimizer().best_design();
+      if (best.has_value()) {
+        design = best->x;
+        s.objective = sign * best->objective;
+        s.max_violation = best->max_violation;
+      }
     }
   } else if (!entry.records.empty()) {
     // Not running in this process: the same choice from the logged records.
