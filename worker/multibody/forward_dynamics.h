@@ -48,9 +48,9 @@ struct ForwardDynamicsOptions {
   // derivatives (others get dense LU of difference quotients): dense LU,
   // or KLU on the sparse Newton matrix whose pattern the system declares
   // (ConstrainedSystem::DerivativePattern); automatic picks KLU from
-  // kSparseFromUnknowns unknowns (2n + 2m) up: measured 1.7x faster than
-  // dense LU at 44 unknowns and 3x at 104-404 (docs/benchmarks.md); below,
-  // dense.
+  // kSparseFromUnknowns unknowns (2n + 2m) up: measured 1.9x faster than
+  // dense LU at 44 unknowns and 2.8-8.8x at 104-404 (docs/benchmarks.md);
+  // below, dense.
   enum class LinearSolver { kAutomatic, kDense, kSparse };
   LinearSolver linear_solver = LinearSolver::kAutomatic;
   static constexpr int kSparseFromUnknowns = 40;
