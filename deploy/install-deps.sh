@@ -21,7 +21,7 @@ packages=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev
   libeigen3-dev
-  libsundials-dev
+  libsundials-dev libsuitesparse-dev
   libzip-dev libpugixml-dev zlib1g-dev
   libsqlite3-dev
   libssl-dev

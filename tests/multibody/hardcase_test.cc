@@ -114,8 +114,12 @@ TEST(MultibodyHardcase, StiffnessRatioOfAMillion) {
             << counters.steps << " steps\n";
   ASSERT_TRUE(f.ok()) << f.reason;
   // The slow mode has a period of 0.9 s: resolving it takes hundreds of
-  // steps; resolving the fast one (0.6 ms) would take tens of thousands.
-  EXPECT_LT(counters.steps, 5000);
+  // steps; resolving the fast one (0.6 ms, 1600 periods in 1 s) would take
+  // tens of thousands. Between the two, the count follows how much the
+  // lightly damped fast mode is excited by the corrector's round-off, so it
+  // moves with the Newton matrix's rounding: 3468 steps with IDAS's
+  // difference quotients, 5141 with the exact matrix.
+  EXPECT_LT(counters.steps, 10000);
   // Damped: the energy never grows beyond the integration tolerance.
   constexpr double kEnergyTolerance = 1e-3;  // J, of 0.5 J
   EXPECT_LT(worst_energy_rise, kEnergyTolerance);

@@ -169,4 +169,27 @@ inline Model TenBodyChain(double theta = -1.2, double pendulum_angle = -2.0) {
   return m;
 }
 
+// A closed chain of `rods` (>= 4) uniform rods (1 kg, 1 m) between two
+// ground pins rods - 2 m apart: the first two rods start 60 degrees below
+// the horizontal, the last two 60 degrees above it, the rest horizontal (a
+// closed start); released at rest under gravity. rods - 2 degrees of freedom
+// (8 for ten rods: the issue-30 chain).
+inline Model RodChain(int rods) {
+  Model m;
+  const double kSlope = std::numbers::pi / 3;
+  Eigen::Vector2d at(0.0, 0.0);
+  for (int i = 0; i < rods; ++i) {
+    const double angle = i < 2 ? -kSlope : i >= rods - 2 ? kSlope : 0.0;
+    const Eigen::Vector2d along(std::cos(angle), std::sin(angle));
+    m.bodies.push_back(Bar("rod" + std::to_string(i), 1.0, 1.0, at + 0.5 * along, angle));
+    const Point previous = i == 0 ? Point{kGround, Eigen::Vector2d::Zero(), ""} : At(i - 1, 0.5);
+    m.joints.push_back(Revolute("pin" + std::to_string(i), previous, At(i, -0.5)));
+    at += along;
+  }
+  m.joints.push_back(Revolute("pin" + std::to_string(rods), At(rods - 1, 0.5),
+                              Point{kGround, Eigen::Vector2d(rods - 2.0, 0.0), ""}));
+  m.gravity_m_per_s2 = Eigen::Vector2d(0.0, -9.81);
+  return m;
+}
+
 }  // namespace mbopt::multibody::testing

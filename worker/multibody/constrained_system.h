@@ -51,6 +51,38 @@ class ConstrainedSystem {
   virtual int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                     Eigen::VectorXd* gamma) const = 0;
 
+  // The derivatives the integrator's Newton matrix needs beyond M and Phi_q
+  // (forward_dynamics.h). A system that returns false here leaves the
+  // integrator to form that matrix by difference quotients of its residual,
+  // one residual per unknown; the others must implement all three below.
+  virtual bool has_analytic_derivatives() const { return false; }
+  // d(Phi_q^T w)/dq for given multipliers w (m values): n x n, symmetric
+  // (the constraints' second derivatives weighted by w).
+  virtual int ConstraintCurvature(double /*t*/, const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*w*/,
+                                  Eigen::MatrixXd* /*curvature*/) const {
+    return -1;
+  }
+  // d(Phi_q v + Phi_t)/dq: m x n.
+  virtual int VelocityConstraintJacobian(double /*t*/, const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*v*/,
+                                         Eigen::MatrixXd* /*jacobian*/) const {
+    return -1;
+  }
+  // dQ/dq (minus the stiffness) and dQ/dv (minus the damping): n x n each.
+  virtual int ForceJacobians(double /*t*/, const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*v*/,
+                             Eigen::MatrixXd* /*q_q*/, Eigen::MatrixXd* /*q_v*/) const {
+    return -1;
+  }
+
+  // Which entries of those derivatives can be non-zero in any state: in
+  // `coupling` (n x n) for M, dQ/dq, dQ/dv and d(Phi_q^T w)/dq, in `rows`
+  // (m x n) for Phi_q and d(Phi_q v + Phi_t)/dq. A sparse Newton matrix's
+  // pattern is built from them once per integration. Default: every entry.
+  using Pattern = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
+  virtual void DerivativePattern(Pattern* coupling, Pattern* rows) const {
+    coupling->setConstant(num_coordinates(), num_coordinates(), true);
+    rows->setConstant(num_constraints(), num_coordinates(), true);
+  }
+
   // Parameters the equations depend on (stiffnesses, masses, ...), for
   // forward sensitivity analysis by difference quotients. Empty by default.
   virtual int num_parameters() const { return 0; }

@@ -3,7 +3,9 @@
 #include <idas/idas.h>
 #include <nvector/nvector_serial.h>
 #include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_klu.h>
 #include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "worker/multibody/ggl_residual.h"
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
@@ -27,49 +30,68 @@ struct Problem {
   spec::AnalysisFailure budget_failure;  // why the budget stopped the integration
   std::string callback_failure;
   const std::vector<ParameterPerturbation>* parameters = nullptr;  // sensitivities, if any
-  // Work space.
-  Eigen::MatrixXd mass, phi_q;
-  VectorXd forces, phi, phi_t;
+  GglWorkspace work;
+  Eigen::MatrixXd newton;
+  // The sparse Newton matrix's pattern in compressed columns (KLU only).
+  std::vector<sunindextype> column_starts, row_indices;
 };
 
-// The GGL residual of system `s` at (t, y, y').
-template <class Y, class YDot, class R>
-int EvaluateResidual(const ConstrainedSystem& s, Problem* p, double t, const Y& y, const YDot& y_dot, R& r) {
-  const int n = p->n, m = p->m;
-  const VectorXd q = y.head(n), v = y.segment(n, n);
-  // Trial states past a validity bound stay finite; the bound's root
-  // function (ValidityBounds below) ends the integration where the motion
-  // crosses it.
-  const ContinuedPastBounds continued(s);
-  int flag = s.MassMatrix(q, &p->mass);
-  if (flag == 0) flag = s.AppliedForces(t, q, v, &p->forces);
-  if (flag == 0 && m > 0) flag = s.ConstraintJacobian(t, q, &p->phi_q);
-  if (flag == 0 && m > 0) flag = s.Constraints(t, q, &p->phi);
-  if (flag == 0 && m > 0) flag = s.ConstraintTimeDerivative(t, q, &p->phi_t);
-  if (flag != 0) return flag;
-  r.head(n) = y_dot.head(n) - v;
-  r.segment(n, n) = p->mass * y_dot.segment(n, n) - p->forces;
-  if (m > 0) {
-    r.head(n) += p->phi_q.transpose() * y.segment(2 * n + m, m);
-    r.segment(n, n) += p->phi_q.transpose() * y.segment(2 * n, m);
-    r.segment(2 * n, m) = p->phi;
-    r.segment(2 * n + m, m) = p->phi_q * v + p->phi_t;
-  }
-  return r.allFinite() ? 0 : 1;
+// Whether the analysis' budget stops the integration at t (and why, kept).
+bool BudgetStops(Problem* p, double t) {
+  if (p->budget == nullptr || !p->budget->Exhausted()) return false;
+  p->budget_failure = p->budget->Check(t);
+  return !p->budget_failure.ok();
 }
 
 int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the residual", [&]() -> int {
-    if (p->budget != nullptr && p->budget->Exhausted()) {
-      p->budget_failure = p->budget->Check(t);
-      if (!p->budget_failure.ok()) return -1;
-    }
+    if (BudgetStops(p, t)) return -1;
     const int size = 2 * p->n + 2 * p->m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
     Map<VectorXd> r(N_VGetArrayPointer(rr), size);
-    return EvaluateResidual(*p->system, p, t, y, y_dot, r);
+    return GglResidual(*p->system, t, y, y_dot, &p->work, r);
+  });
+}
+
+int DenseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_Vector /*rr*/, SUNMatrix jac,
+                      void* user_data, N_Vector, N_Vector, N_Vector) {
+  auto* p = static_cast<Problem*>(user_data);
+  return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
+    if (BudgetStops(p, t)) return -1;
+    const int size = 2 * p->n + 2 * p->m;
+    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
+    if (int flag = GglNewtonMatrix(*p->system, t, cj, y, &p->work, &p->newton); flag != 0) return flag;
+    // SUNDIALS' dense matrices are column-major like Eigen's.
+    Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(jac), size, size) = p->newton;
+    return 0;
+  });
+}
+
+// The same matrix in the compressed-column pattern built once per
+// integration (KLU analyses it once and refactors with it); IDAS zeroes
+// the matrix, indices included, before every call.
+int SparseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_Vector /*rr*/, SUNMatrix jac,
+                       void* user_data, N_Vector, N_Vector, N_Vector) {
+  auto* p = static_cast<Problem*>(user_data);
+  return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
+    if (BudgetStops(p, t)) return -1;
+    const int size = 2 * p->n + 2 * p->m;
+    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
+    if (int flag = GglNewtonMatrix(*p->system, t, cj, y, &p->work, &p->newton); flag != 0) return flag;
+    sunindextype* starts = SUNSparseMatrix_IndexPointers(jac);
+    sunindextype* rows = SUNSparseMatrix_IndexValues(jac);
+    realtype* values = SUNSparseMatrix_Data(jac);
+    std::copy(p->column_starts.begin(), p->column_starts.end(), starts);
+    std::copy(p->row_indices.begin(), p->row_indices.end(), rows);
+    for (int col = 0; col < size; ++col) {
+      for (sunindextype k = p->column_starts[static_cast<size_t>(col)];
+           k < p->column_starts[static_cast<size_t>(col) + 1]; ++k) {
+        values[k] = p->newton(p->row_indices[static_cast<size_t>(k)], col);
+      }
+    }
+    return 0;
   });
 }
 
@@ -125,9 +147,9 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
         const double sigma = 1e-6 * state_scale / direction;
         y_shift = y;
         y_shift.head(2 * n) += sigma * s.head(2 * n);
-        if (int flag = EvaluateResidual(*p->system, p, t, y_shift, y_dot, r_plus); flag != 0) return flag;
+        if (int flag = GglResidual(*p->system, t, y_shift, y_dot, &p->work, r_plus); flag != 0) return flag;
         y_shift.head(2 * n) = y.head(2 * n) - sigma * s.head(2 * n);
-        if (int flag = EvaluateResidual(*p->system, p, t, y_shift, y_dot, r_minus); flag != 0) return flag;
+        if (int flag = GglResidual(*p->system, t, y_shift, y_dot, &p->work, r_minus); flag != 0) return flag;
         result += (r_plus - r_minus) / (2.0 * sigma);
       }
       if (m > 0) {
@@ -154,8 +176,8 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
           result.segment(2 * n + m, m) -= (gamma_plus - gamma_minus) / (4.0 * alpha);
         }
       }
-      if (int flag = EvaluateResidual(*dp.plus, p, t, y, y_dot, r_plus); flag != 0) return flag;
-      if (int flag = EvaluateResidual(*dp.minus, p, t, y, y_dot, r_minus); flag != 0) return flag;
+      if (int flag = GglResidual(*dp.plus, t, y, y_dot, &p->work, r_plus); flag != 0) return flag;
+      if (int flag = GglResidual(*dp.minus, t, y, y_dot, &p->work, r_minus); flag != 0) return flag;
       result += (r_plus - r_minus) / (2.0 * dp.step);
       Map<VectorXd>(N_VGetArrayPointer(rr_s[k]), size) = result;
     }
@@ -168,6 +190,7 @@ void Accumulate(void* ida, ForwardDynamicsCounters* c) {
   if (IDAGetNumSteps(ida, &value) == IDA_SUCCESS) c->steps = value;
   if (IDAGetNumResEvals(ida, &value) == IDA_SUCCESS) c->residual_evaluations = value;
   if (IDAGetNumJacEvals(ida, &value) == IDA_SUCCESS) c->jacobian_evaluations = value;
+  if (IDAGetNumLinResEvals(ida, &value) == IDA_SUCCESS) c->jacobian_residual_evaluations = value;
   if (IDAGetNumNonlinSolvIters(ida, &value) == IDA_SUCCESS) c->nonlinear_iterations = value;
   if (IDAGetNumErrTestFails(ida, &value) == IDA_SUCCESS) c->error_test_failures = value;
   if (IDAGetNumNonlinSolvConvFails(ida, &value) == IDA_SUCCESS) c->convergence_failures = value;
@@ -278,9 +301,30 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   atol.head(2 * n).setConstant(options.absolute_tolerance);
   atol.segment(2 * n, m).setConstant(options.absolute_tolerance);
   atol.tail(m).setConstant(kMuTolerance);
-  h.matrix.reset(SUNDenseMatrix(size, size, h.context.get()));
-  if (!h.matrix) return Failed(spec::FailureKind::kIntegrator, "SUNDenseMatrix failed");
-  h.linear_solver.reset(SUNLinSol_Dense(h.yy.get(), h.matrix.get(), h.context.get()));
+  const bool analytic = system.has_analytic_derivatives();
+  const bool sparse =
+      analytic && (options.linear_solver == ForwardDynamicsOptions::LinearSolver::kSparse ||
+                   (options.linear_solver == ForwardDynamicsOptions::LinearSolver::kAutomatic &&
+                    size >= ForwardDynamicsOptions::kSparseFromUnknowns));
+  counters->sparse_linear_solver = sparse;
+  if (sparse) {
+    const ConstrainedSystem::Pattern pattern = GglNewtonPattern(system);
+    p.column_starts.assign(1, 0);
+    for (int col = 0; col < size; ++col) {
+      for (int row = 0; row < size; ++row) {
+        if (pattern(row, col)) p.row_indices.push_back(row);
+      }
+      p.column_starts.push_back(static_cast<sunindextype>(p.row_indices.size()));
+    }
+    h.matrix.reset(SUNSparseMatrix(size, size, static_cast<sunindextype>(p.row_indices.size()), CSC_MAT,
+                                   h.context.get()));
+    if (!h.matrix) return Failed(spec::FailureKind::kIntegrator, "SUNSparseMatrix failed");
+    h.linear_solver.reset(SUNLinSol_KLU(h.yy.get(), h.matrix.get(), h.context.get()));
+  } else {
+    h.matrix.reset(SUNDenseMatrix(size, size, h.context.get()));
+    if (!h.matrix) return Failed(spec::FailureKind::kIntegrator, "SUNDenseMatrix failed");
+    h.linear_solver.reset(SUNLinSol_Dense(h.yy.get(), h.matrix.get(), h.context.get()));
+  }
   h.ida.reset(IDACreate(h.context.get()));
   if (!h.linear_solver || !h.ida) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   void* ida = h.ida.get();
@@ -295,6 +339,8 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
             check(IDASetUserData(ida, &p), "IDASetUserData") &&
             check(IDASVtolerances(ida, options.relative_tolerance, h.atol.get()), "IDASVtolerances") &&
             check(IDASetLinearSolver(ida, h.linear_solver.get(), h.matrix.get()), "IDASetLinearSolver") &&
+            (!analytic ||
+             check(IDASetJacFn(ida, sparse ? &SparseNewtonMatrix : &DenseNewtonMatrix), "IDASetJacFn")) &&
             check(IDASetId(ida, h.id.get()), "IDASetId") &&
             check(IDASetSuppressAlg(ida, SUNTRUE), "IDASetSuppressAlg") &&
             check(IDASetMaxNumSteps(ida, options.max_steps), "IDASetMaxNumSteps") &&

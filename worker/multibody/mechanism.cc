@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "absl/strings/str_format.h"
+#include "worker/multibody/body_frame.h"
 
 namespace mbopt::multibody {
 namespace {
@@ -13,47 +14,8 @@ using Eigen::Matrix2d;
 using Eigen::Vector2d;
 using Eigen::VectorXd;
 
-Matrix2d Rotation(double phi) {
-  const double c = std::cos(phi), s = std::sin(phi);
-  Matrix2d a;
-  a << c, -s, s, c;
-  return a;
-}
-// dA/dphi: A rotated by a further quarter turn.
-Matrix2d RotationDerivative(double phi) {
-  const double c = std::cos(phi), s = std::sin(phi);
-  Matrix2d b;
-  b << -s, -c, c, -s;
-  return b;
-}
-
-// The kinematic quantities of one body (ground: identity, at rest).
-struct Frame {
-  int body = kGround;
-  Vector2d r = Vector2d::Zero(), r_dot = Vector2d::Zero();
-  double phi = 0.0, phi_dot = 0.0;
-  Matrix2d a = Matrix2d::Identity(), b = Matrix2d::Zero();
-  int column = -1;  // first coordinate of the body, -1 for ground
-
-  Vector2d Position(const Vector2d& s) const { return r + a * s; }
-  Vector2d Velocity(const Vector2d& s) const { return r_dot + b * s * phi_dot; }
-};
-
-Frame FrameOf(int body, const VectorXd& q, const VectorXd* v) {
-  Frame f;
-  f.body = body;
-  if (body == kGround) return f;
-  f.column = 3 * body;
-  f.r = q.segment<2>(f.column);
-  f.phi = q[f.column + 2];
-  f.a = Rotation(f.phi);
-  f.b = RotationDerivative(f.phi);
-  if (v != nullptr) {
-    f.r_dot = v->segment<2>(f.column);
-    f.phi_dot = (*v)[f.column + 2];
-  }
-  return f;
-}
+using frame::Frame;
+using frame::FrameOf;
 
 // Adds `weight` * d(point)/d(q_body) as the 2-row block of `rows` starting at
 // `row` (a revolute-type pair of rows).

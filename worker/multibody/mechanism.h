@@ -61,6 +61,19 @@ class Mechanism : public ConstrainedSystem {
   int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                             Eigen::VectorXd* gamma) const override;
 
+  // Analytic derivatives (docs/physics.md, "The Newton matrix"): the
+  // joints' and drivers' second derivatives, the force elements' stiffness
+  // and damping, the co-rotational beams' tangent stiffness.
+  bool has_analytic_derivatives() const override { return true; }
+  int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
+                          Eigen::MatrixXd* curvature) const override;
+  int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                 Eigen::MatrixXd* jacobian) const override;
+  int ForceJacobians(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, Eigen::MatrixXd* q_q,
+                     Eigen::MatrixXd* q_v) const override;
+  // Bodies couple through their joints, drivers and force elements.
+  void DerivativePattern(Pattern* coupling, Pattern* rows) const override;
+
   // The initial guess of the coordinates: the bodies' initial poses.
   Eigen::VectorXd InitialGuess() const;
 
@@ -100,6 +113,13 @@ class Mechanism : public ConstrainedSystem {
   // One evaluation of every row: whichever outputs are not null.
   void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
                     Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
+  // One second derivative d2 Phi_row / dq_j dq_k; both (j, k) and (k, j)
+  // are listed for j != k.
+  struct SecondDerivative {
+    int row = 0, j = 0, k = 0;
+    double value = 0.0;
+  };
+  void ConstraintSecondDerivatives(const Eigen::VectorXd& q, std::vector<SecondDerivative>* out) const;
   BeamNodes BeamCoordinates(const BeamElement& e, const Eigen::VectorXd& q) const;
   double ReferenceAngle(int joint) const { return reference_angle_[static_cast<size_t>(joint)]; }
   // A spring's length and its rate dL/dt.

@@ -92,6 +92,14 @@ double LinearTable::Continued(double at) const {
   return y[i] + (y[i + 1] - y[i]) / (x[i + 1] - x[i]) * (at - x[i]);
 }
 
+double LinearTable::Slope(double at) const {
+  if (x.size() < 2) return 0.0;
+  const size_t k = std::min<size_t>(static_cast<size_t>(std::upper_bound(x.begin(), x.end(), at) - x.begin()),
+                                    x.size() - 1);
+  const size_t i = k == 0 ? 0 : k - 1;
+  return (y[i + 1] - y[i]) / (x[i + 1] - x[i]);
+}
+
 std::string Model::BodyName(int body) const {
   if (body == kGround) return "ground";
   if (body >= 0 && static_cast<size_t>(body) < bodies.size()) return bodies[static_cast<size_t>(body)].name;

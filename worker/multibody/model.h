@@ -85,6 +85,9 @@ struct LinearTable {
   // segment's line (only for an integrator's trial steps across the table's
   // end, see ConstrainedSystem::ContinuePastBounds, never for a result).
   double Continued(double at) const;
+  // dy/dx of Continued at `at`: the slope of the segment that holds it (at
+  // a breakpoint, the segment above it, as Evaluate picks).
+  double Slope(double at) const;
   bool empty() const { return x.empty(); }
 };
 

@@ -1,0 +1,42 @@
+// The residual of the stabilized index-2 (GGL) equations of motion that the
+// forward-dynamics integrator solves (forward_dynamics.h), and its Newton
+// matrix. Unknowns y = (q, v, lambda, mu), sizes (n, n, m, m):
+//
+//   F = [ q' - v + Phi_q^T mu ; M v' + Phi_q^T lambda - Q ; Phi ; Phi_q v + Phi_t ]
+//
+// Pure numerics on a ConstrainedSystem (no SUNDIALS): the integrator's
+// callbacks call these, and the tests compare the Newton matrix with
+// difference quotients of the residual.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "worker/multibody/constrained_system.h"
+
+namespace mbopt::multibody {
+
+// The matrices one evaluation fills; reused between evaluations.
+struct GglWorkspace {
+  Eigen::MatrixXd mass, phi_q;
+  Eigen::VectorXd forces, phi, phi_t;
+  Eigen::MatrixXd force_q, force_v, curvature_mu, curvature_lambda, velocity_q;
+};
+
+// F(t, y, y') into `r` (size 2n + 2m); the SUNDIALS callback contract: 0 ok,
+// > 0 recoverable, < 0 fatal. Evaluated with the system's validity bounds
+// continued (ContinuedPastBounds): the integrator's trial states may cross
+// them.
+int GglResidual(const ConstrainedSystem& s, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                const Eigen::Ref<const Eigen::VectorXd>& y_dot, GglWorkspace* work, Eigen::Ref<Eigen::VectorXd> r);
+
+// dF/dy + cj dF/dy' at (t, y) (F is linear in y', so y' does not enter),
+// from the system's analytic derivatives: the caller checks
+// has_analytic_derivatives().
+int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen::Ref<const Eigen::VectorXd>& y,
+                    GglWorkspace* work, Eigen::MatrixXd* newton);
+
+// Which entries of the Newton matrix can be non-zero (size x size), from the
+// system's DerivativePattern.
+ConstrainedSystem::Pattern GglNewtonPattern(const ConstrainedSystem& s);
+
+}  // namespace mbopt::multibody
