@@ -88,14 +88,16 @@ constexpr Help kHelp[] = {
      "  --csv                 the cycle history as CSV\n"
      "  --json                result and history as one JSON object\n"},
     {"report",
-     "usage: mbopt report JOB [-o FILE] [--no-responses] [--server HOST:PORT | --db PATH]\n"
+     "usage: mbopt report JOB [-o FILE] [--no-responses] [--plot X:Y ...] [--server HOST:PORT | --db PATH]\n"
      "\n"
      "Writes a self-contained HTML page of the job: history plots, tables, the responses of the\n"
      "initial and final designs.\n"
      "\n"
      "options:\n"
      "  -o, --output FILE     the page (default: JOB.html)\n"
-     "  --no-responses        leave out the response plots (no analyses are run for them)\n"},
+     "  --no-responses        leave out the response plots (no analyses are run for them)\n"
+     "  --plot X:Y            also plot output or response Y against X at both designs, besides\n"
+     "                        the study's `plots`; repeatable\n"},
 };
 
 bool TalksToServer(std::string_view command) { return command != "run" && command != "validate"; }

@@ -718,7 +718,10 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
   }
 
   // Plots for the report: names and units checked like a constraint's.
-  for (int i = 0; i < m.plots_size(); ++i) {
+  if (m.plots_size() > kMaxXyPlots) {
+    errors->Add(where, "plots", absl::StrFormat("%d plots, more than the limit of %d", m.plots_size(), kMaxXyPlots));
+  }
+  for (int i = 0; i < m.plots_size() && i < kMaxXyPlots; ++i) {
     const v1::XyPlot& p = m.plots(i);
     const Where w = where.Child("plots", i);
     XyPlot plot;

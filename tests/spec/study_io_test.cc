@@ -282,6 +282,12 @@ TEST_F(StudyFiles, PlotOfAnUnknownOutputListsTheNamesThatExist) {
   EXPECT_THAT(error, HasSubstr("\"x\", \"acc\""));
 }
 
+TEST_F(StudyFiles, TooManyPlotsAreRefused) {
+  std::string study = kStudy;
+  for (int i = 0; i <= kMaxXyPlots; ++i) study += "plots { x: \"x\" y: \"acc\" }\n";
+  EXPECT_THAT(LoadError(kScene, study), HasSubstr("101 plots, more than the limit of 100"));
+}
+
 TEST_F(StudyFiles, PlotUnitMustFitItsSignal) {
   const std::string study = std::string(kStudy) + "plots { x: \"x\" y: \"acc\" y_unit: \"mm\" }\n";
   const std::string error = LoadError(kScene, study);
