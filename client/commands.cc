@@ -340,11 +340,11 @@ int ReportCommand(const Args& args) {
   if (!status.ok()) return FailRpc(status, c.address, &c.security);
   report::ReportData data = report::ReportDataFromJob(response);
   if (parsed->Has("--no-responses")) {
-    if (!plots.empty()) return Fail("mbopt report: --plot needs the analyses that --no-responses leaves out", kExitBadInput);
+    if (!plots.empty()) return Fail("--plot needs the analyses that --no-responses leaves out", kExitBadInput);
     data.responses_note = "Not analysed (mbopt report --no-responses).";
     SetViolationTolerance(response, &data);
   } else if (absl::Status added = AddResponsePlots(response, plots, &data); !added.ok()) {
-    return Fail("mbopt report: " + std::string(added.message()), kExitBadInput);
+    return Fail(std::string(added.message()), kExitBadInput);
   }
   const std::string html = report::RenderJobReportHtml(data);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
