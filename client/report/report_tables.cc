@@ -123,7 +123,7 @@ const ReportCycle* RecordOfFinalDesign(const ReportData& data) {
     if (r.x_trial_scaled.size() != design.size()) return false;
     for (std::size_t i = 0; i < design.size(); ++i) {
       const double v = ScaleOf(data, i) * r.x_trial_scaled[i];
-      if (!(std::abs(v - design[i]) <= kSameDesignRelativeTolerance * std::max(std::abs(design[i]), 1e-300))) {
+      if (!(std::abs(v - design[i]) <= kSameDesignRelativeTolerance * std::max(std::abs(design[i]), std::abs(v)))) {
         return false;
       }
     }
