@@ -88,7 +88,8 @@ constexpr Help kHelp[] = {
      "  --csv                 the cycle history as CSV\n"
      "  --json                result and history as one JSON object\n"},
     {"report",
-     "usage: mbopt report JOB [-o FILE] [--no-responses] [--no-mechanism] [--server HOST:PORT | --db PATH]\n"
+     "usage: mbopt report JOB [-o FILE] [--no-responses] [--no-mechanism] [--plot X:Y ...]\n"
+     "                        [--server HOST:PORT | --db PATH]\n"
      "\n"
      "Writes a self-contained HTML page of the job: history plots, tables, the responses of the\n"
      "initial and final designs, the mechanism drawn at both.\n"
@@ -96,6 +97,8 @@ constexpr Help kHelp[] = {
      "options:\n"
      "  -o, --output FILE     the page (default: JOB.html)\n"
      "  --no-responses        leave out the response plots (no analyses are run for them)\n"
+     "  --plot X:Y            also plot output or response Y against X at both designs, besides\n"
+     "                        the study's `plots`; repeatable\n"
      "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"},
     {"draw",
      "usage: mbopt draw FILE [-o OUT.html] [--set NAME=VALUE ...]\n"

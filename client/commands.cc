@@ -330,13 +330,22 @@ int WriteReport(const std::string& path, const std::string& html) {
 
 int ReportCommand(const Args& args) {
   // `-o` is the one short option mbopt takes: the usual spelling for an output file.
-  Args spelled = args;
-  for (std::string& a : spelled) {
-    if (a == "-o") a = "--output";
+  // --plot is repeatable, which the option parser's one value per name is
+  // not: taken out first.
+  Args spelled;
+  std::vector<std::string> plots;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--plot" && i + 1 < args.size()) {
+      plots.push_back(args[++i]);
+    } else if (args[i].rfind("--plot=", 0) == 0) {
+      plots.push_back(args[i].substr(7));
+    } else {
+      spelled.push_back(args[i] == "-o" ? "--output" : args[i]);
+    }
   }
-  auto parsed = Parse(spelled, {{"--server", "--db", "--output"}, {"--no-responses", "--no-mechanism"}}, 1,
+  auto parsed = Parse(spelled, {{"--server", "--db", "--output", "--plot"}, {"--no-responses", "--no-mechanism"}}, 1,
                       "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH] [--no-responses] "
-                      "[--no-mechanism]");
+                      "[--no-mechanism] [--plot X:Y ...]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   const std::string job_id = parsed->positional[0];
   std::string path = parsed->Value("--output");
@@ -354,9 +363,11 @@ int ReportCommand(const Args& args) {
   }
   report::ReportData data = report::ReportDataFromJob(response);
   if (parsed->Has("--no-responses")) {
+    if (!plots.empty()) return Fail("--plot needs the analyses that --no-responses leaves out", kExitBadInput);
     data.responses_note = "Not analysed (mbopt report --no-responses).";
-  } else {
-    AddResponsePlots(response, &data);
+    SetViolationTolerance(response, &data);
+  } else if (absl::Status added = AddResponsePlots(response, plots, &data); !added.ok()) {
+    return Fail(std::string(added.message()), kExitBadInput);
   }
   if (parsed->Has("--no-mechanism")) {
     data.mechanism.note = "Not drawn (mbopt report --no-mechanism).";

@@ -29,6 +29,7 @@ inline constexpr int kMaxResponses = 10'000;
 inline constexpr int kMaxLoadCases = 100;
 // Designs of a sweep or sample: each is one analysis (per load case).
 inline constexpr int kMaxDesignSetPoints = 100'000;
+inline constexpr int kMaxXyPlots = 100;  // the study's `plots`: one figure each in the report
 
 // Wall time of one analysis (integrator.max_wall_seconds): the default when
 // a scene does not say, and the most it may say. Over it, the analysis ends

@@ -160,6 +160,15 @@ struct LoadCase {
   std::vector<std::pair<int, double>> parameter_values_si;  // parameter index, SI value
 };
 
+// A plot of signal `y` against signal `x` for the report (not used by the
+// optimization), each axis in its unit.
+struct XyPlot {
+  int x = -1;  // a signal (Study::SignalName)
+  int y = -1;
+  std::string x_unit, y_unit;  // empty: SI
+  double x_si_per_unit = 1.0, y_si_per_unit = 1.0;
+};
+
 struct Study {
   std::string name;
   std::string source_file;
@@ -173,6 +182,7 @@ struct Study {
   AnalysisOverrides analysis;
   // Analyses at these designs instead of an optimization (empty: optimize).
   DesignSet design_set;
+  std::vector<XyPlot> plots;
 
   // SI parameter values of the scene at scaled design x (others at default).
   std::vector<double> ParameterValuesAt(const std::vector<double>& x_scaled) const;

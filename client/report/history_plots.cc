@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "client/report/number_format.h"
+
 namespace mbopt::report {
 namespace {
 
@@ -159,7 +161,8 @@ PlotSpec ViolationPlot(const ReportData& data) {
                                        [](const ReportCycle& r) { return r.max_violation_trial; }));
   spec.log_y = UseLog(data.violation_scale, AllY(spec));
   spec.reference_lines.push_back({kViolationRejectAbove, "0.10 reject (feasible LP)", "#d62728", true});
-  spec.reference_lines.push_back({kViolationConvergedBelow, "0.005 converged below", "#2ca02c", false});
+  spec.reference_lines.push_back(
+      {data.violation_tolerance, FormatValue(data.violation_tolerance, 4) + " converged below", "#2ca02c", false});
   if (!spec.log_y) spec.reference_lines.push_back({0.0, "0 limit", "#444444", true, true});
   return spec;
 }

@@ -20,8 +20,6 @@ inline constexpr double kErrorNarrowAbove = 0.25;
 inline constexpr double kErrorRejectAbove = 0.40;
 // A feasible LP whose trial point violates more than this is rejected.
 inline constexpr double kViolationRejectAbove = 0.10;
-// Convergence needs maxg below this.
-inline constexpr double kViolationConvergedBelow = 0.005;
 
 // The colour of series k (10 distinguishable colours, then repeated with a
 // different dash pattern: see SeriesDash).

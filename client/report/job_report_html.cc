@@ -9,6 +9,7 @@
 #include "client/report/number_format.h"
 #include "client/report/report_tables.h"
 #include "client/report/response_plots.h"
+#include "client/report/scalar_bars.h"
 #include "client/report/svg_line_plot.h"
 
 namespace mbopt::report {
@@ -27,9 +28,13 @@ td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: now
 td.on-bound { font-weight: bold; color: #8a4b00; }
 tr.rejected td { background: #fdecea; }
 div.wide { overflow-x: auto; }
-table.cycles { font-size: 12px; }
-table.cycles td { white-space: nowrap; }
-table.cycles td:last-child { white-space: normal; min-width: 160px; }
+table.cycles { font-size: 12px; width: 100%; table-layout: auto; }
+table.cycles th, table.cycles td { padding: 2px 4px; }
+table.cycles th { white-space: normal; }
+table.cycles td.num { white-space: nowrap; }
+table.cycles td.name { overflow-wrap: anywhere; min-width: 70px; }
+table.cycles td.result { min-width: 120px; }
+table.active td, table.design td { overflow-wrap: anywhere; }
 table.summary th { width: 190px; }
 p.note, p.empty { color: #555; font-size: 13px; }
 div.figure { margin: 10px 0 18px 0; }
@@ -63,8 +68,8 @@ std::string SummaryTable(const ReportData& data) {
   std::string objective = EscapeHtml(FormatValue(FinalObjective(data), 6, "not known"));
   if (!data.objective_unit.empty()) objective += " " + EscapeHtml(data.objective_unit);
   out += Row("final objective F", objective);
-  out += Row("max violation maxg", EscapeHtml(FormatValue(data.max_violation, 4, "not known")) +
-                                       (data.max_violation > 0 ? " (violated)" : ""));
+  out += Row("max violation maxg",
+             EscapeHtml(FormatValue(data.max_violation, 4, "not known") + ViolationMark(data, data.max_violation)));
   if (data.wall_seconds > 0) out += Row("wall time", EscapeHtml(FormatValue(data.wall_seconds, 4)) + " s");
   if (!data.message.empty()) out += Row("message", EscapeHtml(data.message));
   if (!data.failed_analyses_by_kind.empty()) {
@@ -138,10 +143,17 @@ std::string RenderJobReportHtml(const ReportData& data) {
            "multi-series output (stress at every node) the series that comes closest to its limit at the "
            "final design is shown.</p>\n";
     for (const ResponsePlot& plot : data.responses) {
-      out += Figure(ResponsePlotSpec(plot));
+      out += plot.scalar() ? "<div class=\"figure\">\n" + RenderScalarBarsSvg(plot) + "</div>\n"
+                           : Figure(ResponsePlotSpec(plot));
       if (!plot.note.empty()) out += "<p class=\"note\">" + EscapeHtml(plot.note) + "</p>\n";
     }
     if (!data.responses_note.empty()) out += "<p class=\"note\">" + EscapeHtml(data.responses_note) + "</p>\n";
+  }
+  if (!data.xy_plots.empty()) {
+    out += "<h2>Plots of one response against another</h2>\n";
+    out += "<p class=\"note\">Each curve runs over the time grid from its hollow marker (t = 0): the initial "
+           "design grey and dashed, the final design blue.</p>\n";
+    for (const XyPlot& plot : data.xy_plots) out += Figure(XyPlotSpec(plot));
   }
 
   out += "<h2>Final design</h2>\n";

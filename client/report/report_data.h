@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -17,6 +18,10 @@
 #include "client/report/mechanism_drawing.h"
 
 namespace mbopt::report {
+
+// The SLP's default convergence tolerance on maxg (slp::SlpOptions'
+// convergence_violation_tolerance; a test keeps the two equal).
+inline constexpr double kDefaultViolationTolerance = 0.005;
 
 struct ReportVariable {
   std::string name;
@@ -56,8 +61,8 @@ struct ReportCycle {
   bool converged = false;
 };
 
-// A constraint row known to be active (normalized value above
-// kActiveThreshold) at the final design.
+// A constraint row with its normalized value at the final design (> 0
+// violated); the page lists those above kActiveThreshold.
 struct ActiveConstraint {
   std::string name;
   double normalized_value = 0.0;
@@ -72,7 +77,8 @@ enum class ScaleChoice {
 
 // A response over time at the initial and at the final design, with the
 // limits a constraint puts on it: what the page's "Responses" section plots.
-// Values are in `unit`.
+// Values are in `unit`. A scalar (mass, a response of parameters: one value
+// per analysis, times_s of size 1 or empty) is shown as two bars.
 struct ResponsePlot {
   std::string title;        // e.g. "s1: max_abs <= 0.456 in"
   std::string unit;         // empty: SI
@@ -80,11 +86,29 @@ struct ResponsePlot {
   std::vector<double> times_s;
   std::vector<double> initial;  // same length as times_s
   std::vector<double> final;
+  // A limit holds over the instants from_s <= t <= to_s only (a window, or
+  // one instant when from_s == to_s, e.g. a FINAL bound); it is drawn there
+  // and nowhere else.
   struct Limit {
     double value = 0.0;
     std::string label;
+    double from_s = -std::numeric_limits<double>::infinity();
+    double to_s = std::numeric_limits<double>::infinity();
   };
   std::vector<Limit> limits;
+  bool scalar() const { return times_s.size() <= 1; }
+};
+
+// One output or response against another (the study's `plots`, or
+// `mbopt report --plot X:Y`), at the initial and the final design, each
+// axis in its signal's unit. A curve is the pairs (x(t_i), y(t_i)) over the
+// time grid.
+struct XyPlot {
+  std::string title;
+  std::string x_label;  // e.g. "crank_angle [deg]"
+  std::string y_label;
+  std::vector<double> initial_x, initial_y;  // same lengths
+  std::vector<double> final_x, final_y;
 };
 
 struct ReportData {
@@ -106,9 +130,17 @@ struct ReportData {
   // Current best design in physical units, one per variable; empty when
   // unknown (the page then derives it from the last accepted record).
   std::vector<double> final_design_physical;
-  // Rows known to be active at the final design beyond the worst row of the
-  // last accepted record (the job record keeps only that one per trial).
+  // Rows known to be active at the final design beyond its worst row as the
+  // job record has it (the record keeps only that one per trial point).
   std::vector<ActiveConstraint> active_constraints;
+  // True when `active_constraints` holds every row of an analysis of the
+  // final design (at least its worst row, active or not): the page then
+  // lists the active rows from it rather than from the cycle records.
+  bool active_constraints_complete = false;
+  // maxg below this counts as met for convergence (the SLP's
+  // convergence_violation_tolerance for this job's study): a value in
+  // (0, violation_tolerance] is within the tolerance, not "violated".
+  double violation_tolerance = kDefaultViolationTolerance;
 
   std::vector<ReportCycle> records;  // in the order the optimizer emitted them
   // The responses at the initial and final designs; when there are none,
@@ -117,6 +149,8 @@ struct ReportData {
   std::string responses_note;
   // The scene drawn at the initial and final designs.
   MechanismDrawings mechanism;
+  // The x-y plots asked for, from the same two analyses.
+  std::vector<XyPlot> xy_plots;
 
   // kAuto for the objective: logarithmic only when every value is > 0.
   ScaleChoice objective_scale = ScaleChoice::kAuto;

@@ -33,6 +33,16 @@ std::string Num(double v, int significant = 6) {
   return Cell(EscapeHtml(FormatValue(v, significant)), "num");
 }
 
+// A row name escaped, with a break opportunity after its '@' so that
+// "<constraint>@t=<time> <side>" wraps between its parts before anywhere
+// else in a narrow column.
+std::string BreakableName(const std::string& name) {
+  std::string escaped = EscapeHtml(name);
+  const std::size_t at = escaped.find('@');
+  if (at != std::string::npos) escaped.insert(at + 1, "<wbr>");
+  return escaped;
+}
+
 }  // namespace
 
 BoundFlag DesignBoundFlag(const ReportVariable& variable, double physical_value) {
@@ -106,6 +116,34 @@ std::string FinalDesignTableHtml(const ReportData& data) {
   return out;
 }
 
+const ReportCycle* RecordOfFinalDesign(const ReportData& data) {
+  const std::vector<double> design = FinalDesignPhysical(data);
+  if (design.empty()) return nullptr;
+  auto same = [&](const ReportCycle& r) {
+    if (r.x_trial_scaled.size() != design.size()) return false;
+    for (std::size_t i = 0; i < design.size(); ++i) {
+      const double v = ScaleOf(data, i) * r.x_trial_scaled[i];
+      if (!(std::abs(v - design[i]) <= kSameDesignRelativeTolerance * std::max(std::abs(design[i]), std::abs(v)))) {
+        return false;
+      }
+    }
+    return std::isfinite(r.max_violation_trial);
+  };
+  const ReportCycle* last = nullptr;
+  for (auto it = data.records.rbegin(); it != data.records.rend(); ++it) {
+    if (!same(*it)) continue;
+    if (last == nullptr) last = &*it;
+    if (it->max_violation_trial == data.max_violation) return &*it;
+  }
+  return last;
+}
+
+std::string ViolationMark(const ReportData& data, double normalized_value) {
+  if (!(normalized_value > 0)) return "";
+  if (normalized_value > data.violation_tolerance) return " (violated)";
+  return " (within the tolerance " + FormatValue(data.violation_tolerance, 4) + ")";
+}
+
 std::string ActiveConstraintsHtml(const ReportData& data) {
   struct Row {
     std::string name;
@@ -113,38 +151,64 @@ std::string ActiveConstraintsHtml(const ReportData& data) {
     std::string source;
   };
   std::vector<Row> rows;
-  const ReportCycle* last = LastAccepted(data);
-  if (last != nullptr && !last->worst_constraint.empty() &&
-      last->max_violation_trial > kActiveThreshold) {
-    rows.push_back({last->worst_constraint, last->max_violation_trial,
-                    "worst row of the last accepted trial (cycle " + std::to_string(last->cycle) + ")"});
+  auto table = [&]() {
+    std::string out =
+        "<table class=\"active\">\n<thead><tr><th>constraint row</th><th>normalized value</th>"
+        "<th>status</th><th>source</th></tr></thead>\n<tbody>\n";
+    for (const Row& r : rows) {
+      const std::string mark = ViolationMark(data, r.value);
+      // The mark's words without its parentheses; a met row is just active.
+      const std::string status = mark.empty() ? "active" : mark.substr(2, mark.size() - 3);
+      out += "<tr>" + Cell(EscapeHtml(r.name)) + Num(r.value) + Cell(EscapeHtml(status)) +
+             Cell(EscapeHtml(r.source)) + "</tr>\n";
+    }
+    return out + "</tbody>\n</table>\n";
+  };
+  const std::string threshold = EscapeHtml(FormatValue(kActiveThreshold));
+
+  if (data.active_constraints_complete && !data.active_constraints.empty()) {
+    // Every row of an analysis of the final design: nothing is left unknown.
+    const ActiveConstraint* worst = &data.active_constraints.front();
+    for (const ActiveConstraint& a : data.active_constraints) {
+      if (a.normalized_value > worst->normalized_value) worst = &a;
+      if (a.normalized_value > kActiveThreshold) rows.push_back({a.name, a.normalized_value, "analysis of the final design"});
+    }
+    std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.value > b.value; });
+    if (rows.empty()) {
+      return "<p class=\"note\">No row is active at the final design: the most critical, " + EscapeHtml(worst->name) +
+             ", has normalized value " + EscapeHtml(FormatValue(worst->normalized_value)) +
+             " (active means above " + threshold + ").</p>\n";
+    }
+    return table() + "<p class=\"note\">All rows of the analysis of the final design above " + threshold +
+           ", most critical first.</p>\n";
+  }
+
+  const ReportCycle* record = RecordOfFinalDesign(data);
+  if (record != nullptr && !record->worst_constraint.empty() && record->max_violation_trial > kActiveThreshold) {
+    rows.push_back({record->worst_constraint, record->max_violation_trial,
+                    "worst row of the final design (trial point of cycle " + std::to_string(record->cycle) + ")"});
   }
   for (const ActiveConstraint& a : data.active_constraints) {
     const bool seen = std::any_of(rows.begin(), rows.end(), [&](const Row& r) { return r.name == a.name; });
     if (!seen && a.normalized_value > kActiveThreshold) rows.push_back({a.name, a.normalized_value, "job data"});
   }
   std::string out;
-  if (!rows.empty()) {
-    out += "<table class=\"active\">\n<thead><tr><th>constraint row</th><th>normalized value</th>"
-           "<th>source</th></tr></thead>\n<tbody>\n";
-    for (const Row& r : rows) {
-      out += "<tr>" + Cell(EscapeHtml(r.name)) + Num(r.value) + Cell(EscapeHtml(r.source)) + "</tr>\n";
-    }
-    out += "</tbody>\n</table>\n";
-  }
+  if (!rows.empty()) out += table();
   // Say exactly what is known: the record keeps one row per trial point.
-  if (last == nullptr) {
+  if (LastAccepted(data) == nullptr) {
     out += "<p class=\"note\">No trial point has been accepted, so the rows active at the final "
            "design (the initial design) are not recorded.</p>\n";
-  } else if (last->worst_constraint.empty()) {
+  } else if (record == nullptr) {
+    out += "<p class=\"note\">No cycle record has the final design as its trial point, so its rows are "
+           "not recorded here.</p>\n";
+  } else if (record->worst_constraint.empty()) {
     out += "<p class=\"note\">The study has no constraint rows.</p>\n";
   } else if (rows.empty()) {
     out += "<p class=\"note\">No row is known to be active: the most critical row at the final "
-           "design, " + EscapeHtml(last->worst_constraint) + ", has normalized value " +
-           EscapeHtml(FormatValue(last->max_violation_trial)) + " (active means above " +
-           EscapeHtml(FormatValue(kActiveThreshold)) + ").</p>\n";
+           "design, " + EscapeHtml(record->worst_constraint) + ", has normalized value " +
+           EscapeHtml(FormatValue(record->max_violation_trial)) + " (active means above " + threshold + ").</p>\n";
   }
-  if (last != nullptr && !last->worst_constraint.empty() && data.active_constraints.empty()) {
+  if (record != nullptr && !record->worst_constraint.empty() && data.active_constraints.empty()) {
     out += "<p class=\"note\">The job record keeps only the most critical row (the one giving "
            "maxg) of each trial point; other rows may be active at the final design as well.</p>\n";
   }
@@ -170,12 +234,12 @@ std::string CycleTableHtml(const ReportData& data) {
            Num(r.objective_x0) +
            Cell(EscapeHtml(FormatValue(r.objective_trial, 6, "analysis failed")), "num") +
            Num(r.objective_predicted) + Num(r.max_violation_trial, 4) +
-           Cell(EscapeHtml(r.worst_constraint)) + Num(r.objective_error, 4) +
-           Num(r.max_approximation_error, 4) + Cell(EscapeHtml(r.worst_approximation)) +
+           Cell(BreakableName(r.worst_constraint), "name") + Num(r.objective_error, 4) +
+           Num(r.max_approximation_error, 4) + Cell(BreakableName(r.worst_approximation), "name") +
            Num(r.optimality_residual, 3) +
            Cell(r.lp_feasible ? "yes" : "no (s = " + EscapeHtml(FormatValue(r.infeasibility, 3)) + ")") +
-           Cell(EscapeHtml(r.lp_status)) + Cell(std::to_string(r.analyses_total), "num") +
-           Cell(EscapeHtml(result)) + "</tr>\n";
+           Cell(EscapeHtml(r.lp_status), "name") + Cell(std::to_string(r.analyses_total), "num") +
+           Cell(EscapeHtml(result), "result") + "</tr>\n";
   }
   out += "</tbody>\n</table>\n";
   return out;

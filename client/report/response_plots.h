@@ -1,6 +1,7 @@
-// The plot of one response at the initial and final designs (ResponsePlot):
-// time on x, the two analyses as lines, the constraint's limits as
-// reference lines.
+// The plots of the responses at the initial and final designs: a response
+// over time (ResponsePlot) with the constraint's limits drawn over the
+// instants they apply to, and one signal against another (XyPlot). A
+// scalar response is drawn as bars instead (scalar_bars.h).
 #pragma once
 
 #include "client/report/report_data.h"
@@ -8,6 +9,12 @@
 
 namespace mbopt::report {
 
+// Time on x, the two analyses as lines, each limit as a reference line over
+// its window, or a marked bar at its one instant. Not for a scalar plot.
 PlotSpec ResponsePlotSpec(const ResponsePlot& plot);
+
+// x against y at both designs, lines through the grid's instants in order,
+// with a marker where each curve starts (t = 0).
+PlotSpec XyPlotSpec(const XyPlot& plot);
 
 }  // namespace mbopt::report

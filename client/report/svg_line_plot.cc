@@ -18,6 +18,8 @@ constexpr double kMarginRightPx = 220.0;  // legend column
 constexpr double kMarginTopPx = 30.0;
 constexpr double kMarginBottomPx = 46.0;
 constexpr double kLegendRowPx = 18.0;
+// Half the width of the bar that marks a limit at one instant.
+constexpr double kInstantBarHalfPx = 9.0;
 // What fits the legend column at the legend's font size.
 constexpr std::size_t kLegendMaxChars = 24;
 
@@ -231,11 +233,35 @@ std::string RenderLinePlotSvg(const PlotSpec& spec) {
     const double fy = f.y.Fraction(r.y);
     if (!std::isfinite(fy) || fy < -1e-9 || fy > 1 + 1e-9) continue;
     const double py = f.Py(fy);
-    AppendLine(out, f.left, py, f.right, py,
-               "stroke=\"" + Attr(r.color) + "\" stroke-width=\"1.2\" stroke-dasharray=\"6 4\"");
-    AppendText(out, r.label_left ? f.left + 4 : f.right - 4, r.label_below ? py + 11 : py - 4,
-               r.label_left ? "start" : "end",
-               r.label, "class=\"ref-label\"");
+    // The span within the axis: a limit over a window is drawn over it only.
+    const double from = std::max(0.0, std::isfinite(r.x_from) ? f.x.Fraction(r.x_from) : 0.0);
+    const double to = std::min(1.0, std::isfinite(r.x_to) ? f.x.Fraction(r.x_to) : 1.0);
+    if (!(from <= to + 1e-9)) continue;  // outside the axis (or NaN)
+    const double px_from = f.Px(from), px_to = f.Px(to);
+    const std::string color = "stroke=\"" + Attr(r.color) + "\"";
+    double label_right = px_to, label_left = px_from;
+    if (r.x_from == r.x_to) {
+      // One instant: a bar wide enough to see and a diamond on the value.
+      AppendLine(out, px_from - kInstantBarHalfPx, py, px_from + kInstantBarHalfPx, py, color + " stroke-width=\"2\"");
+      out += "<polygon points=\"" + C(px_from - 4) + "," + C(py) + " " + C(px_from) + "," + C(py - 4) + " " +
+             C(px_from + 4) + "," + C(py) + " " + C(px_from) + "," + C(py + 4) + "\" fill=\"" + Attr(r.color) +
+             "\"/>\n";
+      label_right = px_from + kInstantBarHalfPx;
+      label_left = px_from - kInstantBarHalfPx;
+    } else {
+      AppendLine(out, px_from, py, px_to, py, color + " stroke-width=\"1.2\" stroke-dasharray=\"6 4\"");
+    }
+    // The label sits inside the plot: at the span's right end, or left of
+    // its left end when the span reaches the right edge and label_left is
+    // asked for (close lines).
+    if (r.label_left) {
+      AppendText(out, label_left + 4, r.label_below ? py + 11 : py - 4, "start", r.label, "class=\"ref-label\"");
+    } else {
+      const bool room_right = label_right + 4 + 6.0 * static_cast<double>(r.label.size()) < f.right;
+      AppendText(out, room_right && label_right < f.right - 4 ? label_right + 4 : label_right - 4,
+                 r.label_below ? py + 11 : py - 4, room_right && label_right < f.right - 4 ? "start" : "end",
+                 r.label, "class=\"ref-label\"");
+    }
   }
 
   bool any_floor = false;

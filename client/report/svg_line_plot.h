@@ -8,6 +8,7 @@
 // is drawn as a downward triangle on the bottom edge (explained in the plot).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,8 @@ struct PlotSeries {
 };
 
 // A horizontal line at a fixed y (a threshold), dashed, labelled at its
-// right end.
+// right end. It spans x_from <= x <= x_to (the whole axis by default); when
+// x_from == x_to it marks that one x with a short bar and a diamond.
 struct ReferenceLine {
   double y = 0.0;
   std::string label;
@@ -38,6 +40,8 @@ struct ReferenceLine {
   // instead of the right, below the line instead of above.
   bool label_left = false;
   bool label_below = false;
+  double x_from = -std::numeric_limits<double>::infinity();
+  double x_to = std::numeric_limits<double>::infinity();
 };
 
 struct PlotSpec {

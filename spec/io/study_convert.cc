@@ -718,6 +718,23 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     study.constraints.push_back(std::move(out));
   }
 
+  // Plots for the report: names and units checked like a constraint's.
+  if (m.plots_size() > kMaxXyPlots) {
+    errors->Add(where, "plots", absl::StrFormat("%d plots, more than the limit of %d", m.plots_size(), kMaxXyPlots));
+  }
+  for (int i = 0; i < m.plots_size() && i < kMaxXyPlots; ++i) {
+    const v1::XyPlot& p = m.plots(i);
+    const Where w = where.Child("plots", i);
+    XyPlot plot;
+    plot.x = FindOutput(study, w, "x", p.x(), errors);
+    plot.y = FindOutput(study, w, "y", p.y(), errors);
+    plot.x_unit = p.x_unit();
+    plot.y_unit = p.y_unit();
+    if (plot.x >= 0) plot.x_si_per_unit = UnitFactor(w, "x_unit", p.x_unit(), SignalDimension(study, plot.x), errors);
+    if (plot.y >= 0) plot.y_si_per_unit = UnitFactor(w, "y_unit", p.y_unit(), SignalDimension(study, plot.y), errors);
+    study.plots.push_back(std::move(plot));
+  }
+
   // Optimizer settings: 0 / unset keeps the default.
   if (m.has_optimizer()) {
     const Where w = where.Child("optimizer");

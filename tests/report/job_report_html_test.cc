@@ -11,6 +11,7 @@
 
 #include "client/report/history_plots.h"
 #include "client/report/report_tables.h"
+#include "client/report/response_plots.h"
 #include "tests/report/markup_checker.h"
 #include "tests/report/synthetic_report.h"
 
@@ -80,7 +81,7 @@ TEST(JobReportHtml, ShowsTheSummary) {
   EXPECT_THAT(html, HasSubstr("<strong>converged</strong>"));
   EXPECT_THAT(html, HasSubstr("<th>cycles</th><td>11</td>"));
   EXPECT_THAT(html, HasSubstr("<th>final objective F</th><td>252 in/s^2</td>"));
-  EXPECT_THAT(html, HasSubstr("<th>max violation maxg</th><td>0.00025 (violated)</td>"));
+  EXPECT_THAT(html, HasSubstr("<th>max violation maxg</th><td>0.00025 (within the tolerance 0.005)</td>"));
 }
 
 TEST(JobReportHtml, FailedAnalysesLeaveNoNanInThePlots) {
@@ -320,6 +321,82 @@ TEST(JobReportHtml, ShowsResponsesAtTheInitialAndFinalDesignsWithTheirLimits) {
   const std::string none = RenderJobReportHtml(data);
   EXPECT_EQ(testing::SvgFragments(none).size(), 5u);
   EXPECT_THAT(none, HasSubstr("The job has no analysed design yet."));
+}
+
+}  // namespace
+}  // namespace mbopt::report
+
+namespace mbopt::report {
+namespace {
+
+std::string ResponsesSection(const std::string& html) {
+  const std::size_t start = html.find("<h2>Responses");
+  const std::size_t end = html.find("<h2>Final design</h2>");
+  return start == std::string::npos || end == std::string::npos ? "" : html.substr(start, end - start);
+}
+
+// A constraint over the window 0.4-0.8 s hands its limit over with that
+// window; the plot's reference line carries it.
+TEST(JobReportHtml, ALimitIsDrawnOverItsWindowOnly) {
+  ResponsePlot plot;
+  plot.title = "ram: max of ram_position over 0.4-0.8 s <= 0.1 m";
+  plot.times_s = {0.0, 0.5, 1.0};
+  plot.initial = {0.0, 0.2, 0.0};
+  plot.final = {0.0, 0.1, 0.0};
+  plot.limits = {{0.1, "limit", 0.4, 0.8}};
+  const PlotSpec spec = ResponsePlotSpec(plot);
+  ASSERT_EQ(spec.reference_lines.size(), 1u);
+  EXPECT_EQ(spec.reference_lines[0].x_from, 0.4);
+  EXPECT_EQ(spec.reference_lines[0].x_to, 0.8);
+}
+
+TEST(JobReportHtml, AScalarResponseIsTwoBarsWithTheirValuesNotAPoint) {
+  ReportData data = testing::SyntheticVehicleReport();
+  ResponsePlot mass;
+  mass.title = "mass: final of total_mass <= 12 kg";
+  mass.unit = "kg";
+  mass.times_s = {1.0};
+  mass.initial = {14.5};
+  mass.final = {11.25};
+  mass.limits = {{12.0, "upper"}};
+  data.responses = {mass};
+  const std::string section = ResponsesSection(RenderJobReportHtml(data));
+  const std::vector<std::string> svgs = testing::SvgFragments(section);
+  ASSERT_EQ(svgs.size(), 1u);
+  EXPECT_EQ(testing::CheckMarkup(svgs[0], true), "");
+  EXPECT_THAT(svgs[0], HasSubstr("scalar-bars"));
+  EXPECT_EQ(Count(svgs[0], "<rect"), 2);  // one bar per design
+  EXPECT_THAT(svgs[0], HasSubstr(">14.5 kg</text>"));
+  EXPECT_THAT(svgs[0], HasSubstr(">11.25 kg</text>"));
+  EXPECT_THAT(svgs[0], HasSubstr(">upper 12 kg</text>"));
+  EXPECT_THAT(svgs[0], Not(HasSubstr("time [s]")));
+  EXPECT_THAT(svgs[0], Not(HasSubstr("<circle")));
+}
+
+TEST(JobReportHtml, DrawsTheXyPlotsAskedFor) {
+  ReportData data = testing::SyntheticVehicleReport();
+  XyPlot xy;
+  xy.title = "driver_torque against crank_angle";
+  xy.x_label = "crank_angle [deg]";
+  xy.y_label = "driver_torque [N m]";
+  xy.initial_x = {0, 90, 180, 270};
+  xy.initial_y = {1, 3, 2, 1};
+  xy.final_x = {0, 90, 180, 270};
+  xy.final_y = {1, 2, 1.5, 1};
+  data.xy_plots = {xy};
+  const std::string html = RenderJobReportHtml(data);
+  ExpectWellFormedWithCleanCoordinates(html);
+  const std::size_t section = html.find("<h2>Plots of one response against another</h2>");
+  ASSERT_NE(section, std::string::npos);
+  const std::vector<std::string> svgs = testing::SvgFragments(html.substr(section));
+  ASSERT_EQ(svgs.size(), 1u);
+  EXPECT_THAT(svgs[0], HasSubstr("driver_torque against crank_angle"));
+  EXPECT_THAT(svgs[0], HasSubstr(">crank_angle [deg]</text>"));
+  EXPECT_THAT(svgs[0], HasSubstr("driver_torque [N m]"));
+  EXPECT_EQ(Count(svgs[0], "<polyline"), 2);
+
+  data.xy_plots.clear();
+  EXPECT_THAT(RenderJobReportHtml(data), Not(HasSubstr("against another")));
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ namespace mbopt::report::testing {
 namespace {
 
 const std::set<std::string>& VoidElements() {
-  static const std::set<std::string> kVoid = {"meta", "br", "hr", "img", "input", "link"};
+  static const std::set<std::string> kVoid = {"meta", "br", "hr", "img", "input", "link", "wbr"};
   return kVoid;
 }
 

@@ -100,6 +100,59 @@ TEST_F(ReportInBrowser, ParsedPageHasThePlotsAndNoConsoleErrors) {
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
 }
 
+// At a 1280-px-wide window every table fits the page: nothing is cut off on
+// the right or needs the page to scroll sideways. Long row names (the
+// layout's "<constraint>@t=<time> <side>") are the widest cells. A script
+// added to a copy of the page (the report itself has none) measures the
+// laid-out boxes and writes them into the DOM that --dump-dom prints.
+TEST_F(ReportInBrowser, TablesFitThePageWidthAt1280Px) {
+  constexpr int kPageWidthPx = 1280;
+  ReportData data = testing::SyntheticVehicleReport();
+  for (ReportCycle& r : data.records) {
+    if (!r.worst_constraint.empty()) r.worst_constraint = "front_wheel_road_contact_force@t=0.420s lower";
+    if (!r.rejection_reason.empty()) r.rejection_reason += "; the move limits shrink by a quarter before the LP is solved again";
+  }
+  std::string html = RenderJobReportHtml(data);
+  const std::string probe =
+      "<script>\n"
+      "const lines = ['page ' + document.documentElement.scrollWidth + ' ' + window.innerWidth];\n"
+      "for (const t of document.querySelectorAll('table')) {\n"
+      "  const r = t.getBoundingClientRect();\n"
+      "  lines.push('table ' + (t.className || 'plain') + ' ' + Math.ceil(r.right) + ' ' + t.scrollWidth + ' ' + "
+      "Math.ceil(t.parentElement.getBoundingClientRect().right));\n"
+      "}\n"
+      "const pre = document.createElement('pre'); pre.id = 'layout'; pre.textContent = lines.join('\\n');\n"
+      "document.body.appendChild(pre);\n"
+      "</script>\n";
+  html.insert(html.rfind("</body>"), probe);
+  const fs::path page = dir_ / "probe.html";
+  std::ofstream(page) << html;
+  ASSERT_EQ(testing::RunHeadlessChromium(dir_, "--dump-dom", "probe", page, kPageWidthPx, kHeightPx), 0)
+      << ReadFile(dir_ / "probe.err");
+  const std::string dom = ReadFile(dir_ / "probe.out");
+  const std::size_t at = dom.find("<pre id=\"layout\">");
+  ASSERT_NE(at, std::string::npos) << ReadFile(dir_ / "probe.err");
+  std::istringstream layout(dom.substr(at + 17, dom.find("</pre>", at) - at - 17));
+  std::string kind;
+  int tables = 0;
+  while (layout >> kind) {
+    if (kind == "page") {
+      int scroll_width = 0, window_width = 0;
+      layout >> scroll_width >> window_width;
+      EXPECT_EQ(window_width, kPageWidthPx);
+      EXPECT_LE(scroll_width, window_width) << "the page scrolls sideways";
+    } else {
+      std::string name;
+      int right = 0, scroll_width = 0, parent_right = 0;
+      layout >> name >> right >> scroll_width >> parent_right;
+      ++tables;
+      EXPECT_LE(right, parent_right) << "table " << name << " is wider than its box";
+      EXPECT_LE(right, kPageWidthPx) << "table " << name << " runs off the page";
+    }
+  }
+  EXPECT_GE(tables, 4);  // summary, design, active, cycles
+}
+
 // The console check above must be able to fail: a page with a script
 // error shows up in the same log the same way.
 TEST_F(ReportInBrowser, ConsoleErrorsOfABrokenPageWouldBeSeen) {

@@ -162,3 +162,69 @@ TEST(SvgLinePlot, GrowsForALongLegend) {
 
 }  // namespace
 }  // namespace mbopt::report
+
+namespace mbopt::report {
+namespace {
+
+// x1 and x2 of the first <line> drawn in `color`.
+std::pair<double, double> LineEnds(const std::string& svg, const std::string& color) {
+  static const std::regex kLine("<line x1=\"([-0-9.]+)\" y1=\"[-0-9.]+\" x2=\"([-0-9.]+)\" y2=\"[-0-9.]+\" stroke=\"");
+  for (std::sregex_iterator it(svg.begin(), svg.end(), kLine), end; it != end; ++it) {
+    if (svg.compare(static_cast<std::size_t>(it->position() + it->length()), color.size(), color) == 0) {
+      return {std::stod((*it)[1]), std::stod((*it)[2])};
+    }
+  }
+  return {std::nan(""), std::nan("")};
+}
+
+// The plot area of a 1000-px plot runs from 78 px to 780 px (the legend
+// column is the rest); an axis over [0, 10] puts x = 4 at 78 + 0.4 * 702.
+constexpr double kLeftPx = 78.0, kRightPx = 780.0;
+constexpr double kPxTolerance = 0.01;  // coordinates are written with two decimals
+
+TEST(SvgLinePlot, AReferenceLineSpansTheWholeAxisByDefault) {
+  PlotSpec spec = OneSeries({0, 10}, {0, 2});
+  spec.reference_lines.push_back({1.0, "limit", "#d62728"});
+  const auto [x1, x2] = LineEnds(RenderLinePlotSvg(spec), "#d62728");
+  EXPECT_NEAR(x1, kLeftPx, kPxTolerance);
+  EXPECT_NEAR(x2, kRightPx, kPxTolerance);
+}
+
+TEST(SvgLinePlot, AReferenceLineWithASpanIsDrawnOverItOnly) {
+  PlotSpec spec = OneSeries({0, 10}, {0, 2});
+  ReferenceLine line{1.0, "limit over 4..6 s", "#d62728"};
+  line.x_from = 4.0;
+  line.x_to = 6.0;
+  spec.reference_lines.push_back(line);
+  const std::string svg = RenderLinePlotSvg(spec);
+  const auto [x1, x2] = LineEnds(svg, "#d62728");
+  EXPECT_NEAR(x1, kLeftPx + 0.4 * (kRightPx - kLeftPx), kPxTolerance);
+  EXPECT_NEAR(x2, kLeftPx + 0.6 * (kRightPx - kLeftPx), kPxTolerance);
+  EXPECT_EQ(testing::CheckMarkup(svg, true), "");
+}
+
+TEST(SvgLinePlot, AReferenceAtOneInstantIsAMarkedBarThere) {
+  PlotSpec spec = OneSeries({0, 10}, {0, 2});
+  ReferenceLine line{1.0, "final value limit", "#d62728"};
+  line.x_from = line.x_to = 10.0;
+  spec.reference_lines.push_back(line);
+  const std::string svg = RenderLinePlotSvg(spec);
+  const auto [x1, x2] = LineEnds(svg, "#d62728");
+  EXPECT_NEAR((x1 + x2) / 2, kRightPx, kPxTolerance);
+  EXPECT_LT(x2 - x1, 20.0);
+  EXPECT_THAT(svg, HasSubstr("<polygon"));  // the diamond on the value
+  EXPECT_THAT(svg, HasSubstr("final value limit"));
+}
+
+TEST(SvgLinePlot, AReferenceSpanOutsideTheAxisIsNotDrawn) {
+  PlotSpec spec = OneSeries({0, 10}, {0, 2});
+  ReferenceLine line{1.0, "elsewhere", "#d62728"};
+  line.x_from = 20.0;
+  line.x_to = 30.0;
+  spec.reference_lines.push_back(line);
+  const std::string svg = RenderLinePlotSvg(spec);
+  EXPECT_THAT(svg, Not(HasSubstr("elsewhere")));
+}
+
+}  // namespace
+}  // namespace mbopt::report

@@ -262,6 +262,39 @@ TEST_F(StudyFiles, UnknownOutputInConstraintListsTheSceneOutputs) {
   EXPECT_THAT(error, HasSubstr("\"x\", \"acc\""));
 }
 
+TEST_F(StudyFiles, PlotsNameSignalsWithTheirUnits) {
+  Write("oscillator.scene.textproto", kScene);
+  auto study = LoadStudyFile(Write("oscillator.study.textproto",
+                                   std::string(kStudy) + "plots { x: \"x\" y: \"acc\" x_unit: \"mm\" }\n"));
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_EQ(study->plots.size(), 1u);
+  EXPECT_EQ(study->SignalName(study->plots[0].x), "x");
+  EXPECT_EQ(study->SignalName(study->plots[0].y), "acc");
+  EXPECT_DOUBLE_EQ(study->plots[0].x_si_per_unit, 1e-3);
+  EXPECT_DOUBLE_EQ(study->plots[0].y_si_per_unit, 1.0);  // no unit: SI
+}
+
+TEST_F(StudyFiles, PlotOfAnUnknownOutputListsTheNamesThatExist) {
+  const std::string study = std::string(kStudy) + "plots {\n  x: \"x\"\n  y: \"crank_angle\"\n}\n";
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr(StudyPath() + ":" + std::to_string(LineOf(study, "y: \"crank_angle\"")) + ":"));
+  EXPECT_THAT(error, HasSubstr("plots[0].y: unknown output \"crank_angle\""));
+  EXPECT_THAT(error, HasSubstr("\"x\", \"acc\""));
+}
+
+TEST_F(StudyFiles, TooManyPlotsAreRefused) {
+  std::string study = kStudy;
+  for (int i = 0; i <= kMaxXyPlots; ++i) study += "plots { x: \"x\" y: \"acc\" }\n";
+  EXPECT_THAT(LoadError(kScene, study), HasSubstr("101 plots, more than the limit of 100"));
+}
+
+TEST_F(StudyFiles, PlotUnitMustFitItsSignal) {
+  const std::string study = std::string(kStudy) + "plots { x: \"x\" y: \"acc\" y_unit: \"mm\" }\n";
+  const std::string error = LoadError(kScene, study);
+  EXPECT_THAT(error, HasSubstr("plots[0].y_unit"));
+  EXPECT_THAT(error, HasSubstr("length but the output is a acceleration"));
+}
+
 TEST_F(StudyFiles, ConstraintUnitMustFitTheOutput) {
   const std::string study = Replace(kStudy, "unit: \"mm\"", "unit: \"m/s^2\"");
   const std::string error = LoadError(kScene, study);
