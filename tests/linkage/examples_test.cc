@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "proto/mbopt/v1/study.pb.h"
+#include "mbopt/v1/study.pb.h"
 #include "spec/io/study_io.h"
 #include "worker/multibody/linkage_analysis.h"
 
