@@ -56,38 +56,6 @@ absl::StatusOr<v1::AnalysisSeries> Analyse(const std::string& worker, const std:
   return series;
 }
 
-// One signal's plot: the series that comes closest to its limit at the
-// final design (the largest |value| without limits), in `unit`.
-report::ResponsePlot SignalPlot(const v1::AnalysisSeries& initial, const v1::AnalysisSeries& final, int signal,
-                                double si_per_unit, const std::string& unit, const std::string& title) {
-  report::ResponsePlot plot;
-  plot.title = title;
-  plot.unit = unit;
-  const v1::SignalSeries& a = initial.signals(signal);
-  const v1::SignalSeries& b = final.signals(signal);
-  int pick = 0;
-  double largest = -1.0;
-  for (int s = 0; s < b.series_size(); ++s) {
-    for (double v : b.series(s).values_si()) {
-      if (std::abs(v) > largest) {
-        largest = std::abs(v);
-        pick = s;
-      }
-    }
-  }
-  if (b.series_size() > 1 && pick < b.labels_size()) plot.title += " [" + b.labels(pick) + "]";
-  const auto& values_a = a.series(pick).values_si();
-  const auto& values_b = b.series(pick).values_si();
-  if (values_b.size() == 1) {
-    plot.times_s = {final.times_s_size() > 0 ? final.times_s(final.times_s_size() - 1) : 0.0};
-  } else {
-    plot.times_s.assign(final.times_s().begin(), final.times_s().end());
-  }
-  for (double v : values_a) plot.initial.push_back(v / si_per_unit);
-  for (double v : values_b) plot.final.push_back(v / si_per_unit);
-  return plot;
-}
-
 // The series of `signal` a plot shows: the one with the largest |value| at
 // the final design (a stress has one per node).
 int LargestSeries(const v1::AnalysisSeries& final, int signal) {
@@ -103,6 +71,29 @@ int LargestSeries(const v1::AnalysisSeries& final, int signal) {
     }
   }
   return pick;
+}
+
+// One signal's plot: the series that comes closest to its limit at the
+// final design (the largest |value| without limits), in `unit`.
+report::ResponsePlot SignalPlot(const v1::AnalysisSeries& initial, const v1::AnalysisSeries& final, int signal,
+                                double si_per_unit, const std::string& unit, const std::string& title) {
+  report::ResponsePlot plot;
+  plot.title = title;
+  plot.unit = unit;
+  const v1::SignalSeries& a = initial.signals(signal);
+  const v1::SignalSeries& b = final.signals(signal);
+  const int pick = LargestSeries(final, signal);
+  if (b.series_size() > 1 && pick < b.labels_size()) plot.title += " [" + b.labels(pick) + "]";
+  const auto& values_a = a.series(pick).values_si();
+  const auto& values_b = b.series(pick).values_si();
+  if (values_b.size() == 1) {
+    plot.times_s = {final.times_s_size() > 0 ? final.times_s(final.times_s_size() - 1) : 0.0};
+  } else {
+    plot.times_s.assign(final.times_s().begin(), final.times_s().end());
+  }
+  for (double v : values_a) plot.initial.push_back(v / si_per_unit);
+  for (double v : values_b) plot.final.push_back(v / si_per_unit);
+  return plot;
 }
 
 std::string AxisLabel(const spec::Study& study, int signal, const std::string& unit) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "client/report/html_escape.h"
+#include "client/report/page_head.h"
 #include "client/report/number_format.h"
 #include "client/report/svg_line_plot.h"
 
@@ -155,13 +156,7 @@ std::string Table(const DesignSetReportData& data) {
 }  // namespace
 
 std::string RenderDesignSetReportHtml(const DesignSetReportData& data) {
-  const std::string name = data.study_name.empty() ? std::string("(unnamed study)") : data.study_name;
-  std::string out;
-  out += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  out += "<title>mbopt report: " + EscapeHtml(name) + "</title>\n";
-  out += "<style>" + std::string(kStyle) + "</style>\n</head>\n<body>\n";
-  out += "<h1>" + EscapeHtml(name) + "</h1>\n";
-  if (!data.description.empty()) out += "<p class=\"description\">" + EscapeHtml(data.description) + "</p>\n";
+  std::string out = PageHeadHtml(data.study_name, data.description, kStyle);
   out += "<table>\n<tbody>\n";
   if (!data.job_id.empty()) out += "<tr><th>job</th><td>" + EscapeHtml(data.job_id) + "</td></tr>\n";
   out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";

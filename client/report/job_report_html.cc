@@ -5,6 +5,7 @@
 
 #include "client/report/history_plots.h"
 #include "client/report/html_escape.h"
+#include "client/report/page_head.h"
 #include "client/report/mechanism_drawing.h"
 #include "client/report/number_format.h"
 #include "client/report/report_tables.h"
@@ -102,13 +103,7 @@ std::string Figure(const PlotSpec& spec) {
 }  // namespace
 
 std::string RenderJobReportHtml(const ReportData& data) {
-  const std::string name = data.study_name.empty() ? std::string("(unnamed study)") : data.study_name;
-  std::string out;
-  out += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  out += "<title>mbopt report: " + EscapeHtml(name) + "</title>\n";
-  out += "<style>" + std::string(kStyle) + "</style>\n</head>\n<body>\n";
-  out += "<h1>" + EscapeHtml(name) + "</h1>\n";
-  if (!data.description.empty()) out += "<p class=\"description\">" + EscapeHtml(data.description) + "</p>\n";
+  std::string out = PageHeadHtml(data.study_name, data.description, kStyle);
   out += SummaryTable(data);
   out += MechanismSectionHtml(data.mechanism);
 

@@ -55,14 +55,21 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
   });
 }
 
+// The exact Newton matrix into p->newton, for either storage below; the
+// budget is checked here because forming it runs no residual.
+int FormNewtonMatrix(Problem* p, realtype t, realtype cj, N_Vector yy) {
+  if (BudgetStops(p, t)) return -1;
+  const int size = 2 * p->n + 2 * p->m;
+  const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
+  return GglNewtonMatrix(*p->system, t, cj, y, &p->work, &p->newton);
+}
+
 int DenseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_Vector /*rr*/, SUNMatrix jac,
                       void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
-    if (BudgetStops(p, t)) return -1;
+    if (int flag = FormNewtonMatrix(p, t, cj, yy); flag != 0) return flag;
     const int size = 2 * p->n + 2 * p->m;
-    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
-    if (int flag = GglNewtonMatrix(*p->system, t, cj, y, &p->work, &p->newton); flag != 0) return flag;
     // SUNDIALS' dense matrices are column-major like Eigen's.
     Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(jac), size, size) = p->newton;
     return 0;
@@ -76,10 +83,8 @@ int SparseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_
                        void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
-    if (BudgetStops(p, t)) return -1;
+    if (int flag = FormNewtonMatrix(p, t, cj, yy); flag != 0) return flag;
     const int size = 2 * p->n + 2 * p->m;
-    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
-    if (int flag = GglNewtonMatrix(*p->system, t, cj, y, &p->work, &p->newton); flag != 0) return flag;
     sunindextype* starts = SUNSparseMatrix_IndexPointers(jac);
     sunindextype* rows = SUNSparseMatrix_IndexValues(jac);
     realtype* values = SUNSparseMatrix_Data(jac);
