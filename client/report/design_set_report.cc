@@ -26,14 +26,6 @@ td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: now
 td.violated { color: #b00020; font-weight: bold; }
 tr.failed td { background: #fdecea; }
 div.wide { overflow-x: auto; }
-div.figure { margin: 10px 0 18px 0; }
-svg.plot { max-width: 100%; height: auto; font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; }
-svg .plot-title { font-size: 14px; font-weight: bold; fill: #222; }
-svg .tick { font-size: 11px; fill: #333; }
-svg .axis-label { font-size: 12px; fill: #222; }
-svg .legend { font-size: 12px; fill: #222; }
-svg .ref-label { font-size: 10px; fill: #555; }
-svg .note, svg .no-data { font-size: 11px; fill: #555; }
 )css";
 
 // Distinguishable colours for a grid's curves, repeated beyond ten.
@@ -156,7 +148,7 @@ std::string Table(const DesignSetReportData& data) {
 }  // namespace
 
 std::string RenderDesignSetReportHtml(const DesignSetReportData& data) {
-  std::string out = PageHeadHtml(data.study_name, data.description, kStyle);
+  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kStyle) + kPlotStyleCss);
   out += "<table>\n<tbody>\n";
   if (!data.job_id.empty()) out += "<tr><th>job</th><td>" + EscapeHtml(data.job_id) + "</td></tr>\n";
   out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";

@@ -38,14 +38,6 @@ table.cycles td.result { min-width: 120px; }
 table.active td, table.design td { overflow-wrap: anywhere; }
 table.summary th { width: 190px; }
 p.note, p.empty { color: #555; font-size: 13px; }
-div.figure { margin: 10px 0 18px 0; }
-svg.plot { max-width: 100%; height: auto; font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; }
-svg .plot-title { font-size: 14px; font-weight: bold; fill: #222; }
-svg .tick { font-size: 11px; fill: #333; }
-svg .axis-label { font-size: 12px; fill: #222; }
-svg .legend { font-size: 12px; fill: #222; }
-svg .ref-label { font-size: 10px; fill: #555; }
-svg .note, svg .no-data { font-size: 11px; fill: #555; }
 )css";
 
 std::string Row(const std::string& header, const std::string& escaped_value) {
@@ -103,7 +95,7 @@ std::string Figure(const PlotSpec& spec) {
 }  // namespace
 
 std::string RenderJobReportHtml(const ReportData& data) {
-  std::string out = PageHeadHtml(data.study_name, data.description, kStyle);
+  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kStyle) + kPlotStyleCss);
   out += SummaryTable(data);
   out += MechanismSectionHtml(data.mechanism);
 

@@ -7,6 +7,19 @@
 
 namespace mbopt::report {
 
+// The style of the SVG plots (svg_line_plot.h) every page with plots adds
+// to its own.
+inline constexpr const char* kPlotStyleCss = R"css(
+div.figure { margin: 10px 0 18px 0; }
+svg.plot { max-width: 100%; height: auto; font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; }
+svg .plot-title { font-size: 14px; font-weight: bold; fill: #222; }
+svg .tick { font-size: 11px; fill: #333; }
+svg .axis-label { font-size: 12px; fill: #222; }
+svg .legend { font-size: 12px; fill: #222; }
+svg .ref-label { font-size: 10px; fill: #555; }
+svg .note, svg .no-data { font-size: 11px; fill: #555; }
+)css";
+
 // `study_name` empty reads "(unnamed study)"; `style_css` goes inline.
 std::string PageHeadHtml(const std::string& study_name, const std::string& description, std::string_view style_css);
 
