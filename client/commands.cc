@@ -99,6 +99,9 @@ std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int w
   options.db_path = db;
   options.log_dir = c.temp_dir->path();
   options.workers = workers;
+  // Without workers the private server is there to show the jobs: it must
+  // not resume one (nothing would analyse it) nor call it running.
+  options.inspect_only = workers == 0;
   auto cluster = LocalCluster::Start(options);
   if (!cluster.ok()) return ConnectFailure{std::string(cluster.status().message()), kExitUnreachable};
   c.local = *std::move(cluster);

@@ -68,9 +68,10 @@ absl::StatusOr<std::unique_ptr<LocalCluster>> LocalCluster::Start(
   SpawnOptions server_spawn;
   server_spawn.capture_stdout = true;
   server_spawn.stderr_path = options.log_dir + "/server.log";
-  auto server = Subprocess::Start({options.server_binary, "--listen", "127.0.0.1:0", "--db",
-                                   options.db_path, "--port-file", options.log_dir + "/port"},
-                                  server_spawn);
+  std::vector<std::string> server_args = {options.server_binary, "--listen", "127.0.0.1:0", "--db",
+                                          options.db_path,        "--port-file", options.log_dir + "/port"};
+  if (options.inspect_only) server_args.push_back("--inspect");
+  auto server = Subprocess::Start(server_args, server_spawn);
   if (!server.ok()) return server.status();
   cluster->server_ = std::make_unique<Subprocess>(*std::move(server));
   auto line = cluster->server_->ReadStdoutLine(options.ready_timeout);

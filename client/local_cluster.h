@@ -31,6 +31,8 @@ struct LocalClusterOptions {
   std::string db_path;
   std::string log_dir;  // server.log, worker-<i>.log, port
   int workers = 1;
+  // The server only shows the database's jobs (mbopt-server --inspect).
+  bool inspect_only = false;
   // Added to every worker's command line (e.g. --drivers FILE).
   std::vector<std::string> worker_args;
   std::chrono::milliseconds ready_timeout{60000};  // failure guard only

@@ -33,7 +33,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: mbopt-server [--listen HOST:PORT] [--tls-dir DIR | --tls-cert F --tls-key F --tokens F]\n"
-    "                    [--worker-ca F] [--insecure] [--db PATH] [--port-file FILE]\n"
+    "                    [--worker-ca F] [--insecure] [--db PATH] [--inspect] [--port-file FILE]\n"
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N] [--max-result-mb N]\n"
     "                    [--durability full|cycles|normal]\n"
     "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
@@ -58,6 +58,9 @@ constexpr const char* kUsage =
     "                         and tokens (a warning at every start)\n"
     "  SIGHUP reads the token table again (to add or revoke tokens).\n"
     "  --db PATH              job database (default mbopt.db; created if missing)\n"
+    "  --inspect              only show the database's jobs: resume, admit, take\n"
+    "                         and cancel none; a job it calls running is shown\n"
+    "                         interrupted (`mbopt status --db` starts one)\n"
     "  --port-file FILE       write the port listened on to FILE once ready\n"
     "  --lease-ms N           lease of a task given to a worker (default 30000)\n"
     "  --heartbeat-ms N       heartbeat interval asked of workers (default 5000)\n"
@@ -136,6 +139,10 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     }
     if (arg == "--insecure") {
       flags->server.insecure = true;
+      continue;
+    }
+    if (arg == "--inspect") {
+      flags->server.manager.inspect_only = true;
       continue;
     }
     std::string name, value;

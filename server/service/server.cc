@@ -117,6 +117,7 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   s.scheduler_ = std::make_unique<scheduler::Scheduler>(s.clock_, scheduler_options);
   jobs::manager::JobManagerOptions manager_options = s.options_.manager;
   if (manager_options.clock == nullptr) manager_options.clock = s.clock_;
+  if (manager_options.db_path_for_messages.empty()) manager_options.db_path_for_messages = s.options_.db_path;
   if (!manager_options.make_lp_solver) manager_options.make_lp_solver = [] { return lp::MakeClpLpSolver(); };
   s.manager_ = std::make_unique<jobs::manager::JobManager>(s.store_.get(), s.scheduler_.get(), &DecodeStudy, manager_options);
   MBOPT_RETURN_IF_ERROR(s.manager_->Start());

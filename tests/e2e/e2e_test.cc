@@ -301,6 +301,51 @@ TEST(EndToEnd, ServerKilledMidJobResumesBitIdenticallyWithNormalDurability) {
   ExpectServerKilledMidJobResumesBitIdentically(VehicleStudy(), {"--durability", "normal"});
 }
 
+// A database whose server died: `status --db` says so and how to go on,
+// `watch --db` and `list --db` end at once, and none of them resumes the
+// job (nothing would analyse it); `resume --db` then finishes it with the
+// uninterrupted run's result.
+TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesIt) {
+  const std::string reference = Comparable(ReferenceResult(2));
+  ScratchDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::vector<std::string> crash_args = kFastLeases;
+  crash_args.insert(crash_args.end(), {"--crash-after-cycles", "2"});
+  auto server = StartServer(db, crash_args, "127.0.0.1:0", dir.File("server.log"));
+  ASSERT_TRUE(server.ok()) << server.status();
+  std::vector<Subprocess> pool;
+  for (int i = 0; i < 2; ++i) pool.push_back(StartWorker(server->address, {}, dir.File(absl::StrCat("w", i, ".log"))));
+  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
+  const std::string job = Trim(submitted.stdout_text);
+  auto crashed = server->process->Wait(kGuard);
+  ASSERT_TRUE(crashed.ok()) << crashed.status();
+  ASSERT_EQ(*crashed, kKilledBySigkill);
+  for (auto& w : pool) w.Stop(kGuard);
+
+  const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()};
+  for (int look = 0; look < 2; ++look) {  // the second look finds the same: the first changed nothing
+    auto status = Mbopt({"status", job, "--db", db}, env);
+    ASSERT_EQ(status.exit_code, kExitOk) << Describe(status);
+    EXPECT_NE(status.stdout_text.find("status:        interrupted"), std::string::npos) << status.stdout_text;
+    EXPECT_NE(status.stdout_text.find("server not running"), std::string::npos) << status.stdout_text;
+    EXPECT_NE(status.stdout_text.find(absl::StrCat("mbopt resume ", job, " --db ", db)), std::string::npos)
+        << status.stdout_text;
+    EXPECT_EQ(CyclesInStatus(status.stdout_text), 2) << status.stdout_text;
+  }
+  auto listed = Mbopt({"list", "--db", db}, env);
+  ASSERT_EQ(listed.exit_code, kExitOk) << Describe(listed);
+  EXPECT_NE(listed.stdout_text.find("interrupted"), std::string::npos) << listed.stdout_text;
+  auto watched = Mbopt({"watch", job, "--db", db}, env);
+  EXPECT_EQ(watched.exit_code, kExitNotConverged) << Describe(watched);
+
+  auto resumed = Mbopt({"resume", job, "--db", db, "--workers", "2"}, env);
+  ASSERT_EQ(resumed.exit_code, kExitOk) << Describe(resumed);
+  auto results = Mbopt({"results", job, "--json", "--db", db}, env);
+  ASSERT_EQ(results.exit_code, kExitOk) << Describe(results);
+  EXPECT_EQ(Comparable(results.stdout_text), reference);
+}
+
 // ---------------------------------------------------- simulator gradients --
 
 // The report's optimum of the vehicle problem (section 4.1, Table 2): peak

@@ -234,6 +234,57 @@ TEST_F(ServerTest, RestartAfterCrashResumesBitIdentically) {
   ExpectSameCycles(reference, finished);
 }
 
+// An inspecting server (what `mbopt status --db` starts) on a database whose
+// server crashed: the job is shown interrupted and left as it was (no task
+// for a worker, no submit, resume or cancel, nothing written); the next real
+// server resumes it to the uninterrupted result.
+TEST_F(ServerTest, InspectingServerShowsACrashedJobInterruptedAndLeavesItAlone) {
+  v1::GetJobResponse reference = RunToEnd("reference.db", 7);
+  std::string id;
+  {
+    auto server = StartServer("crash.db");
+    id = Submit(*server, OscillatorStudy());
+    FakeWorker worker(server->InProcessChannel(), 99);
+    ASSERT_EQ(worker.Run(7), 7);
+  }
+  {
+    jobs::manager::JobManagerOptions inspect;
+    inspect.inspect_only = true;
+    auto server = StartServer("crash.db", inspect);
+    v1::GetJobResponse shown = Get(*server, id);
+    EXPECT_EQ(shown.summary().state(), v1::JOB_STATE_INTERRUPTED);
+    EXPECT_NE(shown.summary().message().find("server not running"), std::string::npos) << shown.summary().message();
+    EXPECT_NE(shown.summary().message().find("mbopt resume " + id + " --db "), std::string::npos);
+    FakeWorker worker(server->InProcessChannel(), 3);
+    EXPECT_EQ(worker.Run(1), 0) << "an inspecting server hands out no task";
+    grpc::Status submitted = TrySubmit(*server, OscillatorStudy());
+    EXPECT_EQ(submitted.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << submitted.error_message();
+    auto stub = v1::JobService::NewStub(server->InProcessChannel());
+    for (bool cancel : {false, true}) {
+      grpc::ClientContext context;
+      v1::JobRef ref;
+      ref.set_job_id(id);
+      v1::JobSummary summary;
+      grpc::Status status = cancel ? stub->Cancel(&context, ref, &summary) : stub->Resume(&context, ref, &summary);
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << status.error_message();
+    }
+    server->Shutdown();
+  }
+  {
+    auto store = store::Store::Open((dir_ / "crash.db").string());
+    ASSERT_TRUE(store.ok()) << store.status();
+    auto row = store->get()->GetJob(id);
+    ASSERT_TRUE(row.ok());
+    EXPECT_EQ(row->state, "RUNNING") << "inspecting wrote nothing";
+  }
+  auto server = StartServer("crash.db");
+  FakeWorker worker(server->InProcessChannel(), 3);
+  worker.Run();
+  v1::GetJobResponse finished = Get(*server, id);
+  EXPECT_EQ(finished.summary().state(), v1::JOB_STATE_CONVERGED);
+  ExpectSameCycles(reference, finished);
+}
+
 TEST_F(ServerTest, GracefulStopInterruptsAndNextStartResumesBitIdentically) {
   v1::GetJobResponse reference = RunToEnd("reference.db", 7);
   std::string id;

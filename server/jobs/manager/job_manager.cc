@@ -240,6 +240,16 @@ absl::Status JobManager::Start() {
       admission_.Enqueue(entry->row.seq, id, entry->row.owner);
       continue;
     }
+    if (options_.inspect_only) {
+      if (Running(entry->state) || entry->state == JobState::kInterrupted) {
+        // In memory only: the next real server resumes it as it finds it.
+        entry->state = JobState::kInterrupted;
+        entry->message = absl::StrCat("interrupted (server not running); `mbopt resume ", id, " --db ",
+                                      options_.db_path_for_messages, "` continues it");
+      }
+      EvictLocked(*entry);
+      continue;
+    }
     if (entry->state == JobState::kRunning) {
       // It was admitted before the server ended: it counts as running.
       std::lock_guard<std::mutex> admission_lock(admission_mutex_);
@@ -254,8 +264,13 @@ absl::Status JobManager::Start() {
       EvictLocked(*entry);
     }
   }
-  AdmitWaiting();
+  if (!options_.inspect_only) AdmitWaiting();
   return absl::OkStatus();
+}
+
+absl::Status JobManager::InspectOnlyRefusal(const std::string& what) const {
+  return absl::FailedPreconditionError(absl::StrCat(
+      "this server only shows the jobs of ", options_.db_path_for_messages, " (--inspect); it does not ", what));
 }
 
 absl::Status JobManager::NoSuchJob(const std::string& job_id) {
@@ -264,6 +279,7 @@ absl::Status JobManager::NoSuchJob(const std::string& job_id) {
 
 absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, const std::string& source_name,
                                                const std::string& owner, const std::string& actor) {
+  if (options_.inspect_only) return InspectOnlyRefusal("take new jobs");
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shutdown_) return absl::UnavailableError("the server is shutting down");
@@ -730,6 +746,7 @@ void JobManager::ExpireLeases() {
 }
 
 absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id, const std::string& actor) {
+  if (options_.inspect_only) return InspectOnlyRefusal("cancel jobs");
   MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
   JobSummaryData summary;
   {
@@ -748,6 +765,7 @@ absl::StatusOr<JobSummaryData> JobManager::Cancel(const std::string& job_id, con
 }
 
 absl::StatusOr<JobSummaryData> JobManager::Resume(const std::string& job_id, const std::string& actor) {
+  if (options_.inspect_only) return InspectOnlyRefusal("resume jobs");
   std::lock_guard<std::mutex> admit_lock(admit_mutex_);
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -75,6 +75,13 @@ struct JobManagerOptions {
   const scheduler::Clock* clock = nullptr;
   // How many jobs run at once; the others wait (QUEUED) in submission order.
   AdmissionLimits admission;
+  // Inspection only (`mbopt status --db` and the like): Start() resumes and
+  // admits nothing, a job the database calls running is shown INTERRUPTED
+  // (its server is gone: the store's lock proves no other server holds the
+  // file), and Submit and Resume are refused. Nothing is written for them.
+  bool inspect_only = false;
+  // Named in the messages of inspect_only ("mbopt resume JOB --db PATH").
+  std::string db_path_for_messages;
 };
 
 // One result from a worker: where it goes, and the candidate record the
@@ -112,6 +119,7 @@ class JobManager {
   // gives the same for another user's job, so that ids do not tell which
   // jobs exist.
   static absl::Status NoSuchJob(const std::string& job_id);
+  absl::Status InspectOnlyRefusal(const std::string& what) const;
   // Who submitted the job. NotFound naming the id for an unknown job.
   absl::StatusOr<std::string> OwnerOf(const std::string& job_id);
 
