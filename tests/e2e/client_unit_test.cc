@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include "client/json_writer.h"
 #include "client/local_cluster.h"
 #include "worker/service/backoff.h"
+#include "worker/service/batch_log_line.h"
 #include "worker/service/result_size.h"
 
 namespace mbopt {
@@ -52,6 +54,22 @@ TEST(ResultSize, ResultOverTheServersLimitBecomesANamedServiceFailure) {
   EXPECT_NE(result.failure_reason().find("the result is 1.5 MB, more than the server takes (1.0 MB"),
             std::string::npos)
       << result.failure_reason();
+}
+
+// The worker's line per batch names the jobs once each, counts what failed
+// and adds up the analyses' time.
+TEST(BatchLogLine, NamesJobsCountsFailuresAndSumsAnalysisTime) {
+  v1::TaskResults batch;
+  for (const auto& [job, ok, seconds] : {std::tuple{"job-2", true, 0.5}, std::tuple{"job-1", false, 0.25},
+                                         std::tuple{"job-2", true, 0.5}}) {
+    v1::TaskResult* r = batch.add_results();
+    r->set_job_id(job);
+    r->set_ok(ok);
+    r->mutable_counters()->set_wall_seconds(seconds);
+  }
+  EXPECT_EQ(worker::BatchLogLine(batch, 57), "job-2, job-1: 3 results delivered (2 ok, 1 failed), 1.25 s of analysis; 57 in all");
+  batch.mutable_results()->DeleteSubrange(1, 2);
+  EXPECT_EQ(worker::BatchLogLine(batch, 1), "job-2: 1 result delivered (1 ok), 0.50 s of analysis; 1 in all");
 }
 
 TEST(JsonWriter, WritesNestedDocumentsWithCommas) {

@@ -322,6 +322,12 @@ TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesI
   ASSERT_TRUE(crashed.ok()) << crashed.status();
   ASSERT_EQ(*crashed, kKilledBySigkill);
   for (auto& w : pool) w.Stop(kGuard);
+  // At the default level a worker logs one line per batch of results.
+  std::ifstream worker_log(dir.File("w0.log"));
+  std::stringstream worker_text;
+  worker_text << worker_log.rdbuf();
+  EXPECT_NE(worker_text.str().find(absl::StrCat(job, ": ")), std::string::npos) << worker_text.str();
+  EXPECT_NE(worker_text.str().find(" delivered ("), std::string::npos) << worker_text.str();
 
   const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()};
   for (int look = 0; look < 2; ++look) {  // the second look finds the same: the first changed nothing

@@ -47,7 +47,7 @@ const char* ServeUsage() {
          "                       holding the token); never on the command line\n"
          "  Exit status: 0 stopped by a signal, 2 bad options, 3 the server refused the\n"
          "  token or the first connection failed for a reason of this configuration.\n"
-         "  --verbose            one line on stderr per task\n") +
+         "  --verbose            one line on stderr per task (else one per batch)\n") +
       external::ExternalOptionsUsage() +
          "  --task-delay-ms N    testing only: hold each result N ms before reporting it\n"
          "  --die-after-tasks N  testing only: SIGKILL this process on receiving the\n"

@@ -26,6 +26,7 @@
 #include "mbopt/v1/service.grpc.pb.h"
 #include "worker/budget/analysis_budget.h"
 #include "worker/fmu/fmu.h"
+#include "worker/service/batch_log_line.h"
 #include "worker/service/result_size.h"
 #include "worker/service/task_evaluator.h"
 
@@ -523,6 +524,12 @@ class Worker : public std::enable_shared_from_this<Worker> {
       grpc::Status status = in_pieces ? SendInPieces(&context, request, serialized, max_message_bytes, &response)
                                       : stub_->ReportResults(&context, request, &response);
       if (status.ok()) {
+        std::int64_t delivered = 0;
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          delivered = results_delivered_ += request.results_size();
+        }
+        Log(BatchLogLine(request, delivered));
         for (int i = 0; i < response.answers_size() && i < request.results_size(); ++i) {
           const v1::ResultAnswer& answer = response.answers(i);
           if (!answer.error().empty()) {
@@ -696,6 +703,7 @@ class Worker : public std::enable_shared_from_this<Worker> {
   std::map<std::string, std::shared_ptr<const PreparedStudy>> studies_;
   std::map<std::string, std::string> study_errors_;
 
+  std::int64_t results_delivered_ = 0;  // guarded by mutex_; accepted by the server or not
   int tasks_received_ = 0;  // guarded by mutex_
   absl::Status fatal_;      // guarded by mutex_
   bool unreachable_logged_ = false;  // acquiring thread only
