@@ -2,9 +2,14 @@
 
 #include <signal.h>
 #include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <fstream>
+#include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -202,6 +207,55 @@ echo '{}' > results.json
   errno = 0;
   EXPECT_EQ(kill(left, 0), -1) << "process " << left << " outlived its analysis";
   EXPECT_EQ(errno, ESRCH);
+}
+
+// True once `pid` is gone or a zombie (an orphan's new parent may be slow
+// to reap it, or be this test process, a subreaper since the runs above).
+bool Ended(pid_t pid) {
+  while (waitpid(pid, nullptr, WNOHANG) > 0) {
+  }
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return true;
+  const size_t paren = line.rfind(')');
+  return paren != std::string::npos && paren + 2 < line.size() && line[paren + 2] == 'Z';
+}
+
+// A worker killed outright (SIGKILL: no code of it runs) in the middle of an
+// analysis: its guard kills the driver's group, the driver's child that
+// ignores SIGTERM included, instead of leaving them running orphaned.
+TEST(ExternalRunner, ARunnerKilledWithSigkillLeavesNoDriverProcessRunning) {
+  TempDir base, work;
+  const std::filesystem::path pid_file = work.path() / "pids";
+  DriverDeclaration driver = ShDriver(base, R"(
+sh -c 'trap "" TERM; exec sleep 1000' child &
+trap '' TERM
+echo "$$ $!" > "$1.tmp"; mv "$1.tmp" "$1"
+while :; do sleep 1; done
+)");
+  driver.command.push_back(pid_file.string());
+  driver.timeout_s = 600.0;
+  const pid_t runner = fork();
+  ASSERT_GE(runner, 0);
+  if (runner == 0) {
+    (void)RunExternalAnalysis(driver, kValues, Options(work, "k9"));
+    _exit(0);
+  }
+  pid_t driver_pid = 0, child_pid = 0;
+  for (int i = 0; i < 2000 && !(std::ifstream(pid_file) >> driver_pid >> child_pid); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_GT(child_pid, 1) << "the driver wrote no pids to " << pid_file;
+  ASSERT_FALSE(Ended(driver_pid));
+  ASSERT_EQ(kill(runner, SIGKILL), 0);
+  ASSERT_EQ(waitpid(runner, nullptr, 0), runner);
+  bool ended = false;
+  for (int i = 0; i < 1000 && !ended; ++i) {  // up to 10 s on a loaded machine
+    ended = Ended(driver_pid) && Ended(child_pid);
+    if (!ended) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(ended) << "driver " << driver_pid << " or its child " << child_pid << " outlived the killed runner";
+  if (!ended) kill(-driver_pid, SIGKILL);
 }
 
 TEST(ExternalRunner, MalformedResultsNameFileAndLine) {

@@ -5,7 +5,11 @@
 #    docs/images/drawing_<scene>.png;
 #  - the report of the press, isolator and vehicle studies optimized with
 #    `mbopt run`, its top (header and "Mechanism"):
-#    docs/images/report_<study>.png.
+#    docs/images/report_<study>.png;
+#  - sections of those reports alone (the page's head and the sections
+#    from one heading up to the next one not asked for): the press's x-y
+#    plots and responses, the isolator's responses, the tables of all three:
+#    docs/images/report_<study>_<part>.png.
 # Needs the three built programs and Chromium (deploy/install-deps.sh).
 #   usage: bash tests/report/drawing_screenshots.sh [BUILD_DIR]
 set -euo pipefail
@@ -44,6 +48,25 @@ for scene in "${scenes[@]}"; do
   screenshot "$work/$name.html" "$frame" 780 "$height" "$out/drawing_$name.png"
 done
 
+# $1 report page, $2 the page to write, $3... the <h2> headings kept
+section_page() {
+  python3 - "$@" <<'PY'
+import sys
+page, out, keep = sys.argv[1], sys.argv[2], sys.argv[3:]
+html = open(page, encoding="utf-8").read()
+head, _, body = html.partition("<h2>")
+head = head[:head.index("<body>") + len("<body>")] if "<body>" in head else head
+parts = ["<h2>" + p for p in body.split("<h2>")]
+kept = [p for p in parts if any(p.startswith("<h2>" + k + "</h2>") for k in keep)]
+if len(kept) != len(keep):
+    sys.exit("section_page: not every heading of %s is in %s" % (keep, page))
+text = "".join(kept)
+if "</body>" not in text:
+    text += "</body>\n</html>\n"
+open(out, "w", encoding="utf-8").write(head + "\n" + text)
+PY
+}
+
 # study file, frame shown, window height (px)
 reports=(
   "press/press.study.textproto 40 560"
@@ -56,4 +79,20 @@ for report in "${reports[@]}"; do
   "$build/client/mbopt" run "examples/$file" --workers 2 --db "$work/$name.db" --quiet
   "$build/client/mbopt" report job-1 --db "$work/$name.db" -o "$work/${name}_report.html"
   screenshot "$work/${name}_report.html" "$frame" 1000 "$height" "$out/report_$name.png"
+done
+
+# report, part name, window height (px), headings
+sections=(
+  "press xy 1150|Plots of one response against another"
+  "press responses 1250|Responses at the initial and final designs"
+  "isolator responses 1700|Responses at the initial and final designs"
+  "press tables 1000|Final design|Active constraints|Cycles"
+  "isolator tables 1100|Final design|Active constraints|Cycles"
+  "vehicle tables 1500|Final design|Active constraints|Cycles"
+)
+for section in "${sections[@]}"; do
+  IFS='|' read -r -a fields <<<"$section"
+  read -r name part height <<<"${fields[0]}"
+  section_page "$work/${name}_report.html" "$work/${name}_$part.html" "${fields[@]:1}"
+  screenshot "$work/${name}_$part.html" 0 1000 "$height" "$out/report_${name}_$part.png"
 done

@@ -25,6 +25,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "common/status_macros.h"
+#include "worker/external/group_guard.h"
 #include "worker/external/input_template.h"
 #include "worker/external/paths.h"
 
@@ -266,7 +267,11 @@ absl::StatusOr<ExternalOutcome> RunInFolder(const DriverDeclaration& driver, con
   // reaped to the last process (a zombie still counts as a group member).
   prctl(PR_SET_CHILD_SUBREAPER, 1);
   const Clock::time_point start = Clock::now();
+  // Forked before the driver: if this process is killed outright, the
+  // guard ends the group (group_guard.h).
+  MBOPT_ASSIGN_OR_RETURN(GroupGuard guard, GroupGuard::Start());
   MBOPT_ASSIGN_OR_RETURN(const Child child, Spawn(driver, folder));
+  guard.Watch(child.pid);
   int wait_status = 0;
   const WaitEnd end = WaitFor(child, driver.timeout_s, &wait_status);
   if (end == WaitEnd::kTimedOut) {
@@ -275,6 +280,7 @@ absl::StatusOr<ExternalOutcome> RunInFolder(const DriverDeclaration& driver, con
     // The driver is done; whatever it left running in its group is not.
     KillGroup(child.pid);
   }
+  guard.Release();
   if (child.pidfd >= 0) close(child.pidfd);
   outcome.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (end == WaitEnd::kLost) {

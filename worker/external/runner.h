@@ -8,9 +8,10 @@
 // outlives the analysis (the group is killed after the driver ends, and at
 // the time limit with SIGTERM, then SIGKILL after a grace period); the
 // folder is `<work_directory>/<analysis_id>-<driver>`, mode 0700, and is
-// removed afterwards unless `keep_run_folder`. A process that leaves the
-// group (setsid, setpgid) escapes the kill: containing those needs cgroups,
-// which the runner does not use.
+// removed afterwards unless `keep_run_folder`; if this process is killed
+// outright (SIGKILL) during the analysis, a guard process kills the group
+// (group_guard.h). A process that leaves the group (setsid, setpgid) escapes
+// the kill: containing those needs cgroups, which the runner does not use.
 //
 // To reap the driver's orphaned children the runner makes this process a
 // child subreaper (prctl PR_SET_CHILD_SUBREAPER): descendants of the driver
