@@ -74,11 +74,12 @@ constexpr Help kHelp[] = {
      "\n"
      "Stops a queued or running job; its tasks are withdrawn from the workers.\n"},
     {"resume",
-     "usage: mbopt resume JOB [--server HOST:PORT | --db PATH [--workers N]]\n"
+     "usage: mbopt resume JOB [--server HOST:PORT | --db PATH [--workers N] [--drivers FILE [--keep-runs]]]\n"
      "\n"
      "Continues an interrupted or cancelled job from its last durable record; the result is bit\n"
      "for bit the one an uninterrupted run gives (a running job is left alone). With --db,\n"
-     "starts a local server and N workers on that database.\n"},
+     "starts a local server and N workers on that database; an external scene's job needs\n"
+     "--drivers FILE (and --keep-runs) as `mbopt run` had them.\n"},
     {"results",
      "usage: mbopt results JOB [--csv | --json] [--server HOST:PORT | --db PATH]\n"
      "\n"

@@ -18,6 +18,7 @@
 #include "client/interrupts.h"
 #include "client/job_format.h"
 #include "client/local_cluster.h"
+#include "client/local_worker_drivers.h"
 #include "client/report/design_set_report.h"
 #include "client/report/job_report_html.h"
 #include "client/report/report_from_proto.h"
@@ -65,8 +66,10 @@ struct ConnectFailure {
 };
 
 // The server of --server, or with --db PATH a private one on 127.0.0.1 on
-// that database, with `workers` local workers (0: it only answers).
-std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int workers = 0) {
+// that database, with `workers` local workers (0: it only answers) started
+// with `worker_args`.
+std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int workers = 0,
+                                                 std::vector<std::string> worker_args = {}) {
   Connection c;
   const std::string db = parsed.Value("--db");
   if (db.empty()) {
@@ -99,6 +102,7 @@ std::variant<Connection, ConnectFailure> Connect(const ParsedArgs& parsed, int w
   options.db_path = db;
   options.log_dir = c.temp_dir->path();
   options.workers = workers;
+  options.worker_args = std::move(worker_args);
   // Without workers the private server is there to show the jobs: it must
   // not resume one (nothing would analyse it) nor call it running.
   options.inspect_only = workers == 0;
@@ -240,8 +244,9 @@ int WorkersCommand(const Args& args) {
 
 namespace {
 
-int CancelOrResume(const ParsedArgs& parsed, bool cancel, int workers) {
-  auto connected = Connect(parsed, workers);
+int CancelOrResume(const ParsedArgs& parsed, bool cancel, int workers,
+                   std::vector<std::string> worker_args = {}) {
+  auto connected = Connect(parsed, workers, std::move(worker_args));
   if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
   Connection& c = std::get<Connection>(connected);
   const std::string job_id = parsed.positional[0];
@@ -282,16 +287,28 @@ int CancelCommand(const Args& args) {
 }
 
 int ResumeCommand(const Args& args) {
-  auto parsed = Parse(args, {{"--server", "--db", "--workers"}, {}}, 1,
-                      "mbopt resume JOB [--server ADDRESS | --db PATH [--workers N]]");
+  auto parsed = Parse(args, {{"--server", "--db", "--workers", "--drivers"}, {"--keep-runs"}}, 1,
+                      "mbopt resume JOB [--server ADDRESS | --db PATH [--workers N] [--drivers FILE [--keep-runs]]]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   auto workers = parsed->IntValue("--workers", 1);
   if (!workers.ok()) return Fail(std::string(workers.status().message()), kExitBadInput);
-  if (workers->has_value() && parsed->Value("--db").empty()) {
-    return Fail("--workers needs --db (a server's own workers are started with mbopt-worker)", kExitBadInput);
+  const bool local_workers_options = workers->has_value() || !parsed->Value("--drivers").empty() || parsed->Has("--keep-runs");
+  if (local_workers_options && parsed->Value("--db").empty()) {
+    return Fail("--workers, --drivers and --keep-runs need --db (a server's own workers are started with "
+                "mbopt-worker)",
+                kExitBadInput);
+  }
+  std::vector<std::string> worker_args;
+  if (!parsed->Value("--db").empty()) {
+    auto worker_binary = FindMboptBinary("mbopt-worker", "MBOPT_WORKER_BIN", "worker/main");
+    if (!worker_binary.ok()) return Fail(std::string(worker_binary.status().message()), kExitBadInput);
+    auto driver_args = LocalWorkerDriverArgs(*parsed, *worker_binary);
+    if (!driver_args.ok()) return Fail(std::string(driver_args.status().message()), kExitBadInput);
+    worker_args = *std::move(driver_args);
   }
   return CancelOrResume(*parsed, false,
-                        workers->value_or(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))));
+                        workers->value_or(std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
+                        std::move(worker_args));
 }
 
 int ResultsCommand(const Args& args) {

@@ -32,7 +32,7 @@ constexpr char kUsage[] =
     "  list                  all jobs on the server\n"
     "  workers               the server's registered workers: slots, drivers, analyses done\n"
     "  cancel JOB            stop a job\n"
-    "  resume JOB [--db PATH [--workers N]]\n"
+    "  resume JOB [--db PATH [--workers N] [--drivers FILE]]\n"
     "                        continue an interrupted job\n"
     "  results JOB [--csv|--json]\n"
     "                        a job's result and cycle history\n"

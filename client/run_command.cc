@@ -24,6 +24,7 @@
 #include "client/interrupts.h"
 #include "client/job_format.h"
 #include "client/local_cluster.h"
+#include "client/local_worker_drivers.h"
 #include "client/study_file.h"
 #include "client/subprocess.h"
 #include "client/temp_dir.h"
@@ -81,30 +82,6 @@ absl::Status WaitForWorkers(v1::JobService::Stub& job_service, int count) {
     // than a notification the server does not offer.
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-}
-
-// The local workers' --drivers and --keep-runs. The drivers file is checked
-// here (`mbopt-worker drivers FILE`), before anything starts: a worker that
-// refused it would only say so in its log.
-absl::StatusOr<std::vector<std::string>> LocalWorkerDriverArgs(const ParsedArgs& parsed,
-                                                               const std::string& worker_binary) {
-  const std::string drivers = parsed.Value("--drivers");
-  if (drivers.empty()) {
-    if (parsed.Has("--keep-runs")) return absl::InvalidArgumentError("--keep-runs needs --drivers FILE");
-    return std::vector<std::string>{};
-  }
-  std::error_code ec;
-  const std::string absolute = std::filesystem::absolute(drivers, ec).string();
-  if (ec) return absl::InvalidArgumentError(absl::StrCat("--drivers ", drivers, ": ", ec.message()));
-  absl::StatusOr<Subprocess::Output> checked =
-      RunCommand({worker_binary, "drivers", absolute}, std::chrono::seconds(60));
-  if (!checked.ok()) return checked.status();
-  if (checked->exit_code != 0) {
-    return absl::InvalidArgumentError(absl::StrCat("--drivers ", drivers, ":\n", checked->stderr_text));
-  }
-  std::vector<std::string> args = {"--drivers", absolute};
-  if (parsed.Has("--keep-runs")) args.push_back("--keep-runs");
-  return args;
 }
 
 }  // namespace
@@ -214,8 +191,8 @@ int RunCommandMain(const Args& args) {
     if (keep_db) {
       std::fprintf(stderr,
                    "mbopt run: interrupted; server and workers stopped; continue with\n"
-                   "  mbopt resume %s --db %s\n",
-                   job_id.c_str(), db_path.c_str());
+                   "  mbopt resume %s --db %s%s\n",
+                   job_id.c_str(), db_path.c_str(), DriverArgsText(cluster_options.worker_args).c_str());
     } else {
       std::fprintf(stderr, "mbopt run: interrupted; server and workers stopped, temporary database removed\n");
     }

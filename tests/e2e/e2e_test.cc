@@ -305,8 +305,9 @@ TEST(EndToEnd, ServerKilledMidJobResumesBitIdenticallyWithNormalDurability) {
 // `watch --db` and `list --db` end at once, and none of them resumes the
 // job (nothing would analyse it); `resume --db` then finishes it with the
 // uninterrupted run's result.
-TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesIt) {
-  const std::string reference = Comparable(ReferenceResult(2));
+void ExpectStatusOfADeadServersDatabaseAndResume(const std::string& study,
+                                                 const std::vector<std::string>& worker_args = {}) {
+  const std::string reference = Comparable(ReferenceResult(2, study, worker_args));
   ScratchDir dir;
   const std::string db = dir.File("jobs.db");
   std::vector<std::string> crash_args = kFastLeases;
@@ -314,8 +315,11 @@ TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesI
   auto server = StartServer(db, crash_args, "127.0.0.1:0", dir.File("server.log"));
   ASSERT_TRUE(server.ok()) << server.status();
   std::vector<Subprocess> pool;
-  for (int i = 0; i < 2; ++i) pool.push_back(StartWorker(server->address, {}, dir.File(absl::StrCat("w", i, ".log"))));
-  auto submitted = Mbopt({"submit", VehicleStudy(), "--server", server->address});
+  for (int i = 0; i < 2; ++i) {
+    pool.push_back(StartWorker(server->address, worker_args, dir.File(absl::StrCat("w", i, ".log"))));
+  }
+  if (!worker_args.empty()) WorkersWhenRegistered(server->address, pool.size());
+  auto submitted = Mbopt({"submit", study, "--server", server->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto crashed = server->process->Wait(kGuard);
@@ -338,6 +342,8 @@ TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesI
     EXPECT_NE(status.stdout_text.find(absl::StrCat("mbopt resume ", job, " --db ", db)), std::string::npos)
         << status.stdout_text;
     EXPECT_EQ(CyclesInStatus(status.stdout_text), 2) << status.stdout_text;
+    EXPECT_EQ(status.stdout_text.find("--drivers FILE") != std::string::npos, !worker_args.empty())
+        << status.stdout_text;
   }
   auto listed = Mbopt({"list", "--db", db}, env);
   ASSERT_EQ(listed.exit_code, kExitOk) << Describe(listed);
@@ -345,11 +351,24 @@ TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesI
   auto watched = Mbopt({"watch", job, "--db", db}, env);
   EXPECT_EQ(watched.exit_code, kExitNotConverged) << Describe(watched);
 
-  auto resumed = Mbopt({"resume", job, "--db", db, "--workers", "2"}, env);
+  std::vector<std::string> resume = {"resume", job, "--db", db, "--workers", "2"};
+  resume.insert(resume.end(), worker_args.begin(), worker_args.end());
+  auto resumed = Mbopt(resume, env);
   ASSERT_EQ(resumed.exit_code, kExitOk) << Describe(resumed);
   auto results = Mbopt({"results", job, "--json", "--db", db}, env);
   ASSERT_EQ(results.exit_code, kExitOk) << Describe(results);
   EXPECT_EQ(Comparable(results.stdout_text), reference);
+}
+
+TEST(EndToEnd, StatusOfADatabaseWhoseServerDiedSaysInterruptedAndResumeFinishesIt) {
+  ExpectStatusOfADeadServersDatabaseAndResume(VehicleStudy());
+}
+
+// The same for an external simulator's job: the status names the driver
+// the resume needs, and `resume --db --drivers FILE` starts workers that
+// declare it.
+TEST(EndToEnd, ExternalJobOfADeadServerResumesWithDbAndDrivers) {
+  ExpectStatusOfADeadServersDatabaseAndResume(ExternalStudy(), {"--drivers", ExternalDrivers()});
 }
 
 // ---------------------------------------------------- simulator gradients --

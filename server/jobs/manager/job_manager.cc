@@ -244,8 +244,12 @@ absl::Status JobManager::Start() {
       if (Running(entry->state) || entry->state == JobState::kInterrupted) {
         // In memory only: the next real server resumes it as it finds it.
         entry->state = JobState::kInterrupted;
+        // An external scene's analyses need workers that declare its driver.
+        const std::string driver = entry->study_ok && entry->study ? NeedsOf(*entry->study).driver : "";
         entry->message = absl::StrCat("interrupted (server not running); `mbopt resume ", id, " --db ",
-                                      options_.db_path_for_messages, "` continues it");
+                                      options_.db_path_for_messages,
+                                      driver.empty() ? "" : " --drivers FILE", "` continues it",
+                                      driver.empty() ? "" : absl::StrCat(" (FILE declaring driver '", driver, "')"));
       }
       EvictLocked(*entry);
       continue;
