@@ -81,18 +81,18 @@ for report in "${reports[@]}"; do
   screenshot "$work/${name}_report.html" "$frame" 1000 "$height" "$out/report_$name.png"
 done
 
-# report, part name, window height (px), headings
+# report, part name, window width and height (px), headings
 sections=(
-  "press xy 1150|Plots of one response against another"
-  "press responses 1250|Responses at the initial and final designs"
-  "isolator responses 1700|Responses at the initial and final designs"
-  "press tables 1000|Final design|Active constraints|Cycles"
-  "isolator tables 1100|Final design|Active constraints|Cycles"
-  "vehicle tables 1500|Final design|Active constraints|Cycles"
+  "press xy 1000 740|Plots of one response against another"
+  "press responses 1000 900|Responses at the initial and final designs"
+  "isolator responses 1000 560|Responses at the initial and final designs"
+  "press tables 1280 640|Final design|Active constraints|Cycles"
+  "isolator tables 1280 1000|Final design|Active constraints|Cycles"
+  "vehicle tables 1280 900|Final design|Active constraints|Cycles"
 )
 for section in "${sections[@]}"; do
   IFS='|' read -r -a fields <<<"$section"
-  read -r name part height <<<"${fields[0]}"
+  read -r name part width height <<<"${fields[0]}"
   section_page "$work/${name}_report.html" "$work/${name}_$part.html" "${fields[@]:1}"
-  screenshot "$work/${name}_$part.html" 0 1000 "$height" "$out/report_${name}_$part.png"
+  screenshot "$work/${name}_$part.html" 0 "$width" "$height" "$out/report_${name}_$part.png"
 done
