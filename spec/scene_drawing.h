@@ -28,11 +28,13 @@ struct SceneDrawing {
   enum class JointKind { kPin, kSlider, kFixed, kPinInSlot };
   // A joint drawn at `point`; a slider's and a pin-in-slot's axis through it
   // at `axis_angle_rad[instant]` (world axes; empty for the others).
+  // A pin with a rotational spring or damper (or both) drawn around it.
   struct Joint {
     std::string name;
     JointKind kind = JointKind::kPin;
     int point = -1;
     std::vector<double> axis_angle_rad;
+    bool rotational_spring = false, rotational_damper = false;
   };
   // A translational element between two points: spring zigzag, damper pot,
   // or both side by side.
@@ -54,6 +56,18 @@ struct SceneDrawing {
     double direction_x = 0.0, direction_y = 1.0;
   };
 
+  // An applied load: a force at `point` along (direction_x, direction_y)
+  // (world axes, unit; drawn as an arrow ending at the point), or a torque
+  // on the body whose centre of mass is `point` (direction_x: +1 counter-
+  // clockwise, -1 clockwise). Its size is not drawn, only where and which way.
+  enum class LoadKind { kForce, kTorque };
+  struct Load {
+    std::string name;
+    LoadKind kind = LoadKind::kForce;
+    int point = -1;
+    double direction_x = 0.0, direction_y = -1.0;
+  };
+
   std::string scene_name;
   bool schematic = false;
   std::vector<double> times_s;
@@ -64,6 +78,7 @@ struct SceneDrawing {
   std::vector<Element> elements;
   std::vector<Line> lines;
   std::vector<Input> inputs;
+  std::vector<Load> loads;
   std::vector<int> ground_points;  // hatched: fixed to the world
   // Empty when every instant of the grid was drawn; else why the motion
   // stopped (the instants before are kept).

@@ -211,6 +211,74 @@ std::string JointSvg(const Px& at, const SceneDrawing::Joint& joint, double axis
   return out + "</g>";
 }
 
+// A rotational spring (a spiral) and/or damper (an arc with a bar across)
+// around a pin.
+std::string RotationalElementSvg(const Px& at, const SceneDrawing::Joint& joint, const DrawingLayer& layer) {
+  const std::string stroke = "stroke=\"" + layer.color + "\" stroke-width=\"1.2\" fill=\"none\"";
+  std::string out = "<g class=\"rotational\"><title>" + EscapeHtml(joint.name) + ": rotational " +
+                    (joint.rotational_spring && joint.rotational_damper ? "spring and damper"
+                     : joint.rotational_spring                          ? "spring"
+                                                                        : "damper") +
+                    "</title>";
+  if (joint.rotational_spring) {
+    // Two turns from just outside the pin to 15 px.
+    std::vector<Px> spiral;
+    constexpr int kSteps = 48;
+    for (int k = 0; k <= kSteps; ++k) {
+      const double angle = 4.0 * std::numbers::pi * k / kSteps;
+      const double radius = kPinRadiusPx + 2.0 + (15.0 - kPinRadiusPx - 2.0) * k / kSteps;
+      spiral.push_back(Px{at.x + radius * std::cos(angle), at.y - radius * std::sin(angle)});
+    }
+    out += "<polyline class=\"rotational-spring\" points=\"" + Points(spiral) + "\" " + stroke + "/>";
+  }
+  if (joint.rotational_damper) {
+    const double r = joint.rotational_spring ? 19.0 : 12.0;
+    // The lower half circle, and a bar across it at its middle.
+    out += "<path class=\"rotational-damper\" d=\"M " + Pair(Px{at.x - r, at.y}) + " A " + Num(r) + " " + Num(r) +
+           " 0 0 0 " + Pair(Px{at.x + r, at.y}) + "\" " + stroke + "/>";
+    out += "<polyline points=\"" + Pair(Px{at.x, at.y + r - 4}) + " " + Pair(Px{at.x, at.y + r + 4}) + "\" " + stroke +
+           "/>";
+  }
+  return out + "</g>";
+}
+
+// A force: an arrow along its direction ending at its point; a torque: an
+// arc arrow around the body's centre of mass, turning its way.
+std::string LoadSvg(const Px& at, const SceneDrawing::Load& load) {
+  const std::string color = "#7d3c98";
+  std::string out = "<g class=\"load\"><title>" + EscapeHtml(load.name) + "</title>";
+  auto head = [&](const Px& tip, const Px& u) {
+    const Px left{tip.x - 7 * u.x - 4 * u.y, tip.y - 7 * u.y + 4 * u.x};
+    const Px right{tip.x - 7 * u.x + 4 * u.y, tip.y - 7 * u.y - 4 * u.x};
+    return "<polygon points=\"" + Points({tip, left, right}) + "\" fill=\"" + color + "\"/>";
+  };
+  if (load.kind == SceneDrawing::LoadKind::kForce) {
+    const double norm = std::hypot(load.direction_x, load.direction_y);
+    const Px u = norm > 0 ? Px{load.direction_x / norm, -load.direction_y / norm} : Px{0, 1};
+    const Px tail{at.x - 34 * u.x, at.y - 34 * u.y};
+    out += "<polyline points=\"" + Pair(tail) + " " + Pair(at) + "\" stroke=\"" + color +
+           "\" stroke-width=\"1.8\" fill=\"none\"/>" + head(at, u);
+  } else {
+    // Three quarters of a circle of 13 px, counter-clockwise on screen for
+    // a positive torque, the head at its end.
+    constexpr double kRadius = 13.0;
+    const bool ccw = load.direction_x >= 0.0;
+    const double sign = ccw ? 1.0 : -1.0;
+    const double start = -0.25 * std::numbers::pi, sweep = 1.5 * std::numbers::pi;
+    auto on_arc = [&](double angle) {
+      return Px{at.x + kRadius * std::cos(angle), at.y - kRadius * std::sin(angle)};
+    };
+    const double end = start + sign * sweep;
+    const Px from = on_arc(start), to = on_arc(end);
+    out += "<path d=\"M " + Pair(from) + " A " + Num(kRadius) + " " + Num(kRadius) + " 0 1 " + (ccw ? "0" : "1") + " " +
+           Pair(to) + "\" stroke=\"" + color + "\" stroke-width=\"1.8\" fill=\"none\"/>";
+    // The tangent at the end, in the direction of travel (+y down).
+    const Px tangent{-sign * std::sin(end), -sign * std::cos(end)};
+    out += head(Px{to.x + 3 * tangent.x, to.y + 3 * tangent.y}, tangent);
+  }
+  return out + "</g>";
+}
+
 // A ground point: a short base line under it, hatched.
 std::string GroundSvg(const Px& at, const DrawingLayer& layer) {
   const double y = at.y + kPinRadiusPx + 3.0, half = kGroundWidthPx / 2;
@@ -260,6 +328,10 @@ std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mappi
   }
   for (const SceneDrawing::Element& e : d.elements) out += ElementSvg(px(e.a), px(e.b), e, layer);
   for (const SceneDrawing::Input& input : d.inputs) out += InputSvg(px(input.point), input);
+  for (const SceneDrawing::Joint& joint : d.joints) {
+    if (joint.rotational_spring || joint.rotational_damper) out += RotationalElementSvg(px(joint.point), joint, layer);
+  }
+  for (const SceneDrawing::Load& load : d.loads) out += LoadSvg(px(load.point), load);
   // The points themselves, small, under the joints.
   for (size_t p = 0; p < at.size(); ++p) {
     const Px c = px(static_cast<int>(p));

@@ -52,6 +52,8 @@ v1::SceneDrawing DrawingToProto(const SceneDrawing& d) {
     out->set_kind(KindToProto(j.kind));
     out->set_point(j.point);
     out->mutable_axis_angle_rad()->Assign(j.axis_angle_rad.begin(), j.axis_angle_rad.end());
+    out->set_rotational_spring(j.rotational_spring);
+    out->set_rotational_damper(j.rotational_damper);
   }
   for (const SceneDrawing::Element& e : d.elements) {
     v1::DrawingElement* out = m.add_elements();
@@ -72,6 +74,15 @@ v1::SceneDrawing DrawingToProto(const SceneDrawing& d) {
     out->set_point(in.point);
     out->set_direction_x(in.direction_x);
     out->set_direction_y(in.direction_y);
+  }
+  for (const SceneDrawing::Load& load : d.loads) {
+    v1::DrawingLoad* out = m.add_loads();
+    out->set_name(load.name);
+    out->set_kind(load.kind == SceneDrawing::LoadKind::kTorque ? v1::DrawingLoad::KIND_TORQUE
+                                                               : v1::DrawingLoad::KIND_FORCE);
+    out->set_point(load.point);
+    out->set_direction_x(load.direction_x);
+    out->set_direction_y(load.direction_y);
   }
   m.mutable_ground_points()->Assign(d.ground_points.begin(), d.ground_points.end());
   m.set_failure(d.failure);
@@ -119,8 +130,12 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
   for (int j = 0; j < m.joints_size(); ++j) {
     const v1::DrawingJoint& in = m.joints(j);
     if (absl::Status s = check(in.point(), absl::StrFormat("joints[%d].point", j)); !s.ok()) return s;
-    SceneDrawing::Joint joint{in.name(), KindFromProto(in.kind()), in.point(),
-                              std::vector<double>(in.axis_angle_rad().begin(), in.axis_angle_rad().end())};
+    SceneDrawing::Joint joint{in.name(),
+                              KindFromProto(in.kind()),
+                              in.point(),
+                              std::vector<double>(in.axis_angle_rad().begin(), in.axis_angle_rad().end()),
+                              in.rotational_spring(),
+                              in.rotational_damper()};
     const bool axis =
         joint.kind == SceneDrawing::JointKind::kSlider || joint.kind == SceneDrawing::JointKind::kPinInSlot;
     if (axis && in.axis_angle_rad_size() != m.times_s_size()) {
@@ -150,6 +165,13 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
     const v1::DrawingInput& in = m.inputs(i);
     if (absl::Status s = check(in.point(), absl::StrFormat("inputs[%d].point", i)); !s.ok()) return s;
     d.inputs.push_back(SceneDrawing::Input{in.name(), in.point(), in.direction_x(), in.direction_y()});
+  }
+  for (int i = 0; i < m.loads_size(); ++i) {
+    const v1::DrawingLoad& in = m.loads(i);
+    if (absl::Status s = check(in.point(), absl::StrFormat("loads[%d].point", i)); !s.ok()) return s;
+    d.loads.push_back(SceneDrawing::Load{
+        in.name(), in.kind() == v1::DrawingLoad::KIND_TORQUE ? SceneDrawing::LoadKind::kTorque : SceneDrawing::LoadKind::kForce,
+        in.point(), in.direction_x(), in.direction_y()});
   }
   for (int g = 0; g < m.ground_points_size(); ++g) {
     if (absl::Status s = check(m.ground_points(g), absl::StrFormat("ground_points[%d]", g)); !s.ok()) return s;

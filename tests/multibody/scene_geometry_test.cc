@@ -221,3 +221,63 @@ TEST(MultibodyDrawing, AnUnassembledSceneIsDrawnAsGivenWithTheReason) {
 
 }  // namespace
 }  // namespace mbopt::multibody
+
+namespace mbopt::multibody {
+namespace {
+
+// Loads are drawn where they act and which way: the press's 5000 N along +x
+// at the slider's pin.
+TEST(MultibodyDrawing, PointForceIsALoadAtItsMarkerAlongTheForce) {
+  const spec::Scene scene = Load("examples/press/press.scene.textproto");
+  const spec::SceneDrawing d = DrawMultibodyScene(scene, scene.DefaultParameterValues());
+  ASSERT_EQ(d.failure, "");
+  ASSERT_EQ(d.loads.size(), 1u);
+  EXPECT_EQ(d.loads[0].kind, spec::SceneDrawing::LoadKind::kForce);
+  EXPECT_EQ(d.loads[0].point, PointNamed(d, "slider.pin"));
+  EXPECT_EQ(d.loads[0].direction_x, 1.0);
+  EXPECT_EQ(d.loads[0].direction_y, 0.0);
+  for (const spec::SceneDrawing::Joint& j : d.joints) {
+    EXPECT_FALSE(j.rotational_spring || j.rotational_damper) << j.name << ": the press has no rotational spring";
+  }
+}
+
+// A rotational spring-damper is drawn at its pin, a body torque at the
+// body's centre of mass, which joins no outline, with its sense.
+TEST(MultibodyDrawing, RotationalSpringMarksItsPinAndATorqueItsBody) {
+  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(R"pb(
+name: "arm"
+multibody {
+  bodies {
+    name: "arm"
+    mass_kg { value: 2 }
+    inertia_kg_m2 { value: 0.1 }
+    position_m { x { value: 0.4 } }
+    markers { name: "pin" position_m { x { value: -0.4 } } }
+    markers { name: "tip" position_m { x { value: 0.4 } } }
+  }
+  joints { name: "pin" kind: JOINT_REVOLUTE a: "ground.origin" b: "arm.pin" }
+  ground_markers { name: "origin" }
+  rotational_springs { name: "spring" joint: "pin" stiffness_n_m_per_rad { value: 20 } damping_n_m_s_per_rad { value: 0.5 } }
+  torques { body: "arm" torque_n_m { value: -3 } }
+}
+outputs { name: "angle" joint_coordinate { joint: "pin" } }
+time_grid { start_s: 0 end_s: 0.1 points: 3 }
+)pb",
+                                                                   "arm.scene.textproto");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  const spec::SceneDrawing d = DrawMultibodyScene(*scene, scene->DefaultParameterValues());
+  ASSERT_EQ(d.failure, "");
+  ASSERT_EQ(d.joints.size(), 1u);
+  EXPECT_TRUE(d.joints[0].rotational_spring);
+  EXPECT_TRUE(d.joints[0].rotational_damper);
+  ASSERT_EQ(d.loads.size(), 1u);
+  const spec::SceneDrawing::Load& torque = d.loads[0];
+  EXPECT_EQ(torque.kind, spec::SceneDrawing::LoadKind::kTorque);
+  EXPECT_EQ(torque.direction_x, -1.0) << "clockwise";
+  EXPECT_NEAR(d.points_m[0][static_cast<size_t>(torque.point)].x_m, 0.4, kPositionTolerance);
+  ASSERT_EQ(d.bodies.size(), 1u);
+  EXPECT_THAT(d.bodies[0].points, ::testing::Not(::testing::Contains(torque.point)));
+}
+
+}  // namespace
+}  // namespace mbopt::multibody

@@ -82,6 +82,28 @@ TEST(MechanismDrawing, OneInstantIsOnePictureWithoutControls) {
   EXPECT_EQ(testing::CheckMarkup(html, false), "");
 }
 
+// A rotational spring-damper at a pin, a force and a torque: each has its
+// symbol (named in its tooltip) in every frame, and the page stays well formed.
+TEST(MechanismDrawing, RotationalSpringsForcesAndTorquesHaveTheirSymbols) {
+  spec::SceneDrawing d = CrankAndSlider(5);
+  d.joints[0].rotational_spring = true;
+  d.joints[0].rotational_damper = true;
+  d.loads.push_back({"force at block", spec::SceneDrawing::LoadKind::kForce, 2, -1.0, 0.0});
+  d.loads.push_back({"torque on crank", spec::SceneDrawing::LoadKind::kTorque, 1, -1.0, 0.0});
+  const std::string html = SceneDrawingPageHtml(d, "crank.scene.textproto");
+  EXPECT_EQ(testing::CheckMarkup(html, false), "");
+  for (const std::string& svg : testing::SvgFragments(html)) EXPECT_EQ(testing::CheckMarkup(svg, true), "");
+  EXPECT_EQ(testing::CountOccurrences(html, "<polyline class=\"rotational-spring\""), 5);
+  EXPECT_EQ(testing::CountOccurrences(html, "<path class=\"rotational-damper\""), 5);
+  EXPECT_EQ(testing::CountOccurrences(html, "<title>O: rotational spring and damper</title>"), 5);
+  EXPECT_EQ(testing::CountOccurrences(html, "<g class=\"load\"><title>force at block</title>"), 5);
+  EXPECT_EQ(testing::CountOccurrences(html, "<g class=\"load\"><title>torque on crank</title>"), 5);
+  // Without them, none of these symbols.
+  const std::string plain = SceneDrawingPageHtml(CrankAndSlider(5), "crank.scene.textproto");
+  EXPECT_THAT(plain, Not(HasSubstr("rotational")));
+  EXPECT_THAT(plain, Not(HasSubstr("class=\"load\"")));
+}
+
 TEST(MechanismDrawing, LongGridsAreThinnedToTheFrameLimit) {
   const std::string html = SceneDrawingPageHtml(CrankAndSlider(1000), "crank.scene.textproto");
   EXPECT_EQ(testing::CountOccurrences(html, "<g class=\"frame\""), kMaxDrawingFrames);

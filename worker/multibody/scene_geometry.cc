@@ -107,6 +107,12 @@ MultibodyDrawingLayout LayoutMultibodyDrawing(const spec::Scene& scene, const st
     d.joints.push_back(std::move(joint));
     layout.axis_joints.push_back(axis_joint);
   }
+  for (const RotationalSpringDamper& r : model.rotational_springs) {
+    if (r.joint < 0 || r.joint >= static_cast<int>(d.joints.size())) continue;
+    spec::SceneDrawing::Joint& joint = d.joints[static_cast<size_t>(r.joint)];
+    joint.rotational_spring = joint.rotational_spring || r.stiffness_n_m_per_rad != 0.0;
+    joint.rotational_damper = joint.rotational_damper || r.damping_n_m_s_per_rad != 0.0;
+  }
   for (const SpringDamper& s : model.springs) {
     spec::SceneDrawing::Element element;
     element.name = s.name;
@@ -116,7 +122,29 @@ MultibodyDrawingLayout LayoutMultibodyDrawing(const spec::Scene& scene, const st
     element.damper = s.damping_n_s_per_m != 0.0 || !s.velocity_curve.empty();
     d.elements.push_back(std::move(element));
   }
-  for (const PointForce& f : model.point_forces) point_of(f.at);
+  for (size_t k = 0; k < model.point_forces.size(); ++k) {
+    const PointForce& f = model.point_forces[k];
+    spec::SceneDrawing::Load load;
+    load.name = f.at.name.empty() ? absl::StrFormat("force %d", k + 1) : "force at " + f.at.name;
+    load.point = point_of(f.at);
+    const double norm = f.force_n.norm();
+    if (norm > 0.0) {
+      load.direction_x = f.force_n.x() / norm;
+      load.direction_y = f.force_n.y() / norm;
+    }
+    d.loads.push_back(std::move(load));
+  }
+  for (const BodyTorque& t : model.torques) {
+    if (t.body < 0 || t.body >= static_cast<int>(sm.bodies.size()) || t.torque_n_m == 0.0) continue;
+    spec::SceneDrawing::Load load;
+    load.name = "torque on " + sm.bodies[static_cast<size_t>(t.body)].name;
+    load.kind = spec::SceneDrawing::LoadKind::kTorque;
+    // The centre of mass, not part of the body's outline.
+    load.point = PointIndex(Point{t.body, Eigen::Vector2d::Zero(), load.name}, &layout);
+    load.direction_x = t.torque_n_m > 0.0 ? 1.0 : -1.0;
+    load.direction_y = 0.0;
+    d.loads.push_back(std::move(load));
+  }
   for (size_t b = 0; b < sm.bodies.size(); ++b) {
     if (d.bodies[b].points.size() < 2) {
       add_to_body(Point{static_cast<int>(b), Eigen::Vector2d::Zero(), sm.bodies[b].name + " centre of mass"});
