@@ -2,6 +2,8 @@
 // a waiting job is told.
 #include "server/jobs/manager/admission.h"
 
+#include <string>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -59,6 +61,41 @@ TEST(Admission, NoLimitsMeansEveryJobStarts) {
   for (int i = 0; i < 100; ++i) admission.Started("alice");
   EXPECT_TRUE(admission.HasRoomFor("alice"));
   EXPECT_TRUE(admission.CheckQueueRoom("alice").ok());
+}
+
+}  // namespace
+}  // namespace mbopt::jobs::manager
+
+namespace mbopt::jobs::manager {
+namespace {
+
+// A waiting job's place and an owner's count of waiting jobs follow every
+// change of the queue (both are kept, not recounted per question).
+TEST(Admission, PlacesAndQueuedCountsFollowEveryChange) {
+  Admission admission(AdmissionLimits{/*max_running_jobs=*/1, 0, /*max_queued_jobs_per_user=*/3});
+  admission.Started("alice");
+  for (int seq = 1; seq <= 6; ++seq) {
+    admission.Enqueue(seq, "job-" + std::to_string(seq), seq % 2 == 0 ? "bob" : "carol");
+  }
+  EXPECT_THAT(admission.WhyWaiting("job-6"), HasSubstr("5 jobs ahead"));
+  EXPECT_EQ(admission.CheckQueueRoom("bob").code(), absl::StatusCode::kResourceExhausted);
+  admission.Remove("job-2");
+  admission.Remove("job-3");
+  EXPECT_THAT(admission.WhyWaiting("job-4"), HasSubstr("1 job ahead"));
+  EXPECT_THAT(admission.WhyWaiting("job-6"), HasSubstr("3 jobs ahead"));
+  EXPECT_TRUE(admission.CheckQueueRoom("bob").ok()) << "bob waits with 2 jobs now";
+  // Queued again (a resume while the limits are reached) keeps its place by seq.
+  admission.Enqueue(2, "job-2", "bob");
+  EXPECT_THAT(admission.WhyWaiting("job-6"), HasSubstr("4 jobs ahead"));
+  EXPECT_EQ(admission.CheckQueueRoom("bob").code(), absl::StatusCode::kResourceExhausted);
+  admission.Enqueue(7, "job-2", "bob");  // the same job again: moved, not counted twice
+  EXPECT_THAT(admission.WhyWaiting("job-2"), HasSubstr("4 jobs ahead"));
+  EXPECT_EQ(admission.CheckQueueRoom("bob").code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(admission.queued(), 5);
+  admission.Remove("job-2");
+  admission.Remove("job-unknown");
+  EXPECT_TRUE(admission.CheckQueueRoom("bob").ok());
+  EXPECT_EQ(admission.queued(), 4);
 }
 
 }  // namespace

@@ -15,9 +15,8 @@ int Admission::RunningOf(const std::string& owner) const {
 }
 
 int Admission::QueuedOf(const std::string& owner) const {
-  int n = 0;
-  for (const auto& [seq, w] : queue_) n += w.owner == owner ? 1 : 0;
-  return n;
+  auto it = queued_by_owner_.find(owner);
+  return it == queued_by_owner_.end() ? 0 : it->second;
 }
 
 bool Admission::HasRoomFor(const std::string& owner) const {
@@ -49,15 +48,23 @@ void Admission::Stopped(const std::string& owner) {
 
 void Admission::Enqueue(std::int64_t seq, const std::string& job_id, const std::string& owner) {
   Remove(job_id);
+  if (auto taken = queue_.find(seq); taken != queue_.end()) Remove(taken->second.job_id);
   queue_[seq] = Waiting{job_id, owner};
   seq_of_[job_id] = seq;
+  ++queued_by_owner_[owner];
+  places_valid_ = false;
 }
 
 void Admission::Remove(const std::string& job_id) {
   auto it = seq_of_.find(job_id);
   if (it == seq_of_.end()) return;
-  queue_.erase(it->second);
+  auto waiting = queue_.find(it->second);
+  if (auto owner = queued_by_owner_.find(waiting->second.owner); owner != queued_by_owner_.end()) {
+    if (--owner->second == 0) queued_by_owner_.erase(owner);
+  }
+  queue_.erase(waiting);
   seq_of_.erase(it);
+  places_valid_ = false;
 }
 
 std::optional<std::string> Admission::NextToStart() const {
@@ -72,11 +79,13 @@ std::string Admission::WhyWaiting(const std::string& job_id) const {
   auto it = seq_of_.find(job_id);
   if (it == seq_of_.end()) return "";
   const Waiting& w = queue_.at(it->second);
-  int ahead = 0;
-  for (const auto& [seq, other] : queue_) {
-    if (seq >= it->second) break;
-    ++ahead;
+  if (!places_valid_) {
+    place_of_.clear();
+    int place = 0;
+    for (const auto& [seq, waiting] : queue_) place_of_[waiting.job_id] = place++;
+    places_valid_ = true;
   }
+  const int ahead = place_of_.at(job_id);
   std::string limit;
   if (limits_.max_running_jobs > 0 && running_ >= limits_.max_running_jobs) {
     limit = absl::StrCat("the server runs ", running_, " jobs, its limit (--max-running-jobs ",

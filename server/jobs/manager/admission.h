@@ -58,8 +58,14 @@ class Admission {
   AdmissionLimits limits_;
   int running_ = 0;
   std::map<std::string, int> running_by_owner_;
+  std::map<std::string, int> queued_by_owner_;
   std::map<std::int64_t, Waiting> queue_;  // by seq
   std::map<std::string, std::int64_t> seq_of_;
+  // Each waiting job's place, numbered once per change of the queue: a
+  // listing asks every waiting job's place, which would otherwise cost the
+  // queue's length each.
+  mutable std::map<std::string, int> place_of_;
+  mutable bool places_valid_ = false;
 };
 
 }  // namespace mbopt::jobs::manager
