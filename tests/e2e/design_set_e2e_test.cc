@@ -146,12 +146,13 @@ TEST(DesignSetEndToEnd, EveryDesignIsTheWorkersEvaluationOfIt) {
   }
 }
 
-// The server is killed (SIGKILL) once it has logged three designs or more;
-// the restarted server continues the sweep and the table is that of an
-// undisturbed run. Where the kill falls is not fixed: results that arrive
-// together are logged together, and on a loaded machine all nine designs
-// can be logged before the kill (docs/status.md).
-TEST(DesignSetEndToEnd, ServerKilledAfterLoggingDesignsResumesWithTheSameTable) {
+// The server is killed (SIGKILL) once it has logged three designs; the
+// restarted server continues the sweep and the table is that of an
+// undisturbed run. The workers take one task at a time (--batch 1): by
+// default a worker takes many of these cheap analyses at once and reports
+// their results in one call, one commit, so the kill could find the sweep
+// already complete.
+TEST(DesignSetEndToEnd, ServerKilledMidSweepResumesWithTheSameTable) {
   const std::string reference = Comparable(SweepResults(2));
   ASSERT_FALSE(reference.empty());
   ScratchDir dir;
@@ -162,7 +163,7 @@ TEST(DesignSetEndToEnd, ServerKilledAfterLoggingDesignsResumesWithTheSameTable) 
   ASSERT_TRUE(first.ok()) << first.status();
   std::vector<Subprocess> pool;
   for (int i = 0; i < 2; ++i) {
-    pool.push_back(StartWorker(first->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
+    pool.push_back(StartWorker(first->address, {"--batch", "1"}, dir.File(absl::StrCat("worker", i, ".log"))));
   }
   auto submitted = Mbopt({"submit", SweepStudy(), "--server", first->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
@@ -179,7 +180,9 @@ TEST(DesignSetEndToEnd, ServerKilledAfterLoggingDesignsResumesWithTheSameTable) 
   ASSERT_NE(at, std::string::npos) << status.stdout_text;
   const int designs_at_restart = std::atoi(status.stdout_text.c_str() + at + 8);
   EXPECT_GE(designs_at_restart, 3) << status.stdout_text;
-  EXPECT_LE(designs_at_restart, kDesigns) << status.stdout_text;
+  // Designs are logged in their order, so a design finished early waits for
+  // the one before it and may be logged with it: a few past the third, not all.
+  EXPECT_LT(designs_at_restart, kDesigns) << "the kill fell in the middle of the sweep\n" << status.stdout_text;
   if (status.stdout_text.find("interrupted") != std::string::npos) {
     auto resumed = Mbopt({"resume", job, "--server", second->address});
     ASSERT_EQ(resumed.exit_code, kExitOk) << Describe(resumed);
