@@ -63,7 +63,8 @@ TEST(ForwardDynamicsStart, PendulumWithAnInitialRateStartsAtTightTolerances) {
         &counters);
     std::cout << c.mass_kg << " kg, " << c.length_m << " m at " << c.rate_rad_per_s << " rad/s: "
               << (f.ok() ? "ok" : f.reason) << ", " << counters.steps << " steps, energy error " << worst / scale
-              << " of " << scale << " J\n";
+              << " of " << scale << " J (" << counters.error_test_failures << " error-test and "
+              << counters.convergence_failures << " convergence failures)\n";
     ASSERT_TRUE(f.ok()) << f.reason;
     // rtol 1e-8 per step; over 1 s (up to 8 turns) the energy drifts by up
     // to 7.5e-7 of its scale (measured 8.6e-11 to 7.5e-7).
