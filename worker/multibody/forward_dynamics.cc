@@ -307,7 +307,11 @@ spec::AnalysisFailure ConsistentAccelerations(const ConstrainedSystem& system, d
 // What to try after IDAS gave up (its flag) at (t, q) on the way from t0 to
 // `target`: the joint whose constraint rows are nearest to dependent there
 // (the largest entry of Phi_q's left singular vector of its smallest
-// singular value: where a mechanism locks), and the settings to change.
+// singular value: where a mechanism locks) with that value over the largest
+// (near 0: a singular position), and the settings to change. The stabilized
+// form passes through the singular positions tried (a slider-crank with rod
+// and crank of one length, a mass on two crossing lines), so no advice is
+// keyed to the ratio.
 std::string FailureAdvice(const ConstrainedSystem& system, int flag, double t0, double t, double target,
                           const VectorXd& q, const ForwardDynamicsOptions& options, double first_step) {
   std::string advice;
@@ -332,9 +336,6 @@ std::string FailureAdvice(const ConstrainedSystem& system, int flag, double t0, 
           mechanism->is_driver_row(r) ? "'s driver" : "", conditioning);
     }
   }
-  // Below about 1e-6 of the largest, a position the joints can barely hold
-  // (a toggle, a dead centre): no tolerance makes it pass.
-  constexpr double kNearlySingular = 1e-6;
   // The coordinates are known to round-off, eps |q|: an absolute tolerance
   // within 1e3 of it leaves Newton's corrections no room.
   const double round_off = std::numeric_limits<double>::epsilon() * std::max(1.0, MaxAbs(q));
@@ -343,9 +344,6 @@ std::string FailureAdvice(const ConstrainedSystem& system, int flag, double t0, 
   // accelerations).
   constexpr double kStartFraction = 1e-3;
   std::vector<std::string> tries;
-  if (conditioning < kNearlySingular) {
-    tries.push_back("check the geometry and the drivers' ranges: the mechanism is near a singular position");
-  }
   if (options.absolute_tolerance < 1e3 * round_off) {
     tries.push_back(absl::StrFormat("a looser absolute_tolerance (now %.3g, near the coordinates' round-off %.2g)",
                                     options.absolute_tolerance, round_off));
