@@ -180,8 +180,9 @@ AndrewsRun RunAndrews(double relative_tolerance, double absolute_tolerance) {
         if (s.t_s == 0.03) {
           run.worst_angle_error_rad = 0.0;
           for (int k = 0; k < 7; ++k) {
-            run.worst_angle_error_rad = std::max(
-                run.worst_angle_error_rad, std::abs(m.JointCoordinate(joints[static_cast<size_t>(k)], s.q) - kAndrewsReference[k]));
+            run.worst_angle_error_rad =
+                std::max(run.worst_angle_error_rad,
+                         std::abs(m.JointCoordinate(joints[static_cast<size_t>(k)], s.q) - kAndrewsReference[k]));
           }
         }
         return spec::AnalysisFailure::Ok();

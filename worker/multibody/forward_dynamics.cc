@@ -579,11 +579,11 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
                         absl::StrFormat("%s; the integrator gave up near t = %.6g s", system.FailureReason(), t_reached));
         }
         if (!p.budget_failure.ok()) return p.budget_failure;
+        const std::string callback = p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]";
         return Failed(spec::FailureKind::kIntegrator,
                       absl::StrFormat("the integrator failed near t = %.6g s (target %.6g s): %s%s%s", t_reached, t,
-                                      sundials_message, p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]",
-                                      FailureAdvice(system, flag, t0, t_reached, t, y.head(n), options,
-                                                    p.first_step)));
+                                      sundials_message, callback,
+                                      FailureAdvice(system, flag, t0, t_reached, t, y.head(n), options, p.first_step)));
       }
       if (flag == IDA_ROOT_RETURN) {
         if (!check(IDAGetRootInfo(ida, bounds_crossed.data()), "IDAGetRootInfo")) {
