@@ -9,11 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "absl/strings/str_format.h"
 #include "worker/multibody/ggl_residual.h"
+#include "worker/multibody/mechanism.h"
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
@@ -34,6 +36,12 @@ struct Problem {
   Eigen::MatrixXd newton;
   // The sparse Newton matrix's pattern in compressed columns (KLU only).
   std::vector<sunindextype> column_starts, row_indices;
+  // For the error weights (ErrorWeights): the integrator, the tolerances and
+  // the first step, which IDAS has not taken when it first asks for them.
+  void* ida = nullptr;
+  double relative_tolerance = 0.0;
+  const Eigen::VectorXd* absolute_tolerances = nullptr;
+  double first_step = 0.0;
 };
 
 // Whether the analysis' budget stops the integration at t (and why, kept).
@@ -190,6 +198,58 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
   });
 }
 
+// Newton's weight of a multiplier relative to the largest its effect gives:
+// below 1 so that the weights, which IDAS computes once per step, still
+// hold after it has cut the step (by 4 at a convergence failure) within it.
+// 1 failed near the end of Andrews' mechanism at rtol 1e-10 (h cut to 1e-15
+// s); 0.1 runs it from rtol 1e-4 to 1e-10 (docs/accuracy.md).
+constexpr double kMultiplierWeightFactor = 0.1;
+
+// The error weights: 1 / (rtol |y_i| + atol_i) for q and v (IDAS's own),
+// and for the multipliers (algebraic, out of the error test, so only
+// Newton's convergence test sees them) weights scaled to the step. Within a
+// step of size h a correction d_lambda moves v by about h M^-1 Phi_q^T
+// d_lambda and d_mu moves q by h Phi_q^T d_mu, so each multiplier is
+// weighted by the largest weight its constraint row gives the coordinates it
+// moves, times h. Fixed weights do not follow the step: the corrections of
+// mu carry the round-off of Phi (about eps |q|) over h, those of lambda the
+// round-off of v' = cj (v - v_predicted) over h, and at the first step of a
+// fast start (h of 1e-13 s for Andrews' mechanism) that round-off alone
+// failed Newton's test, at every smaller step IDAS then tried.
+int ErrorWeights(N_Vector yy, N_Vector ewt, void* user_data) {
+  auto* p = static_cast<Problem*>(user_data);
+  return sundials::GuardCallback(&p->callback_failure, "the error weights", [&]() -> int {
+    const int n = p->n, m = p->m, size = 2 * n + 2 * m;
+    const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
+    Map<VectorXd> w(N_VGetArrayPointer(ewt), size);
+    const VectorXd& atol = *p->absolute_tolerances;
+    for (int i = 0; i < 2 * n; ++i) {
+      const double tolerance = p->relative_tolerance * std::abs(y[i]) + atol[i];
+      if (!(tolerance > 0.0)) return -1;
+      w[i] = 1.0 / tolerance;
+    }
+    if (m == 0) return 0;
+    realtype h = 0.0, t = 0.0;
+    // Before the first step IDAS has no step yet: the one it will take.
+    if (IDAGetCurrentStep(p->ida, &h) != IDA_SUCCESS || h == 0.0) h = p->first_step;
+    if (IDAGetCurrentTime(p->ida, &t) != IDA_SUCCESS) return -1;
+    const VectorXd q = y.head(n);
+    const ContinuedPastBounds continued(*p->system);
+    if (p->system->MassMatrix(q, &p->work.mass) != 0 || p->system->ConstraintJacobian(t, q, &p->work.phi_q) != 0) {
+      return -1;
+    }
+    const Eigen::ArrayXd q_weight = w.head(n).array();
+    const Eigen::ArrayXd v_weight = w.segment(n, n).array() / p->work.mass.diagonal().array();
+    const double scale = kMultiplierWeightFactor * std::abs(h);
+    for (int j = 0; j < m; ++j) {
+      const Eigen::ArrayXd row = p->work.phi_q.row(j).transpose().array().abs();
+      w[2 * n + j] = scale * (row * v_weight).maxCoeff();
+      w[2 * n + m + j] = scale * (row * q_weight).maxCoeff();
+    }
+    return w.allFinite() ? 0 : -1;
+  });
+}
+
 void Accumulate(void* ida, ForwardDynamicsCounters* c) {
   long value = 0;
   if (IDAGetNumSteps(ida, &value) == IDA_SUCCESS) c->steps = value;
@@ -201,8 +261,8 @@ void Accumulate(void* ida, ForwardDynamicsCounters* c) {
   if (IDAGetNumNonlinSolvConvFails(ida, &value) == IDA_SUCCESS) c->convergence_failures = value;
 }
 
-// Newton's convergence weight of the stabilizing multipliers mu (see
-// IntegrateForward).
+// Newton's convergence weight of the multipliers' sensitivities (see
+// IntegrateForward), divided by the parameter's magnitude.
 constexpr double kMuTolerance = 1e-3;
 
 spec::AnalysisFailure Failed(spec::FailureKind kind, std::string reason) {
@@ -242,6 +302,66 @@ spec::AnalysisFailure ConsistentAccelerations(const ConstrainedSystem& system, d
   }
   *out = lu.solve(rhs);
   return spec::AnalysisFailure::Ok();
+}
+
+// What to try after IDAS gave up (its flag) at (t, q) on the way from t0 to
+// `target`: the joint whose constraint rows are nearest to dependent there
+// (the largest entry of Phi_q's left singular vector of its smallest
+// singular value: where a mechanism locks) with that value over the largest
+// (near 0: a singular position), and the settings to change. The stabilized
+// form passes through the singular positions tried (a slider-crank with rod
+// and crank of one length, a mass on two crossing lines), so no advice is
+// keyed to the ratio.
+std::string FailureAdvice(const ConstrainedSystem& system, int flag, double t0, double t, double target,
+                          const VectorXd& q, const ForwardDynamicsOptions& options, double first_step) {
+  std::string advice;
+  const int m = system.num_constraints();
+  double conditioning = 1.0;
+  Eigen::MatrixXd phi_q;
+  if (m > 0 && system.ConstraintJacobian(t, q, &phi_q) == 0 && phi_q.allFinite()) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(phi_q, Eigen::ComputeFullU);
+    const VectorXd& sigma = svd.singularValues();
+    if (sigma.size() > 0 && sigma[0] > 0.0) conditioning = sigma[sigma.size() - 1] / sigma[0];
+    Eigen::Index row = 0;
+    svd.matrixU().col(svd.matrixU().cols() - 1).cwiseAbs().maxCoeff(&row);
+    // Only a mechanism names its rows (a system written in code for a test
+    // has no joints).
+    const auto* mechanism = dynamic_cast<const Mechanism*>(&system);
+    if (mechanism != nullptr) {
+      const int r = static_cast<int>(row);
+      advice += absl::StrFormat(
+          "; the constraint rows nearest to dependent there are those of joint '%s'%s (smallest singular value of the "
+          "constraint Jacobian %.2g of the largest)",
+          mechanism->model().joints[static_cast<size_t>(mechanism->joint_of_row(r))].name,
+          mechanism->is_driver_row(r) ? "'s driver" : "", conditioning);
+    }
+  }
+  // The coordinates are known to round-off, eps |q|: an absolute tolerance
+  // within 1e3 of it leaves Newton's corrections no room.
+  const double round_off = std::numeric_limits<double>::epsilon() * std::max(1.0, MaxAbs(q));
+  // Failures within the first 1e-3 of the way from t0 to the instant IDAS
+  // was heading for are the start's (its first step comes from the initial
+  // accelerations).
+  constexpr double kStartFraction = 1e-3;
+  std::vector<std::string> tries;
+  if (options.absolute_tolerance < 1e3 * round_off) {
+    tries.push_back(absl::StrFormat("a looser absolute_tolerance (now %.3g, near the coordinates' round-off %.2g)",
+                                    options.absolute_tolerance, round_off));
+  }
+  if (t - t0 <= kStartFraction * (target - t0)) {
+    tries.push_back(absl::StrFormat(
+        "at the start (first step %.3g s, from the initial accelerations over the tolerances): check that the "
+        "initial rates and poses are meant, or loosen absolute_tolerance so that the first step can grow",
+        first_step));
+  }
+  if (flag == IDA_TOO_MUCH_WORK) {
+    tries.push_back(absl::StrFormat("a larger integrator max_steps (now %d)", static_cast<int>(options.max_steps)));
+  }
+  tries.push_back(absl::StrFormat("integrator { relative_tolerance absolute_tolerance } looser than now (%.3g, %.3g)",
+                                  options.relative_tolerance, options.absolute_tolerance));
+  advice += "; try: ";
+  for (size_t k = 0; k < tries.size(); ++k) advice += (k > 0 ? "; or " : "") + tries[k];
+  return advice;
 }
 
 }  // namespace
@@ -293,19 +413,13 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   id.head(2 * n).setOnes();
   id.tail(2 * m).setZero();
   // The multipliers are left out of the error test; their weights only enter
-  // Newton's convergence test. lambda gets the coordinates' tolerance. mu is
-  // zero on the exact solution and only absorbs the drift, so its Newton
-  // corrections are round-off: weighting them like the coordinates makes the
-  // corrector fail within the first steps (seen with 1e-9 and 1e-6 on the
-  // double pendulum and SUNDIALS' slider-crank; none with 1e-3, and the
-  // answers do not change beyond the integration tolerance between 1e-3
-  // and 1e-1).
+  // Newton's convergence test and are scaled to the step (ErrorWeights), so
+  // only q and v have absolute tolerances.
   h.atol.reset(N_VNew_Serial(size, h.context.get()));
   if (!h.atol) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   Map<VectorXd> atol(N_VGetArrayPointer(h.atol.get()), size);
+  atol.setZero();
   atol.head(2 * n).setConstant(options.absolute_tolerance);
-  atol.segment(2 * n, m).setConstant(options.absolute_tolerance);
-  atol.tail(m).setConstant(kMuTolerance);
   const bool analytic = system.has_analytic_derivatives();
   const bool sparse =
       analytic && (options.linear_solver == ForwardDynamicsOptions::LinearSolver::kSparse ||
@@ -333,6 +447,26 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   h.ida.reset(IDACreate(h.context.get()));
   if (!h.linear_solver || !h.ida) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   void* ida = h.ida.get();
+  p.ida = ida;
+  p.relative_tolerance = options.relative_tolerance;
+  const VectorXd absolute_tolerances = atol;
+  p.absolute_tolerances = &absolute_tolerances;
+  // IDAS's own rule for the first step (0.001 of the way to the first
+  // instant, at most 0.5 over the weighted norm of y'0 without the
+  // multipliers), made explicit so that the first step's weights know it.
+  {
+    const auto first_instant = std::find_if(times.begin(), times.end(), [&](double t) { return t > t0; });
+    double first = first_instant == times.end() ? 0.0 : 0.001 * (*first_instant - t0);
+    double squares = 0.0;
+    for (int i = 0; i < 2 * n; ++i) {
+      const double weighted = y_dot[i] / (options.relative_tolerance * std::abs(y[i]) + atol[i]);
+      squares += weighted * weighted;
+    }
+    const double y_dot_norm = std::sqrt(squares / size);
+    if (y_dot_norm * first > 0.5) first = 0.5 / y_dot_norm;
+    if (options.max_step_size > 0.0) first = std::min(first, options.max_step_size);
+    p.first_step = first;
+  }
   auto check = [&](int flag, const char* call) {
     if (flag >= 0) return true;
     sundials_message = absl::StrFormat("%s failed (%d)%s%s", call, flag, sundials_message.empty() ? "" : ": ",
@@ -342,13 +476,14 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   bool ok = check(IDASetErrHandlerFn(ida, &sundials::CaptureMessage, &sundials_message), "IDASetErrHandlerFn") &&
             check(IDAInit(ida, &Residual, t0, h.yy.get(), h.yp.get()), "IDAInit") &&
             check(IDASetUserData(ida, &p), "IDASetUserData") &&
-            check(IDASVtolerances(ida, options.relative_tolerance, h.atol.get()), "IDASVtolerances") &&
+            check(IDAWFtolerances(ida, &ErrorWeights), "IDAWFtolerances") &&
             check(IDASetLinearSolver(ida, h.linear_solver.get(), h.matrix.get()), "IDASetLinearSolver") &&
             (!analytic ||
              check(IDASetJacFn(ida, sparse ? &SparseNewtonMatrix : &DenseNewtonMatrix), "IDASetJacFn")) &&
             check(IDASetId(ida, h.id.get()), "IDASetId") &&
             check(IDASetSuppressAlg(ida, SUNTRUE), "IDASetSuppressAlg") &&
             check(IDASetMaxNumSteps(ida, options.max_steps), "IDASetMaxNumSteps") &&
+            (p.first_step <= 0.0 || check(IDASetInitStep(ida, p.first_step), "IDASetInitStep")) &&
             (options.max_step_size <= 0.0 || check(IDASetMaxStep(ida, options.max_step_size), "IDASetMaxStep"));
   if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
 
@@ -444,9 +579,11 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
                         absl::StrFormat("%s; the integrator gave up near t = %.6g s", system.FailureReason(), t_reached));
         }
         if (!p.budget_failure.ok()) return p.budget_failure;
+        const std::string callback = p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]";
         return Failed(spec::FailureKind::kIntegrator,
-                      absl::StrFormat("the integrator failed near t = %.6g s (target %.6g s): %s%s", t_reached, t,
-                                      sundials_message, p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]"));
+                      absl::StrFormat("the integrator failed near t = %.6g s (target %.6g s): %s%s%s", t_reached, t,
+                                      sundials_message, callback,
+                                      FailureAdvice(system, flag, t0, t_reached, t, y.head(n), options, p.first_step)));
       }
       if (flag == IDA_ROOT_RETURN) {
         if (!check(IDAGetRootInfo(ida, bounds_crossed.data()), "IDAGetRootInfo")) {
