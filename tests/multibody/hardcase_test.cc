@@ -197,7 +197,7 @@ AndrewsRun RunAndrews(double relative_tolerance, double absolute_tolerance) {
 // the multipliers' weights were scaled to the step (forward_dynamics.cc,
 // ErrorWeights) it failed at t = 0 at every absolute tolerance of 1e-6 or
 // below. It must run at the scene's default tolerances and converge to the
-// reference as the tolerances tighten (docs/accuracy.md has the figures).
+// reference as the tolerances tighten (docs/accuracy_multibody.md has the figures).
 TEST(MultibodyHardcase, AndrewsSqueezingMechanismConvergesToThePublishedReference) {
   struct Case {
     double relative_tolerance, absolute_tolerance, bound_rad;
