@@ -16,6 +16,7 @@
 #include "worker/multibody/kinematic_sensitivity.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/multibody/parameter_derivatives.h"
 #include "worker/multibody/static_equilibrium.h"
 
 namespace mbopt::multibody {
@@ -268,6 +269,7 @@ struct Variant {
 };
 struct Perturbed {
   std::unique_ptr<Variant> plus, minus;
+  std::unique_ptr<ParameterDerivativeModel> derivative;  // null: the equations are differenced
   double step = 0.0;
   double magnitude = 1.0;  // |p_k|, or 1 for p_k = 0
 };
@@ -437,6 +439,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
         perturbed.clear();
         break;
       }
+      dp.derivative = ParameterDerivativeModel::Of(*model, dp.plus->model, dp.minus->model, dp.step);
       perturbed.push_back(std::move(dp));
     }
   }
@@ -453,8 +456,9 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   Eigen::MatrixXd phi_q;
   std::vector<ParameterPerturbation> perturbations;
   for (const Perturbed& dp : perturbed) {
-    perturbations.push_back(
-        ParameterPerturbation{dp.plus->mechanism.get(), dp.minus->mechanism.get(), dp.step, dp.magnitude});
+    perturbations.push_back(ParameterPerturbation{dp.plus->mechanism.get(), dp.minus->mechanism.get(), dp.step,
+                                                  dp.magnitude,
+                                                  dp.derivative != nullptr ? &dp.derivative->system() : nullptr});
   }
   const bool driven = assembled.degrees_of_freedom == 0;
   std::vector<StateSensitivity> kinematic;  // work space of the driven path
