@@ -813,13 +813,6 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "SENSITIVITY_METHOD_SIMULATOR is not available for FMU scenes yet (directional derivatives are "
                   "not used); use finite differences");
     }
-    const auto* multibody = std::get_if<MultibodyModel>(&scene.model);
-    if (s.simulator_sensitivities && multibody != nullptr &&
-        multibody->analysis == MultibodyModel::Analysis::kStaticEquilibrium) {
-      errors->Add(w, "sensitivity",
-                  "SENSITIVITY_METHOD_SIMULATOR is not available for a static-equilibrium analysis yet; use "
-                  "finite differences");
-    }
   }
 
   study.design_set = ConvertDesignSet(m, study, where, errors);

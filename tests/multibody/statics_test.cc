@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -240,6 +241,132 @@ TEST(MultibodyStatics, SceneRefusesRatesInAStaticAnalysis) {
   ASSERT_FALSE(scene.ok());
   EXPECT_THAT(std::string(scene.status().message()), HasSubstr("static-equilibrium analysis has no motion"));
   EXPECT_THAT(std::string(scene.status().message()), HasSubstr("energy"));
+}
+
+// The spring-loaded arm with its spring stiffness, its mass and its length
+// (markers, centre and inertia through expressions) as parameters.
+constexpr char kStaticArmDesignScene[] = R"pb(
+name: "arm design"
+parameters { name: "k" value: 20 }
+parameters { name: "mass" value: 2 }
+parameters { name: "length" value: 0.8 }
+effects { gravity { acceleration_m_per_s2 { x { value: 0 } y { value: -9.81 } } } }
+multibody {
+  analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
+  bodies {
+    name: "arm"
+    mass_kg { param: "mass" }
+    inertia_kg_m2 { expr: "mass * length^2 / 12" }
+    position_m { x { expr: "length / 2" } }
+    markers { name: "pin" position_m { x { expr: "-length / 2" } } }
+    markers { name: "tip" position_m { x { expr: "length / 2" } } }
+  }
+  joints { name: "pin" kind: JOINT_REVOLUTE a: "ground.origin" b: "arm.pin" }
+  ground_markers { name: "origin" }
+  rotational_springs { name: "spring" joint: "pin" stiffness_n_m_per_rad { param: "k" } }
+}
+outputs { name: "angle" joint_coordinate { joint: "pin" } }
+outputs { name: "pin_x" joint_reaction { joint: "pin" axis: AXIS_X } }
+outputs { name: "pin_y" joint_reaction { joint: "pin" axis: AXIS_Y } }
+outputs { name: "tip_y" marker_position { marker: "arm.tip" axis: AXIS_Y } }
+time_grid { start_s: 0 end_s: 0 points: 1 }
+)pb";
+
+// Simulator sensitivities of a static equilibrium (the implicit function
+// theorem at the solution) against central differences of whole analyses
+// (step 1e-5 of each value: truncation about 1e-10, the equilibrium solved
+// to 1e-10), for a stiffness and a mass (exact partials) and a length set
+// through expressions (differenced partials).
+TEST(MultibodyStatics, SensitivitiesAgreeWithCentralDifferencesOfWholeAnalyses) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("mbopt_static_design_" + std::to_string(::getpid()) + ".textproto");
+  std::ofstream(path) << kStaticArmDesignScene;
+  absl::StatusOr<spec::Scene> scene = spec::io::LoadSceneFile(path.string());
+  std::filesystem::remove(path);
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(MultibodySensitivityUnavailable(*scene), "");
+  const std::vector<double> p = {20.0, 2.0, 0.8};
+  const MultibodySensitivityResult result = AnalyzeMultibodySceneWithSensitivities(*scene, p, {0, 1, 2});
+  ASSERT_TRUE(result.report.ok()) << result.report.failure.reason;
+  ASSERT_EQ(result.unavailable, "");
+  ASSERT_EQ(result.output_derivatives.size(), 3u);
+  for (size_t i = 0; i < p.size(); ++i) {
+    const double h = 1e-5 * p[i];
+    std::vector<double> plus = p, minus = p;
+    plus[i] += h;
+    minus[i] -= h;
+    const spec::AnalysisReport up = AnalyzeMultibodyScene(*scene, plus), down = AnalyzeMultibodyScene(*scene, minus);
+    ASSERT_TRUE(up.ok() && down.ok());
+    for (size_t o = 0; o < up.outputs.size(); ++o) {
+      const double fd = (up.outputs[o].series[0][0] - down.outputs[o].series[0][0]) / (2 * h);
+      const double simulator = result.output_derivatives[i][o][0];
+      EXPECT_NEAR(simulator, fd, 1e-6 * std::max(1.0, std::abs(fd)))
+          << scene->parameters[i].name << " -> " << scene->outputs[o].name;
+      std::cout << scene->parameters[i].name << " -> " << scene->outputs[o].name << ": " << simulator
+                << ", differences " << fd << "\n";
+    }
+  }
+  // The angle moves with every parameter (not a trivially zero derivative).
+  for (size_t i = 0; i < p.size(); ++i) EXPECT_GT(std::abs(result.output_derivatives[i][0][0]), 1e-3);
+}
+
+// The knee scene of bench_multibody_sensitivity: 101 equilibria under a
+// growing load, two exact partials (the knee spring, the strut) and one
+// differenced (the thigh's length), every output against central
+// differences of whole analyses at every instant, to 1e-6 of the output's
+// largest derivative. A study may ask for simulator sensitivities of it.
+TEST(MultibodyStatics, LoadedArmSensitivitiesAgreeAtEveryInstant) {
+  absl::StatusOr<spec::Scene> scene = spec::io::LoadSceneFile("tests/multibody/knee_statics.scene.textproto");
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  std::vector<double> p;
+  std::vector<int> indices;
+  for (const spec::Parameter& parameter : scene->parameters) {
+    indices.push_back(static_cast<int>(p.size()));
+    p.push_back(parameter.value_si);
+  }
+  const MultibodySensitivityResult result = AnalyzeMultibodySceneWithSensitivities(*scene, p, indices);
+  ASSERT_TRUE(result.report.ok()) << result.report.failure.reason;
+  ASSERT_EQ(result.unavailable, "");
+  double worst = 0.0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const double h = 1e-5 * p[i];
+    std::vector<double> plus = p, minus = p;
+    plus[i] += h;
+    minus[i] -= h;
+    const spec::AnalysisReport up = AnalyzeMultibodyScene(*scene, plus), down = AnalyzeMultibodyScene(*scene, minus);
+    ASSERT_TRUE(up.ok() && down.ok());
+    for (size_t o = 0; o < up.outputs.size(); ++o) {
+      const std::vector<double>& d = result.output_derivatives[i][o];
+      ASSERT_EQ(d.size(), up.outputs[o].series[0].size());
+      double scale = 0.0, difference = 0.0;
+      for (size_t t = 0; t < d.size(); ++t) {
+        const double fd = (up.outputs[o].series[0][t] - down.outputs[o].series[0][t]) / (2 * h);
+        scale = std::max(scale, std::abs(fd));
+        difference = std::max(difference, std::abs(d[t] - fd));
+      }
+      std::cout << scene->parameters[i].name << " -> " << scene->outputs[o].name << ": max |d| " << scale
+                << ", difference " << difference << "\n";
+      if (scale > 0.0) worst = std::max(worst, difference / scale);
+    }
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+// A study may ask for simulator sensitivities of a static-equilibrium scene
+// (the loader refused it before they existed).
+TEST(MultibodyStatics, StudyMayAskForSimulatorSensitivities) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("mbopt_static_study_" + std::to_string(::getpid()) + ".textproto");
+  std::ofstream(path) << "name: \"knee\"\nscene_file: \""
+                      << std::filesystem::absolute("tests/multibody/knee_statics.scene.textproto").string()
+                      << "\"\n"
+                         "variables { name: \"k\" parameter: \"knee_stiffness\" initial: 300 lower: 100 upper: 900 }\n"
+                         "objective { minimize_max_of: \"strut_force\" reduction: REDUCTION_MAX_ABS }\n"
+                         "optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }\n";
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile(path.string());
+  std::filesystem::remove(path);
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_TRUE(study->optimizer.simulator_sensitivities);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "absl/strings/str_format.h"
 #include "worker/multibody/ggl_residual.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/multibody/parameter_derivatives.h"
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
@@ -34,6 +35,11 @@ struct Problem {
   const std::vector<ParameterPerturbation>* parameters = nullptr;  // sensitivities, if any
   GglWorkspace work;
   Eigen::MatrixXd newton;
+  // dF/dy and M at (state_jacobian_t, state_jacobian_at), for the
+  // sensitivity residuals.
+  Eigen::MatrixXd state_jacobian, state_mass;
+  double state_jacobian_t = 0.0;
+  VectorXd state_jacobian_at;
   // The sparse Newton matrix's pattern in compressed columns (KLU only).
   std::vector<sunindextype> column_starts, row_indices;
   // For the error weights (ErrorWeights): the integrator, the tolerances and
@@ -118,81 +124,41 @@ int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* 
   });
 }
 
-// The sensitivity residuals F_y s_k + F_y' s_k' + F_p_k. F is linear in y'
-// and in the multipliers, and M is constant, so those terms are exact:
-// [s_q' + Phi_q^T s_mu; M s_v' + Phi_q^T s_lambda; 0; 0]. The rest are
-// central differences: along (s_q, s_v) with a step scaled to the state
-// (1e-6 of it), and in p between the systems rebuilt at p +- step_k at the
-// unchanged state, which is exactly zero in the rows the parameter does not
-// enter (a stiffness never enters the constraints). Differencing the whole
-// residual along (s, s', e_k) in one step was tried first: its round-off in
-// the constraint rows, divided by the parameter's step, is above the
-// sensitivities' absolute tolerance at rtol 1e-10, and IDAS's corrector
-// failed at the first step.
+// The sensitivity residuals F_y s_k + F_y' s_k' + F_p_k. F_y is the Newton
+// matrix's at cj = 0 (exact, ggl_residual.h) and F_y' s' = (s_q', M s_v',
+// 0, 0) (F is linear in y' and M is constant); both are formed once per
+// state: IDAS's staggered corrector calls this again at the same (t, y) for
+// every iteration of the sensitivities. F_p_k is exact where the parameter
+// has a derivative model, else the central difference of the residual
+// alone between the systems at p_k +- step_k, at the same state
+// (parameter_derivatives.h). The first version differenced the residual
+// along (s, s') too (round-off then forced exact constraint rows by
+// polarization of gamma): eight residuals per parameter and call, and the
+// isolator's sensitivities cost 4.1 plain analyses at two parameters.
 int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vector /*rr*/, N_Vector* y_s,
                         N_Vector* yp_s, N_Vector* rr_s, void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the sensitivity residual", [&]() -> int {
-    const int n = p->n, m = p->m, size = 2 * n + 2 * m;
+    const int n = p->n, size = 2 * n + 2 * p->m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
-    Eigen::MatrixXd mass, phi_q;
-    const VectorXd q = y.head(n);
-    if (int flag = p->system->MassMatrix(q, &mass); flag != 0) return flag;
-    if (m > 0) {
-      if (int flag = p->system->ConstraintJacobian(t, q, &phi_q); flag != 0) return flag;
+    if (!(p->state_jacobian_at.size() == size && p->state_jacobian_t == t && p->state_jacobian_at == y)) {
+      if (int flag = GglNewtonMatrix(*p->system, t, 0.0, y, &p->work, &p->state_jacobian); flag != 0) return flag;
+      p->state_mass = p->work.mass;
+      p->state_jacobian_t = t;
+      p->state_jacobian_at = y;
     }
-    const double state_scale = std::max(1.0, MaxAbs(y.head(2 * n)));
-    VectorXd y_shift(size), r_plus(size), r_minus(size), result(size);
+    VectorXd partial(size);
     for (int k = 0; k < count; ++k) {
       const ParameterPerturbation& dp = (*p->parameters)[static_cast<size_t>(k)];
       const Map<const VectorXd> s(N_VGetArrayPointer(y_s[k]), size);
       const Map<const VectorXd> s_dot(N_VGetArrayPointer(yp_s[k]), size);
-      result.setZero();
-      result.head(n) = s_dot.head(n);
-      result.segment(n, n) = mass * s_dot.segment(n, n);
-      if (m > 0) {
-        result.head(n) += phi_q.transpose() * s.segment(2 * n + m, m);
-        result.segment(n, n) += phi_q.transpose() * s.segment(2 * n, m);
-      }
-      const double direction = MaxAbs(s.head(2 * n));
-      if (direction > 0.0) {
-        const double sigma = 1e-6 * state_scale / direction;
-        y_shift = y;
-        y_shift.head(2 * n) += sigma * s.head(2 * n);
-        if (int flag = GglResidual(*p->system, t, y_shift, y_dot, &p->work, r_plus); flag != 0) return flag;
-        y_shift.head(2 * n) = y.head(2 * n) - sigma * s.head(2 * n);
-        if (int flag = GglResidual(*p->system, t, y_shift, y_dot, &p->work, r_minus); flag != 0) return flag;
-        result += (r_plus - r_minus) / (2.0 * sigma);
-      }
-      if (m > 0) {
-        // The constraint rows exactly: Phi_q s_q, and Phi_q s_v + d(Phi_q v
-        // + Phi_t)/dq s_q, whose second term is bilinear in (v, s_q) apart
-        // from Phi_qt: by polarization of gamma = -(Phi_q v)_q v -
-        // 2 Phi_qt v - Phi_tt it is -(gamma(v + w) - gamma(v - w)) / 4 for
-        // w = s_q (scaled to v's size against round-off). Differences of
-        // positions here would carry round-off of the order of rtol at tight
-        // tolerances.
-        result.segment(2 * n, m) = phi_q * s.head(n);
-        result.segment(2 * n + m, m) = phi_q * s.segment(n, n);
-        const double w_norm = MaxAbs(s.head(n));
-        if (w_norm > 0.0) {
-          const VectorXd v = y.segment(n, n);
-          const double alpha = std::max(MaxAbs(v), 1e-3) / w_norm;
-          VectorXd gamma_plus, gamma_minus;
-          if (int flag = p->system->AccelerationRightSide(t, q, v + alpha * s.head(n), &gamma_plus); flag != 0) {
-            return flag;
-          }
-          if (int flag = p->system->AccelerationRightSide(t, q, v - alpha * s.head(n), &gamma_minus); flag != 0) {
-            return flag;
-          }
-          result.segment(2 * n + m, m) -= (gamma_plus - gamma_minus) / (4.0 * alpha);
-        }
-      }
-      if (int flag = GglResidual(*dp.plus, t, y, y_dot, &p->work, r_plus); flag != 0) return flag;
-      if (int flag = GglResidual(*dp.minus, t, y, y_dot, &p->work, r_minus); flag != 0) return flag;
-      result += (r_plus - r_minus) / (2.0 * dp.step);
-      Map<VectorXd>(N_VGetArrayPointer(rr_s[k]), size) = result;
+      Map<VectorXd> result(N_VGetArrayPointer(rr_s[k]), size);
+      if (int flag = GglParameterDerivative(dp, t, y, y_dot, &p->work, partial); flag != 0) return flag;
+      result.noalias() = p->state_jacobian * s;
+      result.head(n) += s_dot.head(n);
+      result.segment(n, n).noalias() += p->state_mass * s_dot.segment(n, n);
+      result += partial;
     }
     return 0;
   });
@@ -521,6 +487,13 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   const int num_sens = sensitivities != nullptr ? static_cast<int>(sensitivities->parameters.size()) : 0;
   sundials::VectorArray y_s, yp_s, atol_s;
   if (num_sens > 0) {
+    // The sensitivity residuals are formed from the Newton matrix's
+    // derivatives.
+    if (!analytic) {
+      return Failed(spec::FailureKind::kInvalidModel,
+                    "forward sensitivities need a system with analytic derivatives (ConstrainedSystem::"
+                    "has_analytic_derivatives)");
+    }
     p.parameters = &sensitivities->parameters;
     y_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
     yp_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);

@@ -86,10 +86,13 @@ struct ForwardDynamicsCounters {
 // Forward sensitivities with respect to parameters (IDAS's forward
 // sensitivity module, staggered corrector, sensitivities in the error test
 // with absolute tolerances divided by each parameter's magnitude). The
-// sensitivity residuals F_y s + F_y' s' + F_p are central differences of
-// the residual along (s, s', e_k), with the systems rebuilt at p_k +- step_k
-// (ParameterPerturbation); the initial sensitivities of lambda and the
-// accelerations follow from q0_k, v0_k the same way.
+// sensitivity residuals F_y s + F_y' s' + F_p take F_y from the system's
+// analytic derivatives (a system without them gets no sensitivities) and
+// F_p from the parameter's derivative model, else from central differences
+// of the residual alone between the systems rebuilt at p_k +- step_k
+// (ParameterPerturbation, parameter_derivatives.h); the initial
+// sensitivities of lambda and the accelerations are central differences of
+// the consistent start along (q0_k, v0_k, e_k).
 struct ForwardSensitivityInput {
   std::vector<ParameterPerturbation> parameters;
   std::vector<Eigen::VectorXd> q0, v0;  // dq0/dp_k, dv0/dp_k of the assembled start

@@ -6,37 +6,16 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// Phi_q(q) x + b(q): the velocity (x = v, b = Phi_t) and acceleration
-// (x = a, b = -gamma(q, v)) equations of `s`.
-int VelocityEquation(const ConstrainedSystem& s, double t, const VectorXd& q, const VectorXd& v, VectorXd* r) {
+// One varied system's equations along the derivative: every equation after
+// the positions is evaluated at the same moved coordinates q + sign h dq,
+// so their Jacobian (the costly part) is formed once, not once per
+// equation.
+struct Moved {
+  const ConstrainedSystem* system = nullptr;
+  double sign = 1.0;
+  VectorXd q, v, a;
   MatrixXd phi_q;
-  VectorXd phi_t;
-  if (int flag = s.ConstraintJacobian(t, q, &phi_q); flag != 0) return flag;
-  if (int flag = s.ConstraintTimeDerivative(t, q, &phi_t); flag != 0) return flag;
-  *r = phi_q * v + phi_t;
-  return 0;
-}
-
-int AccelerationEquation(const ConstrainedSystem& s, double t, const VectorXd& q, const VectorXd& v,
-                         const VectorXd& a, VectorXd* r) {
-  MatrixXd phi_q;
-  VectorXd gamma;
-  if (int flag = s.ConstraintJacobian(t, q, &phi_q); flag != 0) return flag;
-  if (int flag = s.AccelerationRightSide(t, q, v, &gamma); flag != 0) return flag;
-  *r = phi_q * a - gamma;
-  return 0;
-}
-
-int ForceEquation(const ConstrainedSystem& s, double t, const VectorXd& q, const VectorXd& v, const VectorXd& a,
-                  const VectorXd& lambda, VectorXd* r) {
-  MatrixXd phi_q, mass;
-  VectorXd forces;
-  if (int flag = s.ConstraintJacobian(t, q, &phi_q); flag != 0) return flag;
-  if (int flag = s.MassMatrix(q, &mass); flag != 0) return flag;
-  if (int flag = s.AppliedForces(t, q, v, &forces); flag != 0) return flag;
-  *r = phi_q.transpose() * lambda - forces + mass * a;
-  return 0;
-}
+};
 
 }  // namespace
 
@@ -49,29 +28,44 @@ bool KinematicStateSensitivities(const ConstrainedSystem& system, const std::vec
   Eigen::PartialPivLU<MatrixXd> lu_t;
   if (s.lambda.size() > 0) lu_t.compute(phi_q.transpose());
   sensitivities->resize(parameters.size());
-  VectorXd plus, minus;
+  VectorXd plus, minus, b, gamma, forces;
+  MatrixXd mass;
   for (size_t k = 0; k < parameters.size(); ++k) {
     const ParameterPerturbation& dp = parameters[k];
     const double h = dp.step;
     StateSensitivity* out = &(*sensitivities)[k];
     if (dp.plus->Constraints(t, s.q, &plus) != 0 || dp.minus->Constraints(t, s.q, &minus) != 0) return false;
     out->q = -lu.solve((plus - minus) / (2 * h));
-    if (VelocityEquation(*dp.plus, t, s.q + h * out->q, s.v, &plus) != 0 ||
-        VelocityEquation(*dp.minus, t, s.q - h * out->q, s.v, &minus) != 0) {
-      return false;
+    Moved moved[2] = {{dp.plus, 1.0, {}, {}, {}, {}}, {dp.minus, -1.0, {}, {}, {}, {}}};
+    VectorXd* r[2] = {&plus, &minus};
+    // Phi_q v + Phi_t with v held.
+    for (int i = 0; i < 2; ++i) {
+      Moved& x = moved[i];
+      x.q = s.q + x.sign * h * out->q;
+      if (x.system->ConstraintJacobian(t, x.q, &x.phi_q) != 0 || x.system->ConstraintTimeDerivative(t, x.q, &b) != 0) {
+        return false;
+      }
+      *r[i] = x.phi_q * s.v + b;
     }
     out->v = -lu.solve((plus - minus) / (2 * h));
-    if (AccelerationEquation(*dp.plus, t, s.q + h * out->q, s.v + h * out->v, s.a, &plus) != 0 ||
-        AccelerationEquation(*dp.minus, t, s.q - h * out->q, s.v - h * out->v, s.a, &minus) != 0) {
-      return false;
+    // Phi_q a - gamma(q, v) with a held.
+    for (int i = 0; i < 2; ++i) {
+      Moved& x = moved[i];
+      x.v = s.v + x.sign * h * out->v;
+      if (x.system->AccelerationRightSide(t, x.q, x.v, &gamma) != 0) return false;
+      *r[i] = x.phi_q * s.a - gamma;
     }
     out->a = -lu.solve((plus - minus) / (2 * h));
     out->lambda.resize(0);
     if (s.lambda.size() > 0) {
-      if (ForceEquation(*dp.plus, t, s.q + h * out->q, s.v + h * out->v, s.a + h * out->a, s.lambda, &plus) != 0 ||
-          ForceEquation(*dp.minus, t, s.q - h * out->q, s.v - h * out->v, s.a - h * out->a, s.lambda, &minus) !=
-              0) {
-        return false;
+      // Phi_q^T lambda - Q + M a with lambda held.
+      for (int i = 0; i < 2; ++i) {
+        Moved& x = moved[i];
+        x.a = s.a + x.sign * h * out->a;
+        if (x.system->MassMatrix(x.q, &mass) != 0 || x.system->AppliedForces(t, x.q, x.v, &forces) != 0) {
+          return false;
+        }
+        *r[i] = x.phi_q.transpose() * s.lambda - forces + mass * x.a;
       }
       out->lambda = -lu_t.solve((plus - minus) / (2 * h));
     }

@@ -32,14 +32,20 @@ struct MotionSample {
   int branch_sign = 0;
 };
 
-// A system's parameter dependence for sensitivity analysis, as central
-// differences: the system rebuilt at p_k + step_k and p_k - step_k (same
-// structure: coordinates, rows). The systems outlive the analysis.
+// A system's parameter dependence for sensitivity analysis: the system
+// rebuilt at p_k + step_k and p_k - step_k (same structure: coordinates,
+// rows), and its exact derivative where there is one. The systems outlive
+// the analysis.
 struct ParameterPerturbation {
   const ConstrainedSystem* plus = nullptr;
   const ConstrainedSystem* minus = nullptr;
   double step = 0.0;
   double magnitude = 1.0;  // |p_k| (1 for p_k = 0): scales the sensitivities' absolute tolerances
+  // When p_k enters only coefficients the equations are linear in: a system
+  // whose mass matrix and applied forces are dM/dp_k and dQ/dp_k (the
+  // constraints do not depend on p_k; parameter_derivatives.h). Null: the
+  // equations' derivative in p_k is a central difference of plus and minus.
+  const ConstrainedSystem* derivative = nullptr;
 };
 
 // Sees every output instant in turn; a failure stops the analysis.

@@ -16,6 +16,7 @@
 #include "worker/multibody/kinematic_sensitivity.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/multibody/parameter_derivatives.h"
 #include "worker/multibody/static_equilibrium.h"
 
 namespace mbopt::multibody {
@@ -268,6 +269,7 @@ struct Variant {
 };
 struct Perturbed {
   std::unique_ptr<Variant> plus, minus;
+  std::unique_ptr<ParameterDerivativeModel> derivative;  // null: the equations are differenced
   double step = 0.0;
   double magnitude = 1.0;  // |p_k|, or 1 for p_k = 0
 };
@@ -419,7 +421,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   const bool is_static = sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium;
   std::vector<Perturbed> perturbed;
-  if (sensitivities && (is_static || has_stress)) result->unavailable = MultibodySensitivityUnavailable(scene);
+  if (sensitivities && has_stress) result->unavailable = MultibodySensitivityUnavailable(scene);
   if (sensitivities && result->unavailable.empty()) {
     for (const int index : *parameters) {
       Perturbed dp;
@@ -437,6 +439,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
         perturbed.clear();
         break;
       }
+      dp.derivative = ParameterDerivativeModel::Of(*model, dp.plus->model, dp.minus->model, dp.step);
       perturbed.push_back(std::move(dp));
     }
   }
@@ -453,11 +456,12 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   Eigen::MatrixXd phi_q;
   std::vector<ParameterPerturbation> perturbations;
   for (const Perturbed& dp : perturbed) {
-    perturbations.push_back(
-        ParameterPerturbation{dp.plus->mechanism.get(), dp.minus->mechanism.get(), dp.step, dp.magnitude});
+    perturbations.push_back(ParameterPerturbation{dp.plus->mechanism.get(), dp.minus->mechanism.get(), dp.step,
+                                                  dp.magnitude,
+                                                  dp.derivative != nullptr ? &dp.derivative->system() : nullptr});
   }
   const bool driven = assembled.degrees_of_freedom == 0;
-  std::vector<StateSensitivity> kinematic;  // work space of the driven path
+  std::vector<StateSensitivity> kinematic;  // work space of the driven and static paths
   const MotionCallback record = [&](const MotionSample& s) {
     if (budget != nullptr) {
       if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
@@ -489,11 +493,15 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       report.outputs[k].series[0].push_back(value);
     }
     if (!with_derivatives || !result->unavailable.empty()) return spec::AnalysisFailure::Ok();
-    // Forward dynamics brings the state's derivatives; a driven mechanism's
-    // come from its differentiated constraint equations.
+    // Forward dynamics brings the state's derivatives; a static
+    // equilibrium's come from its equations by the implicit function
+    // theorem, a driven mechanism's from its differentiated constraint
+    // equations.
     const std::vector<StateSensitivity>* ds = &s.sensitivities;
     if (ds->size() != perturbed.size()) {
-      if (!driven || !KinematicStateSensitivities(mechanism, perturbations, s, &kinematic)) {
+      const bool found = is_static ? StaticStateSensitivities(mechanism, perturbations, s, &kinematic)
+                                   : driven && KinematicStateSensitivities(mechanism, perturbations, s, &kinematic);
+      if (!found) {
         result->unavailable = absl::StrFormat("no state derivative at t = %.6g s", s.t_s);
         return spec::AnalysisFailure::Ok();
       }
@@ -571,9 +579,6 @@ MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Sc
 std::string MultibodySensitivityUnavailable(const spec::Scene& scene) {
   const auto* sm = std::get_if<spec::MultibodyModel>(&scene.model);
   if (sm == nullptr) return "not a multibody scene";
-  if (sm->analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium) {
-    return "a static-equilibrium analysis has no simulator sensitivities yet";
-  }
   for (const spec::Output& o : scene.outputs) {
     if (std::holds_alternative<spec::BendingStressOutput>(o.kind)) {
       return "bending-stress outputs of flexible links have no simulator sensitivities yet";

@@ -38,9 +38,11 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
 // link length through an expression): the model is also compiled at
 // p_k +- step_k (step 1e-5 |p_k|, or 1e-5 for p_k = 0) and the analysis
 // differentiates through those. Forward dynamics: IDAS forward
-// sensitivities (forward_dynamics.h); driven mechanisms: the differentiated
-// constraint equations at each instant (kinematic_sensitivity.h); outputs:
-// central differences along (state derivative, e_k).
+// sensitivities (forward_dynamics.h); static equilibrium: the implicit
+// function theorem at each instant (static_equilibrium.h); driven
+// mechanisms: the differentiated constraint equations at each instant
+// (kinematic_sensitivity.h); outputs: central differences along (state
+// derivative, e_k).
 struct MultibodySensitivityResult {
   spec::AnalysisReport report;
   // [k][output][instant]: d output / d parameter_values_si[parameters[k]];
@@ -54,7 +56,7 @@ MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Sc
                                                                   budget::AnalysisBudget* budget = nullptr);
 
 // Empty if the scene's analysis has simulator sensitivities; else why not
-// (a static-equilibrium analysis).
+// (bending-stress outputs of flexible links).
 std::string MultibodySensitivityUnavailable(const spec::Scene& scene);
 
 // The model of a multibody scene at the given parameter values (SI), checked

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
+#include "worker/multibody/parameter_derivatives.h"
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
@@ -119,6 +120,42 @@ double RelativeLeastStiffness(Problem* p, const VectorXd& x, bool* ok) {
 }
 
 }  // namespace
+
+bool StaticStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
+                              const MotionSample& sample, std::vector<StateSensitivity>* sensitivities) {
+  if (!system.has_analytic_derivatives()) return false;
+  const int n = system.num_coordinates(), m = system.num_constraints();
+  const double t = sample.t_s;
+  const VectorXd& q = sample.q;
+  const VectorXd lambda = m > 0 ? sample.lambda : VectorXd();
+  MatrixXd force_q, force_v, phi_q, curvature;
+  if (system.ForceJacobians(t, q, VectorXd::Zero(n), &force_q, &force_v) != 0) return false;
+  MatrixXd jacobian = MatrixXd::Zero(n + m, n + m);
+  jacobian.topLeftCorner(n, n) = force_q;
+  if (m > 0) {
+    if (system.ConstraintJacobian(t, q, &phi_q) != 0 || system.ConstraintCurvature(t, q, lambda, &curvature) != 0) {
+      return false;
+    }
+    jacobian.topLeftCorner(n, n) -= curvature;
+    jacobian.topRightCorner(n, m) = -phi_q.transpose();
+    jacobian.bottomLeftCorner(m, n) = phi_q;
+  }
+  const Eigen::FullPivLU<MatrixXd> lu(jacobian);
+  if (!lu.isInvertible()) return false;
+  sensitivities->resize(parameters.size());
+  VectorXd partial;
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    if (StaticParameterDerivative(parameters[k], t, q, lambda, &partial) != 0) return false;
+    const VectorXd dx = -lu.solve(partial);
+    if (!dx.allFinite()) return false;
+    StateSensitivity& out = (*sensitivities)[k];
+    out.q = dx.head(n);
+    out.v = VectorXd::Zero(n);
+    out.a = VectorXd::Zero(n);
+    out.lambda = dx.tail(m);
+  }
+  return true;
+}
 
 spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, const VectorXd& q0,
                                            const std::vector<double>& times, const StaticOptions& options,

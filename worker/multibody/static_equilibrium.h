@@ -54,6 +54,20 @@ struct StaticCounters {
   std::int64_t residual_evaluations = 0;  // KINSOL's, Jacobian differences included
 };
 
+// The derivatives of an equilibrium (q, lambda) of `sample` (as
+// RunStaticEquilibrium reports it) with respect to each parameter, by the
+// implicit function theorem on G(q, lambda; p) = 0:
+//
+//   [Q_q - (Phi_q^T lambda)_q   -Phi_q^T] [dq/dp      ]     [dG/dp]
+//   [Phi_q                        0     ] [dlambda/dp ] = - [     ]
+//
+// the matrix from the system's analytic derivatives (velocities zero), one
+// LU for every parameter; dG/dp from parameter_derivatives.h. Velocities
+// and accelerations stay zero. False when the system has no analytic
+// derivatives or the matrix is singular (a dead centre).
+bool StaticStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
+                              const MotionSample& sample, std::vector<StateSensitivity>* sensitivities);
+
 // From (q0) assembled at times_s.front(); `times_s` ascending.
 spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, const Eigen::VectorXd& q0,
                                            const std::vector<double>& times_s, const StaticOptions& options,
