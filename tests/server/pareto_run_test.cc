@@ -201,6 +201,39 @@ TEST(ParetoRun, ObjectivesThatDoNotConflictLeaveThePointsBetweenUnrun) {
   }
 }
 
+TEST(ParetoRun, AFailedEndLeavesThePointsBetweenUnrunAndSaysWhy) {
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(TwoSpheres(true), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  std::vector<slp::CycleRecord> records;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    for (const slp::AnalysisRequest& request : (*run)->PendingRequests()) {
+      AnalysisRecord record = Answer(request);
+      // Every analysis of the last point's run fails.
+      if (request.id / ParetoRun::kRequestStride == kPoints - 1) {
+        record.objective_terms.clear();
+        record.constraint_values.clear();
+        record.objective_gradients.clear();
+        record.constraint_gradients.clear();
+        record.failure = spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "step size too small");
+      }
+      ASSERT_TRUE((*run)->Submit(record).ok());
+    }
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+  }
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints));
+  EXPECT_TRUE(records.front().accepted);
+  EXPECT_EQ(records.back().pareto_state, "failed");
+  EXPECT_FALSE(records.back().accepted);
+  EXPECT_TRUE(std::isnan(records.back().pareto_value_si));
+  for (int k = 1; k + 1 < kPoints; ++k) {
+    EXPECT_EQ(records[static_cast<size_t>(k)].pareto_state, "not_run");
+    EXPECT_NE(records[static_cast<size_t>(k)].rejection_reason.find("point 9 (an anchor) has no feasible result"),
+              std::string::npos)
+        << records[static_cast<size_t>(k)].rejection_reason;
+  }
+}
+
 TEST(ParetoRunRecords, ArePointRecordsAfterAnEncodeAndDecode) {
   std::vector<slp::CycleRecord> records;
   RunFront(true, 2, 3, &records);
