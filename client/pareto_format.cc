@@ -174,7 +174,7 @@ std::string ParetoCsv(const v1::GetJobResponse& job) {
 
 namespace {
 
-void PointObject(const v1::GetJobResponse& job, const ParetoFront& front, const ParetoPointRow& p, JsonWriter& w) {
+void PointObject(const v1::GetJobResponse& job, const ParetoPointRow& p, JsonWriter& w) {
   const v1::JobSummary& s = job.summary();
   const v1::CycleRecord& r = *p.record;
   w.BeginObject();
@@ -198,7 +198,6 @@ void PointObject(const v1::GetJobResponse& job, const ParetoFront& front, const 
   w.Field("status", p.status);
   w.Field("reason", r.rejection_reason());
   w.EndObject();
-  (void)front;
 }
 
 }  // namespace
@@ -222,7 +221,7 @@ std::string ParetoJson(const v1::GetJobResponse& job, const std::string& databas
   w.Field("message", s.message());
   w.Key("points");
   w.BeginArray();
-  for (const ParetoPointRow& p : front.points) PointObject(job, front, p, w);
+  for (const ParetoPointRow& p : front.points) PointObject(job, p, w);
   w.EndArray();
   w.EndObject();
   return w.str() + "\n";
@@ -267,7 +266,7 @@ absl::StatusOr<std::string> ParetoPointJson(const v1::GetJobResponse& job, int p
   for (const ParetoPointRow& p : front.points) {
     if (p.point != point) continue;
     JsonWriter w;
-    PointObject(job, front, p, w);
+    PointObject(job, p, w);
     return w.str() + "\n";
   }
   return NoSuchPoint(job, point);
