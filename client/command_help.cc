@@ -81,13 +81,16 @@ constexpr Help kHelp[] = {
      "starts a local server and N workers on that database; an external scene's job needs\n"
      "--drivers FILE (and --keep-runs) as `mbopt run` had them.\n"},
     {"results",
-     "usage: mbopt results JOB [--csv | --json] [--server HOST:PORT | --db PATH]\n"
+     "usage: mbopt results JOB [--csv | --json | --point K [--json]] [--server HOST:PORT | --db PATH]\n"
      "\n"
-     "The job's result (outcome, objective, design) and its cycle history.\n"
+     "The job's result (outcome, objective, design) and its cycle history; for a sweep or sample\n"
+     "its designs, for a Pareto front its points.\n"
      "\n"
      "options:\n"
-     "  --csv                 the cycle history as CSV\n"
-     "  --json                result and history as one JSON object\n"},
+     "  --csv                 the cycle history (designs, points) as CSV\n"
+     "  --json                result and history as one JSON object\n"
+     "  --point K             a Pareto front's point K (1-based) in full: level, objectives,\n"
+     "                        design, every constraint\n"},
     {"report",
      "usage: mbopt report JOB [-o FILE] [--no-responses] [--no-mechanism] [--plot X:Y ...]\n"
      "                        [--server HOST:PORT | --db PATH]\n"
@@ -100,7 +103,8 @@ constexpr Help kHelp[] = {
      "  --no-responses        leave out the response plots (no analyses are run for them)\n"
      "  --plot X:Y            also plot output or response Y against X at both designs, besides\n"
      "                        the study's `plots`; repeatable\n"
-     "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"},
+     "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"
+     "  --point K             a Pareto front's page: mark point K as the chosen design and show it\n"},
     {"draw",
      "usage: mbopt draw FILE [-o OUT.html] [--set NAME=VALUE ...]\n"
      "\n"

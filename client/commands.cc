@@ -13,6 +13,8 @@
 #include "client/args.h"
 #include "client/connection.h"
 #include "client/design_set_format.h"
+#include "client/pareto_format.h"
+#include "client/pareto_report_from_job.h"
 #include "client/design_set_report_from_job.h"
 #include "client/exit_codes.h"
 #include "client/interrupts.h"
@@ -20,6 +22,7 @@
 #include "client/local_cluster.h"
 #include "client/local_worker_drivers.h"
 #include "client/report/design_set_report.h"
+#include "client/report/pareto_report.h"
 #include "client/report/job_report_html.h"
 #include "client/report/report_from_proto.h"
 #include "client/report_mechanism.h"
@@ -312,11 +315,16 @@ int ResumeCommand(const Args& args) {
 }
 
 int ResultsCommand(const Args& args) {
-  auto parsed = Parse(args, {{"--server", "--db"}, {"--csv", "--json"}}, 1,
-                      "mbopt results JOB [--csv | --json] [--server ADDRESS | --db PATH]");
+  auto parsed = Parse(args, {{"--server", "--db", "--point"}, {"--csv", "--json"}}, 1,
+                      "mbopt results JOB [--csv | --json | --point K [--json]] [--server ADDRESS | --db PATH]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
   if (parsed->Has("--csv") && parsed->Has("--json")) {
     return Fail("--csv and --json exclude each other", kExitBadInput);
+  }
+  auto point = parsed->IntValue("--point", 1);
+  if (!point.ok()) return Fail(std::string(point.status().message()), kExitBadInput);
+  if (point->has_value() && parsed->Has("--csv")) {
+    return Fail("--point shows one point: as text, or with --json; --csv lists them all", kExitBadInput);
   }
   auto connected = Connect(*parsed);
   if (auto* f = std::get_if<ConnectFailure>(&connected)) return Fail(f->message, f->exit_code);
@@ -324,6 +332,17 @@ int ResultsCommand(const Args& args) {
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, parsed->positional[0], &response);
   if (!status.ok()) return FailRpc(status, c.address, &c.security);
+  if (point->has_value()) {
+    if (!IsParetoJob(response)) {
+      return Fail("--point picks a point of a Pareto front; job " + parsed->positional[0] + " is not one",
+                  kExitBadInput);
+    }
+    absl::StatusOr<std::string> shown = parsed->Has("--json") ? ParetoPointJson(response, **point)
+                                                              : ParetoPointText(response, **point);
+    if (!shown.ok()) return Fail(std::string(shown.status().message()), kExitBadInput);
+    std::fputs(shown->c_str(), stdout);
+    return ExitCodeForState(response.summary().state());
+  }
   if (parsed->Has("--json")) {
     std::fputs(ResultsJson(response).c_str(), stdout);
   } else if (parsed->Has("--csv")) {
@@ -363,10 +382,13 @@ int ReportCommand(const Args& args) {
       spelled.push_back(args[i] == "-o" ? "--output" : args[i]);
     }
   }
-  auto parsed = Parse(spelled, {{"--server", "--db", "--output", "--plot"}, {"--no-responses", "--no-mechanism"}}, 1,
+  auto parsed = Parse(spelled, {{"--server", "--db", "--output", "--plot", "--point"}, {"--no-responses", "--no-mechanism"}},
+                      1,
                       "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH] [--no-responses] "
-                      "[--no-mechanism] [--plot X:Y ...]");
+                      "[--no-mechanism] [--plot X:Y ...] [--point K (a Pareto front's chosen point)]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  auto point = parsed->IntValue("--point", 1);
+  if (!point.ok()) return Fail(std::string(point.status().message()), kExitBadInput);
   const std::string job_id = parsed->positional[0];
   std::string path = parsed->Value("--output");
   if (path.empty()) path = job_id + ".html";
@@ -376,6 +398,18 @@ int ReportCommand(const Args& args) {
   v1::GetJobResponse response;
   grpc::Status status = GetJob(c, job_id, &response);
   if (!status.ok()) return FailRpc(status, c.address, &c.security);
+  if (IsParetoJob(response)) {
+    // A front's page draws its points; --point marks the one picked.
+    if (point->has_value()) {
+      if (absl::StatusOr<std::string> found = ParetoPointText(response, **point); !found.ok()) {
+        return Fail(std::string(found.status().message()), kExitBadInput);
+      }
+    }
+    return WriteReport(path, report::RenderParetoReportHtml(ParetoReportFromJob(response, point->value_or(0))));
+  }
+  if (point->has_value()) {
+    return Fail("--point picks a point of a Pareto front; job " + job_id + " is not one", kExitBadInput);
+  }
   if (IsDesignSetJob(response)) {
     // A sweep or sample has no optimization history: its page plots the
     // objective and constraints against the design.

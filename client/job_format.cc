@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_format.h"
 #include "client/design_set_format.h"
+#include "client/pareto_format.h"
 #include "client/exit_codes.h"
 #include "client/json_writer.h"
 #include "client/report/report_from_proto.h"
@@ -137,7 +138,10 @@ std::string SummaryText(const v1::JobSummary& s, const v1::Study* study) {
   out += "study:         " + s.study_name() + "\n";
   if (!s.owner().empty()) out += "submitted by:  " + s.owner() + "\n";
   out += "status:        " + StateName(s.state()) + "\n";
-  if (s.design_set()) {
+  if (s.pareto()) {
+    out += "points:        " + std::to_string(s.cycles()) + " of " + std::to_string(s.max_cycles()) +
+           " on the Pareto front computed\n";
+  } else if (s.design_set()) {
     out += "designs:       " + std::to_string(s.cycles()) + " of " + std::to_string(s.max_cycles()) + " analysed\n";
   } else {
     out += "cycles:        " + std::to_string(s.cycles()) +
@@ -193,6 +197,7 @@ std::string WorkersRow(const v1::WorkerSummary& w) {
 }
 
 std::string ResultsTable(const v1::GetJobResponse& job) {
+  if (IsParetoJob(job)) return ParetoTable(job);
   if (IsDesignSetJob(job)) return DesignSetTable(job);
   std::string out = SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr);
   // Appended piece by piece: GCC 12 at -O3 reports a false -Wrestrict for
@@ -208,6 +213,7 @@ std::string ResultsTable(const v1::GetJobResponse& job) {
 }
 
 std::string ResultsCsv(const v1::GetJobResponse& job) {
+  if (IsParetoJob(job)) return ParetoCsv(job);
   if (IsDesignSetJob(job)) return DesignSetCsv(job);
   const auto& s = job.summary();
   std::string out = "cycle,attempt,accepted,objective,max_violation,max_approximation_error,"
@@ -234,6 +240,7 @@ std::string ResultsCsv(const v1::GetJobResponse& job) {
 }
 
 std::string ResultsJson(const v1::GetJobResponse& job, const std::string& database) {
+  if (IsParetoJob(job)) return ParetoJson(job, database);
   if (IsDesignSetJob(job)) return DesignSetJson(job, database);
   const auto& s = job.summary();
   JsonWriter w;

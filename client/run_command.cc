@@ -20,6 +20,7 @@
 #include "client/commands.h"
 #include "client/connection.h"
 #include "client/design_set_format.h"
+#include "client/pareto_format.h"
 #include "client/exit_codes.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
@@ -211,9 +212,10 @@ int RunCommandMain(const Args& args) {
     std::fputs(ResultsJson(job, keep_db ? db_path : "").c_str(), stdout);
   } else if (!quiet) {
     // A design set's table is its result: every design with its values.
-    std::printf("\n%s", IsDesignSetJob(job)
-                             ? DesignSetTable(job).c_str()
-                             : SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr).c_str());
+    // A Pareto front's table is its points.
+    std::printf("\n%s", IsParetoJob(job)      ? ParetoTable(job).c_str()
+                       : IsDesignSetJob(job) ? DesignSetTable(job).c_str()
+                                             : SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr).c_str());
     if (keep_db) {
       std::printf("database:      %s\n"
                   "report:        mbopt report %s --db %s\n",

@@ -1,6 +1,7 @@
 #include "client/watch.h"
 
 #include "client/design_set_format.h"
+#include "client/pareto_format.h"
 #include "client/interrupts.h"
 #include "client/job_format.h"
 
@@ -16,8 +17,9 @@ void DrawProgress(const WatchOptions& options, const v1::JobSummary& s) {
   char objective[64] = "";
   if (s.cycles() > 0) std::snprintf(objective, sizeof objective, ", F = %.7g", s.objective());
   if (s.design_set()) {
-    std::fprintf(options.table_out, "\r\033[K  %s: %d of %d designs, %lld analyses, %.1f s",
-                 StateName(s.state()).c_str(), s.cycles(), s.max_cycles(), static_cast<long long>(s.analyses()),
+    std::fprintf(options.table_out, "\r\033[K  %s: %d of %d %s, %lld analyses, %.1f s",
+                 StateName(s.state()).c_str(), s.cycles(), s.max_cycles(), s.pareto() ? "points" : "designs",
+                 static_cast<long long>(s.analyses()),
                  s.wall_seconds());
     std::fflush(options.table_out);
     return;
@@ -45,12 +47,17 @@ WatchOutcome WatchJob(v1::JobService::Stub& job_service, const std::string& addr
       if (options.table_out == nullptr) continue;
       ClearProgress(options);
       const bool design = event.cycle().design_set();
+      const bool point = event.cycle().pareto();
       if (!header_printed) {
-        std::fprintf(options.table_out, "%s\n", (design ? DesignWatchHeader() : CycleTableHeader()).c_str());
+        std::fprintf(options.table_out, "%s\n",
+                     (point ? ParetoWatchHeader() : design ? DesignWatchHeader() : CycleTableHeader()).c_str());
         header_printed = true;
       }
       std::fprintf(options.table_out, "%s\n",
-                   (design ? DesignWatchRow(event.cycle()) : CycleTableRow(event.cycle())).c_str());
+                   (point    ? ParetoWatchRow(event.cycle())
+                    : design ? DesignWatchRow(event.cycle())
+                             : CycleTableRow(event.cycle()))
+                       .c_str());
       std::fflush(options.table_out);
     } else if (event.has_summary()) {
       outcome.summary = event.summary();

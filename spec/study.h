@@ -10,6 +10,7 @@
 
 #include "spec/design_set.h"
 #include "spec/expression.h"
+#include "spec/pareto.h"
 #include "spec/scene.h"
 #include "spec/units.h"
 
@@ -182,6 +183,8 @@ struct Study {
   AnalysisOverrides analysis;
   // Analyses at these designs instead of an optimization (empty: optimize).
   DesignSet design_set;
+  // A Pareto front instead of one optimum (spec/pareto.h).
+  Pareto pareto;
   std::vector<XyPlot> plots;
 
   // SI parameter values of the scene at scaled design x (others at default).

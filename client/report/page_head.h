@@ -17,6 +17,7 @@ svg .tick { font-size: 11px; fill: #333; }
 svg .axis-label { font-size: 12px; fill: #222; }
 svg .legend { font-size: 12px; fill: #222; }
 svg .ref-label { font-size: 10px; fill: #555; }
+svg .point-label { font-size: 11px; fill: #222; }
 svg .note, svg .no-data { font-size: 11px; fill: #555; }
 )css";
 

@@ -87,6 +87,7 @@ void AppendSeries(std::string& out, const PlotSeries& s, const Frame& f, bool& a
   };
   std::vector<std::pair<double, double>> markers;
   std::vector<double> floor_markers;
+  std::string labels;
   for (std::size_t i = 0; i < n; ++i) {
     const double fx = f.x.Fraction(s.x[i]);
     const double fy = f.y.Fraction(s.y[i]);
@@ -94,6 +95,10 @@ void AppendSeries(std::string& out, const PlotSeries& s, const Frame& f, bool& a
       const std::pair<double, double> p{f.Px(fx), f.Py(fy)};
       segment.push_back(p);
       markers.push_back(p);
+      if (i < s.point_labels.size() && !s.point_labels[i].empty()) {
+        AppendText(labels, p.first + s.marker_radius_px + 2, p.second - s.marker_radius_px - 2, "start",
+                   s.point_labels[i], "class=\"point-label\"");
+      }
       continue;
     }
     flush();
@@ -103,6 +108,7 @@ void AppendSeries(std::string& out, const PlotSeries& s, const Frame& f, bool& a
   }
   flush();
   for (const auto& [px, py] : markers) AppendMarker(out, s.marker, s.marker_radius_px, s.color, px, py);
+  out += labels;
   for (double px : floor_markers) AppendFloorMarker(out, s.color, px, f.bottom);
   if (!floor_markers.empty()) any_floor = true;
 }

@@ -26,6 +26,9 @@ struct PlotSeries {
   double marker_radius_px = 3.0;
   std::string dash;               // stroke-dasharray, empty: solid
   bool in_legend = true;         // series without points are left out anyway
+  // Optional, one per point: a short text drawn above and right of its
+  // marker (a Pareto front's point numbers). Empty: no labels.
+  std::vector<std::string> point_labels;
 };
 
 // A horizontal line at a fixed y (a threshold), dashed, labelled at its

@@ -78,6 +78,25 @@ absl::StatusOr<std::unique_ptr<Job>> Job::Create(std::shared_ptr<const spec::Stu
                                                  std::unique_ptr<lp::LpSolver> lp_solver,
                                                  std::optional<slp::SlpOptions> options) {
   MBOPT_CHECK(study != nullptr, "Job::Create needs a study");
+  if (study->pareto.enabled()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        study->name, " asks for a Pareto front, which needs an LP solver for each point's run: create its job "
+                     "with an LP solver factory"));
+  }
+  return CreateWith(std::move(study), std::move(lp_solver), nullptr, std::move(options));
+}
+
+absl::StatusOr<std::unique_ptr<Job>> Job::Create(std::shared_ptr<const spec::Study> study,
+                                                 const LpSolverFactory& make_lp_solver,
+                                                 std::optional<slp::SlpOptions> options) {
+  MBOPT_CHECK(study != nullptr && make_lp_solver, "Job::Create needs a study and an LP solver factory");
+  return CreateWith(std::move(study), make_lp_solver(), make_lp_solver, std::move(options));
+}
+
+absl::StatusOr<std::unique_ptr<Job>> Job::CreateWith(std::shared_ptr<const spec::Study> study,
+                                                     std::unique_ptr<lp::LpSolver> lp_solver,
+                                                     const LpSolverFactory& make_lp_solver,
+                                                     std::optional<slp::SlpOptions> options) {
   MBOPT_ASSIGN_OR_RETURN(spec::StudyLayout layout, spec::MakeStudyLayout(*study));
   MBOPT_ASSIGN_OR_RETURN(slp::ProblemSpec problem, ProblemSpecFromStudy(*study, layout));
   slp::SlpOptions settings;
@@ -97,37 +116,58 @@ absl::StatusOr<std::unique_ptr<Job>> Job::Create(std::shared_ptr<const spec::Stu
     design_set = std::make_unique<DesignSetRun>(problem, std::move(designs), std::move(row_constraints),
                                                 static_cast<int>(study->constraints.size()));
   }
+  std::unique_ptr<ParetoRun> pareto;
+  if (study->pareto.enabled()) {
+    ParetoSetup setup;
+    setup.problem = problem;
+    setup.options = settings;
+    for (const spec::ConstraintRow& row : layout.rows) setup.row_constraints.push_back(row.constraint);
+    setup.num_constraints = static_cast<int>(study->constraints.size());
+    setup.traded_constraint = study->pareto.constraint;
+    setup.points = study->pareto.points;
+    absl::StatusOr<std::unique_ptr<ParetoRun>> made = ParetoRun::Create(std::move(setup), make_lp_solver);
+    if (!made.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(study->source_file, ": pareto: ", made.status().message()));
+    }
+    pareto = *std::move(made);
+  }
   auto optimizer = std::make_unique<slp::SlpOptimizer>(std::move(problem), settings, std::move(lp_solver));
   std::unique_ptr<Job> job(new Job(std::move(study), std::make_shared<const spec::StudyLayout>(std::move(layout)),
                                    settings, std::move(optimizer)));
   job->design_set_ = std::move(design_set);
+  job->pareto_ = std::move(pareto);
   return job;
 }
 
 JobState Job::state() const {
+  if (pareto_ != nullptr) return pareto_->done() ? JobState::kCompleted : JobState::kRunning;
   if (design_set_ == nullptr) return JobStateOf(optimizer_->state());
   return design_set_->done() ? JobState::kCompleted : JobState::kRunning;
 }
 
 int Job::cycles_completed() const {
+  if (pareto_ != nullptr) return pareto_->points_done();
   return design_set_ == nullptr ? optimizer_->cycles_completed() : static_cast<int>(design_set_->designs_done());
 }
 
 std::int64_t Job::analyses_used() const {
+  if (pareto_ != nullptr) return pareto_->analyses_used();
   return design_set_ == nullptr ? optimizer_->analyses_used() : design_set_->analyses_used();
 }
 
-std::string Job::end_reason() const { return design_set_ == nullptr ? optimizer_->end_reason() : ""; }
+std::string Job::end_reason() const { return is_design_set() ? "" : optimizer_->end_reason(); }
 
 std::vector<std::string> Job::result_notes() const {
-  return design_set_ == nullptr ? optimizer_->result_notes() : std::vector<std::string>{};
+  return is_design_set() ? std::vector<std::string>{} : optimizer_->result_notes();
 }
 
 std::vector<slp::AnalysisRequest> Job::PendingRequests() const {
+  if (pareto_ != nullptr) return pareto_->PendingRequests();
   return design_set_ == nullptr ? optimizer_->PendingRequests() : design_set_->PendingRequests();
 }
 
 bool Job::IsPending(std::int64_t request_id) const {
+  if (pareto_ != nullptr) return pareto_->IsPending(request_id);
   return design_set_ == nullptr ? optimizer_->IsPending(request_id) : design_set_->IsPending(request_id);
 }
 
@@ -211,7 +251,9 @@ absl::StatusOr<AnalysisRecord> Job::Intake(AnalysisRecord candidate) const {
 }
 
 absl::StatusOr<std::vector<slp::CycleRecord>> Job::Apply(const AnalysisRecord& record) {
-  if (design_set_ != nullptr) {
+  if (pareto_ != nullptr) {
+    MBOPT_RETURN_IF_ERROR(pareto_->Submit(record));
+  } else if (design_set_ != nullptr) {
     MBOPT_RETURN_IF_ERROR(design_set_->Submit(record));
   } else {
     MBOPT_RETURN_IF_ERROR(optimizer_->SubmitResult(ResultOf(record, optimizer_->spec())));
@@ -220,6 +262,7 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Apply(const AnalysisRecord& r
     ++failures_by_kind_[record.failure.kind];
     last_failure_ = record.failure;
   }
+  if (pareto_ != nullptr) return pareto_->TakeNewRecords();
   return design_set_ != nullptr ? design_set_->TakeNewRecords() : optimizer_->TakeNewRecords();
 }
 

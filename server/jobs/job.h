@@ -1,8 +1,9 @@
 // One optimization: a study (or, for analytic test problems, a bare
 // problem), its layout, and the SLP optimizer that runs it; or, for a study
 // with a design set (a sweep or sample), the DesignSetRun that analyses its
-// designs in the optimizer's place (design_set_run.h), behind the same
-// calls. The Job is the only thing that drives the SLP core, in one of two
+// designs in the optimizer's place (design_set_run.h); or, for a study with
+// a Pareto front, the ParetoRun of its points' SLP runs (pareto_run.h);
+// all behind the same calls. The Job is the only thing that drives the SLP core, in one of two
 // ways that share every step that matters:
 //  - Run(evaluator): the job asks, the evaluator answers each batch, and the
 //    job goes on until the optimizer ends (in-process runs, tests, tools);
@@ -36,6 +37,7 @@
 #include "server/jobs/design_set_run.h"
 #include "server/jobs/evaluator.h"
 #include "server/jobs/job_state.h"
+#include "server/jobs/pareto_run.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/slp_optimizer.h"
 #include "spec/layout.h"
@@ -68,6 +70,11 @@ class Job {
   static absl::StatusOr<std::unique_ptr<Job>> Create(std::shared_ptr<const spec::Study> study,
                                                      std::unique_ptr<lp::LpSolver> lp_solver,
                                                      std::optional<slp::SlpOptions> options = std::nullopt);
+  // The same with an LP solver made for each SLP run: a study with a Pareto
+  // front has one run per point (the two calls above refuse such a study).
+  static absl::StatusOr<std::unique_ptr<Job>> Create(std::shared_ptr<const spec::Study> study,
+                                                     const LpSolverFactory& make_lp_solver,
+                                                     std::optional<slp::SlpOptions> options = std::nullopt);
   // A job for a problem that has no study (analytic problems in tests).
   static absl::StatusOr<std::unique_ptr<Job>> CreateForProblem(slp::ProblemSpec problem, slp::SlpOptions options,
                                                                std::unique_ptr<lp::LpSolver> lp_solver);
@@ -83,7 +90,10 @@ class Job {
   // The SLP core; for a design set it is made but never driven (what the
   // job tells goes through the calls below, which know both).
   const slp::SlpOptimizer& optimizer() const { return *optimizer_; }
-  bool is_design_set() const { return design_set_ != nullptr; }
+  // Whether the job's records are designs, one each (a sweep, a sample or
+  // the points of a Pareto front) rather than an optimizer's cycles.
+  bool is_design_set() const { return design_set_ != nullptr || pareto_ != nullptr; }
+  bool is_pareto() const { return pareto_ != nullptr; }
   bool running() const { return state() == JobState::kRunning; }
   // kRunning, or how the run ended (a design set: kCompleted).
   JobState state() const;
@@ -141,12 +151,19 @@ class Job {
  private:
   Job(std::shared_ptr<const spec::Study> study, std::shared_ptr<const spec::StudyLayout> layout,
       slp::SlpOptions options, std::unique_ptr<slp::SlpOptimizer> optimizer);
+  // `lp_solver` for the optimizer of the study's problem; `make_lp_solver`
+  // (null unless the study has a Pareto front) for the runs of its points.
+  static absl::StatusOr<std::unique_ptr<Job>> CreateWith(std::shared_ptr<const spec::Study> study,
+                                                         std::unique_ptr<lp::LpSolver> lp_solver,
+                                                         const LpSolverFactory& make_lp_solver,
+                                                         std::optional<slp::SlpOptions> options);
 
   std::shared_ptr<const spec::Study> study_;  // never null
   std::shared_ptr<const spec::StudyLayout> layout_;
   slp::SlpOptions options_;
   std::unique_ptr<slp::SlpOptimizer> optimizer_;
   std::unique_ptr<DesignSetRun> design_set_;  // null: an optimization
+  std::unique_ptr<ParetoRun> pareto_;         // null: not a Pareto front
   std::map<spec::FailureKind, std::int64_t> failures_by_kind_;
   spec::AnalysisFailure last_failure_;
 };

@@ -15,7 +15,11 @@ namespace {
 // failure_kind after restoration. Only such records are written as 4: an optimization's records
 // stay version 3 byte for byte, so a job logged before resumes (its replay
 // compares the bytes).
-constexpr unsigned char kVersion = 4;
+// 5: the records of a Pareto front's points: a design set's record and the
+// point's level, value, run state, cycles and analyses. Only those are
+// written as 5, so a design set logged before resumes byte for byte.
+constexpr unsigned char kVersion = 5;
+constexpr unsigned char kDesignSetVersion = 4;
 constexpr unsigned char kOptimizationVersion = 3;
 constexpr unsigned char kOldestReadVersion = 2;
 
@@ -114,7 +118,9 @@ class Reader {
 
 std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   Writer w;
-  w.out().push_back(static_cast<char>(r.design_set ? kVersion : kOptimizationVersion));
+  w.out().push_back(static_cast<char>(r.pareto       ? kVersion
+                                      : r.design_set ? kDesignSetVersion
+                                                     : kOptimizationVersion));
   w.Int(r.cycle);
   w.Int(r.attempt);
   w.Bool(r.accepted);
@@ -143,10 +149,17 @@ std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   w.Int64(r.analyses_total);
   w.Bool(r.converged);
   w.Bool(r.restoration);
-  if (r.design_set) {
+  if (r.design_set || r.pareto) {  // a Pareto point is a design set's record and more
     w.U32(static_cast<std::uint32_t>(r.constraint_violations.size()));
     for (double v : r.constraint_violations) w.Double(v);
     w.String(r.failure_kind);
+  }
+  if (r.pareto) {
+    w.Double(r.pareto_level_si);
+    w.Double(r.pareto_value_si);
+    w.String(r.pareto_state);
+    w.Int(r.pareto_cycles);
+    w.Int64(r.pareto_analyses);
   }
   return std::move(w.out());
 }
@@ -194,6 +207,14 @@ absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
     const Eigen::VectorXd violations = r.Vector();
     c.constraint_violations.assign(violations.data(), violations.data() + violations.size());
     c.failure_kind = r.String();
+  }
+  if (version >= 5) {
+    c.pareto = true;
+    c.pareto_level_si = r.Double();
+    c.pareto_value_si = r.Double();
+    c.pareto_state = r.String();
+    c.pareto_cycles = r.Int();
+    c.pareto_analyses = r.Int64();
   }
   if (!r.ok() || !r.at_end()) {
     return absl::DataLossError(absl::StrCat("a cycle record of ", bytes.size(), " bytes is truncated or too long"));

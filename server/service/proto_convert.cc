@@ -33,6 +33,7 @@ v1::JobSummary ToProto(const jobs::manager::JobSummaryData& s) {
   out.set_created_unix_ms(s.created_unix_ms);
   out.set_max_cycles(s.max_cycles);
   out.set_design_set(s.design_set);
+  out.set_pareto(s.pareto);
   for (const auto& [kind, count] : s.failed_analyses_by_kind) (*out.mutable_failed_analyses_by_kind())[kind] = count;
   return out;
 }
@@ -110,6 +111,14 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
   for (double v : r.constraint_violations) out.add_constraint_violations(v);
   out.set_failure_kind(r.failure_kind);
   out.set_design_set(r.design_set);
+  if (r.pareto) {
+    out.set_pareto(true);
+    out.set_pareto_level_si(r.pareto_level_si);
+    out.set_pareto_value_si(r.pareto_value_si);
+    out.set_pareto_state(r.pareto_state);
+    out.set_pareto_cycles(r.pareto_cycles);
+    out.set_pareto_analyses(r.pareto_analyses);
+  }
   return out;
 }
 

@@ -143,6 +143,19 @@ struct CycleRecord {
   bool design_set = false;  // the record of one design of a design set
   std::vector<double> constraint_violations;
   std::string failure_kind;
+  // Set only in the records of a Pareto front's points (one record per
+  // point, design_set set as well: server/jobs/pareto_run.h): x0 is the
+  // point's result, objective_x0 the study's F there, max_violation_x0 the
+  // point's run's own maxg; the traded constraint's level for this point
+  // and its largest value at the result (SI; NaN for an anchor's level and
+  // where no design was analysed), the run's end (RunStateName, or
+  // "not_run"), and the run's cycles and analyses.
+  bool pareto = false;
+  double pareto_level_si = 0;
+  double pareto_value_si = 0;
+  std::string pareto_state;
+  int pareto_cycles = 0;
+  std::int64_t pareto_analyses = 0;
 };
 
 class SlpOptimizer {

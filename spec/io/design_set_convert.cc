@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "spec/io/pareto_convert.h"
 #include "spec/limits.h"
 
 namespace mbopt::spec::io {
@@ -160,7 +161,7 @@ std::string DescribeStudyForm(const Study& study) {
   };
   switch (set.form) {
     case DesignSet::Form::kNone:
-      return "an optimization";
+      return study.pareto.enabled() ? DescribePareto(study) : "an optimization";
     case DesignSet::Form::kSweep:
       if (set.axes.size() == 1) return absl::StrCat("a sweep of ", axis(set.axes[0]));
       return absl::StrCat("a grid of ", axis(set.axes[0]), " by ", axis(set.axes[1]), ", ", set.size(), " designs");

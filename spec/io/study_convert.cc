@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "spec/io/declared_name.h"
 #include "spec/io/design_set_convert.h"
+#include "spec/io/pareto_convert.h"
 #include "spec/layout.h"
 #include "spec/limits.h"
 #include "spec/units.h"
@@ -816,6 +817,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
   }
 
   study.design_set = ConvertDesignSet(m, study, where, errors);
+  study.pareto = ConvertPareto(m, study, where, errors);
 
   if (errors->empty()) {
     // Catch what only the layout sees (e.g. minimize on a multi-series output).

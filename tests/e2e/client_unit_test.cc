@@ -14,6 +14,7 @@
 #include "client/job_format.h"
 #include "client/json_writer.h"
 #include "client/local_cluster.h"
+#include "client/pareto_format.h"
 #include "worker/service/backoff.h"
 #include "worker/service/batch_log_line.h"
 #include "worker/service/result_size.h"
@@ -250,6 +251,86 @@ TEST(DesignSetFormat, TableAndJsonListEveryDesign) {
   EXPECT_NE(json.find("\"status\": \"integrator\""), std::string::npos) << json;
   EXPECT_EQ(json.find("\"history\""), std::string::npos) << "a sweep has no optimization history\n" << json;
   EXPECT_NE(client::DesignWatchRow(job.cycles(1)).find("integrator"), std::string::npos);
+}
+
+// A front of four points against "travel" (in mm): 1 and 4 the ends, 2
+// dominated by 3 (worse in both), 3 on the front; or 2 infeasible.
+v1::GetJobResponse FourPointFront(bool infeasible_second = false) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  v1::GetJobResponse job;
+  job.mutable_study()->mutable_pareto()->set_against("travel");
+  v1::Constraint* travel = job.mutable_study()->add_constraints();
+  travel->set_name("travel");
+  travel->set_unit("mm");
+  job.mutable_study()->add_constraints()->set_name("stroke");
+  v1::JobSummary* s = job.mutable_summary();
+  s->set_job_id("job-5");
+  s->set_state(v1::JOB_STATE_COMPLETED);
+  s->set_design_set(true);
+  s->set_pareto(true);
+  s->set_cycles(4);
+  s->set_max_cycles(4);
+  s->set_objective_unit("m/s^2");
+  s->add_design_names("x1");
+  s->add_design_units("N/m");
+  const double objective[] = {1.0, 1.6, 1.5, 2.0};
+  const double value_m[] = {0.004, 0.003, 0.0025, 0.001};
+  const double level_m[] = {kNaN, 0.003, 0.002, kNaN};
+  for (int k = 0; k < 4; ++k) {
+    v1::CycleRecord* r = job.add_cycles();
+    r->set_cycle(k + 1);
+    r->set_design_set(true);
+    r->set_pareto(true);
+    r->set_accepted(!(infeasible_second && k == 1));
+    if (!r->accepted()) r->set_rejection_reason("no feasible design: maxg 0.2 at the best design");
+    r->add_x_trial_physical(10.0 * (k + 1));
+    r->set_objective_trial(objective[k]);
+    r->set_max_violation_trial(r->accepted() ? -0.01 : 0.2);
+    r->set_pareto_value_si(value_m[k]);
+    r->set_pareto_level_si(level_m[k]);
+    r->set_pareto_state("converged");
+    r->set_pareto_cycles(3);
+    r->add_constraint_violations(0.1);
+    r->add_constraint_violations(-0.5);
+  }
+  return job;
+}
+
+TEST(ParetoFormat, CsvListsThePointsInTheConstraintsUnitWithDominanceDecided) {
+  const v1::GetJobResponse job = FourPointFront();
+  ASSERT_TRUE(client::IsParetoJob(job));
+  EXPECT_EQ(client::ResultsCsv(job),
+            "point,level,objective,travel,max_violation,run_state,cycles,analyses,x1,status,reason\n"
+            "1,,1,4,-0.01,converged,3,0,10,front,\n"
+            "2,3,1.6000000000000001,3,-0.01,converged,3,0,20,dominated,\n"
+            "3,2,1.5,2.5,-0.01,converged,3,0,30,front,\n"
+            "4,,2,1,-0.01,converged,3,0,40,front,\n");
+}
+
+TEST(ParetoFormat, AnInfeasiblePointIsNeitherOnTheFrontNorDominated) {
+  const v1::GetJobResponse job = FourPointFront(/*infeasible_second=*/true);
+  const std::string table = client::ResultsTable(job);
+  EXPECT_NE(table.find("points:        4 of 4 on the Pareto front computed"), std::string::npos) << table;
+  EXPECT_NE(table.find("level [mm]"), std::string::npos) << table;
+  EXPECT_NE(table.find("travel [mm]"), std::string::npos) << table;
+  EXPECT_NE(table.find("  infeasible\n"), std::string::npos) << table;
+  EXPECT_EQ(table.find("dominated"), std::string::npos) << table;
+  EXPECT_NE(table.find("point 2: no feasible design"), std::string::npos) << table;
+}
+
+TEST(ParetoFormat, OnePointInFullOrWhichPointsThereAre) {
+  const v1::GetJobResponse job = FourPointFront();
+  absl::StatusOr<std::string> point = client::ParetoPointText(job, 3);
+  ASSERT_TRUE(point.ok()) << point.status();
+  EXPECT_NE(point->find("point 3 of 4 (front)"), std::string::npos) << *point;
+  EXPECT_NE(point->find("level:       travel <= 2 mm"), std::string::npos) << *point;
+  EXPECT_NE(point->find("  stroke       -0.5"), std::string::npos) << *point;
+  absl::StatusOr<std::string> json = client::ParetoPointJson(job, 3);
+  ASSERT_TRUE(json.ok());
+  EXPECT_NE(json->find("\"status\": \"front\""), std::string::npos) << *json;
+  absl::StatusOr<std::string> missing = client::ParetoPointText(job, 5);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().message(), "--point 5: job job-5 has points 1 to 4 (of 4)");
 }
 
 TEST(Backoff, GrowsGeometricallyUpToTheCapWithBoundedJitter) {

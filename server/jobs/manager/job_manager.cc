@@ -301,7 +301,7 @@ absl::StatusOr<std::string> JobManager::Submit(const std::string& study_bytes, c
         offered.empty() ? "no drivers" : absl::StrCat("\"", absl::StrJoin(offered, "\", \""), "\""),
         " (a worker offers drivers with mbopt-worker serve --drivers FILE)"));
   }
-  MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study, options_.make_lp_solver()));
+  MBOPT_ASSIGN_OR_RETURN(std::unique_ptr<jobs::Job> job, jobs::Job::Create(study, options_.make_lp_solver));
   // Decoding a large study takes a while: the admission decision waits for
   // it outside the lock that admissions after every result batch take too.
   std::lock_guard<std::mutex> admit_lock(admit_mutex_);
@@ -400,7 +400,7 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why, cons
     FailJobLocked(entry, message);
     return absl::FailedPreconditionError(message);
   }
-  absl::StatusOr<std::unique_ptr<jobs::Job>> job = jobs::Job::Create(entry.study, options_.make_lp_solver());
+  absl::StatusOr<std::unique_ptr<jobs::Job>> job = jobs::Job::Create(entry.study, options_.make_lp_solver);
   if (!job.ok()) {
     FailJobLocked(entry, absl::StrCat("cannot resume: ", job.status().message()));
     return job.status();

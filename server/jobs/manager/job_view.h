@@ -44,6 +44,8 @@ struct JobSummaryData {
   // A design set (sweep or sample): cycles are its designs done and
   // max_cycles all of them.
   bool design_set = false;
+  // A Pareto front (design_set is set too): cycles are its points done.
+  bool pareto = false;
 };
 
 // What a client needs to show a job's records with names and units.

@@ -61,6 +61,12 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
       s.design_set = true;
       s.max_cycles = static_cast<int>(entry.study->design_set.size());
     }
+    // A Pareto front's records are its points, one each.
+    if (entry.study->pareto.enabled()) {
+      s.design_set = true;
+      s.pareto = true;
+      s.max_cycles = entry.study->pareto.points;
+    }
     design.resize(static_cast<Eigen::Index>(entry.study->variables.size()));
     for (size_t i = 0; i < entry.study->variables.size(); ++i) {
       const spec::DesignVariable& v = entry.study->variables[i];

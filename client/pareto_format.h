@@ -1,0 +1,56 @@
+// How the CLI shows a Pareto front's job (docs/study.md, "Pareto fronts"):
+// one row per point with its level, both objectives, its run's end and
+// whether it is on the front, dominated, infeasible, failed or not run, as
+// a plain table, CSV or JSON (`mbopt results`, `mbopt run`); and one
+// point's full results (`mbopt results JOB --point K`). Pure formatting; no
+// I/O.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "mbopt/v1/service.pb.h"
+
+namespace mbopt::client {
+
+// The job computes a Pareto front (its study has a `pareto` section).
+bool IsParetoJob(const v1::GetJobResponse& job);
+
+// One point as the tables show it, the traded constraint's values in its
+// unit. status: "front", "dominated", "infeasible", "failed" or "not run".
+struct ParetoPointRow {
+  int point = 0;  // 1-based
+  const v1::CycleRecord* record = nullptr;
+  double objective = 0;  // as reported (a maximized value as itself)
+  double value = 0;      // the traded constraint's largest value, in its unit
+  double level = 0;      // its level at this point, in its unit; NaN at the anchors
+  std::string status;
+};
+
+// The watch's lines as each point's record arrives: "point" (1-based), F,
+// the traded constraint's largest value and the level (SI: the watch has
+// no study), the run's end and its cycles.
+std::string ParetoWatchHeader();
+std::string ParetoWatchRow(const v1::CycleRecord& record);
+
+// The traded constraint's name and unit ("" for SI), and the points in
+// their order with dominance decided among the usable ones.
+struct ParetoFront {
+  std::string against;
+  std::string unit;
+  std::vector<ParetoPointRow> points;
+};
+ParetoFront FrontOfJob(const v1::GetJobResponse& job);
+
+std::string ParetoTable(const v1::GetJobResponse& job);
+std::string ParetoCsv(const v1::GetJobResponse& job);
+std::string ParetoJson(const v1::GetJobResponse& job, const std::string& database = "");
+
+// Point `point` (1-based) in full: its design, its values, each
+// constraint's largest normalized value, its run; as text or JSON.
+// InvalidArgument naming the points there are when it has no such point.
+absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int point);
+absl::StatusOr<std::string> ParetoPointJson(const v1::GetJobResponse& job, int point);
+
+}  // namespace mbopt::client

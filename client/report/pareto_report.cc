@@ -1,0 +1,166 @@
+#include "client/report/pareto_report.h"
+
+#include <cmath>
+#include <string>
+
+#include "client/report/html_escape.h"
+#include "client/report/number_format.h"
+#include "client/report/page_head.h"
+#include "client/report/svg_line_plot.h"
+
+namespace mbopt::report {
+namespace {
+
+constexpr const char* kStyle = R"css(
+body { font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; color: #222;
+       margin: 24px; max-width: 1180px; }
+h1 { font-size: 22px; margin-bottom: 4px; }
+h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccc; }
+p.description, p.note { color: #555; }
+p.note { font-size: 13px; }
+table { border-collapse: collapse; font-size: 13px; margin: 8px 0; }
+th, td { border: 1px solid #ccc; padding: 3px 7px; text-align: left; }
+th { background: #f2f2f2; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+td.violated { color: #b00020; font-weight: bold; }
+tr.failed td { background: #fdecea; }
+tr.dominated td { color: #777; }
+tr.chosen td { background: #fff6d5; }
+div.wide { overflow-x: auto; }
+)css";
+
+using Point = ParetoReportData::Point;
+
+std::string WithUnit(const std::string& name, const std::string& unit) {
+  return unit.empty() ? name : name + " [" + unit + "]";
+}
+
+std::string Cell(double value, bool violated_above_zero = false) {
+  const bool violated = violated_above_zero && std::isfinite(value) && value > 0;
+  return std::string("<td class=\"num") + (violated ? " violated" : "") + "\">" +
+         EscapeHtml(FormatValue(value, 6)) + "</td>";
+}
+
+// The points of one status as one series: the front joined by a line in
+// the order of the points, the others as markers only.
+PlotSeries SeriesOf(const ParetoReportData& data, const std::string& status, const std::string& name,
+                    const std::string& color, MarkerShape marker) {
+  PlotSeries s;
+  s.name = name;
+  s.color = color;
+  s.marker = marker;
+  s.draw_line = status == "front";
+  s.marker_radius_px = 4.0;
+  for (const Point& p : data.points) {
+    if (p.status != status) continue;
+    s.x.push_back(p.value);
+    s.y.push_back(p.objective);
+    s.point_labels.push_back(std::to_string(p.index));
+  }
+  return s;
+}
+
+std::string FrontPlot(const ParetoReportData& data) {
+  PlotSpec spec;
+  spec.title = "Pareto front: objective F against the largest value of " + data.against;
+  spec.x_label = WithUnit(data.against, data.against_unit);
+  spec.y_label = WithUnit("F", data.objective_unit);
+  spec.height_px = 420.0;
+  spec.series.push_back(SeriesOf(data, "front", "on the front", "#1f77b4", MarkerShape::kCircle));
+  spec.series.push_back(SeriesOf(data, "dominated", "dominated", "#7f7f7f", MarkerShape::kHollowCircle));
+  spec.series.push_back(SeriesOf(data, "infeasible", "infeasible (its level not met)", "#b00020",
+                                 MarkerShape::kHollowCircle));
+  for (const Point& p : data.points) {
+    if (p.index != data.chosen) continue;
+    PlotSeries chosen;
+    chosen.name = "chosen: point " + std::to_string(p.index);
+    chosen.color = "#ff7f0e";
+    chosen.draw_line = false;
+    chosen.marker = MarkerShape::kHollowCircle;
+    chosen.marker_radius_px = 9.0;
+    chosen.x = {p.value};
+    chosen.y = {p.objective};
+    spec.series.push_back(std::move(chosen));
+  }
+  return "<div class=\"figure\">\n" + RenderLinePlotSvg(spec) + "</div>\n";
+}
+
+std::string PointsTable(const ParetoReportData& data) {
+  std::string out = "<div class=\"wide\">\n<table>\n<thead><tr><th>point</th>";
+  out += "<th>" + EscapeHtml(WithUnit("level", data.against_unit)) + "</th>";
+  out += "<th>" + EscapeHtml(WithUnit("F", data.objective_unit)) + "</th>";
+  out += "<th>" + EscapeHtml(WithUnit(data.against, data.against_unit)) + "</th>";
+  out += "<th>maxg</th><th>run</th><th>cycles</th>";
+  for (size_t v = 0; v < data.variable_names.size(); ++v) {
+    out += "<th>" + EscapeHtml(WithUnit(data.variable_names[v], data.variable_units[v])) + "</th>";
+  }
+  out += "<th>status</th></tr></thead>\n<tbody>\n";
+  for (const Point& p : data.points) {
+    const bool failed = p.status == "failed" || p.status == "not run" || p.status == "infeasible";
+    out += p.index == data.chosen       ? "<tr class=\"chosen\">"
+           : failed                     ? "<tr class=\"failed\">"
+           : p.status == "dominated"    ? "<tr class=\"dominated\">"
+                                        : "<tr>";
+    out += "<td class=\"num\">" + std::to_string(p.index) + "</td>";
+    out += Cell(p.level) + Cell(p.objective) + Cell(p.value) + Cell(p.max_violation, true);
+    out += "<td>" + EscapeHtml(p.run_state) + "</td><td class=\"num\">" + std::to_string(p.cycles) + "</td>";
+    for (size_t v = 0; v < data.variable_names.size(); ++v) {
+      out += Cell(v < p.design.size() && p.status != "not run" ? p.design[v] : std::nan(""));
+    }
+    out += "<td>" + EscapeHtml(p.status) + (p.reason.empty() ? "" : ": " + EscapeHtml(p.reason)) + "</td></tr>\n";
+  }
+  out += "</tbody>\n</table>\n</div>\n";
+  return out;
+}
+
+std::string ChosenPoint(const ParetoReportData& data) {
+  for (const Point& p : data.points) {
+    if (p.index != data.chosen) continue;
+    std::string out = "<h2>Chosen design: point " + std::to_string(p.index) + "</h2>\n<table>\n<tbody>\n";
+    for (size_t v = 0; v < data.variable_names.size(); ++v) {
+      out += "<tr><th>" + EscapeHtml(WithUnit(data.variable_names[v], data.variable_units[v])) + "</th>" +
+             Cell(v < p.design.size() ? p.design[v] : std::nan("")) + "</tr>\n";
+    }
+    out += "</tbody>\n</table>\n";
+    out += "<p class=\"note\">Each constraint's largest (g - limit) / scale against the study's limits "
+           "(the traded constraint's too): above 0 violated.</p>\n<table>\n<tbody>\n";
+    for (size_t c = 0; c < data.constraint_names.size(); ++c) {
+      out += "<tr><th>" + EscapeHtml(data.constraint_names[c]) + "</th>" +
+             Cell(c < p.constraints.size() ? p.constraints[c] : std::nan(""), true) + "</tr>\n";
+    }
+    out += "</tbody>\n</table>\n";
+    return out;
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string RenderParetoReportHtml(const ParetoReportData& data) {
+  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kStyle) + kPlotStyleCss);
+  out += "<table>\n<tbody>\n";
+  if (!data.job_id.empty()) out += "<tr><th>job</th><td>" + EscapeHtml(data.job_id) + "</td></tr>\n";
+  out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";
+  out += "<tr><th>points computed</th><td>" + std::to_string(data.points.size()) + " of " +
+         std::to_string(data.points_total) + "</td></tr>\n";
+  out += "<tr><th>traded against</th><td>the largest value of " + EscapeHtml(data.against) + "</td></tr>\n";
+  if (!data.message.empty()) out += "<tr><th>message</th><td>" + EscapeHtml(data.message) + "</td></tr>\n";
+  out += "</tbody>\n</table>\n";
+  out += "<h2>Pareto front</h2>\n";
+  if (data.points.empty()) {
+    out += "<p class=\"note\">No point has been computed yet.</p>\n";
+  } else {
+    out += "<p class=\"note\">Each point is one optimization: the least F with " + EscapeHtml(data.against) +
+           " held below the point's level (point 1: " + EscapeHtml(data.against) +
+           " free; the last point: its least value). Points are numbered as in the table; a point "
+           "another beats in both is dominated.</p>\n";
+    out += FrontPlot(data);
+  }
+  out += "<h2>Points</h2>\n";
+  out += PointsTable(data);
+  out += ChosenPoint(data);
+  out += "</body>\n</html>\n";
+  return out;
+}
+
+}  // namespace mbopt::report

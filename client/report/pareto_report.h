@@ -1,0 +1,52 @@
+// The report page of a Pareto front's job (docs/report.md, "Pareto
+// fronts"): the front drawn as the objective against the traded
+// constraint's largest value, every point labelled with its number, the
+// dominated and the failed points set apart, the chosen point (if one was
+// picked) marked; then the table of the points and, for the chosen one, its
+// design and its constraints. Plain data in, one self-contained HTML page
+// out.
+//
+// Units: the objective in `objective_unit`, the traded constraint's value
+// and levels in `against_unit`, designs in their variables' units,
+// constraint values normalized ((g - limit) / scale, > 0 violated).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace mbopt::report {
+
+struct ParetoReportData {
+  std::string job_id;
+  std::string study_name;
+  std::string description;
+  std::string state;
+  std::string message;
+  std::string objective_unit;
+  std::string against;       // the traded constraint's name
+  std::string against_unit;
+  int points_total = 0;
+  std::vector<std::string> variable_names;
+  std::vector<std::string> variable_units;
+  std::vector<std::string> constraint_names;
+
+  struct Point {
+    int index = 0;                  // 1-based
+    double level = 0;               // NaN at the two ends
+    double objective = 0;           // NaN without a result
+    double value = 0;               // the traded constraint's largest value
+    double max_violation = 0;
+    std::string run_state;          // "converged", ..., "not_run"
+    int cycles = 0;
+    std::string status;             // "front", "dominated", "infeasible", "failed", "not run"
+    std::string reason;
+    std::vector<double> design;     // physical, per variable
+    std::vector<double> constraints;  // per constraint name
+  };
+  std::vector<Point> points;  // in the points' order
+  int chosen = 0;             // 1-based; 0: none picked
+};
+
+std::string RenderParetoReportHtml(const ParetoReportData& data);
+
+}  // namespace mbopt::report

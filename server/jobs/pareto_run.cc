@@ -1,0 +1,319 @@
+#include "server/jobs/pareto_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "common/check.h"
+#include "server/jobs/analysis_gradients.h"
+#include "spec/pareto.h"
+
+namespace mbopt::jobs {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool SameBits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
+}
+
+Eigen::VectorXd Pick(const Eigen::VectorXd& values, const std::vector<int>& rows) {
+  Eigen::VectorXd picked(static_cast<Eigen::Index>(rows.size()));
+  for (size_t j = 0; j < rows.size(); ++j) picked[static_cast<Eigen::Index>(j)] = values[rows[j]];
+  return picked;
+}
+
+// Rows `rows` of a row-major matrix of `columns` columns, each times `factor`.
+std::vector<double> PickRows(const std::vector<double>& matrix, std::size_t columns, const std::vector<int>& rows,
+                             double factor) {
+  std::vector<double> picked;
+  picked.reserve(rows.size() * columns);
+  for (int row : rows) {
+    for (std::size_t c = 0; c < columns; ++c) picked.push_back(matrix[static_cast<std::size_t>(row) * columns + c] * factor);
+  }
+  return picked;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, LpSolverFactory make_lp_solver) {
+  if (setup.points < spec::kMinParetoPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("a Pareto front needs at least %d points, got %d", spec::kMinParetoPoints, setup.points));
+  }
+  if (!make_lp_solver) return absl::InvalidArgumentError("a Pareto front needs an LP solver for each of its points");
+  std::vector<int> traded;
+  for (size_t h = 0; h < setup.row_constraints.size(); ++h) {
+    if (setup.row_constraints[h] == setup.traded_constraint) traded.push_back(static_cast<int>(h));
+  }
+  if (traded.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the traded constraint ", setup.traded_constraint, " has no constraint rows"));
+  }
+  const slp::ProblemSpec& p = setup.problem;
+  for (int h : traded) {
+    if (p.constraint_limits[h] != p.constraint_limits[traded[0]] ||
+        p.constraint_scales[h] != p.constraint_scales[traded[0]]) {
+      return absl::InvalidArgumentError(absl::StrCat("the traded constraint's rows \"", p.constraint_names[traded[0]],
+                                                     "\" and \"", p.constraint_names[h],
+                                                     "\" have different limits; a front moves one limit"));
+    }
+  }
+  std::unique_ptr<ParetoRun> run(new ParetoRun(std::move(setup), std::move(make_lp_solver)));
+  run->traded_rows_ = std::move(traded);
+  run->traded_scale_ = run->setup_.problem.constraint_scales[run->traded_rows_[0]];
+  run->StartRuns();
+  return run;
+}
+
+ParetoRun::ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver)
+    : setup_(std::move(setup)), make_lp_solver_(std::move(make_lp_solver)) {
+  points_.resize(static_cast<std::size_t>(setup_.points));
+  const std::vector<int> parents = spec::ParetoWarmStartParents(setup_.points);
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    points_[k].parent = parents[k];
+    points_[k].level_si = kNaN;
+  }
+}
+
+bool ParetoRun::IsTraded(int row) const {
+  return setup_.row_constraints[static_cast<std::size_t>(row)] == setup_.traded_constraint;
+}
+
+void ParetoRun::StartRuns() {
+  const int last = setup_.points - 1;
+  for (int k : {0, last}) {
+    if (points_[static_cast<std::size_t>(k)].run == nullptr && !points_[static_cast<std::size_t>(k)].ended) {
+      Start(k, setup_.problem.initial);
+    }
+  }
+  const Point& first = points_.front();
+  const Point& least = points_.back();
+  if (!first.ended || !least.ended) return;
+  std::string reason;
+  if (!first.usable || !least.usable) {
+    reason = absl::StrCat("the front has no end to start from: point ", first.usable ? last + 1 : 1,
+                          " (an anchor) has no feasible result");
+  } else if (!(first.record.pareto_value_si > least.record.pareto_value_si)) {
+    reason = absl::StrFormat(
+        "the objectives do not conflict: where the objective is least, the traded constraint's largest value "
+        "(%.9g SI) is already no more than its least value (%.9g SI)",
+        first.record.pareto_value_si, least.record.pareto_value_si);
+  }
+  for (int k = 1; k < last; ++k) {
+    Point& point = points_[static_cast<std::size_t>(k)];
+    if (point.ended || point.run != nullptr) continue;
+    if (!reason.empty()) {
+      EndWithoutRun(k, reason);
+      continue;
+    }
+    const Point& parent = points_[static_cast<std::size_t>(point.parent)];
+    if (!parent.ended) continue;
+    point.level_si = spec::ParetoLevel(k, setup_.points, first.record.pareto_value_si, least.record.pareto_value_si);
+    Start(k, parent.record.x0);
+  }
+}
+
+void ParetoRun::Start(int k, const Eigen::VectorXd& initial) {
+  Point& point = points_[static_cast<std::size_t>(k)];
+  const slp::ProblemSpec& study = setup_.problem;
+  slp::ProblemSpec problem = study;
+  slp::SlpOptions options = setup_.options;
+  problem.initial = initial;
+  const bool leaves_out_traded = k == 0 || k == setup_.points - 1;
+  point.rows.clear();
+  for (int h = 0; h < study.num_constraints(); ++h) {
+    if (!leaves_out_traded || !IsTraded(h)) point.rows.push_back(h);
+  }
+  if (leaves_out_traded) {
+    problem.constraint_names.clear();
+    for (int h : point.rows) problem.constraint_names.push_back(study.constraint_names[static_cast<std::size_t>(h)]);
+    problem.constraint_limits = Pick(study.constraint_limits, point.rows);
+    problem.constraint_scales = Pick(study.constraint_scales, point.rows);
+  } else {
+    // An ordinary limit at the level, scaled as the study's layout scales a
+    // limit (spec/layout.cc), so a single run with this limit written in
+    // the study is the same problem.
+    const double scale = point.level_si != 0.0 ? std::abs(point.level_si) : 1.0;
+    for (int h : traded_rows_) {
+      problem.constraint_limits[h] = point.level_si;
+      problem.constraint_scales[h] = scale;
+    }
+  }
+  if (k == setup_.points - 1) {
+    // The traded constraint's largest value, in the study's scale of its
+    // rows so that F is of order one near the study's limit.
+    problem.num_objective_terms = static_cast<int>(traded_rows_.size());
+    problem.objective_form = traded_rows_.size() == 1 ? slp::ObjectiveForm::kScalar : slp::ObjectiveForm::kMinMax;
+    problem.objective_group_sizes.clear();
+    options.objective_target.reset();  // the study's target is for its own objective
+  }
+  const absl::Status valid = problem.Validate();
+  MBOPT_CHECK(valid.ok(), absl::StrCat("Pareto point ", k + 1, ": ", valid.message()).c_str());
+  point.problem = problem;
+  point.run = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, make_lp_solver_());
+}
+
+void ParetoRun::EndWithoutRun(int k, const std::string& reason) {
+  Point& point = points_[static_cast<std::size_t>(k)];
+  point.ended = true;
+  point.usable = false;
+  point.not_run_reason = reason;
+  slp::CycleRecord& r = point.record;
+  r.design_set = true;
+  r.pareto = true;
+  r.cycle = k + 1;
+  r.x0 = r.x_trial = setup_.problem.initial;
+  r.accepted = false;
+  r.rejection_reason = reason;
+  r.objective_x0 = r.objective_trial = r.objective_predicted = kNaN;
+  r.max_violation_x0 = r.max_violation_trial = kNaN;
+  r.objective_error = r.max_approximation_error = r.optimality_residual = kNaN;
+  r.constraint_violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
+  r.pareto_level_si = point.level_si;
+  r.pareto_value_si = kNaN;
+  r.pareto_state = "not_run";
+}
+
+void ParetoRun::End(int k) {
+  Point& point = points_[static_cast<std::size_t>(k)];
+  const slp::SlpOptimizer& run = *point.run;
+  point.ended = true;
+  const slp::DesignPoint best = run.best_design();
+  const Analysed* values = nullptr;
+  for (auto it = point.analysed.rbegin(); it != point.analysed.rend() && values == nullptr; ++it) {
+    if (SameBits(it->x, best.x)) values = &*it;
+  }
+  slp::CycleRecord& r = point.record;
+  r.design_set = true;
+  r.pareto = true;
+  r.cycle = k + 1;
+  r.x0 = r.x_trial = best.x;
+  r.objective_predicted = r.objective_error = r.max_approximation_error = r.optimality_residual = kNaN;
+  r.pareto_level_si = point.level_si;
+  r.pareto_state = slp::RunStateName(run.state());
+  r.pareto_cycles = run.cycles_completed();
+  r.pareto_analyses = run.analyses_used();
+  if (values == nullptr) {
+    r.objective_x0 = r.objective_trial = kNaN;
+    r.max_violation_x0 = r.max_violation_trial = kNaN;
+    r.constraint_violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
+    r.pareto_value_si = kNaN;
+  } else {
+    r.objective_x0 = r.objective_trial = values->objective;
+    r.max_violation_x0 = r.max_violation_trial = best.max_violation;
+    r.constraint_violations = values->violations;
+    r.pareto_value_si = values->traded_value_si;
+  }
+  point.usable = values != nullptr && run.state() != slp::RunState::kFailed &&
+                 best.max_violation <= setup_.options.convergence_violation_tolerance;
+  r.accepted = point.usable;
+  if (!point.usable) {
+    r.rejection_reason = run.state() == slp::RunState::kFailed || values == nullptr
+                             ? absl::StrCat("the run failed: ", run.end_reason())
+                             : absl::StrFormat("no feasible design: maxg %.4g at the best design", best.max_violation);
+  }
+}
+
+ParetoRun::Analysed ParetoRun::Analyse(const AnalysisRecord& record) const {
+  const slp::ProblemSpec& p = setup_.problem;
+  Analysed a;
+  a.x = Eigen::Map<const Eigen::VectorXd>(record.x_scaled.data(), static_cast<Eigen::Index>(record.x_scaled.size()));
+  const Eigen::Map<const Eigen::VectorXd> terms(record.objective_terms.data(),
+                                                static_cast<Eigen::Index>(record.objective_terms.size()));
+  a.objective = slp::ObjectiveValue(p, terms);
+  a.traded_value_si = -std::numeric_limits<double>::infinity();
+  a.violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
+  for (std::size_t h = 0; h < record.constraint_values.size(); ++h) {
+    const double g = record.constraint_values[h];
+    const auto row = static_cast<Eigen::Index>(h);
+    if (IsTraded(static_cast<int>(h))) a.traded_value_si = std::max(a.traded_value_si, g);
+    const int c = setup_.row_constraints[h];
+    if (c >= 0 && c < setup_.num_constraints) {
+      const double normalized = (g - p.constraint_limits[row]) / p.constraint_scales[row];
+      double& of_constraint = a.violations[static_cast<std::size_t>(c)];
+      of_constraint = std::isnan(of_constraint) ? normalized : std::max(of_constraint, normalized);
+    }
+  }
+  return a;
+}
+
+slp::AnalysisResult ParetoRun::ResultFor(const Point& point, const AnalysisRecord& record) const {
+  slp::AnalysisResult result;
+  result.request_id = record.request_id % kRequestStride;
+  result.outcome = record.ok() ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
+  result.failure_reason = record.failure.reason;
+  if (!record.ok()) return result;
+  const Eigen::Map<const Eigen::VectorXd> terms(record.objective_terms.data(),
+                                                static_cast<Eigen::Index>(record.objective_terms.size()));
+  const Eigen::Map<const Eigen::VectorXd> values(record.constraint_values.data(),
+                                                 static_cast<Eigen::Index>(record.constraint_values.size()));
+  const bool traded_objective = &point == &points_.back();
+  result.objective_terms = traded_objective ? Eigen::VectorXd(Pick(values, traded_rows_) / traded_scale_)
+                                            : Eigen::VectorXd(terms);
+  result.constraint_values = Pick(values, point.rows);
+  if (!record.objective_gradients.empty()) {
+    const std::size_t n = static_cast<std::size_t>(setup_.problem.num_variables());
+    const std::vector<double> objective_gradients =
+        traded_objective ? PickRows(record.constraint_gradients, n, traded_rows_, 1.0 / traded_scale_)
+                         : record.objective_gradients;
+    const std::vector<double> constraint_gradients = PickRows(record.constraint_gradients, n, point.rows, 1.0);
+    AttachGradients(point.problem, objective_gradients, constraint_gradients, &result);
+  }
+  return result;
+}
+
+std::vector<slp::AnalysisRequest> ParetoRun::PendingRequests() const {
+  std::vector<slp::AnalysisRequest> pending;
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Point& point = points_[k];
+    if (point.run == nullptr || point.ended) continue;
+    for (slp::AnalysisRequest request : point.run->PendingRequests()) {
+      request.id += static_cast<std::int64_t>(k) * kRequestStride;
+      pending.push_back(std::move(request));
+    }
+  }
+  return pending;
+}
+
+bool ParetoRun::IsPending(std::int64_t request_id) const {
+  if (request_id < 0) return false;
+  const std::int64_t k = request_id / kRequestStride;
+  if (k >= static_cast<std::int64_t>(points_.size())) return false;
+  const Point& point = points_[static_cast<std::size_t>(k)];
+  return point.run != nullptr && !point.ended && point.run->IsPending(request_id % kRequestStride);
+}
+
+absl::Status ParetoRun::Submit(const AnalysisRecord& record) {
+  if (!IsPending(record.request_id)) {
+    return absl::InvalidArgumentError(absl::StrCat("request ", record.request_id, " is not pending in the front"));
+  }
+  const int k = static_cast<int>(record.request_id / kRequestStride);
+  Point& point = points_[static_cast<std::size_t>(k)];
+  ++analyses_;
+  if (record.ok()) point.analysed.push_back(Analyse(record));
+  const absl::Status submitted = point.run->SubmitResult(ResultFor(point, record));
+  if (!submitted.ok()) return submitted;
+  point.run->TakeNewRecords();  // the run's own cycles are not logged (see the header)
+  if (point.run->state() != slp::RunState::kRunning) {
+    End(k);
+    StartRuns();
+  }
+  std::int64_t analyses_total = emitted_ == 0 ? 0 : points_[emitted_ - 1].record.analyses_total;
+  while (emitted_ < points_.size() && points_[emitted_].ended) {
+    slp::CycleRecord& r = points_[emitted_].record;
+    analyses_total += r.pareto_analyses;
+    r.analyses_total = analyses_total;
+    new_records_.push_back(r);
+    ++emitted_;
+  }
+  return absl::OkStatus();
+}
+
+std::vector<slp::CycleRecord> ParetoRun::TakeNewRecords() { return std::exchange(new_records_, {}); }
+
+}  // namespace mbopt::jobs

@@ -1,0 +1,121 @@
+// The run of a Pareto front (spec/pareto.h): one SLP run of the existing
+// core per point, all in one job. It plays the part the SLP core plays in an
+// optimization job and keeps its contract, as DesignSetRun does, so the job
+// manager, the store, the scheduler and resume need nothing new:
+//  - every point's run is a slp::SlpOptimizer of its own (own LP solver),
+//    whose problem is the study's with the traded constraint's rows left
+//    out (point 0), made the objective (the last point, a min-max over the
+//    rows, each divided by the rows' scale), or bounded at the point's level
+//    (the points between);
+//  - request ids: point k's request r is k * kRequestStride + r, so the
+//    runs' requests never collide and a result finds its run by its id;
+//  - a run starts when what it needs is known: the anchors at once, the
+//    others when both anchors and the point that warm-starts them
+//    (spec::ParetoWarmStartParents) have ended. Each run's state is a
+//    function of its own results only, so runs side by side on any number
+//    of workers, answered in any order, give the same front bit for bit;
+//  - one record per point (a design set's record with the Pareto fields,
+//    slp::CycleRecord), emitted in the points' order: point k's once points
+//    0..k have ended, so the record log does not depend on the order of
+//    results either, and a replay of the logged analyses emits it again.
+// The runs' own cycle records are not logged: the analyses are, and they
+// make every run again.
+//
+// Pure: no I/O, no clock, no threads.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "server/jobs/analysis_record.h"
+#include "server/lp/linear_program.h"
+#include "server/slp/options.h"
+#include "server/slp/problem.h"
+#include "server/slp/slp_optimizer.h"
+
+namespace mbopt::jobs {
+
+using LpSolverFactory = std::function<std::unique_ptr<lp::LpSolver>()>;
+
+struct ParetoSetup {
+  slp::ProblemSpec problem;  // the study's problem: every objective term and row
+  slp::SlpOptions options;   // the study's optimizer settings, for every run
+  // The study constraint of each row (spec::ConstraintRow::constraint), and
+  // how many the study has.
+  std::vector<int> row_constraints;
+  int num_constraints = 0;
+  int traded_constraint = -1;  // the constraint whose largest value is traded
+  int points = 0;              // >= 3
+};
+
+class ParetoRun {
+ public:
+  // Point k's request r has id k * kRequestStride + r: far more analyses than
+  // a run may use (JobRunOptions::max_analyses).
+  static constexpr std::int64_t kRequestStride = 1'000'000'000;
+
+  // InvalidArgument when the setup does not fit (no rows for the traded
+  // constraint, rows of different limits, too few points).
+  static absl::StatusOr<std::unique_ptr<ParetoRun>> Create(ParetoSetup setup, LpSolverFactory make_lp_solver);
+
+  std::vector<slp::AnalysisRequest> PendingRequests() const;
+  bool IsPending(std::int64_t request_id) const;
+  // One result (validated by the job's intake, in the study's shape).
+  // InvalidArgument for a request that is not pending.
+  absl::Status Submit(const AnalysisRecord& record);
+  std::vector<slp::CycleRecord> TakeNewRecords();
+
+  bool done() const { return emitted_ == points_.size(); }
+  int size() const { return static_cast<int>(points_.size()); }
+  int points_done() const { return static_cast<int>(emitted_); }
+  std::int64_t analyses_used() const { return analyses_; }
+
+ private:
+  // A design a run analysed, with what the point's record needs of it.
+  struct Analysed {
+    Eigen::VectorXd x;
+    double objective = 0;                 // the study's F
+    double traded_value_si = 0;           // the traded constraint's largest value
+    std::vector<double> violations;       // per study constraint, against the study's limits
+  };
+  struct Point {
+    int parent = -1;
+    double level_si = 0;                  // NaN for the anchors
+    slp::ProblemSpec problem;             // set when the run starts
+    std::vector<int> rows;                // the run's row h -> the study's row
+    std::unique_ptr<slp::SlpOptimizer> run;  // null until it starts
+    std::vector<Analysed> analysed;       // its successful analyses, in arrival order
+    bool ended = false;
+    bool usable = false;                  // ended with a feasible result
+    std::string not_run_reason;           // "" unless the point was never run
+    slp::CycleRecord record;              // set when it ends
+  };
+
+  explicit ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
+  void StartRuns();
+  void Start(int k, const Eigen::VectorXd& initial);
+  void EndWithoutRun(int k, const std::string& reason);
+  void End(int k);
+  slp::AnalysisResult ResultFor(const Point& point, const AnalysisRecord& record) const;
+  Analysed Analyse(const AnalysisRecord& record) const;
+  bool IsTraded(int row) const;
+
+  ParetoSetup setup_;
+  LpSolverFactory make_lp_solver_;
+  std::vector<int> traded_rows_;
+  double traded_scale_ = 1;  // the traded rows' scale in the study
+  std::vector<Point> points_;
+  std::int64_t analyses_ = 0;
+  std::size_t emitted_ = 0;
+  std::vector<slp::CycleRecord> new_records_;
+};
+
+}  // namespace mbopt::jobs

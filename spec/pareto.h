@@ -1,0 +1,54 @@
+// A Pareto front (docs/study.md, "Pareto fronts"): the trade-off between a
+// study's objective and the largest value of one of its constraints, by the
+// epsilon-constraint method. Point 0 minimizes the objective without the
+// traded constraint, point N-1 minimizes the traded constraint's largest
+// value (the anchors); point k between minimizes the objective with that
+// constraint's limit at the level ParetoLevel(k). Each point is an SLP run.
+//
+// The warm-start chain is a function of the study alone, never of which run
+// ends first: the anchors start from the study's initial design; the other
+// points are visited by bisection of the index range (the middle point of
+// [0, N-1], then the middle points of both halves, and so on), each started
+// from the result of the nearer end of its interval, which is already a
+// point of the front. So points of one generation run side by side, and
+// the front is the same bit for bit whatever the number of workers.
+#pragma once
+
+#include <vector>
+
+namespace mbopt::spec {
+
+inline constexpr int kDefaultParetoPoints = 9;
+inline constexpr int kMinParetoPoints = 3;
+inline constexpr int kMaxParetoPoints = 65;
+
+struct Pareto {
+  int constraint = -1;  // index into Study::constraints; -1: no Pareto front
+  int points = 0;       // the two anchors included
+
+  bool enabled() const { return constraint >= 0; }
+};
+
+// The level of the traded constraint for point k of `points` (0 < k <
+// points-1), evenly spaced from `value_at_first` (the constraint's value
+// where the objective alone is minimized) down to `value_at_last` (its
+// least value); both in the same unit.
+double ParetoLevel(int k, int points, double value_at_first, double value_at_last);
+
+// parent[k]: the point whose result starts point k's run; -1 for the two
+// anchors (they start from the study's initial design).
+std::vector<int> ParetoWarmStartParents(int points);
+
+// A point of a front as the client sees it: both objectives (minimized),
+// and whether its run gave a usable, feasible result.
+struct FrontPoint {
+  double first = 0;
+  double second = 0;
+  bool usable = false;
+};
+
+// dominated[k]: usable point k is dominated by another usable point (no
+// worse in both objectives and better in one). Unusable points: false.
+std::vector<bool> DominatedPoints(const std::vector<FrontPoint>& points);
+
+}  // namespace mbopt::spec

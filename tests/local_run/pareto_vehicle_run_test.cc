@@ -1,0 +1,82 @@
+// The vehicle's comfort-against-seat-travel front
+// (examples/vehicle/vehicle_pareto.study.textproto) run in process, and one
+// of its points made again by a separate single run: the ride-comfort study
+// with the point's level written as the ordinary limit of s1.
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "server/jobs/job.h"
+#include "server/lp/make_clp_lp_solver.h"
+#include "spec/io/study_io.h"
+#include "spec/pareto.h"
+#include "tests/testing/local_run/in_process_evaluator.h"
+#include "tests/testing/local_run/local_run.h"
+
+namespace mbopt::local_run {
+namespace {
+
+constexpr int kPoints = 5;
+// A point's run and the single run start from different designs (the
+// neighbour's result, the study's initial design) and each stops at the
+// method's relative objective tolerance (0.005, docs/method.md section 3):
+// they agree to that tolerance.
+constexpr double kSameOptimumRelative = 5e-3;
+
+std::vector<slp::CycleRecord> RunFront(const spec::Study& study) {
+  absl::StatusOr<std::unique_ptr<jobs::Job>> job =
+      jobs::Job::Create(std::make_shared<const spec::Study>(study), [] { return lp::MakeClpLpSolver(); });
+  EXPECT_TRUE(job.ok()) << job.status();
+  if (!job.ok()) return {};
+  InProcessEvaluator evaluator((*job)->study(), (*job)->layout());
+  std::vector<slp::CycleRecord> records;
+  jobs::JobRunOptions options;
+  options.on_record = [&records](const slp::CycleRecord& r) { records.push_back(r); };
+  const absl::Status ran = (*job)->Run(evaluator, options);
+  EXPECT_TRUE(ran.ok()) << ran;
+  EXPECT_EQ((*job)->state(), jobs::JobState::kCompleted);
+  return records;
+}
+
+TEST(VehicleParetoFront, TradesComfortAgainstSeatTravelAndAPointIsASingleRunsOptimum) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_pareto.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_TRUE(study->pareto.enabled());
+  const std::vector<slp::CycleRecord> front = RunFront(*study);
+  ASSERT_EQ(front.size(), static_cast<size_t>(kPoints));
+  std::vector<spec::FrontPoint> points;
+  for (const slp::CycleRecord& r : front) {
+    std::cout << "point " << r.cycle << ": F " << r.objective_x0 << " m/s^2, |s1| " << r.pareto_value_si / 0.0254
+              << " in (level " << r.pareto_level_si / 0.0254 << "), " << r.pareto_state << ", " << r.pareto_cycles
+              << " cycles, " << r.pareto_analyses << " analyses\n";
+    EXPECT_TRUE(r.accepted) << "point " << r.cycle << ": " << r.rejection_reason;
+    points.push_back({r.objective_x0, r.pareto_value_si, r.accepted});
+  }
+  // Less travel costs comfort: along the front F rises as |s1| falls.
+  for (int k = 1; k < kPoints; ++k) {
+    EXPECT_GT(front[static_cast<size_t>(k)].objective_x0, front[static_cast<size_t>(k - 1)].objective_x0);
+    EXPECT_LT(front[static_cast<size_t>(k)].pareto_value_si, front[static_cast<size_t>(k - 1)].pareto_value_si);
+  }
+  for (bool dominated : spec::DominatedPoints(points)) EXPECT_FALSE(dominated);
+
+  // The middle point again, as the ride-comfort study with its level as s1's
+  // limit (in the study's unit, inches).
+  const slp::CycleRecord& middle = front[2];
+  spec::Study single = *study;
+  single.pareto = spec::Pareto{};
+  spec::Constraint& s1 = single.constraints[static_cast<size_t>(study->pareto.constraint)];
+  s1.limit = middle.pareto_level_si / s1.si_per_unit;
+  absl::StatusOr<LocalRunResult> run = RunStudyLocally(single, LocalRunOptions{});
+  ASSERT_TRUE(run.ok()) << run.status();
+  EXPECT_EQ(run->outcome.state, slp::RunState::kConverged) << run->end_reason;
+  EXPECT_LE(run->outcome.max_violation, 0.0);
+  EXPECT_NEAR(run->outcome.objective, middle.objective_x0, kSameOptimumRelative * middle.objective_x0);
+  std::cout << "single run at the level " << s1.limit << " in: F " << run->outcome.objective << " (the front's "
+            << middle.objective_x0 << "), " << run->outcome.analyses << " analyses\n";
+}
+
+}  // namespace
+}  // namespace mbopt::local_run

@@ -1,0 +1,103 @@
+// The report page of a Pareto front (client/report/pareto_report.h): well
+// formed, one plot of the objective against the traded value with every
+// point labelled, dominated and infeasible points set apart, unrun points
+// left out of the plot, and the chosen point marked and listed.
+#include "client/report/pareto_report.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "tests/report/markup_checker.h"
+
+namespace mbopt::report {
+namespace {
+
+// Five points: 1, 2, 4 and 5 on the front, 3 dominated; or, with
+// `unrun_middle`, 2 to 4 not run.
+ParetoReportData Front(bool unrun_middle = false) {
+  ParetoReportData data;
+  data.job_id = "job-3";
+  data.study_name = "a <front>";
+  data.state = "completed";
+  data.objective_unit = "m/s^2";
+  data.against = "s1";
+  data.against_unit = "in";
+  data.points_total = 5;
+  data.variable_names = {"k", "c"};
+  data.variable_units = {"N/m", "N s/m"};
+  data.constraint_names = {"s1", "s2"};
+  const double objective[] = {1.0, 1.2, 1.6, 1.7, 2.5};
+  const double value[] = {0.8, 0.6, 0.61, 0.3, 0.1};
+  for (int i = 0; i < 5; ++i) {
+    ParetoReportData::Point p;
+    p.index = i + 1;
+    p.level = i == 0 || i == 4 ? std::nan("") : 0.8 - 0.175 * i;
+    p.objective = objective[i];
+    p.value = value[i];
+    p.max_violation = -0.1;
+    p.run_state = "converged";
+    p.cycles = 7;
+    p.status = i == 2 ? "dominated" : "front";
+    p.design = {100.0 * (i + 1), 20.0};
+    p.constraints = {0.2 - 0.1 * i, -0.5};
+    if (unrun_middle && i > 0 && i < 4) {
+      p.objective = p.value = p.max_violation = std::nan("");
+      p.run_state = "not_run";
+      p.status = "not run";
+      p.reason = "the objectives do not conflict";
+    }
+    data.points.push_back(p);
+  }
+  return data;
+}
+
+TEST(ParetoReport, IsWellFormedWithTheFrontLabelledAndTheDominatedPointApart) {
+  const std::string html = RenderParetoReportHtml(Front());
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  const std::vector<std::string> svgs = testing::SvgFragments(html);
+  ASSERT_EQ(svgs.size(), 1u);
+  const std::string& svg = svgs[0];
+  EXPECT_EQ(testing::CheckMarkup(svg, /*xml_strict=*/true), "");
+  EXPECT_NE(svg.find("Pareto front: objective F against the largest value of s1"), std::string::npos);
+  EXPECT_NE(svg.find("s1 [in]"), std::string::npos);
+  EXPECT_NE(svg.find("F [m/s^2]"), std::string::npos);
+  EXPECT_NE(svg.find("on the front"), std::string::npos);
+  EXPECT_NE(svg.find("dominated"), std::string::npos);
+  for (int k = 1; k <= 5; ++k) {
+    EXPECT_NE(svg.find("class=\"point-label\">" + std::to_string(k) + "</text>"), std::string::npos) << k;
+  }
+  EXPECT_EQ(svg.find("chosen"), std::string::npos);
+  EXPECT_NE(html.find("a &lt;front&gt;"), std::string::npos);
+  EXPECT_EQ(html.find("Chosen design"), std::string::npos);
+}
+
+TEST(ParetoReport, MarksAndListsTheChosenPoint) {
+  ParetoReportData data = Front();
+  data.chosen = 4;
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  EXPECT_NE(html.find("chosen: point 4"), std::string::npos);
+  EXPECT_NE(html.find("<tr class=\"chosen\"><td class=\"num\">4</td>"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Chosen design: point 4</h2>"), std::string::npos);
+  // Its design, and its constraints against the study's limits (s1 at -0.1
+  // is met: no red cell).
+  EXPECT_NE(html.find("<tr><th>k [N/m]</th><td class=\"num\">400</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><th>s1</th><td class=\"num\">-0.1</td></tr>"), std::string::npos);
+}
+
+TEST(ParetoReport, UnrunPointsAreListedWithTheirReasonAndNotDrawn) {
+  const std::string html = RenderParetoReportHtml(Front(/*unrun_middle=*/true));
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  const std::vector<std::string> svgs = testing::SvgFragments(html);
+  ASSERT_EQ(svgs.size(), 1u);
+  EXPECT_NE(svgs[0].find(">1</text>"), std::string::npos);
+  EXPECT_EQ(svgs[0].find("class=\"point-label\">3</text>"), std::string::npos);
+  EXPECT_NE(html.find("not run: the objectives do not conflict"), std::string::npos);
+  for (const char* nan : {"\"nan", "nan\"", ">nan", " nan", ",nan"}) {
+    EXPECT_EQ(html.find(nan), std::string::npos) << nan;
+  }
+}
+
+}  // namespace
+}  // namespace mbopt::report

@@ -1,0 +1,253 @@
+// A Pareto front driven directly (server/jobs/pareto_run.h) on a
+// bi-objective problem whose front is known in closed form, a
+// two-variable form of Schaffer's problem SCH (J. D. Schaffer, 1985;
+// problem SCH of K. Deb, "Multi-Objective Optimization using Evolutionary
+// Algorithms", 2001): two spheres with centres a = (1, 1) and b = (2, 2),
+//   f1 = 1 + |x - a|^2,  f2 = 1 + |x - b|^2,  x in [0.5, 3]^2.
+// The Pareto-optimal designs are the segment from a to b, and on it
+// sqrt(f1 - 1) + sqrt(f2 - 1) = |b - a| = sqrt(2): the front is
+//   f1 = 1 + (sqrt(2) - sqrt(f2 - 1))^2,  f2 in [1, 3].
+// f1 is the objective; f2 is the one row of the traded constraint (study
+// limit 2, so the rows' scale is 2).
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "server/jobs/pareto_run.h"
+#include "server/jobs/record_codec.h"
+#include "server/lp/make_clp_lp_solver.h"
+#include "spec/pareto.h"
+
+namespace mbopt::jobs {
+namespace {
+
+constexpr int kPoints = 9;
+// With the runs' tolerances at 1e-5 (TwoSpheres), every point lies on the
+// closed-form front to 1e-8 in f1 (measured: 9e-9 at most), since a point
+// that meets its level is optimal for that level to the LP's precision;
+// 1e-6 leaves room for another LP solver's rounding.
+constexpr double kFrontTolerance = 1e-6;
+// The anchors are unconstrained minima, found to the runs' stopping test
+// (1e-5 in F): measured 1e-6 from f = 1 and 4.5e-6 from f = 3.
+constexpr double kAnchorTolerance = 1e-5;
+// Each run's requests are far fewer than this; it only stops a broken run.
+constexpr int kMaxRounds = 20'000;
+
+double F1(const Eigen::VectorXd& x) { return 1 + (x[0] - 1) * (x[0] - 1) + (x[1] - 1) * (x[1] - 1); }
+double F2(const Eigen::VectorXd& x) { return 1 + (x[0] - 2) * (x[0] - 2) + (x[1] - 2) * (x[1] - 2); }
+
+double FrontF1(double f2) {
+  const double d = std::sqrt(2.0) - std::sqrt(std::max(f2 - 1.0, 0.0));
+  return 1 + d * d;
+}
+
+ParetoSetup TwoSpheres(bool gradients) {
+  ParetoSetup setup;
+  slp::ProblemSpec& p = setup.problem;
+  p.variable_names = {"x1", "x2"};
+  p.lower = Eigen::Vector2d(0.5, 0.5);
+  p.upper = Eigen::Vector2d(3, 3);
+  p.initial = Eigen::Vector2d(2.5, 0.8);
+  p.objective_form = slp::ObjectiveForm::kScalar;
+  p.num_objective_terms = 1;
+  p.constraint_names = {"f2"};
+  p.constraint_limits = Eigen::VectorXd::Constant(1, 2.0);
+  p.constraint_scales = Eigen::VectorXd::Constant(1, 2.0);
+  setup.options.analyses_provide_gradients = gradients;
+  setup.options.max_cycles = 60;
+  // Tighter than the method's defaults (0.005), so that the front is
+  // checked to a tolerance that says something of the method rather than
+  // of its stopping test.
+  setup.options.convergence_objective_tolerance = 1e-5;
+  setup.options.convergence_violation_tolerance = 1e-5;
+  setup.options.convergence_optimality_tolerance = 1e-5;
+  setup.row_constraints = {0};
+  setup.num_constraints = 1;
+  setup.traded_constraint = 0;
+  setup.points = kPoints;
+  return setup;
+}
+
+AnalysisRecord Answer(const slp::AnalysisRequest& request) {
+  AnalysisRecord record;
+  record.request_id = request.id;
+  record.x_scaled.assign(request.x.data(), request.x.data() + request.x.size());
+  record.objective_terms = {F1(request.x)};
+  record.constraint_values = {F2(request.x)};
+  if (request.want_gradients) {
+    record.objective_gradients = {2 * (request.x[0] - 1), 2 * (request.x[1] - 1)};
+    record.constraint_gradients = {2 * (request.x[0] - 2), 2 * (request.x[1] - 2)};
+  }
+  return record;
+}
+
+// Drives the front to its end as `workers` workers would: each round answers
+// at most `workers` of the pending requests, picked and ordered by `seed`.
+// Returns the encoded records in the order they came out.
+std::vector<std::string> RunFront(bool gradients, int workers, unsigned seed, std::vector<slp::CycleRecord>* out) {
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(TwoSpheres(gradients), [] { return lp::MakeClpLpSolver(); });
+  EXPECT_TRUE(run.ok()) << run.status();
+  if (!run.ok()) return {};
+  std::mt19937 random(seed);
+  std::vector<std::string> encoded;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    std::vector<slp::AnalysisRequest> pending = (*run)->PendingRequests();
+    EXPECT_FALSE(pending.empty()) << "the front is not done but asks for nothing";
+    if (pending.empty()) break;
+    std::shuffle(pending.begin(), pending.end(), random);
+    if (static_cast<int>(pending.size()) > workers) pending.resize(static_cast<size_t>(workers));
+    for (const slp::AnalysisRequest& request : pending) {
+      EXPECT_TRUE((*run)->Submit(Answer(request)).ok());
+      for (slp::CycleRecord& record : (*run)->TakeNewRecords()) {
+        encoded.push_back(EncodeCycleRecord(record));
+        if (out != nullptr) out->push_back(std::move(record));
+      }
+    }
+  }
+  EXPECT_TRUE((*run)->done());
+  return encoded;
+}
+
+TEST(ParetoRun, ReproducesTheClosedFormFrontOfTheTwoSpheres) {
+  std::vector<slp::CycleRecord> records;
+  RunFront(/*gradients=*/true, /*workers=*/4, /*seed=*/1, &records);
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints));
+  for (int k = 0; k < kPoints; ++k) {
+    const slp::CycleRecord& r = records[static_cast<size_t>(k)];
+    SCOPED_TRACE(::testing::Message() << "point " << k + 1 << " (" << r.pareto_state << ")");
+    EXPECT_TRUE(r.pareto);
+    EXPECT_EQ(r.cycle, k + 1);
+    EXPECT_TRUE(r.accepted) << r.rejection_reason;
+    const double f1 = F1(r.x0);
+    const double f2 = F2(r.x0);
+    EXPECT_DOUBLE_EQ(r.objective_x0, f1);
+    EXPECT_DOUBLE_EQ(r.pareto_value_si, f2);
+    EXPECT_NEAR(f1, FrontF1(f2), kFrontTolerance) << "f2 = " << f2;
+  }
+  // The anchors: the objective's own optimum (f1 = 1 at a, f2 = 3 there)
+  // and the traded value's (f2 = 1 at b, f1 = 3).
+  EXPECT_NEAR(records.front().objective_x0, 1.0, kAnchorTolerance);
+  EXPECT_NEAR(records.front().pareto_value_si, 3.0, kAnchorTolerance);
+  EXPECT_NEAR(records.back().pareto_value_si, 1.0, kAnchorTolerance);
+  EXPECT_NEAR(records.back().objective_x0, 3.0, kAnchorTolerance);
+  EXPECT_TRUE(std::isnan(records.front().pareto_level_si));
+  // The levels between are evenly spread between the anchors' values, and
+  // each point meets its level.
+  for (int k = 1; k + 1 < kPoints; ++k) {
+    const slp::CycleRecord& r = records[static_cast<size_t>(k)];
+    const double level = spec::ParetoLevel(k, kPoints, records.front().pareto_value_si,
+                                           records.back().pareto_value_si);
+    EXPECT_EQ(r.pareto_level_si, level);
+    // Met within the runs' violation tolerance (1e-5 of the level).
+    EXPECT_LE(r.pareto_value_si, level * (1 + 1e-5));
+  }
+  std::vector<spec::FrontPoint> front;
+  for (const slp::CycleRecord& r : records) front.push_back({r.objective_x0, r.pareto_value_si, r.accepted});
+  for (bool dominated : spec::DominatedPoints(front)) EXPECT_FALSE(dominated);
+}
+
+TEST(ParetoRun, SameRecordsWhateverTheWorkersAndTheOrderOfResults) {
+  const std::vector<std::string> one = RunFront(/*gradients=*/false, 1, 7, nullptr);
+  ASSERT_EQ(one.size(), static_cast<size_t>(kPoints));
+  EXPECT_EQ(RunFront(false, 3, 11, nullptr), one);
+  EXPECT_EQ(RunFront(false, 64, 12345, nullptr), one);
+}
+
+TEST(ParetoRun, PointsOfOneGenerationRunSideBySide) {
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(TwoSpheres(true), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  // At the start both anchors ask for their first design.
+  std::vector<slp::AnalysisRequest> pending = (*run)->PendingRequests();
+  ASSERT_EQ(pending.size(), 2u);
+  EXPECT_EQ(pending[0].id / ParetoRun::kRequestStride, 0);
+  EXPECT_EQ(pending[1].id / ParetoRun::kRequestStride, kPoints - 1);
+  EXPECT_FALSE((*run)->IsPending(1 * ParetoRun::kRequestStride));
+  slp::AnalysisRequest not_started = pending[0];
+  not_started.id = 5 * ParetoRun::kRequestStride;
+  EXPECT_FALSE((*run)->Submit(Answer(not_started)).ok());
+}
+
+TEST(ParetoRun, ObjectivesThatDoNotConflictLeaveThePointsBetweenUnrun) {
+  ParetoSetup setup = TwoSpheres(true);
+  // The traded row is f1 itself: where f1 is least, so is the row.
+  auto answer_same = [](const slp::AnalysisRequest& request) {
+    AnalysisRecord record = Answer(request);
+    record.constraint_values = {F1(request.x)};
+    if (request.want_gradients) record.constraint_gradients = record.objective_gradients;
+    return record;
+  };
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(std::move(setup), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  std::vector<slp::CycleRecord> records;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    for (const slp::AnalysisRequest& request : (*run)->PendingRequests()) {
+      ASSERT_TRUE((*run)->Submit(answer_same(request)).ok());
+    }
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+  }
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints));
+  for (int k = 1; k + 1 < kPoints; ++k) {
+    EXPECT_EQ(records[static_cast<size_t>(k)].pareto_state, "not_run");
+    EXPECT_NE(records[static_cast<size_t>(k)].rejection_reason.find("do not conflict"), std::string::npos);
+    EXPECT_FALSE(records[static_cast<size_t>(k)].accepted);
+  }
+}
+
+TEST(ParetoRun, AFailedEndLeavesThePointsBetweenUnrunAndSaysWhy) {
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(TwoSpheres(true), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  std::vector<slp::CycleRecord> records;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    for (const slp::AnalysisRequest& request : (*run)->PendingRequests()) {
+      AnalysisRecord record = Answer(request);
+      // Every analysis of the last point's run fails.
+      if (request.id / ParetoRun::kRequestStride == kPoints - 1) {
+        record.objective_terms.clear();
+        record.constraint_values.clear();
+        record.objective_gradients.clear();
+        record.constraint_gradients.clear();
+        record.failure = spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "step size too small");
+      }
+      ASSERT_TRUE((*run)->Submit(record).ok());
+    }
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+  }
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints));
+  EXPECT_TRUE(records.front().accepted);
+  EXPECT_EQ(records.back().pareto_state, "failed");
+  EXPECT_FALSE(records.back().accepted);
+  EXPECT_TRUE(std::isnan(records.back().pareto_value_si));
+  for (int k = 1; k + 1 < kPoints; ++k) {
+    EXPECT_EQ(records[static_cast<size_t>(k)].pareto_state, "not_run");
+    EXPECT_NE(records[static_cast<size_t>(k)].rejection_reason.find("point 9 (an anchor) has no feasible result"),
+              std::string::npos)
+        << records[static_cast<size_t>(k)].rejection_reason;
+  }
+}
+
+TEST(ParetoRunRecords, ArePointRecordsAfterAnEncodeAndDecode) {
+  std::vector<slp::CycleRecord> records;
+  RunFront(true, 2, 3, &records);
+  ASSERT_FALSE(records.empty());
+  for (const slp::CycleRecord& r : records) {
+    absl::StatusOr<slp::CycleRecord> decoded = DecodeCycleRecord(EncodeCycleRecord(r));
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    EXPECT_TRUE(decoded->pareto);
+    EXPECT_TRUE(decoded->design_set);
+    EXPECT_EQ(EncodeCycleRecord(*decoded), EncodeCycleRecord(r));
+    EXPECT_EQ(decoded->pareto_state, r.pareto_state);
+    EXPECT_EQ(decoded->pareto_analyses, r.pareto_analyses);
+  }
+}
+
+}  // namespace
+}  // namespace mbopt::jobs

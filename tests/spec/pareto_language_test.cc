@@ -1,0 +1,91 @@
+// The study's `pareto` section as a user writes it: what it becomes, how
+// `mbopt validate` names it, and the messages that name the file, line and
+// field of a mistake.
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "spec/io/design_set_convert.h"
+#include "spec/io/study_io.h"
+#include "tests/spec/oscillator_scene.h"
+
+namespace mbopt::spec::io {
+namespace {
+
+using ::testing::HasSubstr;
+
+const char kStudyHead[] = R"pb(name: "oscillator front"
+scene_file: "oscillator.scene.textproto"
+variables { name: "x1" parameter: "k" scale: 10 lower: 5 upper: 20 }
+objective { minimize_max_of: "acc" reduction: REDUCTION_MAX_ABS }
+constraints { name: "travel" output: "x" reduction: REDUCTION_MAX_ABS limit: 0.02 unit: "m" }
+constraints { name: "low" output: "x" reduction: REDUCTION_MIN limit: -1 unit: "m" }
+constraints { name: "settles" output: "x" reduction: REDUCTION_FINAL equals: 0 tolerance: 0.001 }
+)pb";
+
+class ParetoLanguage : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    dir_ = std::filesystem::path(::testing::TempDir()) / ("pareto_language_" + test);
+    std::filesystem::create_directories(dir_);
+  }
+  absl::StatusOr<Study> Load(const std::string& tail) {
+    std::ofstream(dir_ / "oscillator.scene.textproto") << ::mbopt::testing::kOscillatorScene;
+    const std::string path = (dir_ / "oscillator.study.textproto").string();
+    std::ofstream(path) << kStudyHead << tail;
+    return LoadStudyFile(path);
+  }
+  std::string LoadError(const std::string& tail) {
+    absl::StatusOr<Study> loaded = Load(tail);
+    EXPECT_FALSE(loaded.ok());
+    return loaded.ok() ? "" : std::string(loaded.status().message());
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(ParetoLanguage, AgainstAConstraintWithTheDefaultPoints) {
+  absl::StatusOr<Study> study = Load("pareto { against: \"travel\" }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_TRUE(study->pareto.enabled());
+  EXPECT_EQ(study->pareto.constraint, 0);
+  EXPECT_EQ(study->pareto.points, 9);
+  EXPECT_EQ(DescribeStudyForm(*study),
+            "a Pareto front of the objective against the largest value of travel (m), 9 points (epsilon-constraint "
+            "method)");
+}
+
+TEST_F(ParetoLanguage, WithoutTheSectionNoFront) {
+  absl::StatusOr<Study> study = Load("");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_FALSE(study->pareto.enabled());
+  EXPECT_EQ(DescribeStudyForm(*study), "an optimization");
+}
+
+TEST_F(ParetoLanguage, UnknownConstraintNamesTheLineFieldAndTheConstraints) {
+  const std::string error = LoadError("pareto {\n  against: \"stroke\"\n}\n");
+  EXPECT_THAT(error, HasSubstr("oscillator.study.textproto:9:"));
+  EXPECT_THAT(error, HasSubstr("pareto.against"));
+  EXPECT_THAT(error, HasSubstr("unknown constraint \"stroke\"; the study's constraints: \"travel\", \"low\", "
+                               "\"settles\""));
+  EXPECT_THAT(LoadError("pareto { points: 5 }\n"), HasSubstr("pareto.against: name the constraint"));
+}
+
+TEST_F(ParetoLanguage, OnlyAnUpperLimitCanBeTraded) {
+  EXPECT_THAT(LoadError("pareto { against: \"low\" }\n"), HasSubstr("is a lower limit (REDUCTION_MIN)"));
+  EXPECT_THAT(LoadError("pareto { against: \"settles\" }\n"), HasSubstr("it holds a value (equals)"));
+}
+
+TEST_F(ParetoLanguage, PointsOutOfRangeAndSweepsAreRefused) {
+  EXPECT_THAT(LoadError("pareto { against: \"travel\" points: 2 }\n"),
+              HasSubstr("pareto.points: must be between 3 and 65 (the two ends included), got 2"));
+  EXPECT_THAT(LoadError("pareto { against: \"travel\" points: 66 }\n"), HasSubstr("got 66"));
+  EXPECT_THAT(LoadError("pareto { against: \"travel\" }\n"
+                        "sweep { axis { variable: \"x1\" from: 6 to: 8 points: 2 } }\n"),
+              HasSubstr("a Pareto front or a sweep or sample, not both"));
+}
+
+}  // namespace
+}  // namespace mbopt::spec::io
