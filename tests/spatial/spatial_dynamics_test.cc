@@ -4,7 +4,7 @@
 // precession, the tennis-racket instability about the intermediate axis
 // and the stability about the major one, conservation of energy and
 // angular momentum, a cylindrical joint's free slide, a driven hinge, the
-// Euler parameters' unit norm.
+// Euler parameters' unit norm, a Cardan joint's speed fluctuation.
 #include <cmath>
 #include <iostream>
 #include <numbers>
@@ -349,6 +349,60 @@ TEST(SpatialDynamics, DrivenHingeFollowsItsProfile) {
   }
   EXPECT_LT(worst, 1e-8);
   EXPECT_GT(elbow, 0.1);  // the arm swings out of the crank's plane
+}
+
+// A Cardan (universal) joint between an input shaft driven at w and an
+// output shaft at the angle beta to it: the output turns at
+//   w2 / w = cos beta / (1 - sin^2 beta cos^2 theta),
+// theta the input yoke's angle from the plane of the two shafts (here the
+// yoke starts normal to that plane, theta = w t + pi/2), between cos beta
+// and 1 / cos beta. The output shaft is held by the joint's centre and a
+// point-on-line bearing at its far end, so the loop has no redundant row.
+TEST(SpatialDynamics, UniversalJointOutputSpeedFluctuates) {
+  const double beta = 0.5, w = 2 * std::numbers::pi;
+  const Vector3d along(std::cos(beta), std::sin(beta), 0.0);
+  const Matrix3d input_axes = AxisAngle({0, 1, 0}, std::numbers::pi / 2);  // body z along world x
+  const Matrix3d output_axes = AxisAngle({0, 0, 1}, beta) * input_axes;   // body z along `along`
+  Model m;
+  Body input, output;
+  input.name = "input";
+  input.inertia_kg_m2 = Vector3d(0.1, 0.1, 0.01).asDiagonal();
+  input.orientation = input_axes;
+  input.position_m = {-0.5, 0, 0};
+  output = input;
+  output.name = "output";
+  output.orientation = output_axes;
+  output.position_m = 0.5 * along;
+  m.bodies = {input, output};
+  m.joints.push_back({"input bearing", Joint::Kind::kRevolute, FrameOn(kGround, {-0.5, 0, 0}, input_axes),
+                      FrameOn(0, {0, 0, 0})});
+  m.joints.push_back({"cardan", Joint::Kind::kUniversal, FrameOn(0, {0, 0, 0.5}), FrameOn(1, {0, 0, -0.5})});
+  m.joints.push_back(
+      {"output bearing", Joint::Kind::kPointOnLine, FrameOn(kGround, along, output_axes), FrameOn(1, {0, 0, 0.5})});
+  Driver d;
+  d.joint = 0;
+  d.profile.rate = w;
+  m.drivers.push_back(d);
+  ASSERT_TRUE(m.Validate().ok());
+  const SpatialSystem s(m);
+  const SpatialAssembly assembled = AssembleSpatial(s, 0.0);
+  ASSERT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  EXPECT_EQ(assembled.degrees_of_freedom, 0);
+  EXPECT_EQ(assembled.redundant_rows, 0);
+  const Trajectory run = Simulate(s, 1.0, 200, 1e-8);  // one input turn; see kTolerance
+  double worst = 0.0, lowest = 10.0, highest = 0.0;
+  for (size_t i = 0; i < run.t.size(); ++i) {
+    const double ratio = s.AngularVelocity(1, run.q[i], run.v[i]).dot(along) /
+                         s.AngularVelocity(0, run.q[i], run.v[i]).dot(Vector3d::UnitX());
+    const double sine = std::sin(beta) * std::sin(w * run.t[i]);
+    worst = std::max(worst, std::abs(ratio - std::cos(beta) / (1.0 - sine * sine)));
+    lowest = std::min(lowest, ratio);
+    highest = std::max(highest, ratio);
+  }
+  EXPECT_LT(worst, 1e-6);  // measured: 3.0e-8
+  EXPECT_NEAR(lowest, std::cos(beta), 1e-6);  // sampled at the extremes (every quarter turn)
+  EXPECT_NEAR(highest, 1.0 / std::cos(beta), 1e-6);
+  std::cout << "Cardan joint: speed ratio " << lowest << " to " << highest << ", largest error " << worst << "\n";
 }
 
 }  // namespace
