@@ -57,8 +57,8 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   int num_constraints() const override { return num_rows_; }
   int first_row_of_joint(int joint) const { return joint_row_[static_cast<size_t>(joint)]; }
   int row_of_driver(int driver) const { return driver_row_[static_cast<size_t>(driver)]; }
-  // What a constraint row belongs to, for messages: "joint 'A' (revolute)",
-  // "the unit norm of body 'B'", "the driver of joint 'A'".
+  // What a constraint row belongs to, for messages: "revolute joint 'A'
+  // (equation 4)", "the unit norm of body 'B'", "the driver of joint 'A'".
   std::string RowOwner(int row) const;
 
   int MassMatrix(const Eigen::VectorXd& q, Eigen::MatrixXd* mass) const override;
