@@ -1,0 +1,141 @@
+// mbopt's spatial kernel against Simbody (relative coordinates, its own
+// integrator; the program mbopt_simbody_spatial_oracle) on the same
+// mechanism: centres of mass and rotation matrices agree to 1e-6 over 2 s
+// when released at rest. Started spinning, mbopt's integrator does not start
+// at tolerances of 1e-9 and tighter (docs/status.md): compared at 1e-8.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/spatial/spatial_oracle.h"
+#include "worker/multibody/forward_dynamics.h"
+#include "worker/spatial/euler_parameters.h"
+#include "worker/spatial/spatial_assembly.h"
+#include "worker/spatial/spatial_system.h"
+
+namespace mbopt::spatial {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// Simbody at accuracy 1e-12 (Runge-Kutta-Merson) throughout.
+std::vector<std::vector<double>> RunSimbody(const std::string& mechanism, bool* ok) {
+  std::vector<std::vector<double>> values;
+  const std::string command = std::string(MBOPT_SIMBODY_SPATIAL_ORACLE) + " " + mechanism + " 1e-12 2 100";
+  FILE* pipe = popen(command.c_str(), "r");
+  *ok = pipe != nullptr;
+  if (pipe == nullptr) return values;
+  char line[8192];
+  while (std::fgets(line, sizeof line, pipe) != nullptr) {
+    std::istringstream in(line);
+    double t = 0.0, v = 0.0;
+    in >> t;
+    std::vector<double> row;
+    while (in >> v) row.push_back(v);
+    values.push_back(row);
+  }
+  *ok = pclose(pipe) == 0;
+  return values;
+}
+
+Model DoublePendulum(const oracle::SpatialDoublePendulum& p, bool spinning) {
+  Model m;
+  const Vector3d w = spinning ? Vector3d(p.angular_velocity_rad_per_s[0], p.angular_velocity_rad_per_s[1],
+                                         p.angular_velocity_rad_per_s[2])
+                              : Vector3d::Zero();
+  Vector3d joint = Vector3d::Zero();  // the body's inboard joint, world
+  for (int i = 0; i < 2; ++i) {
+    Body b;
+    b.name = i == 0 ? "upper" : "lower";
+    b.mass_kg = p.mass_kg[i];
+    b.inertia_kg_m2 = Vector3d(p.inertia_kg_m2[i][0], p.inertia_kg_m2[i][1], p.inertia_kg_m2[i][2]).asDiagonal();
+    b.orientation = AxisAngle(Vector3d(p.axis[i][0], p.axis[i][1], p.axis[i][2]), p.angle_rad[i]);
+    b.position_m = joint + b.orientation * Vector3d(0, 0, -p.half_length_m[i]);
+    b.angular_velocity_rad_per_s = w;
+    b.velocity_m_per_s = w.cross(b.position_m);  // one rigid body turning about the shoulder
+    joint = b.position_m + b.orientation * Vector3d(0, 0, -p.half_length_m[i]);
+    m.bodies.push_back(b);
+  }
+  Frame ground, upper_top, upper_bottom, lower_top;
+  upper_top.body = 0;
+  upper_top.position_m = {0, 0, p.half_length_m[0]};
+  upper_bottom.body = 0;
+  upper_bottom.position_m = {0, 0, -p.half_length_m[0]};
+  lower_top.body = 1;
+  lower_top.position_m = {0, 0, p.half_length_m[1]};
+  m.joints.push_back({"shoulder", Joint::Kind::kSpherical, ground, upper_top});
+  m.joints.push_back({"elbow", Joint::Kind::kSpherical, upper_bottom, lower_top});
+  m.gravity_m_per_s2 = Vector3d(0, 0, -p.g);
+  return m;
+}
+
+// The largest difference of mbopt's values to Simbody's over 2 s.
+double Compare(bool spinning, double tolerance) {
+  const oracle::SpatialDoublePendulum p;
+  bool ok = false;
+  const std::vector<std::vector<double>> simbody =
+      RunSimbody(spinning ? "spinning_double_pendulum" : "double_pendulum", &ok);
+  EXPECT_TRUE(ok) << "the Simbody oracle failed";
+  const Model model = DoublePendulum(p, spinning);
+  EXPECT_TRUE(model.Validate().ok());
+  const SpatialSystem s(model);
+  const SpatialAssembly assembled = AssembleSpatial(s, 0.0);
+  EXPECT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
+  // The initial velocities are consistent: assembly keeps them.
+  EXPECT_LT((assembled.v - s.InitialVelocityGuess()).cwiseAbs().maxCoeff(), 1e-14);
+  std::vector<double> times;
+  for (int i = 0; i <= 100; ++i) times.push_back(0.02 * i);
+  multibody::ForwardDynamicsOptions options;
+  options.relative_tolerance = tolerance;
+  options.absolute_tolerance = tolerance;
+  multibody::ForwardDynamicsCounters counters;
+  std::vector<std::vector<double>> ours;
+  const spec::AnalysisFailure f = multibody::IntegrateForward(
+      s, 0.0, assembled.q, assembled.v, times, options,
+      [&](const multibody::MotionSample& sample) {
+        std::vector<double> row;
+        for (int b = 0; b < 2; ++b) {
+          for (int k = 0; k < 3; ++k) row.push_back(sample.q[7 * b + k]);
+        }
+        for (int b = 0; b < 2; ++b) {
+          const Matrix3d r = s.BodyRotation(b, sample.q);
+          for (int i = 0; i < 3; ++i) {
+            for (int k = 0; k < 3; ++k) row.push_back(r(i, k));
+          }
+        }
+        ours.push_back(row);
+        return spec::AnalysisFailure::Ok();
+      },
+      &counters);
+  EXPECT_TRUE(f.ok()) << f.reason;
+  EXPECT_EQ(simbody.size(), ours.size());
+  double worst = 0.0, swing = 0.0;
+  for (size_t i = 0; i < std::min(ours.size(), simbody.size()); ++i) {
+    EXPECT_EQ(simbody[i].size(), ours[i].size());
+    for (size_t k = 0; k < std::min(ours[i].size(), simbody[i].size()); ++k) {
+      worst = std::max(worst, std::abs(ours[i][k] - simbody[i][k]));
+      swing = std::max(swing, std::abs(ours[i][k] - ours[0][k]));
+    }
+  }
+  EXPECT_GT(swing, 0.5);  // the pendulum moves: metres and rotation entries of order 1
+  std::cout << (spinning ? "spinning" : "released") << " spatial double pendulum at tolerance " << tolerance
+            << ": largest difference to Simbody " << worst << " over 2 s, " << counters.steps << " steps\n";
+  return worst;
+}
+
+// At tolerance 1e-10, as the planar comparison (tests/oracle): measured 2.2e-8.
+TEST(SpatialSimbodyComparison, DoublePendulumReleasedAtRest) {
+  EXPECT_LT(Compare(false, 1e-10), 1e-6);  // m, and rotation matrix entries
+}
+
+// At 1e-8, the tightest this start integrates at: measured 5.3e-6.
+TEST(SpatialSimbodyComparison, DoublePendulumStartedSpinning) { EXPECT_LT(Compare(true, 1e-8), 2e-5); }
+
+}  // namespace
+}  // namespace mbopt::spatial

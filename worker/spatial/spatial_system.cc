@@ -1,0 +1,404 @@
+#include "worker/spatial/spatial_system.h"
+
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "worker/spatial/euler_parameters.h"
+
+namespace mbopt::spatial {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+using Eigen::Vector4d;
+using Eigen::VectorXd;
+
+constexpr int kBlock = SpatialSystem::kCoordinatesPerBody;
+constexpr double kNormRowScale = SpatialSystem::kNormRowScale;
+// The two bodies of a joint or spring: slot 0 for frame (point) a's body,
+// slot 1 for b's; each slot spans the body's 7 coordinates.
+constexpr int kPairColumns = 2 * kBlock;
+
+struct BodyCoordinates {
+  Vector3d r = Vector3d::Zero(), r_dot = Vector3d::Zero();
+  Vector4d p = Vector4d(1.0, 0.0, 0.0, 0.0), p_dot = Vector4d::Zero();
+  bool ground = true;
+};
+
+BodyCoordinates CoordinatesOf(int body, const VectorXd& q, const VectorXd* v) {
+  BodyCoordinates c;
+  if (body == kGround) return c;
+  c.ground = false;
+  const int at = kBlock * body;
+  c.r = q.segment<3>(at);
+  c.p = q.segment<4>(at + 3);
+  if (v != nullptr) {
+    c.r_dot = v->segment<3>(at);
+    c.p_dot = v->segment<4>(at + 3);
+  }
+  return c;
+}
+
+// A vector of a joint's equations: its value, its rate, its second time
+// derivative with zero accelerations (the part gamma needs) and its
+// Jacobian over the pair's coordinates.
+struct PairVector {
+  Vector3d x = Vector3d::Zero(), x_dot = Vector3d::Zero(), x_ddot0 = Vector3d::Zero();
+  Eigen::Matrix<double, 3, kPairColumns> jacobian = Eigen::Matrix<double, 3, kPairColumns>::Zero();
+};
+
+struct PairScalar {
+  double f = 0.0, f_dot = 0.0, f_ddot0 = 0.0;
+  Eigen::Matrix<double, 1, kPairColumns> jacobian = Eigen::Matrix<double, 1, kPairColumns>::Zero();
+};
+
+// r + A(p) s for a point (with_origin), A(p) s for a direction.
+PairVector FixedIn(const BodyCoordinates& c, int slot, const Vector3d& s, bool with_origin) {
+  PairVector out;
+  const Eigen::Matrix<double, 3, 4> d = RotatedVectorJacobian(c.p, s);
+  out.x = RotationOf(c.p) * s + (with_origin ? c.r : Vector3d::Zero());
+  if (c.ground) return out;
+  out.x_dot = d * c.p_dot + (with_origin ? c.r_dot : Vector3d::Zero());
+  out.x_ddot0 = 2.0 * RotationOf(c.p_dot) * s;
+  out.jacobian.block<3, 4>(0, kBlock * slot + 3) = d;
+  if (with_origin) out.jacobian.block<3, 3>(0, kBlock * slot).setIdentity();
+  return out;
+}
+
+PairVector Minus(const PairVector& a, const PairVector& b) {
+  PairVector out;
+  out.x = a.x - b.x;
+  out.x_dot = a.x_dot - b.x_dot;
+  out.x_ddot0 = a.x_ddot0 - b.x_ddot0;
+  out.jacobian = a.jacobian - b.jacobian;
+  return out;
+}
+
+PairScalar Dot(const PairVector& a, const PairVector& b) {
+  PairScalar out;
+  out.f = a.x.dot(b.x);
+  out.f_dot = a.x_dot.dot(b.x) + a.x.dot(b.x_dot);
+  out.f_ddot0 = a.x_ddot0.dot(b.x) + 2.0 * a.x_dot.dot(b.x_dot) + a.x.dot(b.x_ddot0);
+  out.jacobian = b.x.transpose() * a.jacobian + a.x.transpose() * b.jacobian;
+  return out;
+}
+
+PairScalar Component(const PairVector& a, int k) {
+  PairScalar out;
+  out.f = a.x[k];
+  out.f_dot = a.x_dot[k];
+  out.f_ddot0 = a.x_ddot0[k];
+  out.jacobian = a.jacobian.row(k);
+  return out;
+}
+
+// A frame's origin and axes in world axes.
+struct FrameVectors {
+  PairVector origin, x, y, z;
+};
+
+FrameVectors FrameOf(const Frame& f, int slot, const VectorXd& q, const VectorXd* v) {
+  const BodyCoordinates c = CoordinatesOf(f.body, q, v);
+  return {FixedIn(c, slot, f.position_m, true), FixedIn(c, slot, f.axes.col(0), false),
+          FixedIn(c, slot, f.axes.col(1), false), FixedIn(c, slot, f.axes.col(2), false)};
+}
+
+// The scalar equations of a joint, in the order docs/physics.md lists them.
+std::vector<PairScalar> JointEquations(const Joint& joint, const VectorXd& q, const VectorXd* v) {
+  const FrameVectors a = FrameOf(joint.a, 0, q, v), b = FrameOf(joint.b, 1, q, v);
+  const PairVector d = Minus(b.origin, a.origin);
+  std::vector<PairScalar> rows;
+  auto coincide = [&] {
+    for (int k = 0; k < 3; ++k) rows.push_back(Component(d, k));
+  };
+  auto on_axis = [&] {
+    rows.push_back(Dot(a.x, d));
+    rows.push_back(Dot(a.y, d));
+  };
+  auto axes_aligned = [&] {
+    rows.push_back(Dot(a.z, b.x));
+    rows.push_back(Dot(a.z, b.y));
+  };
+  switch (joint.kind) {
+    case Joint::Kind::kSpherical:
+      coincide();
+      break;
+    case Joint::Kind::kRevolute:
+      coincide();
+      axes_aligned();
+      break;
+    case Joint::Kind::kUniversal:
+      coincide();
+      rows.push_back(Dot(a.x, b.y));
+      break;
+    case Joint::Kind::kFixed:
+      coincide();
+      axes_aligned();
+      rows.push_back(Dot(a.x, b.y));
+      break;
+    case Joint::Kind::kPrismatic:
+      on_axis();
+      axes_aligned();
+      rows.push_back(Dot(a.x, b.y));
+      break;
+    case Joint::Kind::kCylindrical:
+      on_axis();
+      axes_aligned();
+      break;
+    case Joint::Kind::kPlanar:
+      rows.push_back(Dot(a.z, d));
+      axes_aligned();
+      break;
+    case Joint::Kind::kPointOnLine:
+      on_axis();
+      break;
+    case Joint::Kind::kPointOnPlane:
+      rows.push_back(Dot(a.z, d));
+      break;
+  }
+  return rows;
+}
+
+// Adds a pair's row (or rows) into a matrix of all coordinates.
+template <class PairMatrix>
+void Scatter(const PairMatrix& pair, int body_a, int body_b, Eigen::Ref<Eigen::MatrixXd> out) {
+  if (body_a != kGround) out.middleCols(kBlock * body_a, kBlock) += pair.leftCols(kBlock);
+  if (body_b != kGround) out.middleCols(kBlock * body_b, kBlock) += pair.rightCols(kBlock);
+}
+
+bool AllFinite(const VectorXd& x) { return x.allFinite(); }
+
+}  // namespace
+
+SpatialSystem::SpatialSystem(const Model& model) : model_(model) {
+  int row = static_cast<int>(model_.bodies.size());
+  for (const Joint& j : model_.joints) {
+    joint_row_.push_back(row);
+    row += JointEquationCount(j.kind);
+  }
+  for (size_t i = 0; i < model_.drivers.size(); ++i) driver_row_.push_back(row++);
+  num_rows_ = row;
+}
+
+std::string SpatialSystem::RowOwner(int row) const {
+  if (row < static_cast<int>(model_.bodies.size())) return "the unit norm of " + model_.BodyName(row);
+  for (size_t d = 0; d < driver_row_.size(); ++d) {
+    if (driver_row_[d] == row) {
+      return "the driver of joint '" + model_.joints[static_cast<size_t>(model_.drivers[d].joint)].name + "'";
+    }
+  }
+  for (size_t j = joint_row_.size(); j-- > 0;) {
+    if (joint_row_[j] <= row) {
+      const Joint& joint = model_.joints[j];
+      return absl::StrFormat("%s joint '%s' (equation %d)", JointKindName(joint.kind), joint.name,
+                             row - joint_row_[j] + 1);
+    }
+  }
+  return absl::StrFormat("row %d", row);
+}
+
+int SpatialSystem::MassMatrix(const VectorXd& q, Eigen::MatrixXd* mass) const {
+  const int n = num_coordinates();
+  mass->setZero(n, n);
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const Body& b = model_.bodies[i];
+    const int at = kBlock * static_cast<int>(i);
+    const Vector4d p = q.segment<4>(at + 3);
+    const Eigen::Matrix<double, 3, 4> l = BodyRateMatrix(p);
+    mass->block<3, 3>(at, at) = b.mass_kg * Matrix3d::Identity();
+    // 4 L^T J L is singular along p; the p p^T term lies in the
+    // normalization row's reaction (see the header).
+    const double along_p = 4.0 * b.inertia_kg_m2.trace() / 3.0;
+    mass->block<4, 4>(at + 3, at + 3) = 4.0 * l.transpose() * b.inertia_kg_m2 * l + along_p * p * p.transpose();
+  }
+  return mass->allFinite() ? 0 : 1;
+}
+
+int SpatialSystem::AppliedForces(double /*t*/, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
+  forces->setZero(num_coordinates());
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const Body& b = model_.bodies[i];
+    const int at = kBlock * static_cast<int>(i);
+    if (model_.gravity_m_per_s2) forces->segment<3>(at) += b.mass_kg * *model_.gravity_m_per_s2;
+    const Vector4d p = q.segment<4>(at + 3), p_dot = v.segment<4>(at + 3);
+    const Eigen::Matrix<double, 3, 4> l_dot = BodyRateMatrix(p_dot);
+    forces->segment<4>(at + 3) += 8.0 * l_dot.transpose() * b.inertia_kg_m2 * l_dot * p;
+  }
+  for (const SpringDamper& s : model_.springs) {
+    const PairVector d = Minus(FixedIn(CoordinatesOf(s.b.body, q, &v), 1, s.b.position_m, true),
+                               FixedIn(CoordinatesOf(s.a.body, q, &v), 0, s.a.position_m, true));
+    const double length = d.x.norm();
+    // The force's direction is undefined at zero length: the step is cut.
+    if (!(length > 0.0)) return 1;
+    const Vector3d unit = d.x / length;
+    const double tension = s.stiffness_n_per_m * (length - s.free_length_m) + s.damping_n_s_per_m * unit.dot(d.x_dot);
+    Eigen::Map<Eigen::RowVectorXd> row(forces->data(), forces->size());
+    Eigen::Matrix<double, 1, kPairColumns> pair = -tension * unit.transpose() * d.jacobian;
+    Eigen::MatrixXd scattered = Eigen::MatrixXd::Zero(1, num_coordinates());
+    Scatter(pair, s.a.body, s.b.body, scattered);
+    row += scattered.row(0);
+  }
+  return AllFinite(*forces) ? 0 : 1;
+}
+
+void SpatialSystem::EvaluateRows(double t, const VectorXd& q, const VectorXd* v, VectorXd* phi,
+                                 Eigen::MatrixXd* phi_q, VectorXd* phi_t, VectorXd* gamma) const {
+  const int n = num_coordinates(), m = num_rows_;
+  if (phi != nullptr) phi->setZero(m);
+  if (phi_q != nullptr) phi_q->setZero(m, n);
+  if (phi_t != nullptr) phi_t->setZero(m);
+  if (gamma != nullptr) gamma->setZero(m);
+  auto put = [&](int row, const PairScalar& s, int body_a, int body_b) {
+    if (phi != nullptr) (*phi)[row] = s.f;
+    if (phi_q != nullptr) Scatter(s.jacobian, body_a, body_b, phi_q->middleRows(row, 1));
+    if (gamma != nullptr) (*gamma)[row] = -s.f_ddot0;
+  };
+  for (int i = 0; i < static_cast<int>(model_.bodies.size()); ++i) {
+    const Vector4d p = q.segment<4>(kBlock * i + 3);
+    if (phi != nullptr) (*phi)[i] = kNormRowScale * (p.squaredNorm() - 1.0);
+    if (phi_q != nullptr) phi_q->block<1, 4>(i, kBlock * i + 3) = kNormRowScale * 2.0 * p.transpose();
+    if (gamma != nullptr) (*gamma)[i] = -kNormRowScale * 2.0 * v->segment<4>(kBlock * i + 3).squaredNorm();
+  }
+  for (size_t j = 0; j < model_.joints.size(); ++j) {
+    const Joint& joint = model_.joints[j];
+    const std::vector<PairScalar> rows = JointEquations(joint, q, v);
+    for (size_t k = 0; k < rows.size(); ++k) put(joint_row_[j] + static_cast<int>(k), rows[k], joint.a.body, joint.b.body);
+  }
+  for (size_t d = 0; d < model_.drivers.size(); ++d) {
+    // sin(angle - angle(t)) = sin(angle) cos(angle(t)) - cos(angle) sin(angle(t)),
+    // with sin(angle) = x_b.y_a and cos(angle) = x_b.x_a: smooth in q, and
+    // zero at the prescribed angle.
+    const Joint& joint = model_.joints[static_cast<size_t>(model_.drivers[d].joint)];
+    const FrameVectors a = FrameOf(joint.a, 0, q, v), b = FrameOf(joint.b, 1, q, v);
+    const PairScalar sine = Dot(b.x, a.y), cosine = Dot(b.x, a.x);
+    const multibody::Profile::Value angle = model_.drivers[d].profile.At(t);
+    const double c = std::cos(angle.q), s = std::sin(angle.q);
+    const int row = driver_row_[d];
+    PairScalar f;
+    f.f = c * sine.f - s * cosine.f;
+    f.jacobian = c * sine.jacobian - s * cosine.jacobian;
+    f.f_ddot0 = c * sine.f_ddot0 - s * cosine.f_ddot0;
+    put(row, f, joint.a.body, joint.b.body);
+    const double along = s * sine.f + c * cosine.f;
+    if (phi_t != nullptr) (*phi_t)[row] = -angle.q_dot * along;
+    if (gamma != nullptr) {
+      // -(Phi_q v)_q v - 2 Phi_qt v - Phi_tt.
+      (*gamma)[row] = -f.f_ddot0 + 2.0 * angle.q_dot * (s * sine.f_dot + c * cosine.f_dot) +
+                      angle.q_ddot * along + angle.q_dot * angle.q_dot * f.f;
+    }
+  }
+}
+
+int SpatialSystem::Constraints(double t, const VectorXd& q, VectorXd* phi) const {
+  EvaluateRows(t, q, nullptr, phi, nullptr, nullptr, nullptr);
+  return AllFinite(*phi) ? 0 : 1;
+}
+
+int SpatialSystem::ConstraintJacobian(double t, const VectorXd& q, Eigen::MatrixXd* phi_q) const {
+  EvaluateRows(t, q, nullptr, nullptr, phi_q, nullptr, nullptr);
+  return phi_q->allFinite() ? 0 : 1;
+}
+
+int SpatialSystem::ConstraintTimeDerivative(double t, const VectorXd& q, VectorXd* phi_t) const {
+  EvaluateRows(t, q, nullptr, nullptr, nullptr, phi_t, nullptr);
+  return AllFinite(*phi_t) ? 0 : 1;
+}
+
+int SpatialSystem::AccelerationRightSide(double t, const VectorXd& q, const VectorXd& v, VectorXd* gamma) const {
+  EvaluateRows(t, q, &v, nullptr, nullptr, nullptr, gamma);
+  return AllFinite(*gamma) ? 0 : 1;
+}
+
+VectorXd SpatialSystem::InitialGuess() const {
+  VectorXd q(num_coordinates());
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const Body& b = model_.bodies[i];
+    q.segment<3>(kBlock * static_cast<int>(i)) = b.position_m;
+    q.segment<4>(kBlock * static_cast<int>(i) + 3) = EulerParametersOf(b.orientation);
+  }
+  return q;
+}
+
+VectorXd SpatialSystem::InitialVelocityGuess() const {
+  const VectorXd q = InitialGuess();
+  VectorXd v(num_coordinates());
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const Body& b = model_.bodies[i];
+    const int at = kBlock * static_cast<int>(i);
+    v.segment<3>(at) = b.velocity_m_per_s;
+    v.segment<4>(at + 3) = EulerParameterRate(q.segment<4>(at + 3), b.angular_velocity_rad_per_s);
+  }
+  return v;
+}
+
+Vector3d SpatialSystem::PointPosition(const Point& p, const VectorXd& q) const {
+  return FixedIn(CoordinatesOf(p.body, q, nullptr), 0, p.position_m, true).x;
+}
+
+Vector3d SpatialSystem::PointVelocity(const Point& p, const VectorXd& q, const VectorXd& v) const {
+  return FixedIn(CoordinatesOf(p.body, q, &v), 0, p.position_m, true).x_dot;
+}
+
+Matrix3d SpatialSystem::BodyRotation(int body, const VectorXd& q) const {
+  return RotationOf(CoordinatesOf(body, q, nullptr).p);
+}
+
+Vector3d SpatialSystem::AngularVelocity(int body, const VectorXd& q, const VectorXd& v) const {
+  const BodyCoordinates c = CoordinatesOf(body, q, &v);
+  return 2.0 * WorldRateMatrix(c.p) * c.p_dot;
+}
+
+Vector3d SpatialSystem::BodyAngularVelocity(int body, const VectorXd& q, const VectorXd& v) const {
+  const BodyCoordinates c = CoordinatesOf(body, q, &v);
+  return 2.0 * BodyRateMatrix(c.p) * c.p_dot;
+}
+
+double SpatialSystem::JointAngle(int joint, const VectorXd& q) const {
+  const Joint& j = model_.joints[static_cast<size_t>(joint)];
+  const FrameVectors a = FrameOf(j.a, 0, q, nullptr), b = FrameOf(j.b, 1, q, nullptr);
+  return std::atan2(b.x.x.dot(a.y.x), b.x.x.dot(a.x.x));
+}
+
+double SpatialSystem::JointTranslation(int joint, const VectorXd& q) const {
+  const Joint& j = model_.joints[static_cast<size_t>(joint)];
+  const FrameVectors a = FrameOf(j.a, 0, q, nullptr), b = FrameOf(j.b, 1, q, nullptr);
+  return a.z.x.dot(b.origin.x - a.origin.x);
+}
+
+double SpatialSystem::KineticEnergy(const VectorXd& q, const VectorXd& v) const {
+  double energy = 0.0;
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const Body& b = model_.bodies[i];
+    const Vector3d w = BodyAngularVelocity(static_cast<int>(i), q, v);
+    energy += 0.5 * b.mass_kg * v.segment<3>(kBlock * static_cast<int>(i)).squaredNorm() +
+              0.5 * w.dot(b.inertia_kg_m2 * w);
+  }
+  return energy;
+}
+
+double SpatialSystem::PotentialEnergy(const VectorXd& q) const {
+  double energy = 0.0;
+  if (model_.gravity_m_per_s2) {
+    for (size_t i = 0; i < model_.bodies.size(); ++i) {
+      energy -= model_.bodies[i].mass_kg * model_.gravity_m_per_s2->dot(q.segment<3>(kBlock * static_cast<int>(i)));
+    }
+  }
+  for (const SpringDamper& s : model_.springs) {
+    const double stretch = (PointPosition(s.b, q) - PointPosition(s.a, q)).norm() - s.free_length_m;
+    energy += 0.5 * s.stiffness_n_per_m * stretch * stretch;
+  }
+  return energy;
+}
+
+Vector3d SpatialSystem::AngularMomentum(const VectorXd& q, const VectorXd& v) const {
+  Vector3d h = Vector3d::Zero();
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const Body& b = model_.bodies[i];
+    const int body = static_cast<int>(i), at = kBlock * body;
+    h += b.mass_kg * q.segment<3>(at).cross(v.segment<3>(at)) +
+         BodyRotation(body, q) * (b.inertia_kg_m2 * BodyAngularVelocity(body, q, v));
+  }
+  return h;
+}
+
+}  // namespace mbopt::spatial

@@ -1,0 +1,107 @@
+// The equations of a spatial multibody Model in absolute coordinates with
+// Euler parameters: q = (r, p) per body, r the centre of mass in world axes
+// (m) and p its unit quaternion (4 values, body to world), 7 coordinates per
+// body; v = dq/dt, as the GGL integrator (worker/multibody/forward_dynamics.h)
+// assumes. Implements multibody::ConstrainedSystem, so the planar kernel's
+// forward dynamics serve spatial scenes unchanged.
+//
+// Row layout: one normalization row per body (s (p.p - 1) = 0 with
+// s = kNormRowScale, in body order),
+// then each joint's rows in joint order (JointEquationCount), then one row
+// per driver. The equations of every joint are written from two kinds of
+// building block: the difference of two points and the dot product of two
+// vectors fixed in bodies (docs/physics.md, "Spatial scenes").
+//
+// The mass matrix: 4 L^T J L of the Euler parameters is singular along p.
+// The kernel adds (4 tr(J) / 3) p p^T, which makes it positive definite;
+// since 2 p^T is the normalization row's Jacobian, the added force lies in
+// that row's reaction and only its multiplier changes, not the motion.
+//
+// No analytic Newton derivatives yet (has_analytic_derivatives() is false):
+// the integrator forms its Newton matrix by difference quotients.
+//
+// Immutable after construction; the model must be valid (Model::Validate)
+// and must outlive the system.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "worker/multibody/constrained_system.h"
+#include "worker/spatial/spatial_model.h"
+
+namespace mbopt::spatial {
+
+class SpatialSystem : public multibody::ConstrainedSystem {
+ public:
+  explicit SpatialSystem(const Model& model);
+  // Keeps a reference to its model: a temporary would die first.
+  explicit SpatialSystem(const Model&&) = delete;
+
+  static constexpr int kCoordinatesPerBody = 7;
+  // The normalization rows are written s (p.p - 1) = 0. Their multipliers
+  // are no physical reaction, yet IDAS's Newton convergence test weighs
+  // them with the coordinates' tolerances, and the dense LU (partial
+  // pivoting) of the GGL Newton matrix delivers them only to some 1e-6
+  // relative: at s = 1 the corrector fails from the first step at
+  // tolerances of 1e-9 and tighter (a free body, 1e-8 still passed). At
+  // s = 1e6 the multipliers are 1e6 times smaller and held to the absolute
+  // tolerance instead: measured to integrate at 1e-10 (1e4 did not).
+  // The motion does not depend on s.
+  static constexpr double kNormRowScale = 1e6;
+
+  const Model& model() const { return model_; }
+  int num_coordinates() const override { return kCoordinatesPerBody * static_cast<int>(model_.bodies.size()); }
+  int num_constraints() const override { return num_rows_; }
+  int first_row_of_joint(int joint) const { return joint_row_[static_cast<size_t>(joint)]; }
+  int row_of_driver(int driver) const { return driver_row_[static_cast<size_t>(driver)]; }
+  // What a constraint row belongs to, for messages: "revolute joint 'A'
+  // (equation 4)", "the unit norm of body 'B'", "the driver of joint 'A'".
+  std::string RowOwner(int row) const;
+
+  int MassMatrix(const Eigen::VectorXd& q, Eigen::MatrixXd* mass) const override;
+  // Gravity, spring-dampers and the quadratic velocity terms of the Euler
+  // parameters' equations (8 L(p')^T J L(p') p).
+  int AppliedForces(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                    Eigen::VectorXd* forces) const override;
+  int Constraints(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi) const override;
+  int ConstraintJacobian(double t, const Eigen::VectorXd& q, Eigen::MatrixXd* phi_q) const override;
+  int ConstraintTimeDerivative(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi_t) const override;
+  int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                            Eigen::VectorXd* gamma) const override;
+
+  // The bodies' initial poses and velocities as coordinates (not yet
+  // consistent with the joints: see AssembleSpatial).
+  Eigen::VectorXd InitialGuess() const;
+  Eigen::VectorXd InitialVelocityGuess() const;
+
+  // Outputs of a state (SI, world axes).
+  Eigen::Vector3d PointPosition(const Point& p, const Eigen::VectorXd& q) const;
+  Eigen::Vector3d PointVelocity(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  // Body to world, from the coordinates as they are (|p| = 1 within the
+  // integration tolerance).
+  Eigen::Matrix3d BodyRotation(int body, const Eigen::VectorXd& q) const;
+  Eigen::Vector3d AngularVelocity(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;  // world
+  Eigen::Vector3d BodyAngularVelocity(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;  // body
+  // Revolute or cylindrical joint: the rotation coordinate (rad, in (-pi, pi]).
+  double JointAngle(int joint, const Eigen::VectorXd& q) const;
+  // Prismatic or cylindrical joint: the translation coordinate (m).
+  double JointTranslation(int joint, const Eigen::VectorXd& q) const;
+  double KineticEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  // Gravity (zero at the world origin) and the springs' strain energy.
+  double PotentialEnergy(const Eigen::VectorXd& q) const;
+  // Of all bodies about the world origin, world axes (kg m^2/s).
+  Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+
+ private:
+  void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
+                    Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
+
+  const Model& model_;
+  int num_rows_ = 0;
+  std::vector<int> joint_row_, driver_row_;
+};
+
+}  // namespace mbopt::spatial
