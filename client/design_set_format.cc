@@ -9,30 +9,17 @@
 #include "absl/strings/str_format.h"
 #include "client/job_format.h"
 #include "client/json_writer.h"
+#include "client/record_cells.h"
 
 namespace mbopt::client {
 namespace {
 
 std::string Status(const v1::CycleRecord& r) { return r.failure_kind().empty() ? "ok" : r.failure_kind(); }
 
-// "%.7g", or `missing` for a value the analysis did not give.
-std::string Value(double v, const char* missing) {
-  return std::isfinite(v) ? absl::StrFormat("%.7g", v) : std::string(missing);
-}
-
 std::vector<std::string> ConstraintNames(const v1::GetJobResponse& job) {
   std::vector<std::string> names;
   for (const auto& c : job.study().constraints()) names.push_back(c.name());
   return names;
-}
-
-double Physical(const v1::CycleRecord& r, int i) {
-  return i < r.x_trial_physical_size() ? r.x_trial_physical(i) : std::nan("");
-}
-
-double Violation(const v1::CycleRecord& r, size_t c) {
-  return static_cast<int>(c) < r.constraint_violations_size() ? r.constraint_violations(static_cast<int>(c))
-                                                              : std::nan("");
 }
 
 // The header cell of variable i: "name [unit]".
@@ -58,8 +45,8 @@ std::string DesignWatchRow(const v1::CycleRecord& r) {
   for (int i = 0; i < r.x_trial_physical_size(); ++i) {
     variables += (i == 0 ? "" : " ") + absl::StrFormat("%.7g", r.x_trial_physical(i));
   }
-  return absl::StrFormat("%6d %14s %10s %-12s  %s", r.cycle(), Value(r.objective_trial(), "-"),
-                         Value(r.max_violation_trial(), "-"), Status(r), variables);
+  return absl::StrFormat("%6d %14s %10s %-12s  %s", r.cycle(), CellValue(r.objective_trial(), "-"),
+                         CellValue(r.max_violation_trial(), "-"), Status(r), variables);
 }
 
 std::string DesignSetTable(const v1::GetJobResponse& job) {
@@ -76,26 +63,14 @@ std::string DesignSetTable(const v1::GetJobResponse& job) {
   std::vector<std::vector<std::string>> rows = {header};
   for (const v1::CycleRecord& r : job.cycles()) {
     std::vector<std::string> row = {std::to_string(r.cycle())};
-    for (int i = 0; i < s.design_names_size(); ++i) row.push_back(Value(Physical(r, i), "-"));
-    row.push_back(Value(r.objective_trial(), "-"));
-    row.push_back(Value(r.max_violation_trial(), "-"));
-    for (size_t c = 0; c < constraints.size(); ++c) row.push_back(Value(Violation(r, c), "-"));
+    for (int i = 0; i < s.design_names_size(); ++i) row.push_back(CellValue(TrialPhysical(r, i), "-"));
+    row.push_back(CellValue(r.objective_trial(), "-"));
+    row.push_back(CellValue(r.max_violation_trial(), "-"));
+    for (size_t c = 0; c < constraints.size(); ++c) row.push_back(CellValue(ConstraintViolation(r, static_cast<int>(c)), "-"));
     row.push_back(Status(r));
     rows.push_back(std::move(row));
   }
-  // Every column as wide as its widest cell, numbers right-aligned.
-  std::vector<size_t> widths(header.size(), 0);
-  for (const auto& row : rows) {
-    for (size_t k = 0; k < row.size(); ++k) widths[k] = std::max(widths[k], row[k].size());
-  }
-  for (const auto& row : rows) {
-    std::string line;
-    for (size_t k = 0; k < row.size(); ++k) {
-      const bool last = k + 1 == row.size();
-      line += last ? "  " + row[k] : absl::StrFormat("%*s ", static_cast<int>(widths[k]), row[k]);
-    }
-    out += line + "\n";
-  }
+  out += AlignedRows(rows);
   out += "maxg and the constraint columns: the largest (g - limit) / scale, > 0 violated\n";
   return out;
 }
@@ -112,9 +87,9 @@ std::string DesignSetCsv(const v1::GetJobResponse& job) {
   auto cell = [](double v) { return std::isfinite(v) ? JsonWriter::FormatDouble(v) : std::string(); };
   for (const v1::CycleRecord& r : job.cycles()) {
     out += std::to_string(r.cycle());
-    for (int i = 0; i < s.design_names_size(); ++i) out += "," + cell(Physical(r, i));
+    for (int i = 0; i < s.design_names_size(); ++i) out += "," + cell(TrialPhysical(r, i));
     out += "," + cell(r.objective_trial()) + "," + cell(r.max_violation_trial());
-    for (size_t c = 0; c < constraints.size(); ++c) out += "," + cell(Violation(r, c));
+    for (size_t c = 0; c < constraints.size(); ++c) out += "," + cell(ConstraintViolation(r, static_cast<int>(c)));
     // A reason is free text: quoted, its quotes doubled (RFC 4180).
     std::string reason;
     for (char ch : r.rejection_reason()) reason += ch == '"' ? std::string("\"\"") : std::string(1, ch);
@@ -171,14 +146,14 @@ std::string DesignSetJson(const v1::GetJobResponse& job, const std::string& data
     w.Field("design", r.cycle());
     w.Key("values");
     w.BeginObject();
-    for (int i = 0; i < s.design_names_size(); ++i) w.Field(s.design_names(i), Physical(r, i));
+    for (int i = 0; i < s.design_names_size(); ++i) w.Field(s.design_names(i), TrialPhysical(r, i));
     w.EndObject();
     w.NumberArray("x_scaled", std::vector<double>(r.x_trial_scaled().begin(), r.x_trial_scaled().end()));
     w.Field("objective", r.objective_trial());
     w.Field("max_violation", r.max_violation_trial());
     w.Key("constraints");
     w.BeginObject();
-    for (size_t c = 0; c < constraints.size(); ++c) w.Field(constraints[c], Violation(r, c));
+    for (size_t c = 0; c < constraints.size(); ++c) w.Field(constraints[c], ConstraintViolation(r, static_cast<int>(c)));
     w.EndObject();
     w.Field("status", Status(r));
     w.Field("failure_reason", r.rejection_reason());

@@ -10,28 +10,16 @@
 #include "absl/strings/str_format.h"
 #include "client/job_format.h"
 #include "client/json_writer.h"
+#include "client/record_cells.h"
 #include "spec/pareto.h"
 #include "spec/units.h"
 
 namespace mbopt::client {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string Value(double v, const char* missing) {
-  return std::isfinite(v) ? absl::StrFormat("%.7g", v) : std::string(missing);
-}
 
 std::string Heading(const std::string& name, const std::string& unit) {
   return unit.empty() ? name : absl::StrCat(name, " [", unit, "]");
-}
-
-double Physical(const v1::CycleRecord& r, int i) {
-  return i < r.x_trial_physical_size() ? r.x_trial_physical(i) : kNaN;
-}
-
-double Violation(const v1::CycleRecord& r, int c) {
-  return c < r.constraint_violations_size() ? r.constraint_violations(c) : kNaN;
 }
 
 const v1::CycleRecord* PointRecord(const v1::GetJobResponse& job, int point) {
@@ -62,8 +50,8 @@ std::string ParetoWatchHeader() {
 }
 
 std::string ParetoWatchRow(const v1::CycleRecord& r) {
-  return absl::StrFormat("%5d %14s %14s %14s %-10s %6d", r.cycle(), Value(r.objective_trial(), "-"),
-                         Value(r.pareto_value_si(), "-"), Value(r.pareto_level_si(), "-"), r.pareto_state(),
+  return absl::StrFormat("%5d %14s %14s %14s %-10s %6d", r.cycle(), CellValue(r.objective_trial(), "-"),
+                         CellValue(r.pareto_value_si(), "-"), CellValue(r.pareto_level_si(), "-"), r.pareto_state(),
                          r.pareto_cycles());
 }
 
@@ -122,26 +110,16 @@ std::string ParetoTable(const v1::GetJobResponse& job) {
   std::vector<std::vector<std::string>> rows = {header};
   for (const ParetoPointRow& p : front.points) {
     const v1::CycleRecord& r = *p.record;
-    std::vector<std::string> row = {std::to_string(p.point), Value(p.level, "-"), Value(p.objective, "-"),
-                                    Value(p.value, "-"), Value(r.max_violation_trial(), "-"), r.pareto_state(),
+    std::vector<std::string> row = {std::to_string(p.point), CellValue(p.level, "-"), CellValue(p.objective, "-"),
+                                    CellValue(p.value, "-"), CellValue(r.max_violation_trial(), "-"), r.pareto_state(),
                                     std::to_string(r.pareto_cycles())};
     for (int i = 0; i < s.design_names_size(); ++i) {
-      row.push_back(p.status == "not run" ? "-" : Value(Physical(r, i), "-"));
+      row.push_back(p.status == "not run" ? "-" : CellValue(TrialPhysical(r, i), "-"));
     }
     row.push_back(p.status);
     rows.push_back(std::move(row));
   }
-  std::vector<size_t> widths(header.size(), 0);
-  for (const auto& row : rows) {
-    for (size_t k = 0; k < row.size(); ++k) widths[k] = std::max(widths[k], row[k].size());
-  }
-  for (const auto& row : rows) {
-    std::string line;
-    for (size_t k = 0; k < row.size(); ++k) {
-      line += k + 1 == row.size() ? "  " + row[k] : absl::StrFormat("%*s ", static_cast<int>(widths[k]), row[k]);
-    }
-    out += line + "\n";
-  }
+  out += AlignedRows(rows);
   out += absl::StrCat("level: the limit on ", front.against,
                       " for the point (none at the two ends); maxg: the point's run's largest (g - limit) / scale\n");
   for (const ParetoPointRow& p : front.points) {
@@ -164,7 +142,7 @@ std::string ParetoCsv(const v1::GetJobResponse& job) {
     out += absl::StrCat(p.point, ",", cell(p.level), ",", cell(p.objective), ",", cell(p.value), ",",
                         cell(r.max_violation_trial()), ",", r.pareto_state(), ",", r.pareto_cycles(), ",",
                         r.pareto_analyses());
-    for (int i = 0; i < s.design_names_size(); ++i) out += "," + cell(Physical(r, i));
+    for (int i = 0; i < s.design_names_size(); ++i) out += "," + cell(TrialPhysical(r, i));
     std::string reason;
     for (char ch : r.rejection_reason()) reason += ch == '"' ? std::string("\"\"") : std::string(1, ch);
     out += "," + p.status + "," + (reason.empty() ? "" : "\"" + reason + "\"") + "\n";
@@ -188,12 +166,12 @@ void PointObject(const v1::GetJobResponse& job, const ParetoPointRow& p, JsonWri
   w.Field("analyses", static_cast<long long>(r.pareto_analyses()));
   w.Key("design");
   w.BeginObject();
-  for (int i = 0; i < s.design_names_size(); ++i) w.Field(s.design_names(i), Physical(r, i));
+  for (int i = 0; i < s.design_names_size(); ++i) w.Field(s.design_names(i), TrialPhysical(r, i));
   w.EndObject();
   w.NumberArray("x_scaled", std::vector<double>(r.x_trial_scaled().begin(), r.x_trial_scaled().end()));
   w.Key("constraints");
   w.BeginObject();
-  for (int c = 0; c < job.study().constraints_size(); ++c) w.Field(job.study().constraints(c).name(), Violation(r, c));
+  for (int c = 0; c < job.study().constraints_size(); ++c) w.Field(job.study().constraints(c).name(), ConstraintViolation(r, c));
   w.EndObject();
   w.Field("status", p.status);
   w.Field("reason", r.rejection_reason());
@@ -241,22 +219,22 @@ absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int p
   const std::string unit = front.unit.empty() ? "" : " " + front.unit;
   out += std::isfinite(p->level) ? absl::StrFormat("level:       %s <= %.9g%s\n", front.against, p->level, unit)
                                   : absl::StrFormat("level:       none (an end of the front)\n");
-  out += absl::StrFormat("objective:   %s%s\n", Value(p->objective, "-"),
+  out += absl::StrFormat("objective:   %s%s\n", CellValue(p->objective, "-"),
                          s.objective_unit().empty() ? "" : " " + s.objective_unit());
-  out += absl::StrFormat("%-12s %s%s\n", front.against + ":", Value(p->value, "-"), unit);
-  out += absl::StrFormat("maxg:        %s\n", Value(r.max_violation_trial(), "-"));
+  out += absl::StrFormat("%-12s %s%s\n", front.against + ":", CellValue(p->value, "-"), unit);
+  out += absl::StrFormat("maxg:        %s\n", CellValue(r.max_violation_trial(), "-"));
   out += absl::StrFormat("run:         %s after %d cycles, %d analyses\n", r.pareto_state(), r.pareto_cycles(),
                          static_cast<long long>(r.pareto_analyses()));
   if (!r.rejection_reason().empty()) out += "reason:      " + r.rejection_reason() + "\n";
   out += "design:\n";
   for (int i = 0; i < s.design_names_size(); ++i) {
     const std::string design_unit = i < s.design_units_size() ? s.design_units(i) : "";
-    out += absl::StrFormat("  %-12s %.9g%s\n", s.design_names(i), Physical(r, i),
+    out += absl::StrFormat("  %-12s %.9g%s\n", s.design_names(i), TrialPhysical(r, i),
                            design_unit.empty() ? "" : " " + design_unit);
   }
   out += "constraints (largest (g - limit) / scale against the study's limits, > 0 violated):\n";
   for (int c = 0; c < job.study().constraints_size(); ++c) {
-    out += absl::StrFormat("  %-12s %s\n", job.study().constraints(c).name(), Value(Violation(r, c), "-"));
+    out += absl::StrFormat("  %-12s %s\n", job.study().constraints(c).name(), CellValue(ConstraintViolation(r, c), "-"));
   }
   return out;
 }

@@ -12,22 +12,6 @@
 namespace mbopt::report {
 namespace {
 
-constexpr const char* kStyle = R"css(
-body { font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; color: #222;
-       margin: 24px; max-width: 1180px; }
-h1 { font-size: 22px; margin-bottom: 4px; }
-h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccc; }
-p.description, p.note { color: #555; }
-p.note { font-size: 13px; }
-table { border-collapse: collapse; font-size: 13px; margin: 8px 0; }
-th, td { border: 1px solid #ccc; padding: 3px 7px; text-align: left; }
-th { background: #f2f2f2; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
-td.violated { color: #b00020; font-weight: bold; }
-tr.failed td { background: #fdecea; }
-div.wide { overflow-x: auto; }
-)css";
-
 // Distinguishable colours for a grid's curves, repeated beyond ten.
 constexpr const char* kColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
                                    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
@@ -148,7 +132,7 @@ std::string Table(const DesignSetReportData& data) {
 }  // namespace
 
 std::string RenderDesignSetReportHtml(const DesignSetReportData& data) {
-  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kStyle) + kPlotStyleCss);
+  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kDesignsPageStyleCss) + kPlotStyleCss);
   out += "<table>\n<tbody>\n";
   if (!data.job_id.empty()) out += "<tr><th>job</th><td>" + EscapeHtml(data.job_id) + "</td></tr>\n";
   out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";

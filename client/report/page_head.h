@@ -21,6 +21,24 @@ svg .point-label { font-size: 11px; fill: #222; }
 svg .note, svg .no-data { font-size: 11px; fill: #555; }
 )css";
 
+// The page style of the reports of several designs (a design set's, a
+// Pareto front's): text, headings and the designs' table.
+inline constexpr const char* kDesignsPageStyleCss = R"css(
+body { font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; color: #222;
+       margin: 24px; max-width: 1180px; }
+h1 { font-size: 22px; margin-bottom: 4px; }
+h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccc; }
+p.description, p.note { color: #555; }
+p.note { font-size: 13px; }
+table { border-collapse: collapse; font-size: 13px; margin: 8px 0; }
+th, td { border: 1px solid #ccc; padding: 3px 7px; text-align: left; }
+th { background: #f2f2f2; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+td.violated { color: #b00020; font-weight: bold; }
+tr.failed td { background: #fdecea; }
+div.wide { overflow-x: auto; }
+)css";
+
 // `study_name` empty reads "(unnamed study)"; `style_css` goes inline.
 std::string PageHeadHtml(const std::string& study_name, const std::string& description, std::string_view style_css);
 

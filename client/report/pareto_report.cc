@@ -11,22 +11,10 @@
 namespace mbopt::report {
 namespace {
 
-constexpr const char* kStyle = R"css(
-body { font-family: "DejaVu Sans", "Liberation Sans", Arial, sans-serif; color: #222;
-       margin: 24px; max-width: 1180px; }
-h1 { font-size: 22px; margin-bottom: 4px; }
-h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccc; }
-p.description, p.note { color: #555; }
-p.note { font-size: 13px; }
-table { border-collapse: collapse; font-size: 13px; margin: 8px 0; }
-th, td { border: 1px solid #ccc; padding: 3px 7px; text-align: left; }
-th { background: #f2f2f2; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
-td.violated { color: #b00020; font-weight: bold; }
-tr.failed td { background: #fdecea; }
+// Beside the shared page style: dominated points and the chosen one.
+constexpr const char* kFrontRowsCss = R"css(
 tr.dominated td { color: #777; }
 tr.chosen td { background: #fff6d5; }
-div.wide { overflow-x: auto; }
 )css";
 
 using Point = ParetoReportData::Point;
@@ -137,7 +125,7 @@ std::string ChosenPoint(const ParetoReportData& data) {
 }  // namespace
 
 std::string RenderParetoReportHtml(const ParetoReportData& data) {
-  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kStyle) + kPlotStyleCss);
+  std::string out = PageHeadHtml(data.study_name, data.description, std::string(kDesignsPageStyleCss) + kFrontRowsCss + kPlotStyleCss);
   out += "<table>\n<tbody>\n";
   if (!data.job_id.empty()) out += "<tr><th>job</th><td>" + EscapeHtml(data.job_id) + "</td></tr>\n";
   out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";
