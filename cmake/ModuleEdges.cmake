@@ -147,7 +147,7 @@ function(mbopt_declare_modules)
     LIBS mbopt_auth
     SUMMARY "who may call the server: tokens and their hashed table, roles, TLS certificates (OpenSSL)")
   mbopt_module(service DIRS server/service USES auth job_manager jobs lp scheduler store spec spec_io proto common
-    LIBS mbopt_service
+    LIBS mbopt_service mbopt_service_convert
     SUMMARY "boundary: the gRPC services and the server object")
   mbopt_module(server_main DIRS server/main USES version service auth store jobs common
     LIBS mbopt_refused_connection mbopt-server

@@ -8,6 +8,9 @@
 # job that did not end converged, or a server that died is an error (exit 1).
 #
 #   bash bench/reliability/soak.sh [JOBS] [IN_FLIGHT] [WORKERS] [STUDY] [CHECK]
+#
+# SOAK_SERVER_ARGS adds options to mbopt-server, e.g. admission limits:
+#   SOAK_SERVER_ARGS="--max-running-jobs 4" bash bench/reliability/soak.sh 200 200 2
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 JOBS=${1:-1000}
@@ -21,7 +24,8 @@ trap 'pkill -P $$ 2>/dev/null || true; rm -rf "$DIR"' EXIT
 
 # shellcheck source=bench/loopback.sh
 source bench/loopback.sh
-start_server
+read -r -a server_args <<< "${SOAK_SERVER_ARGS:-}"
+start_server "${server_args[@]}"
 server=$SERVER_PID address=$ADDRESS
 start_workers "$WORKERS"
 mbopt() { "$B/client/mbopt" "$@" --server "$address"; }

@@ -38,6 +38,7 @@ constexpr const char* kUsage =
     "                    [--durability full|cycles|normal]\n"
     "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
     "                    [--max-calls-per-second-per-user N]\n"
+    "                    [--max-call-threads N] [--max-streams-per-connection N]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
@@ -83,6 +84,12 @@ constexpr const char* kUsage =
     "  --max-calls-per-second-per-user N  job calls a user token may make per\n"
     "                         second, in bursts of twice that (default 100; 0: no\n"
     "                         limit; admins and workers are not limited)\n"
+    "  --max-call-threads N   threads the server runs calls on (default 1024, at\n"
+    "                         least 8): a call that needs one more is refused\n"
+    "                         (RESOURCE_EXHAUSTED); a worker holds about 2, a\n"
+    "                         watcher 1\n"
+    "  --max-streams-per-connection N  calls one connection may have open at once\n"
+    "                         (default 100); more wait in the client\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -216,6 +223,13 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
         return false;
       }
       flags->server.max_calls_per_second_per_user = rate;
+    } else if (name == "--max-call-threads") {
+      // A few threads are gRPC's own pollers: below 8 calls would get almost none.
+      if (!ParseInt(name, value, 8, &number)) return false;
+      flags->server.max_call_threads = static_cast<int>(std::min<std::int64_t>(number, 1 << 20));
+    } else if (name == "--max-streams-per-connection") {
+      if (!ParseInt(name, value, 1, &number)) return false;
+      flags->server.max_streams_per_connection = static_cast<int>(std::min<std::int64_t>(number, 1 << 20));
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

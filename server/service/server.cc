@@ -8,6 +8,8 @@
 #include <optional>
 #include <utility>
 
+#include <grpcpp/resource_quota.h>
+
 #include "absl/strings/str_cat.h"
 #include "common/private_file.h"
 #include "common/read_file.h"
@@ -131,6 +133,10 @@ absl::StatusOr<std::unique_ptr<MboptServer>> MboptServer::Start(ServerOptions op
   // on a port in use would silently share it instead of failing.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, static_cast<int>(s.options_.handshake_timeout_ms));
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, s.options_.max_streams_per_connection);
+  grpc::ResourceQuota quota("mbopt-server");
+  quota.SetMaxThreads(s.options_.max_call_threads);
+  builder.SetResourceQuota(quota);
   builder.SetMaxReceiveMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.SetMaxSendMessageSize(static_cast<int>(s.options_.max_message_bytes));
   builder.AddListeningPort(s.options_.listen_address, credentials, &s.port_);

@@ -62,6 +62,15 @@ struct ServerOptions {
   // connections from anyone who reaches the port would otherwise hold a
   // descriptor each for gRPC's default of 120 s.
   std::int64_t handshake_timeout_ms = 10'000;
+  // The most threads the server runs calls on (gRPC's resource quota): a
+  // call that would need one more is refused with RESOURCE_EXHAUSTED, so
+  // callers holding long calls open (watches, long polls) cannot make the
+  // server start threads without end. Each worker holds about two (its
+  // attach stream and its long poll), each watcher one.
+  int max_call_threads = 1024;
+  // The most calls one connection may have open at once (HTTP/2's
+  // SETTINGS_MAX_CONCURRENT_STREAMS): further calls wait in the client.
+  int max_streams_per_connection = 100;
   // JobService calls per second a user-role token may make (bursts of
   // twice that); 0: no limit. Admins and workers are not limited.
   double max_calls_per_second_per_user = 0;

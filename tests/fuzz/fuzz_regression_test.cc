@@ -15,6 +15,7 @@
 #include "spec/io/study_io.h"
 #include "tests/fuzz/fuzz_checks.h"
 #include "tests/fuzz/mutate.h"
+#include "tests/fuzz/result_intake_check.h"
 
 namespace mbopt::fuzz {
 namespace {
@@ -82,6 +83,25 @@ TEST(FuzzSeeds, PackedValuesSeedsAndTheirMutantsAreHandled) {
   }
 }
 
+// The result_intake seeds pass, and so do their single-byte changes and
+// truncations (a third of them, spread over each seed).
+TEST(FuzzSeeds, ResultIntakeSeedsAndTheirMutantsAreHandled) {
+  const std::vector<std::string> seeds = ResultIntakeSeeds();
+  ASSERT_EQ(seeds.size(), 3u);
+  int checked = 0;
+  for (const std::string& seed : seeds) {
+    CheckResultIntake(seed);
+    for (size_t at = 1; at < seed.size(); at += 23) {
+      std::string mutant = seed;
+      mutant[at] = static_cast<char>(mutant[at] ^ 0x5A);
+      CheckResultIntake(mutant);
+      CheckResultIntake(std::string_view(seed).substr(0, at));
+      checked += 2;
+    }
+  }
+  EXPECT_GT(checked, 20);
+}
+
 TEST(FuzzRegressions, EveryKeptFindingIsHandled) {
   const std::filesystem::path root = "tests/fuzz/regressions";
   ASSERT_TRUE(std::filesystem::is_directory(root));
@@ -90,7 +110,8 @@ TEST(FuzzRegressions, EveryKeptFindingIsHandled) {
            {"study_text", &CheckStudyText},
            {"scene_text", &CheckSceneText},
            {"study_binary", &CheckStudyBinary},
-           {"packed_values", &CheckPackedValues}}) {
+           {"packed_values", &CheckPackedValues},
+           {"result_intake", &CheckResultIntake}}) {
     if (!std::filesystem::is_directory(root / target)) continue;
     for (const auto& file : std::filesystem::directory_iterator(root / target)) {
       SCOPED_TRACE(file.path().string());

@@ -2,7 +2,8 @@
 // OUT/study_text/NAME (the study with its scene inline, text format),
 // OUT/study_binary/NAME (the same as a binary message) and
 // OUT/scene_text/NAME (the scene alone), and OUT/packed_values/seed-K (the
-// packings of PackedValuesSeeds). Usage: make_fuzz_seeds OUT STUDY...
+// packings of PackedValuesSeeds), and OUT/result_intake/seed-K (the batches
+// of ResultIntakeSeeds). Usage: make_fuzz_seeds OUT STUDY...
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,6 +13,7 @@
 
 #include "spec/io/study_io.h"
 #include "tests/fuzz/fuzz_checks.h"
+#include "tests/fuzz/result_intake_check.h"
 
 namespace {
 
@@ -46,11 +48,13 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  const std::vector<std::string> packed_seeds = mbopt::fuzz::PackedValuesSeeds();
-  for (size_t k = 0; k < packed_seeds.size(); ++k) {
-    if (!Write(out / "packed_values" / ("seed-" + std::to_string(k)), packed_seeds[k])) {
-      std::cerr << "make_fuzz_seeds: cannot write under " << out << "\n";
-      return 1;
+  for (const auto& [target, seeds] : {std::pair{"packed_values", mbopt::fuzz::PackedValuesSeeds()},
+                                     std::pair{"result_intake", mbopt::fuzz::ResultIntakeSeeds()}}) {
+    for (size_t k = 0; k < seeds.size(); ++k) {
+      if (!Write(out / target / ("seed-" + std::to_string(k)), seeds[k])) {
+        std::cerr << "make_fuzz_seeds: cannot write under " << out << "\n";
+        return 1;
+      }
     }
   }
   return 0;

@@ -11,14 +11,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds=20
-targets=(study_text scene_text study_binary packed_values)
+targets=(study_text scene_text study_binary packed_values result_intake)
 jobs=1
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --target) targets=("$2"); shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
-    *) echo "usage: tests/fuzz/run.sh [--seconds N] [--target study_text|scene_text|study_binary|packed_values] [--jobs N]" >&2; exit 2 ;;
+    *) echo "usage: tests/fuzz/run.sh [--seconds N] [--target study_text|scene_text|study_binary|packed_values|result_intake] [--jobs N]" >&2; exit 2 ;;
   esac
 done
 build=build-fuzz

@@ -1433,3 +1433,74 @@ TEST_F(ServerTest, TheStudyIsStoredAndServedAsTheBytesItsUserSent) {
 
 }  // namespace
 }  // namespace mbopt::service
+
+namespace mbopt::service {
+namespace {
+
+// Calls held open (here watches of a job that waits for workers) cannot
+// make the server start threads without end: beyond its quota a call is
+// refused with RESOURCE_EXHAUSTED, and once the held calls end the server
+// answers again.
+TEST_F(ServerTest, CallsBeyondTheThreadQuotaAreRefusedAndTheServerAnswersOnceTheyEnd) {
+  ServerOptions options;
+  options.listen_address = "127.0.0.1:0";
+  options.db_path = (dir_ / "a.db").string();
+  options.clock = &clock_;
+  options.max_call_threads = 12;
+  absl::StatusOr<std::unique_ptr<MboptServer>> started = MboptServer::Start(options);
+  ASSERT_TRUE(started.ok()) << started.status();
+  MboptServer& server = **started;
+  const std::string id = Submit(server, OscillatorStudy());
+  constexpr int kWatchers = 40;
+  std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+  std::vector<grpc::StatusCode> codes(kWatchers, grpc::StatusCode::OK);
+  std::atomic<int> ended{0};
+  std::vector<std::thread> watchers;
+  for (int i = 0; i < kWatchers; ++i) contexts.push_back(std::make_unique<grpc::ClientContext>());
+  for (int i = 0; i < kWatchers; ++i) {
+    watchers.emplace_back([&, i] {
+      auto stub = v1::JobService::NewStub(server.InProcessChannel());
+      v1::JobRef ref;
+      ref.set_job_id(id);
+      auto reader = stub->Watch(contexts[static_cast<size_t>(i)].get(), ref);
+      v1::JobEvent event;
+      while (reader->Read(&event)) {
+      }
+      codes[static_cast<size_t>(i)] = reader->Finish().error_code();
+      ++ended;
+    });
+  }
+  // The refused ones end by themselves; the others stay open.
+  for (int waited_ms = 0; waited_ms < 10'000 && ended.load() == 0; waited_ms += 20) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const int refused_while_held = ended.load();
+  for (auto& context : contexts) context->TryCancel();
+  for (std::thread& watcher : watchers) watcher.join();
+  const int exhausted = static_cast<int>(std::count(codes.begin(), codes.end(), grpc::StatusCode::RESOURCE_EXHAUSTED));
+  EXPECT_GT(refused_while_held, 0);
+  EXPECT_GT(exhausted, 0);
+  EXPECT_LT(exhausted, kWatchers);  // some were served
+  // The cancelled watches' threads end at their next look at the call (a
+  // watch waits for changes in slices); then the server answers.
+  grpc::Status status;
+  for (int waited_ms = 0; waited_ms < 10'000; waited_ms += 50) {
+    auto stub = v1::JobService::NewStub(server.InProcessChannel());
+    grpc::ClientContext context;
+    v1::JobRef ref;
+    ref.set_job_id(id);
+    v1::GetJobResponse response;
+    status = stub->Get(&context, ref, &response);
+    if (status.ok()) {
+      EXPECT_EQ(response.summary().job_id(), id);
+      break;
+    }
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+}  // namespace
+}  // namespace mbopt::service
