@@ -38,7 +38,7 @@ constexpr const char* kUsage =
     "                    [--durability full|cycles|normal]\n"
     "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
     "                    [--max-calls-per-second-per-user N]\n"
-    "                    [--max-call-threads N] [--max-streams-per-connection N]\n"
+    "                    [--max-call-threads N] [--max-streams-per-connection N] [--max-held-calls-per-peer N]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
@@ -90,6 +90,9 @@ constexpr const char* kUsage =
     "                         watcher 1\n"
     "  --max-streams-per-connection N  calls one connection may have open at once\n"
     "                         (default 100); more wait in the client\n"
+    "  --max-held-calls-per-peer N  calls one address may hold open (watches, attach\n"
+    "                         streams, long polls; default 512, 0: no limit); a\n"
+    "                         worker holds about 2\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -230,6 +233,9 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     } else if (name == "--max-streams-per-connection") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->server.max_streams_per_connection = static_cast<int>(std::min<std::int64_t>(number, 1 << 20));
+    } else if (name == "--max-held-calls-per-peer") {
+      if (!ParseInt(name, value, 0, &number)) return false;
+      flags->server.max_held_calls_per_peer = static_cast<int>(std::min<std::int64_t>(number, 1 << 20));
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

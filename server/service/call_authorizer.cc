@@ -92,6 +92,18 @@ void CallAuthorizer::LimitUserCalls(double calls_per_second, std::function<std::
   now_ms_ = std::move(now_ms);
 }
 
+void CallAuthorizer::LimitHeldCallsPerPeer(int max_per_peer) {
+  held_calls_ = max_per_peer > 0 ? std::make_unique<PeerCallLimiter>(max_per_peer) : nullptr;
+}
+
+absl::StatusOr<PeerCallLimiter::Slot> CallAuthorizer::HoldCall(const grpc::ServerContext& context,
+                                                               const char* method) const {
+  if (held_calls_ == nullptr) return PeerCallLimiter::Slot();
+  absl::StatusOr<PeerCallLimiter::Slot> slot = held_calls_->Take(context.peer());
+  if (!slot.ok()) return Refuse(context, method, nullptr, slot.status());
+  return slot;
+}
+
 absl::StatusOr<auth::Principal> CallAuthorizer::ForWorkers(const grpc::ServerContext& context,
                                                            const char* method) const {
   absl::StatusOr<auth::Principal> principal = Identify(context);

@@ -22,6 +22,7 @@
 #include "server/auth/principal.h"
 #include "server/auth/token_table.h"
 #include "server/service/call_rate_limiter.h"
+#include "server/service/peer_call_limiter.h"
 
 namespace mbopt::service {
 
@@ -48,6 +49,14 @@ class CallAuthorizer {
   // that) from each user-role token holder, on the clock `now_ms`; admins
   // and workers are not limited, nor anyone on a server without tokens.
   void LimitUserCalls(double calls_per_second, std::function<std::int64_t()> now_ms);
+
+  // At most `max_per_peer` calls held open (watches, attach streams, long
+  // polls, results in pieces) per peer address; <= 0: no limit.
+  void LimitHeldCallsPerPeer(int max_per_peer);
+  // A place for a call that stays open (peer_call_limiter.h), or
+  // ResourceExhausted (written to the audit log) when its address holds
+  // its limit.
+  absl::StatusOr<PeerCallLimiter::Slot> HoldCall(const grpc::ServerContext& context, const char* method) const;
 
   // The caller of a JobService method (`method` names it in messages).
   // Unauthenticated without a known token; PermissionDenied for a worker;
@@ -76,6 +85,7 @@ class CallAuthorizer {
   mutable std::mutex mutex_;
   std::shared_ptr<const auth::TokenTable> tokens_;  // null without tokens
   std::unique_ptr<CallRateLimiter> user_calls_;     // null: no limit
+  std::unique_ptr<PeerCallLimiter> held_calls_;     // null: no limit
   std::function<std::int64_t()> now_ms_;
 };
 

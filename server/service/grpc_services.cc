@@ -130,6 +130,8 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
   if (absl::StatusOr<auth::Principal> access = CheckJobAccess(*context, "Watch", request->job_id()); !access.ok()) {
     return ToGrpcStatus(access.status());
   }
+  absl::StatusOr<PeerCallLimiter::Slot> held = authorizer_->HoldCall(*context, "Watch");
+  if (!held.ok()) return ToGrpcStatus(held.status());
   if (absl::Status status = manager_->StartWatching(request->job_id()); !status.ok()) return ToGrpcStatus(status);
   absl::Cleanup stop_watching = [this, request] { manager_->StopWatching(request->job_id()); };
   std::size_t next_record = 0;
@@ -257,6 +259,10 @@ grpc::Status WorkerServiceImpl::AcquireTasks(grpc::ServerContext* context, const
     return ToGrpcStatus(caller.status());
   }
   const std::int64_t wait_ms = std::clamp<std::int64_t>(request->wait_ms(), 0, kMaxWaitMs);
+  // Only a long poll holds its thread.
+  absl::StatusOr<PeerCallLimiter::Slot> held =
+      wait_ms > 0 ? authorizer_->HoldCall(*context, "AcquireTasks") : PeerCallLimiter::Slot();
+  if (!held.ok()) return ToGrpcStatus(held.status());
   absl::StatusOr<std::vector<scheduler::Task>> tasks =
       scheduler_->AcquireWait(request->worker_id(), std::clamp(request->max_tasks(), 1, kMaxTasksPerCall), wait_ms);
   if (!tasks.ok()) return ToGrpcStatus(tasks.status());
@@ -321,6 +327,8 @@ grpc::Status WorkerServiceImpl::ReportResultInPieces(grpc::ServerContext* contex
                                                      v1::ReportResultsResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResultInPieces");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
+  absl::StatusOr<PeerCallLimiter::Slot> held = authorizer_->HoldCall(*context, "ReportResultInPieces");
+  if (!held.ok()) return ToGrpcStatus(held.status());
   v1::ResultPiece piece;
   if (!reader->Read(&piece)) return ToGrpcStatus(absl::InvalidArgumentError("a result in pieces without a piece"));
   const std::int64_t total = piece.total_bytes();
@@ -399,6 +407,8 @@ grpc::Status WorkerServiceImpl::Attach(grpc::ServerContext* context, const v1::A
   if (absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "Attach"); !caller.ok()) {
     return ToGrpcStatus(caller.status());
   }
+  absl::StatusOr<PeerCallLimiter::Slot> held = authorizer_->HoldCall(*context, "Attach");
+  if (!held.ok()) return ToGrpcStatus(held.status());
   const std::string& worker_id = request->worker_id();
   if (!scheduler_->IsKnownWorker(worker_id)) {
     return ToGrpcStatus(absl::NotFoundError(absl::StrCat("no worker '", worker_id, "': register again")));

@@ -69,6 +69,7 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MboptServer::LoadSecuri
   if (options_.max_calls_per_second_per_user > 0) {
     authorizer_->LimitUserCalls(options_.max_calls_per_second_per_user, [this] { return clock_->NowMs(); });
   }
+  authorizer_->LimitHeldCallsPerPeer(options_.max_held_calls_per_peer);
   if (!tls) return grpc::InsecureServerCredentials();
   if (options_.tls_cert_file.empty() || options_.tls_key_file.empty()) {
     return absl::InvalidArgumentError("TLS needs both the certificate (--tls-cert) and its key (--tls-key)");

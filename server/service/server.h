@@ -71,6 +71,10 @@ struct ServerOptions {
   // The most calls one connection may have open at once (HTTP/2's
   // SETTINGS_MAX_CONCURRENT_STREAMS): further calls wait in the client.
   int max_streams_per_connection = 100;
+  // The most calls held open (watches, attach streams, long polls, results
+  // in pieces) by one peer address, so that one machine cannot take every
+  // call thread; <= 0: no limit. A worker holds about 2.
+  int max_held_calls_per_peer = 512;
   // JobService calls per second a user-role token may make (bursts of
   // twice that); 0: no limit. Admins and workers are not limited.
   double max_calls_per_second_per_user = 0;

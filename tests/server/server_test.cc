@@ -1504,3 +1504,65 @@ TEST_F(ServerTest, CallsBeyondTheThreadQuotaAreRefusedAndTheServerAnswersOnceThe
 
 }  // namespace
 }  // namespace mbopt::service
+
+namespace mbopt::service {
+namespace {
+
+// One address cannot hold more calls open than its share: the watches
+// beyond the limit are refused naming it, and the address's calls are
+// taken again once the held ones end.
+TEST_F(ServerTest, WatchesBeyondAnAddresssHeldCallLimitAreRefusedNamingIt) {
+  ServerOptions options;
+  options.listen_address = "127.0.0.1:0";
+  options.db_path = (dir_ / "a.db").string();
+  options.clock = &clock_;
+  options.max_held_calls_per_peer = 4;
+  absl::StatusOr<std::unique_ptr<MboptServer>> started = MboptServer::Start(options);
+  ASSERT_TRUE(started.ok()) << started.status();
+  MboptServer& server = **started;
+  const std::string id = Submit(server, OscillatorStudy());
+  auto channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", server.port()), grpc::InsecureChannelCredentials());
+  auto stub = v1::JobService::NewStub(channel);
+  v1::JobRef ref;
+  ref.set_job_id(id);
+  constexpr int kWatches = 8;
+  std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+  std::vector<std::unique_ptr<grpc::ClientReader<v1::JobEvent>>> readers;
+  int served = 0, refused = 0;
+  for (int i = 0; i < kWatches; ++i) {
+    contexts.push_back(std::make_unique<grpc::ClientContext>());
+    readers.push_back(stub->Watch(contexts.back().get(), ref));
+    v1::JobEvent event;
+    // A served watch sends the job's summary at once; a refused one ends.
+    if (readers.back()->Read(&event)) {
+      ++served;
+    } else {
+      const grpc::Status status = readers.back()->Finish();
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+      EXPECT_THAT(status.error_message(), HasSubstr("ipv4:127.0.0.1 holds 4 calls open"));
+      ++refused;
+    }
+  }
+  EXPECT_EQ(served, 4);
+  EXPECT_EQ(refused, kWatches - 4);
+  // Short calls are not held: they go on.
+  EXPECT_EQ(Get(server, id).summary().job_id(), id);
+  for (int i = 0; i < kWatches; ++i) contexts[static_cast<size_t>(i)]->TryCancel();
+  readers.clear();
+  // The cancelled watches give their places back when their handlers see
+  // the cancellation (a watch waits in slices).
+  bool watched_again = false;
+  for (int waited_ms = 0; waited_ms < 10'000 && !watched_again; waited_ms += 50) {
+    grpc::ClientContext context;
+    auto reader = stub->Watch(&context, ref);
+    v1::JobEvent event;
+    watched_again = reader->Read(&event);
+    context.TryCancel();
+    reader->Finish();
+    if (!watched_again) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(watched_again);
+}
+
+}  // namespace
+}  // namespace mbopt::service
