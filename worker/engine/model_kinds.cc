@@ -131,9 +131,9 @@ std::vector<ModelKind> MakeTable() {
       nullptr};
   table[IndexOf<spec::FmuModel>()] = {
       "fmu",
-      "an FMI 2.0 FMU: Model Exchange integrated by CVODES with its events, or Co-Simulation stepped "
+      "an FMI 2.0 or 3.0 FMU: Model Exchange integrated by CVODES with its events, or Co-Simulation stepped "
       "(worker/fmu/scene_analysis.h)",
-      "time_steps: CVODES steps (Model Exchange) or fmi2DoStep calls (Co-Simulation)",
+      "time_steps: CVODES steps (Model Exchange) or fmi2DoStep / fmi3DoStep calls (Co-Simulation)",
       &AnalyzeFmu,
       [](const spec::Scene&, const std::vector<int>&) {
         return Never("an FMU's directional derivatives are not read: its gradients are differenced");

@@ -4,15 +4,15 @@
 
 #include <vector>
 
-#include "worker/fmu/fmi2_instance.h"
+#include "worker/fmu/model_instance.h"
 #include "worker/fmu/simulation.h"
 
 namespace mbopt::fmu::internal {
 
 // A request checked against the model description, as value references.
 struct CheckedRun {
-  std::vector<fmi2ValueReference> output_references;
-  std::vector<fmi2ValueReference> parameter_references;
+  std::vector<ValueReference> output_references;
+  std::vector<ValueReference> parameter_references;
   std::vector<double> parameter_values;
   double stop_time_s = 0.0;
 };
@@ -24,14 +24,14 @@ bool WithinBudget(const RunOptions& options, double time_s, RunResult* result);
 // Marks `result` failed with `outcome` and `reason`; returns false.
 bool Fail(RunResult* result, RunOutcome outcome, std::string reason);
 
-// fmi2SetupExperiment, the parameters, and initialization mode entered and
-// left. False (and `result` failed) when the FMU refuses any of it.
-bool Initialize(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
+// The experiment set up, the parameters set, and initialization mode
+// entered and left. False (and `result` failed) when the FMU refuses any of it.
+bool Initialize(ModelInstance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
                 RunResult* result);
 
 // Reads the outputs into result->values[.][time_index].
-bool ReadOutputs(Fmi2Instance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result);
+bool ReadOutputs(ModelInstance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result);
 
-RunResult RunModelExchange(const Fmu& fmu, Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run);
+RunResult RunModelExchange(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run);
 
 }  // namespace mbopt::fmu::internal

@@ -115,12 +115,11 @@ absl::StatusOr<double> CommunicationStep(const Fmu& fmu, const RunOptions& optio
   return *step;
 }
 
-RunResult RunCoSimulation(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double step_s) {
+RunResult RunCoSimulation(ModelInstance& instance, const RunOptions& options, const CheckedRun& run, double step_s) {
   RunResult result;
   result.values.assign(run.output_references.size(), std::vector<double>(options.output_times_s.size()));
   const double tolerance = options.relative_tolerance;
   if (!internal::Initialize(instance, options, run, tolerance, &result)) return result;
-  const Fmi2Functions& f = instance.f();
   // Communication points are start + m * step, computed from m each time so
   // that no rounding accumulates over many steps.
   std::int64_t m = 0;
@@ -128,17 +127,25 @@ RunResult RunCoSimulation(Fmi2Instance& instance, const RunOptions& options, con
     const auto target = static_cast<std::int64_t>(std::llround((options.output_times_s[i] - options.start_time_s) / step_s));
     for (; m < target; ++m) {
       const double point = options.start_time_s + static_cast<double>(m) * step_s;
-      const fmi2Status status = f.do_step(instance.component(), point, step_s, fmi2True);
+      bool terminate = false;
+      const CallStatus status = instance.DoStep(point, step_s, &terminate);
       ++result.integrator_steps;
-      if (status != fmi2OK && status != fmi2Warning) {
-        Fail(&result, RunOutcome::kModelError, instance.Failure("fmi2DoStep", status, point));
+      if (!Succeeded(status)) {
+        Fail(&result, RunOutcome::kModelError, instance.Failure(Call::kDoStep, status, point));
+        return result;
+      }
+      if (terminate) {
+        const std::string messages = instance.RecentMessages();
+        Fail(&result, RunOutcome::kTerminated,
+             absl::StrCat("the FMU ended the simulation at t = ", point + step_s, " s, before the last output time (",
+                          run.stop_time_s, " s)", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
         return result;
       }
       if (!internal::WithinBudget(options, point + step_s, &result)) return result;
     }
     if (!internal::ReadOutputs(instance, run, static_cast<int>(i), options.output_times_s[i], &result)) return result;
   }
-  f.terminate(instance.component());
+  instance.Terminate();
   return result;
 }
 
@@ -172,35 +179,35 @@ bool Fail(RunResult* result, RunOutcome outcome, std::string reason) {
   return false;
 }
 
-bool Initialize(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
+bool Initialize(ModelInstance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
                 RunResult* result) {
-  const Fmi2Functions& f = instance.f();
   const double t0 = options.start_time_s;
-  fmi2Status status = f.setup_experiment(instance.component(), fmi2True, tolerance, t0, fmi2True, run.stop_time_s);
-  if (status > fmi2Warning) return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2SetupExperiment", status, t0));
+  CallStatus status = instance.SetUpExperiment(tolerance, t0, run.stop_time_s);
+  if (!Succeeded(status)) return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetUpExperiment, status, t0));
   if (!run.parameter_references.empty()) {
-    status = f.set_real(instance.component(), run.parameter_references.data(), run.parameter_references.size(),
-                        run.parameter_values.data());
-    if (status > fmi2Warning) return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2SetReal (parameters)", status, t0));
+    status = instance.SetFloat64(run.parameter_references.data(), run.parameter_references.size(),
+                                 run.parameter_values.data());
+    if (!Succeeded(status)) {
+      return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetFloat64, status, t0, "parameters"));
+    }
   }
-  status = f.enter_initialization_mode(instance.component());
-  if (status > fmi2Warning) {
-    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2EnterInitializationMode", status, t0));
+  status = instance.EnterInitializationMode();
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kEnterInitializationMode, status, t0));
   }
-  status = f.exit_initialization_mode(instance.component());
-  if (status > fmi2Warning) {
-    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2ExitInitializationMode", status, t0));
+  status = instance.ExitInitializationMode();
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kExitInitializationMode, status, t0));
   }
   return true;
 }
 
-bool ReadOutputs(Fmi2Instance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result) {
+bool ReadOutputs(ModelInstance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result) {
   if (run.output_references.empty()) return true;
   std::vector<double> values(run.output_references.size());
-  const fmi2Status status =
-      instance.f().get_real(instance.component(), run.output_references.data(), values.size(), values.data());
-  if (status > fmi2Warning) {
-    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2GetReal (outputs)", status, time_s));
+  const CallStatus status = instance.GetFloat64(run.output_references.data(), values.size(), values.data());
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kGetFloat64, status, time_s, "outputs"));
   }
   for (std::size_t k = 0; k < values.size(); ++k) result->values[k][time_index] = values[k];
   return true;
@@ -217,12 +224,16 @@ absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options) {
     if (!checked_step.ok()) return checked_step.status();
     step = *checked_step;
   }
-  std::unique_ptr<Fmi2Instance> instance = Fmi2Instance::Create(fmu);
-  if (instance->component() == nullptr) {
+  std::unique_ptr<ModelInstance> instance = fmu.Instantiate();
+  if (!instance->instantiated()) {
     RunResult result;
     const std::string messages = instance->RecentMessages();
+    const char* function = fmu.description().fmi_major_version >= 3
+                               ? (fmu.interface() == Interface::kModelExchange ? "fmi3InstantiateModelExchange"
+                                                                               : "fmi3InstantiateCoSimulation")
+                               : "fmi2Instantiate";
     Fail(&result, RunOutcome::kModelError,
-         absl::StrCat("fmi2Instantiate refused to make an instance", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
+         absl::StrCat(function, " refused to make an instance", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
     return result;
   }
   if (step.has_value()) return RunCoSimulation(*instance, options, *run, *step);

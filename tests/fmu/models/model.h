@@ -1,7 +1,9 @@
-/* The test models' side of the FMI 2.0 interface: model_frame.c implements
- * the fmi2 functions once, over a model that keeps all its Real variables in
- * one array indexed by value reference and supplies the functions below.
- * Each test FMU is model_frame.c plus one model file. */
+/* The test models' side of the FMI interface: model_frame.c implements the
+ * fmi2 functions once, model_frame3.c the fmi3 ones, over a model that keeps
+ * all its Real variables in one array indexed by value reference and
+ * supplies the functions below. Each test FMU is one frame plus one model
+ * file; the FMI 3.0 frame maps the fmi2 types and statuses used here onto
+ * its own (the statuses have the same values in both versions). */
 #ifndef MBOPT_TESTS_FMU_MODELS_MODEL_H_
 #define MBOPT_TESTS_FMU_MODELS_MODEL_H_
 
