@@ -24,6 +24,11 @@ struct Callbacks {
   int num_states = 0;  // the FMU's; CVODES integrates one dummy state when 0
   int num_indicators = 0;
   std::string failure;
+  // Sensitivities: the knowns of the directional derivatives (the states,
+  // then one parameter) and their seed (the state sensitivities, then 1).
+  const SensitivityRun* sensitivities = nullptr;
+  std::vector<ValueReference> knowns;
+  std::vector<double> seed;
 };
 
 // An FMI status as a SUNDIALS callback's answer: a discard asks for a
@@ -66,6 +71,28 @@ int EventIndicators(double t, N_Vector y, double* indicators, void* user_data) {
   });
 }
 
+// d x' / d p_k = (d f / d x) s_k + d f / d p_k from one directional
+// derivative per parameter: the states and p_k known, seeded with s_k and 1.
+int SensitivityRhs(int count, double t, N_Vector y, N_Vector /*ydot*/, N_Vector* y_s, N_Vector* y_s_dot,
+                   void* user_data, N_Vector /*tmp1*/, N_Vector /*tmp2*/) {
+  auto* callbacks = static_cast<Callbacks*>(user_data);
+  return sundials::GuardCallback(&callbacks->failure, "the FMU's directional derivatives", [&] {
+    if (int code = SetTimeAndStates(callbacks, t, N_VGetArrayPointer(y)); code != 0) return code;
+    const SensitivityRun& run = *callbacks->sensitivities;
+    const int n = callbacks->num_states;
+    for (int k = 0; k < count; ++k) {
+      callbacks->knowns[n] = run.parameter_references[k];
+      std::copy_n(N_VGetArrayPointer(y_s[k]), n, callbacks->seed.begin());
+      callbacks->seed[n] = 1.0;
+      const CallStatus status = callbacks->instance->GetDirectionalDerivative(
+          run.derivative_references.data(), n, callbacks->knowns.data(), n + 1, callbacks->seed.data(),
+          N_VGetArrayPointer(y_s_dot[k]));
+      if (int code = CallbackCode(callbacks, status, Call::kGetDirectionalDerivative, t); code != 0) return code;
+    }
+    return 0;
+  });
+}
+
 // The FMU's discrete states iterated to a fixed point at one event (the
 // FMU is in event mode). False (and `result` failed) on an error or when
 // the iteration does not settle.
@@ -91,8 +118,9 @@ bool IterateEvent(ModelInstance& instance, const RunOptions& options, double t, 
 
 class ModelExchangeRun {
  public:
-  ModelExchangeRun(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run)
-      : fmu_(fmu), instance_(instance), options_(options), run_(run) {}
+  ModelExchangeRun(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run,
+                   SensitivityRun* sensitivities)
+      : fmu_(fmu), instance_(instance), options_(options), run_(run), sensitivities_(sensitivities) {}
 
   RunResult Go();
 
@@ -119,11 +147,21 @@ class ModelExchangeRun {
   // interpolation over the last step.
   bool OutputsUpTo(double t_reached);
   bool HandleEvent(double t);
+  // Sensitivities: the states' at t0 (in initialization mode), CVODES' set
+  // up, the outputs' at one output time, and giving them up with a reason
+  // while the run goes on.
+  bool InitialSensitivities(double t0);
+  bool SetUpSensitivities();
+  void OutputDerivatives(int time_index, double t);
+  void DropSensitivities(std::string reason);
+  bool sensitivities_on() const { return sensitivities_ != nullptr && sensitivities_->unavailable.empty(); }
 
   const Fmu& fmu_;
   ModelInstance& instance_;
   const RunOptions& options_;
   const CheckedRun& run_;
+  SensitivityRun* sensitivities_;
+  std::vector<std::vector<double>> initial_sensitivities_;  // [k][state]
   RunResult result_;
   DiscreteStateUpdate info_;
   Callbacks callbacks_;
@@ -137,6 +175,7 @@ class ModelExchangeRun {
   sundials::Vector y_interpolated_;
   sundials::Matrix matrix_;
   sundials::LinearSolver linear_solver_;
+  sundials::VectorArray y_s_;
   sundials::Memory<CVodeFree> cvode_;
 };
 
@@ -170,7 +209,92 @@ bool ModelExchangeRun::SetUpCvodes(double t0) {
          CheckCvodes(CVodeSetLinearSolver(mem, linear_solver_.get(), matrix_.get()), "CVodeSetLinearSolver") &&
          CheckCvodes(CVodeSetMaxNumSteps(mem, static_cast<long>(options_.max_steps)), "CVodeSetMaxNumSteps") &&
          (callbacks_.num_indicators == 0 ||
-          CheckCvodes(CVodeRootInit(mem, callbacks_.num_indicators, EventIndicators), "CVodeRootInit"));
+          CheckCvodes(CVodeRootInit(mem, callbacks_.num_indicators, EventIndicators), "CVodeRootInit")) &&
+         SetUpSensitivities();
+}
+
+bool ModelExchangeRun::InitialSensitivities(double t0) {
+  // d x(t0) / d p_k: the states are initial unknowns, the parameter known.
+  const SensitivityRun& run = *sensitivities_;
+  const int n = callbacks_.num_states;
+  initial_sensitivities_.assign(run.parameter_references.size(), std::vector<double>(n, 0.0));
+  for (std::size_t k = 0; k < run.parameter_references.size() && n > 0; ++k) {
+    const double one = 1.0;
+    const CallStatus status = instance_.GetDirectionalDerivative(run.state_references.data(), n,
+                                                                 &run.parameter_references[k], 1, &one,
+                                                                 initial_sensitivities_[k].data());
+    if (!Succeeded(status)) {
+      DropSensitivities(absl::StrCat("the initial states' derivatives: ",
+                                     instance_.Failure(Call::kGetDirectionalDerivative, status, t0)));
+      return true;
+    }
+  }
+  return true;
+}
+
+bool ModelExchangeRun::SetUpSensitivities() {
+  if (!sensitivities_on()) return true;
+  const int count = static_cast<int>(sensitivities_->parameter_references.size());
+  const int n = callbacks_.num_states;
+  y_s_ = sundials::VectorArray(N_VCloneVectorArray(count, y_.get()), count);
+  if (!y_s_) return Fail(&result_, RunOutcome::kIntegratorFailure, "out of memory");
+  for (int k = 0; k < count; ++k) {
+    N_VConst(0.0, y_s_[k]);
+    std::copy_n(initial_sensitivities_[k].begin(), n, N_VGetArrayPointer(y_s_[k]));
+  }
+  callbacks_.sensitivities = sensitivities_;
+  callbacks_.knowns = sensitivities_->state_references;
+  callbacks_.knowns.push_back(0);
+  callbacks_.seed.assign(n + 1, 0.0);
+  void* mem = cvode_.get();
+  // Staggered: the states' Newton iteration is left as without
+  // sensitivities; the sensitivities are in the error test.
+  return CheckCvodes(CVodeSensInit(mem, count, CV_STAGGERED, SensitivityRhs, y_s_.get()), "CVodeSensInit") &&
+         CheckCvodes(CVodeSensEEtolerances(mem), "CVodeSensEEtolerances") &&
+         CheckCvodes(CVodeSetSensErrCon(mem, SUNTRUE), "CVodeSetSensErrCon");
+}
+
+void ModelExchangeRun::DropSensitivities(std::string reason) {
+  if (!sensitivities_on()) return;
+  sensitivities_->unavailable = std::move(reason);
+  sensitivities_->output_derivatives.clear();
+  if (cvode_) CVodeSensToggleOff(cvode_.get());
+}
+
+void ModelExchangeRun::OutputDerivatives(int time_index, double t) {
+  if (!sensitivities_on()) return;
+  SensitivityRun& run = *sensitivities_;
+  const int count = static_cast<int>(run.parameter_references.size());
+  const int n = callbacks_.num_states;
+  // CVODES' interpolation of the sensitivities, as of the states; before
+  // the first step there is nothing to interpolate (and CVODES would
+  // divide by its zero step), so the initial sensitivities.
+  const int flag = result_.integrator_steps == 0 ? 0 : CVodeGetSensDky(cvode_.get(), t, 0, y_s_.get());
+  if (flag < 0) {
+    DropSensitivities(absl::StrCat("CVodeGetSensDky failed at t = ", t, " s (flag ", flag, ")"));
+    return;
+  }
+  for (int k = 0; k < count; ++k) {
+    const double* s = N_VGetArrayPointer(y_s_[k]);
+    callbacks_.knowns[n] = run.parameter_references[k];
+    std::copy_n(s, n, callbacks_.seed.begin());
+    callbacks_.seed[n] = 1.0;
+    for (std::size_t o = 0; o < run.output_state_index.size(); ++o) {
+      double derivative = 0.0;
+      if (run.output_state_index[o] >= 0) {
+        derivative = s[run.output_state_index[o]];
+      } else {
+        const CallStatus status = instance_.GetDirectionalDerivative(
+            &run_.output_references[o], 1, callbacks_.knowns.data(), n + 1, callbacks_.seed.data(), &derivative);
+        if (!Succeeded(status)) {
+          DropSensitivities(absl::StrCat("output ", o + 1, "'s derivative: ",
+                                         instance_.Failure(Call::kGetDirectionalDerivative, status, t)));
+          return;
+        }
+      }
+      run.output_derivatives[k][o][time_index] = derivative;
+    }
+  }
 }
 
 bool ModelExchangeRun::OutputsUpTo(double t_reached) {
@@ -186,6 +310,7 @@ bool ModelExchangeRun::OutputsUpTo(double t_reached) {
       return Fail(&result_, RunOutcome::kModelError, callbacks_.failure);
     }
     if (!ReadOutputs(instance_, run_, static_cast<int>(next_output_), t, &result_)) return false;
+    OutputDerivatives(static_cast<int>(next_output_), t);
     ++next_output_;
   }
   return true;
@@ -197,6 +322,8 @@ bool ModelExchangeRun::HandleEvent(double t) {
                 absl::StrCat("more than ", options_.max_events, " events by t = ", t,
                              " s (events chattering, or max_events too small)"));
   }
+  // The sensitivities jump at an event in a way the FMU does not tell.
+  DropSensitivities(absl::StrCat("an event at t = ", t, " s: sensitivities across events are not computed"));
   if (!Check(instance_.EnterEventMode(), Call::kEnterEventMode, t)) return false;
   if (!IterateEvent(instance_, options_, t, &info_, &result_)) return false;
   if (info_.terminate) return Terminated(t);
@@ -215,7 +342,17 @@ RunResult ModelExchangeRun::Go() {
   const double t0 = options_.start_time_s;
   const double t_end = run_.stop_time_s;
 
-  if (!Initialize(instance_, options_, run_, options_.relative_tolerance, &result_)) return result_;
+  if (sensitivities_ != nullptr) {
+    sensitivities_->output_derivatives.assign(
+        sensitivities_->parameter_references.size(),
+        std::vector<std::vector<double>>(run_.output_references.size(),
+                                         std::vector<double>(options_.output_times_s.size(), 0.0)));
+  }
+  const std::function<bool()> in_initialization =
+      sensitivities_ == nullptr ? std::function<bool()>() : [this, t0] { return InitialSensitivities(t0); };
+  if (!Initialize(instance_, options_, run_, options_.relative_tolerance, &result_, in_initialization)) {
+    return result_;
+  }
   // Initialization is an event: discrete states settle before time runs.
   if (!IterateEvent(instance_, options_, t0, &info_, &result_)) return result_;
   if (info_.terminate) {
@@ -276,8 +413,9 @@ RunResult ModelExchangeRun::Go() {
 
 }  // namespace
 
-RunResult RunModelExchange(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run) {
-  ModelExchangeRun me(fmu, instance, options, run);
+RunResult RunModelExchange(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run,
+                           SensitivityRun* sensitivities) {
+  ModelExchangeRun me(fmu, instance, options, run, sensitivities);
   return me.Go();
 }
 

@@ -32,66 +32,6 @@ std::string NamesOf(const ModelDescription& description, bool (*keep)(const Scal
   return names.empty() ? "none" : absl::StrJoin(names, ", ");
 }
 
-absl::StatusOr<CheckedRun> Check(const Fmu& fmu, const RunOptions& options) {
-  const ModelDescription& description = fmu.description();
-  const std::string where = fmu.archive_path().string();
-  CheckedRun run;
-  std::set<std::string> seen;
-  for (const auto& [name, value] : options.parameters) {
-    const ScalarVariable* variable = description.Find(name);
-    if (variable == nullptr || !IsSettableParameter(*variable)) {
-      const std::string what =
-          variable == nullptr
-              ? "has no variable"
-              : absl::StrCat("has a variable (causality ", CausalityName(variable->causality),
-                             ") that is not a Real parameter of variability fixed or tunable,");
-      return absl::InvalidArgumentError(absl::StrCat(where, " ", what, " named \"", name,
-                                                     "\"; its Real parameters are: ",
-                                                     NamesOf(description, IsSettableParameter)));
-    }
-    if (!seen.insert(name).second) {
-      return absl::InvalidArgumentError(absl::StrCat(where, ": parameter \"", name, "\" is set twice"));
-    }
-    if (!std::isfinite(value)) {
-      return absl::InvalidArgumentError(absl::StrCat(where, ": parameter \"", name, "\" set to ", value,
-                                                     "; expected a finite value"));
-    }
-    run.parameter_references.push_back(variable->value_reference);
-    run.parameter_values.push_back(value);
-  }
-  for (const std::string& name : options.outputs) {
-    const ScalarVariable* variable = description.Find(name);
-    if (variable == nullptr || variable->type != VariableType::kReal) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          where, variable == nullptr ? " has no variable" : " has a variable that is not Real", " named \"", name,
-          "\" to output; its Real variables are: ",
-          NamesOf(description, [](const ScalarVariable& v) { return v.type == VariableType::kReal; })));
-    }
-    run.output_references.push_back(variable->value_reference);
-  }
-  if (!std::isfinite(options.start_time_s)) {
-    return absl::InvalidArgumentError(absl::StrCat("start time ", options.start_time_s, " s is not finite"));
-  }
-  if (options.output_times_s.empty()) return absl::InvalidArgumentError("no output times");
-  double previous = options.start_time_s;
-  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
-    const double t = options.output_times_s[i];
-    if (!std::isfinite(t) || t < previous) {
-      return absl::InvalidArgumentError(absl::StrCat("output time ", i, " (", t, " s) is before ",
-                                                     i == 0 ? "the start time" : "the one before it", " (",
-                                                     previous, " s) or not finite"));
-    }
-    previous = t;
-  }
-  run.stop_time_s = options.output_times_s.back();
-  if (!(options.relative_tolerance > 0.0) || !(options.absolute_tolerance > 0.0) || options.max_steps <= 0 ||
-      options.max_events < 0 || options.max_event_iterations <= 0) {
-    return absl::InvalidArgumentError(
-        "run options: tolerances must be > 0, max_steps and max_event_iterations > 0, max_events >= 0");
-  }
-  return run;
-}
-
 absl::StatusOr<double> CommunicationStep(const Fmu& fmu, const RunOptions& options) {
   const std::optional<double> step =
       options.communication_step_s ? options.communication_step_s : fmu.description().default_experiment.step_size_s;
@@ -165,6 +105,80 @@ const char* RunOutcomeName(RunOutcome outcome) {
 
 namespace internal {
 
+absl::StatusOr<CheckedRun> CheckRequest(const Fmu& fmu, const RunOptions& options) {
+  const ModelDescription& description = fmu.description();
+  const std::string where = fmu.archive_path().string();
+  CheckedRun run;
+  std::set<std::string> seen;
+  for (const auto& [name, value] : options.parameters) {
+    const ScalarVariable* variable = description.Find(name);
+    if (variable == nullptr || !IsSettableParameter(*variable)) {
+      const std::string what =
+          variable == nullptr
+              ? "has no variable"
+              : absl::StrCat("has a variable (causality ", CausalityName(variable->causality),
+                             ") that is not a Real parameter of variability fixed or tunable,");
+      return absl::InvalidArgumentError(absl::StrCat(where, " ", what, " named \"", name,
+                                                     "\"; its Real parameters are: ",
+                                                     NamesOf(description, IsSettableParameter)));
+    }
+    if (!seen.insert(name).second) {
+      return absl::InvalidArgumentError(absl::StrCat(where, ": parameter \"", name, "\" is set twice"));
+    }
+    if (!std::isfinite(value)) {
+      return absl::InvalidArgumentError(absl::StrCat(where, ": parameter \"", name, "\" set to ", value,
+                                                     "; expected a finite value"));
+    }
+    run.parameter_references.push_back(variable->value_reference);
+    run.parameter_values.push_back(value);
+  }
+  for (const std::string& name : options.outputs) {
+    const ScalarVariable* variable = description.Find(name);
+    if (variable == nullptr || variable->type != VariableType::kReal) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          where, variable == nullptr ? " has no variable" : " has a variable that is not Real", " named \"", name,
+          "\" to output; its Real variables are: ",
+          NamesOf(description, [](const ScalarVariable& v) { return v.type == VariableType::kReal; })));
+    }
+    run.output_references.push_back(variable->value_reference);
+  }
+  if (!std::isfinite(options.start_time_s)) {
+    return absl::InvalidArgumentError(absl::StrCat("start time ", options.start_time_s, " s is not finite"));
+  }
+  if (options.output_times_s.empty()) return absl::InvalidArgumentError("no output times");
+  double previous = options.start_time_s;
+  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
+    const double t = options.output_times_s[i];
+    if (!std::isfinite(t) || t < previous) {
+      return absl::InvalidArgumentError(absl::StrCat("output time ", i, " (", t, " s) is before ",
+                                                     i == 0 ? "the start time" : "the one before it", " (",
+                                                     previous, " s) or not finite"));
+    }
+    previous = t;
+  }
+  run.stop_time_s = options.output_times_s.back();
+  if (!(options.relative_tolerance > 0.0) || !(options.absolute_tolerance > 0.0) || options.max_steps <= 0 ||
+      options.max_events < 0 || options.max_event_iterations <= 0) {
+    return absl::InvalidArgumentError(
+        "run options: tolerances must be > 0, max_steps and max_event_iterations > 0, max_events >= 0");
+  }
+  return run;
+}
+
+std::unique_ptr<ModelInstance> Instantiate(const Fmu& fmu, RunResult* result) {
+  std::unique_ptr<ModelInstance> instance = fmu.Instantiate();
+  if (instance->instantiated()) return instance;
+  const std::string messages = instance->RecentMessages();
+  const char* function = fmu.description().fmi_major_version >= 3
+                             ? (fmu.interface() == Interface::kModelExchange ? "fmi3InstantiateModelExchange"
+                                                                             : "fmi3InstantiateCoSimulation")
+                             : "fmi2Instantiate";
+  Fail(result, RunOutcome::kModelError,
+       absl::StrCat(function, " refused to make an instance",
+                    messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
+  return nullptr;
+}
+
 bool WithinBudget(const RunOptions& options, double time_s, RunResult* result) {
   if (options.budget == nullptr) return true;
   spec::AnalysisFailure spent = options.budget->Check(time_s);
@@ -180,7 +194,7 @@ bool Fail(RunResult* result, RunOutcome outcome, std::string reason) {
 }
 
 bool Initialize(ModelInstance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
-                RunResult* result) {
+                RunResult* result, const std::function<bool()>& in_initialization_mode) {
   const double t0 = options.start_time_s;
   CallStatus status = instance.SetUpExperiment(tolerance, t0, run.stop_time_s);
   if (!Succeeded(status)) return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetUpExperiment, status, t0));
@@ -195,6 +209,7 @@ bool Initialize(ModelInstance& instance, const RunOptions& options, const Checke
   if (!Succeeded(status)) {
     return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kEnterInitializationMode, status, t0));
   }
+  if (in_initialization_mode && !in_initialization_mode()) return false;
   status = instance.ExitInitializationMode();
   if (!Succeeded(status)) {
     return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kExitInitializationMode, status, t0));
@@ -216,7 +231,7 @@ bool ReadOutputs(ModelInstance& instance, const CheckedRun& run, int time_index,
 }  // namespace internal
 
 absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options) {
-  auto run = Check(fmu, options);
+  auto run = internal::CheckRequest(fmu, options);
   if (!run.ok()) return run.status();
   std::optional<double> step;
   if (fmu.interface() == Interface::kCoSimulation) {
@@ -224,18 +239,9 @@ absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options) {
     if (!checked_step.ok()) return checked_step.status();
     step = *checked_step;
   }
-  std::unique_ptr<ModelInstance> instance = fmu.Instantiate();
-  if (!instance->instantiated()) {
-    RunResult result;
-    const std::string messages = instance->RecentMessages();
-    const char* function = fmu.description().fmi_major_version >= 3
-                               ? (fmu.interface() == Interface::kModelExchange ? "fmi3InstantiateModelExchange"
-                                                                               : "fmi3InstantiateCoSimulation")
-                               : "fmi2Instantiate";
-    Fail(&result, RunOutcome::kModelError,
-         absl::StrCat(function, " refused to make an instance", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
-    return result;
-  }
+  RunResult result;
+  std::unique_ptr<ModelInstance> instance = internal::Instantiate(fmu, &result);
+  if (instance == nullptr) return result;
   if (step.has_value()) return RunCoSimulation(*instance, options, *run, *step);
   return internal::RunModelExchange(fmu, *instance, options, *run);
 }

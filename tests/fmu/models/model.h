@@ -43,6 +43,14 @@ void ModelEventIndicators(const Model* m, fmi2Real* indicators);
  * Returns whether a continuous state changed. */
 fmi2Boolean ModelEvent(Model* m);
 
+/* d unknown / d known at the current values, for the frames'
+ * fmi2/fmi3GetDirectionalDerivative: unknowns are derivatives and outputs
+ * (knowns: states and tunable parameters) and, in initialization, states
+ * (knowns: parameters). fmi2Error (with a message logged) for a pair the
+ * model does not differentiate; models that declare no directional
+ * derivatives answer so for every pair. */
+fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial);
+
 void ModelLog(const Model* m, fmi2Status status, const char* message, double value);
 
 #endif /* MBOPT_TESTS_FMU_MODELS_MODEL_H_ */

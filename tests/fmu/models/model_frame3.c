@@ -194,6 +194,32 @@ EXPORT fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 indi
   return fmi3OK;
 }
 
+/* sensitivity = (d unknowns / d knowns) seed, from the model's partials. */
+static int DirectionalDerivative(Model* m, const unsigned int unknowns[], size_t n_unknowns,
+                                 const unsigned int knowns[], size_t n_knowns, const double seed[],
+                                 double sensitivity[]) {
+  ModelEvaluate(m);
+  for (size_t i = 0; i < n_unknowns; ++i) {
+    sensitivity[i] = 0.0;
+    for (size_t j = 0; j < n_knowns; ++j) {
+      double partial = 0.0;
+      if (ModelPartialDerivative(m, unknowns[i], knowns[j], &partial) != fmi2OK) return 0;
+      sensitivity[i] += partial * seed[j];
+    }
+  }
+  return 1;
+}
+
+EXPORT fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[],
+                                               size_t n_unknowns, const fmi3ValueReference knowns[], size_t n_knowns,
+                                               const fmi3Float64 seed[], size_t n_seed, fmi3Float64 sensitivity[],
+                                               size_t n_sensitivity) {
+  if (n_seed != n_knowns || n_sensitivity != n_unknowns) return fmi3Error;
+  return DirectionalDerivative((Model*)instance, unknowns, n_unknowns, knowns, n_knowns, seed, sensitivity)
+             ? fmi3OK
+             : fmi3Error;
+}
+
 /* One classical Runge-Kutta step of length h from m->time. */
 static void RungeKuttaStep(Model* m, fmi3Float64 h) {
   fmi3Float64 x0[MODEL_MAX_REALS], k[4][MODEL_MAX_REALS];

@@ -52,3 +52,11 @@ fmi2Boolean ModelEvent(Model* m) {
   /* The input is discrete; the state y does not jump. */
   return fmi2False;
 }
+
+fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial) {
+  (void)known;
+  *partial = 0.0;
+  ModelLog(m, fmi2Error, "this model declares no directional derivatives (asked for value reference %g)",
+           (double)unknown);
+  return fmi2Error;
+}
