@@ -12,6 +12,7 @@
 #include "tests/fmu/closed_forms.h"
 #include "tests/testing/temp_dir.h"
 #include "worker/engine/analysis.h"
+#include "worker/fmu/scene_analysis.h"
 
 namespace mbopt::fmu {
 namespace {
@@ -138,6 +139,49 @@ TEST_F(FmuScene, TheFmusOwnErrorFailsTheAnalysisAsAnInvalidModel) {
   ASSERT_FALSE(report.ok());
   EXPECT_EQ(report.failure.kind, spec::FailureKind::kInvalidModel);
   EXPECT_THAT(report.failure.reason, HasSubstr("mass_kg must be > 0, got 0"));
+}
+
+// Simulator sensitivities of an FMU scene: the chain rule through the
+// bindings (a scene parameter setting two FMU parameters through
+// expressions), against differences of plain analyses.
+TEST_F(FmuScene, SensitivitiesFollowTheBindingsExpressions) {
+  const std::string body = R"pb(
+  path: "models/oscillator.fmu"
+  parameters { variable: "stiffness_n_per_m" value { expr: "2 * stiffness" } }
+  parameters { variable: "damping_n_s_per_m" value { expr: "0.1 * stiffness" } })pb";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(FmuSensitivitiesUnavailable(*scene, {0}), "");
+  const double k = 9.0;
+  FmuSensitivityAnalysis with = AnalyzeFmuSceneWithSensitivities(*scene, {k}, {0});
+  ASSERT_TRUE(with.report.ok()) << with.report.failure.reason;
+  ASSERT_EQ(with.unavailable, "");
+  ASSERT_EQ(with.output_derivatives.size(), 1u);
+  const double h = 1e-5 * k;
+  const spec::AnalysisReport up = engine::Analyze(*scene, {k + h});
+  const spec::AnalysisReport down = engine::Analyze(*scene, {k - h});
+  ASSERT_TRUE(up.ok() && down.ok());
+  double largest = 0.0;
+  for (std::size_t o = 0; o < 2; ++o) {
+    for (std::size_t i = 0; i < with.report.times_s.size(); ++i) {
+      const double difference = (up.outputs[o].series[0][i] - down.outputs[o].series[0][i]) / (2 * h);
+      largest = std::max(largest, std::abs(difference));
+      EXPECT_NEAR(with.output_derivatives[0][o][i], difference, 1e-5) << "output " << o << " at " << i;
+    }
+  }
+  EXPECT_GT(largest, 1e-2);
+}
+
+TEST_F(FmuScene, SensitivitiesUnavailableSayWhy) {
+  const std::string fixed_mass = std::string(kOscillator) + R"pb(
+  parameters { variable: "mass_kg" value { param: "stiffness" } })pb";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(fixed_mass, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_THAT(FmuSensitivitiesUnavailable(*scene, {0}), HasSubstr("FMU parameter \"mass_kg\" is not tunable"));
+  const std::string co_simulation = std::string(kOscillator) + "\n  interface: FMU_CO_SIMULATION";
+  scene = spec::io::LoadSceneFile(Write("c.scene.textproto", Scene(co_simulation, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_THAT(FmuSensitivitiesUnavailable(*scene, {0}), HasSubstr("a Co-Simulation FMU integrates itself"));
 }
 
 }  // namespace
