@@ -25,7 +25,8 @@ std::string Refusal(const std::string& body) {
 }
 
 TEST(Fmi3ModelDescription, ReadsFloat64VariablesStatesAndEventIndicatorsByValueReference) {
-  auto description = ParseModelDescription(Fmi3(R"xml(<ModelExchange modelIdentifier="m" providesDirectionalDerivatives="true"/>
+  auto description = ParseModelDescription(Fmi3(R"xml(<ModelExchange modelIdentifier="m"
+    providesDirectionalDerivatives="true"/>
 <CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>
 <DefaultExperiment stopTime="2" stepSize="0.01"/>
 <ModelVariables>

@@ -131,6 +131,22 @@ TEST(FmuSensitivityUnavailable, SaysWhatIsMissing) {
   EXPECT_EQ(SensitivitiesUnavailable(Open("damped_oscillator_fmi3"), {"stiffness_n_per_m", "damping_n_s_per_m"}), "");
 }
 
+// The lag's input steps at a time event: the run goes on with its values,
+// the sensitivities are given up with the event's time as the reason.
+TEST(FmuSensitivityUnavailable, ATimeEventEndsTheSensitivitiesNotTheRun) {
+  RunOptions options;
+  options.parameters = {{"tau_s", 0.25}, {"t_step_s", 0.37}};
+  options.outputs = {"y"};
+  options.output_times_s = Grid(0.0, 2.0, 100);
+  auto result = SimulateWithSensitivities(Open("step_response"), options, {0});
+  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_EQ(result->run.outcome, RunOutcome::kOk) << result->run.reason;
+  EXPECT_EQ(result->unavailable, "an event at t = 0.37 s: sensitivities across events are not computed");
+  EXPECT_TRUE(result->output_derivatives.empty());
+  const testing::StepResponse exact{0.25, 0.37};
+  EXPECT_NEAR(result->run.values[0][100], exact.Y(2.0), 1e-6);
+}
+
 TEST(FmuSensitivityUnavailable, SimulateWithSensitivitiesRefusesWhatIsUnavailable) {
   auto result = SimulateWithSensitivities(Open("damped_oscillator"), Oscillator(kStiffness, kDamping), {0});
   ASSERT_FALSE(result.ok());

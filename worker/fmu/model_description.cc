@@ -117,8 +117,8 @@ absl::StatusOr<ModelDescription> ParseModelDescription(std::string_view xml_text
   // 3.0.x are compatible revisions of 3.0.
   if (description.fmi_version.rfind("3.0", 0) == 0) return internal::ParseFmi3ModelDescription(at, root);
   if (description.fmi_version != "2.0") {
-    return at.Error(root, absl::StrCat("attribute fmiVersion: expected \"2.0\" or \"3.0\", got \"", description.fmi_version,
-                                       "\""));
+    return at.Error(root, absl::StrCat("attribute fmiVersion: expected \"2.0\" or \"3.0\", got \"",
+                                       description.fmi_version, "\""));
   }
   description.model_name = root.attribute("modelName").value();
   description.guid = root.attribute("guid").value();

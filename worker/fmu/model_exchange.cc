@@ -77,9 +77,13 @@ int SensitivityRhs(int count, double t, N_Vector y, N_Vector /*ydot*/, N_Vector*
                    void* user_data, N_Vector /*tmp1*/, N_Vector /*tmp2*/) {
   auto* callbacks = static_cast<Callbacks*>(user_data);
   return sundials::GuardCallback(&callbacks->failure, "the FMU's directional derivatives", [&] {
+    const int n = callbacks->num_states;
+    if (n == 0) {  // CVODES' one dummy state has no sensitivity
+      for (int k = 0; k < count; ++k) N_VConst(0.0, y_s_dot[k]);
+      return 0;
+    }
     if (int code = SetTimeAndStates(callbacks, t, N_VGetArrayPointer(y)); code != 0) return code;
     const SensitivityRun& run = *callbacks->sensitivities;
-    const int n = callbacks->num_states;
     for (int k = 0; k < count; ++k) {
       callbacks->knowns[n] = run.parameter_references[k];
       std::copy_n(N_VGetArrayPointer(y_s[k]), n, callbacks->seed.begin());

@@ -197,7 +197,9 @@ bool Initialize(ModelInstance& instance, const RunOptions& options, const Checke
                 RunResult* result, const std::function<bool()>& in_initialization_mode) {
   const double t0 = options.start_time_s;
   CallStatus status = instance.SetUpExperiment(tolerance, t0, run.stop_time_s);
-  if (!Succeeded(status)) return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetUpExperiment, status, t0));
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetUpExperiment, status, t0));
+  }
   if (!run.parameter_references.empty()) {
     status = instance.SetFloat64(run.parameter_references.data(), run.parameter_references.size(),
                                  run.parameter_values.data());

@@ -54,9 +54,18 @@ fmi2Boolean ModelEvent(Model* m) {
 }
 
 fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial) {
-  (void)known;
+  const fmi2Real tau = m->r[kTau];
   *partial = 0.0;
-  ModelLog(m, fmi2Error, "this model declares no directional derivatives (asked for value reference %g)",
-           (double)unknown);
-  return fmi2Error;
+  switch (unknown) {
+    case kY: /* in initialization: y = 0 */
+      if (known == kY) *partial = 1.0;
+      return fmi2OK;
+    case kDerY: /* (u - y) / tau */
+      if (known == kY) *partial = -1.0 / tau;
+      if (known == kTau) *partial = -m->r[kDerY] / tau;
+      return fmi2OK;
+    default:
+      ModelLog(m, fmi2Error, "no directional derivative of the variable with value reference %g", (double)unknown);
+      return fmi2Error;
+  }
 }
