@@ -110,6 +110,33 @@ TEST_F(FmuScene, AnalysisReportsTheFmuVariablesOnTheGridAtTheDesignsValues) {
   EXPECT_GT(report.counters.time_steps, 0);
 }
 
+// An FMI 3.0 FMU is a scene like any other: the same scene file over the
+// oscillator's FMI 3.0 build reports what its FMI 2.0 build does, bit for
+// bit, with simulator sensitivities too.
+TEST_F(FmuScene, AnFmi3FmuRunsThroughTheSameSceneAsItsFmi2Build) {
+  std::filesystem::copy_file(TestFmu("damped_oscillator_fmi3"), folder_ / "models" / "oscillator3.fmu");
+  std::string body = kOscillator;
+  body.replace(body.find("oscillator.fmu"), 14, "oscillator3.fmu");
+  auto fmi3 = spec::io::LoadSceneFile(Write("s3.scene.textproto", Scene(body, kPositionAndForce)));
+  auto fmi2 = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(kOscillator, kPositionAndForce)));
+  ASSERT_TRUE(fmi3.ok() && fmi2.ok());
+  const spec::AnalysisReport report3 = engine::Analyze(*fmi3, {16.0});
+  const spec::AnalysisReport report2 = engine::Analyze(*fmi2, {16.0});
+  ASSERT_TRUE(report3.ok()) << report3.failure.reason;
+  ASSERT_TRUE(report2.ok()) << report2.failure.reason;
+  const DampedOscillator exact{1.0, 0.5, 16.0, 0.1};
+  for (std::size_t i = 0; i < report3.times_s.size(); ++i) {
+    EXPECT_NEAR(report3.outputs[0].series[0][i], exact.X(report3.times_s[i]), 1e-8);
+  }
+  EXPECT_EQ(report3.outputs[0].series, report2.outputs[0].series);
+  EXPECT_EQ(report3.outputs[1].series, report2.outputs[1].series);
+  const FmuSensitivityAnalysis with3 = AnalyzeFmuSceneWithSensitivities(*fmi3, {16.0}, {0});
+  const FmuSensitivityAnalysis with2 = AnalyzeFmuSceneWithSensitivities(*fmi2, {16.0}, {0});
+  ASSERT_EQ(with3.unavailable, "");
+  ASSERT_EQ(with3.output_derivatives.size(), 1u);
+  EXPECT_EQ(with3.output_derivatives, with2.output_derivatives);
+}
+
 TEST_F(FmuScene, CoSimulationSceneSteppedAtItsCommunicationStep) {
   const std::string body = std::string(kOscillator) + "\n  interface: FMU_CO_SIMULATION communication_step_s: 0.005";
   auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
