@@ -119,7 +119,7 @@ function(mbopt_declare_modules)
     SUMMARY "lumped scenes (small motion, linear): the model's M, K, C and inputs, dynamics with CVODES, forward sensitivities")
   mbopt_module(fmu DIRS worker/fmu USES budget sundials spec PURE
     LIBS mbopt_fmu mbopt_fmu_scene
-    SUMMARY "FMI 2.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
+    SUMMARY "FMI 2.0 and 3.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
   mbopt_module(multibody DIRS worker/multibody USES budget sundials spec common PURE
     LIBS mbopt_multibody
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")

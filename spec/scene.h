@@ -230,7 +230,7 @@ struct ExternalModel {
 };
 
 // ---- FMU
-// An FMI 2.0 FMU run by the worker (worker/fmu). Its variables are checked
+// An FMI 2.0 or 3.0 FMU run by the worker (worker/fmu). Its variables are checked
 // against the FMU's model description when an analysis opens it.
 struct FmuParameterBinding {
   std::string variable;  // the FMU's Real parameter

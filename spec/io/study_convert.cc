@@ -809,11 +809,6 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "SENSITIVITY_METHOD_SIMULATOR is not available for external scenes yet: their drivers' "
                   "gradients are not read; use finite differences");
     }
-    if (s.simulator_sensitivities && std::holds_alternative<FmuModel>(scene.model)) {
-      errors->Add(w, "sensitivity",
-                  "SENSITIVITY_METHOD_SIMULATOR is not available for FMU scenes yet (directional derivatives are "
-                  "not used); use finite differences");
-    }
   }
 
   study.design_set = ConvertDesignSet(m, study, where, errors);

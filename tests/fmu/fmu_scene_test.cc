@@ -12,6 +12,7 @@
 #include "tests/fmu/closed_forms.h"
 #include "tests/testing/temp_dir.h"
 #include "worker/engine/analysis.h"
+#include "worker/fmu/scene_analysis.h"
 
 namespace mbopt::fmu {
 namespace {
@@ -109,6 +110,33 @@ TEST_F(FmuScene, AnalysisReportsTheFmuVariablesOnTheGridAtTheDesignsValues) {
   EXPECT_GT(report.counters.time_steps, 0);
 }
 
+// An FMI 3.0 FMU is a scene like any other: the same scene file over the
+// oscillator's FMI 3.0 build reports what its FMI 2.0 build does, bit for
+// bit, with simulator sensitivities too.
+TEST_F(FmuScene, AnFmi3FmuRunsThroughTheSameSceneAsItsFmi2Build) {
+  std::filesystem::copy_file(TestFmu("damped_oscillator_fmi3"), folder_ / "models" / "oscillator3.fmu");
+  std::string body = kOscillator;
+  body.replace(body.find("oscillator.fmu"), 14, "oscillator3.fmu");
+  auto fmi3 = spec::io::LoadSceneFile(Write("s3.scene.textproto", Scene(body, kPositionAndForce)));
+  auto fmi2 = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(kOscillator, kPositionAndForce)));
+  ASSERT_TRUE(fmi3.ok() && fmi2.ok());
+  const spec::AnalysisReport report3 = engine::Analyze(*fmi3, {16.0});
+  const spec::AnalysisReport report2 = engine::Analyze(*fmi2, {16.0});
+  ASSERT_TRUE(report3.ok()) << report3.failure.reason;
+  ASSERT_TRUE(report2.ok()) << report2.failure.reason;
+  const DampedOscillator exact{1.0, 0.5, 16.0, 0.1};
+  for (std::size_t i = 0; i < report3.times_s.size(); ++i) {
+    EXPECT_NEAR(report3.outputs[0].series[0][i], exact.X(report3.times_s[i]), 1e-8);
+  }
+  EXPECT_EQ(report3.outputs[0].series, report2.outputs[0].series);
+  EXPECT_EQ(report3.outputs[1].series, report2.outputs[1].series);
+  const FmuSensitivityAnalysis with3 = AnalyzeFmuSceneWithSensitivities(*fmi3, {16.0}, {0});
+  const FmuSensitivityAnalysis with2 = AnalyzeFmuSceneWithSensitivities(*fmi2, {16.0}, {0});
+  ASSERT_EQ(with3.unavailable, "");
+  ASSERT_EQ(with3.output_derivatives.size(), 1u);
+  EXPECT_EQ(with3.output_derivatives, with2.output_derivatives);
+}
+
 TEST_F(FmuScene, CoSimulationSceneSteppedAtItsCommunicationStep) {
   const std::string body = std::string(kOscillator) + "\n  interface: FMU_CO_SIMULATION communication_step_s: 0.005";
   auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
@@ -138,6 +166,49 @@ TEST_F(FmuScene, TheFmusOwnErrorFailsTheAnalysisAsAnInvalidModel) {
   ASSERT_FALSE(report.ok());
   EXPECT_EQ(report.failure.kind, spec::FailureKind::kInvalidModel);
   EXPECT_THAT(report.failure.reason, HasSubstr("mass_kg must be > 0, got 0"));
+}
+
+// Simulator sensitivities of an FMU scene: the chain rule through the
+// bindings (a scene parameter setting two FMU parameters through
+// expressions), against differences of plain analyses.
+TEST_F(FmuScene, SensitivitiesFollowTheBindingsExpressions) {
+  const std::string body = R"pb(
+  path: "models/oscillator.fmu"
+  parameters { variable: "stiffness_n_per_m" value { expr: "2 * stiffness" } }
+  parameters { variable: "damping_n_s_per_m" value { expr: "0.1 * stiffness" } })pb";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(body, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_EQ(FmuSensitivitiesUnavailable(*scene, {0}), "");
+  const double k = 9.0;
+  FmuSensitivityAnalysis with = AnalyzeFmuSceneWithSensitivities(*scene, {k}, {0});
+  ASSERT_TRUE(with.report.ok()) << with.report.failure.reason;
+  ASSERT_EQ(with.unavailable, "");
+  ASSERT_EQ(with.output_derivatives.size(), 1u);
+  const double h = 1e-5 * k;
+  const spec::AnalysisReport up = engine::Analyze(*scene, {k + h});
+  const spec::AnalysisReport down = engine::Analyze(*scene, {k - h});
+  ASSERT_TRUE(up.ok() && down.ok());
+  double largest = 0.0;
+  for (std::size_t o = 0; o < 2; ++o) {
+    for (std::size_t i = 0; i < with.report.times_s.size(); ++i) {
+      const double difference = (up.outputs[o].series[0][i] - down.outputs[o].series[0][i]) / (2 * h);
+      largest = std::max(largest, std::abs(difference));
+      EXPECT_NEAR(with.output_derivatives[0][o][i], difference, 1e-5) << "output " << o << " at " << i;
+    }
+  }
+  EXPECT_GT(largest, 1e-2);
+}
+
+TEST_F(FmuScene, SensitivitiesUnavailableSayWhy) {
+  const std::string fixed_mass = std::string(kOscillator) + R"pb(
+  parameters { variable: "mass_kg" value { param: "stiffness" } })pb";
+  auto scene = spec::io::LoadSceneFile(Write("s.scene.textproto", Scene(fixed_mass, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_THAT(FmuSensitivitiesUnavailable(*scene, {0}), HasSubstr("FMU parameter \"mass_kg\" is not tunable"));
+  const std::string co_simulation = std::string(kOscillator) + "\n  interface: FMU_CO_SIMULATION";
+  scene = spec::io::LoadSceneFile(Write("c.scene.textproto", Scene(co_simulation, kPositionAndForce)));
+  ASSERT_TRUE(scene.ok()) << scene.status();
+  EXPECT_THAT(FmuSensitivitiesUnavailable(*scene, {0}), HasSubstr("a Co-Simulation FMU integrates itself"));
 }
 
 }  // namespace

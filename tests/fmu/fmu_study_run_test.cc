@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 
@@ -57,6 +58,37 @@ TEST(FmuStudy, OscillatorExampleReachesItsClosedFormOptimum) {
   for (int i = 200; i <= 400; ++i) worst_m = std::max(worst_m, std::abs(design.X(0.01 * i)));
   EXPECT_LE(worst_m, 0.01 * (1.0 + 1e-6));
   EXPECT_EQ(run->analyses_failed, 0);
+}
+
+// The same study with SENSITIVITY_METHOD_SIMULATOR: the oscillator FMU
+// provides directional derivatives, so the gradients come from CVODES'
+// forward sensitivities, one analysis per design instead of 1 + 2.
+TEST(FmuStudy, SimulatorSensitivitiesReachTheSameOptimumWithFewerAnalyses) {
+  const ::mbopt::testing::TempDir dir;
+  const std::string path = CopyExample(dir.path());
+  std::string text = ReadFile(path);
+  const std::size_t at = text.find("optimizer { ");
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at + 12, "sensitivity: SENSITIVITY_METHOD_SIMULATOR ");
+  std::ofstream(path) << text;
+  auto study = spec::io::LoadStudyFile(path);
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_TRUE(study->optimizer.simulator_sensitivities);
+  auto simulator = local_run::RunStudyLocally(*study);
+  study->optimizer.simulator_sensitivities = false;
+  auto differences = local_run::RunStudyLocally(*study);
+  ASSERT_TRUE(simulator.ok()) << simulator.status();
+  ASSERT_TRUE(differences.ok()) << differences.status();
+  EXPECT_EQ(simulator->outcome.state, slp::RunState::kConverged) << simulator->end_reason;
+  ASSERT_EQ(simulator->design_si.size(), 2u);
+  EXPECT_NEAR(simulator->design_si[0], 1.355513, 2e-4);
+  EXPECT_NEAR(simulator->design_si[1], 1.376517, 2e-4);
+  EXPECT_EQ(simulator->analyses_failed, 0);
+  EXPECT_LT(simulator->analyses_run, differences->analyses_run);
+  std::cout << "FMU oscillator: " << simulator->outcome.cycles << " cycles, " << simulator->analyses_run
+            << " analyses, " << simulator->wall_seconds << " s with simulator sensitivities; "
+            << differences->outcome.cycles << " cycles, " << differences->analyses_run << " analyses, "
+            << differences->wall_seconds << " s with finite differences\n";
 }
 
 }  // namespace

@@ -71,6 +71,12 @@ spec::AnalysisReport AnalyzeFmu(const spec::Scene& scene, const std::vector<doub
   return fmu::AnalyzeFmuScene(scene, p, budget);
 }
 
+SensitivityAnalysis AnalyzeFmuWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
+                                                const std::vector<int>& parameters, budget::AnalysisBudget* budget) {
+  fmu::FmuSensitivityAnalysis result = fmu::AnalyzeFmuSceneWithSensitivities(scene, p, parameters, budget);
+  return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
+}
+
 spec::AnalysisReport AnalyzeExternal(const spec::Scene& scene, const std::vector<double>& p,
                                      budget::AnalysisBudget* budget, const ExternalAnalyzer* external) {
   // The driver's process has its own time limit (worker/external); a
@@ -131,14 +137,14 @@ std::vector<ModelKind> MakeTable() {
       nullptr};
   table[IndexOf<spec::FmuModel>()] = {
       "fmu",
-      "an FMI 2.0 FMU: Model Exchange integrated by CVODES with its events, or Co-Simulation stepped "
+      "an FMI 2.0 or 3.0 FMU: Model Exchange integrated by CVODES with its events, or Co-Simulation stepped "
       "(worker/fmu/scene_analysis.h)",
-      "time_steps: CVODES steps (Model Exchange) or fmi2DoStep calls (Co-Simulation)",
+      "time_steps: CVODES steps (Model Exchange) or fmi2DoStep / fmi3DoStep calls (Co-Simulation)",
       &AnalyzeFmu,
-      [](const spec::Scene&, const std::vector<int>&) {
-        return Never("an FMU's directional derivatives are not read: its gradients are differenced");
+      [](const spec::Scene& scene, const std::vector<int>& parameters) {
+        return fmu::FmuSensitivitiesUnavailable(scene, parameters);
       },
-      nullptr};
+      &AnalyzeFmuWithSensitivities};
   for (const ModelKind& kind : table) MBOPT_CHECK(kind.analyze != nullptr, "a scene model kind has no table entry");
   return table;
 }

@@ -1,37 +1,48 @@
-// One instance of an FMU's model (fmi2Instantiate .. fmi2FreeInstance) with
-// the logger that keeps the FMU's recent messages, so that a failed call's
-// reason says what the model itself reported instead of printing it.
+// One instance of an FMI 2.0 FMU's model (fmi2Instantiate ..
+// fmi2FreeInstance) behind the version-independent ModelInstance, with the
+// logger that keeps the FMU's recent messages for failure reasons.
 #pragma once
 
-#include <deque>
 #include <memory>
 #include <string>
 
 #include "worker/fmu/fmi2_api.h"
-#include "worker/fmu/fmu.h"
+#include "worker/fmu/fmi2_library.h"
+#include "worker/fmu/model_instance.h"
 
 namespace mbopt::fmu {
 
-class Fmi2Instance {
+class Fmi2Instance final : public ModelInstance {
  public:
-  // Instantiates the model; component() is null when the FMU refused, and
-  // RecentMessages() says why if it logged anything. Held by pointer: the
-  // FMU keeps the address of the instance for its logger.
-  static std::unique_ptr<Fmi2Instance> Create(const Fmu& fmu);
+  // Instantiates the model; instantiated() is false when the FMU refused.
+  // Held by pointer: the FMU keeps the instance's address for its logger.
+  static std::unique_ptr<Fmi2Instance> Create(const Fmi2Functions& functions, Interface interface,
+                                              const std::string& model_identifier, const std::string& guid,
+                                              const std::string& resource_uri);
+  ~Fmi2Instance() override;
 
-  Fmi2Instance(const Fmi2Instance&) = delete;
-  Fmi2Instance& operator=(const Fmi2Instance&) = delete;
-  ~Fmi2Instance();
-
-  fmi2Component component() const { return component_; }
-  const Fmi2Functions& f() const { return *functions_; }
-
-  // "CALL returned fmi2Error at t = T s (FMU: messages)"; for a failed call.
-  std::string Failure(const std::string& call, fmi2Status status, double time_s) const;
-  // The FMU's last few messages of any status, "; "-separated, or "".
-  std::string RecentMessages() const;
-
-  void Log(fmi2Status status, const std::string& category, std::string message);
+  bool instantiated() const override { return component_ != nullptr; }
+  CallStatus SetUpExperiment(double tolerance, double start_time_s, double stop_time_s) override;
+  CallStatus EnterInitializationMode() override;
+  CallStatus ExitInitializationMode() override;
+  CallStatus Terminate() override;
+  CallStatus GetFloat64(const ValueReference* references, std::size_t count, double* values) override;
+  CallStatus SetFloat64(const ValueReference* references, std::size_t count, const double* values) override;
+  CallStatus GetDirectionalDerivative(const ValueReference* unknowns, std::size_t unknown_count,
+                                      const ValueReference* knowns, std::size_t known_count, const double* seed,
+                                      double* sensitivity) override;
+  CallStatus SetTime(double time_s) override;
+  CallStatus SetContinuousStates(const double* states, std::size_t count) override;
+  CallStatus GetContinuousStates(double* states, std::size_t count) override;
+  CallStatus GetDerivatives(double* derivatives, std::size_t count) override;
+  CallStatus GetEventIndicators(double* indicators, std::size_t count) override;
+  CallStatus EnterEventMode() override;
+  CallStatus UpdateDiscreteStates(DiscreteStateUpdate* update) override;
+  CallStatus EnterContinuousTimeMode() override;
+  CallStatus CompletedIntegratorStep(bool* enter_event_mode, bool* terminate) override;
+  CallStatus DoStep(double time_s, double step_s, bool* terminate) override;
+  const char* FunctionName(Call call) const override;
+  const char* StatusName(CallStatus status) const override;
 
  private:
   explicit Fmi2Instance(const Fmi2Functions* functions) : functions_(functions) {}
@@ -39,9 +50,6 @@ class Fmi2Instance {
   const Fmi2Functions* functions_;
   fmi2CallbackFunctions callbacks_{};
   fmi2Component component_ = nullptr;
-  std::deque<std::string> messages_;
 };
-
-const char* StatusName(fmi2Status status);
 
 }  // namespace mbopt::fmu

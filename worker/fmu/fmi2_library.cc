@@ -25,10 +25,6 @@ absl::Status Resolve(void* handle, const std::filesystem::path& binary, const ch
 
 }  // namespace
 
-const char* InterfaceName(Interface interface) {
-  return interface == Interface::kModelExchange ? "Model Exchange" : "Co-Simulation";
-}
-
 absl::StatusOr<Fmi2Library> Fmi2Library::Load(const std::filesystem::path& binary, Interface interface) {
   Fmi2Library library;
   // RTLD_LOCAL: two FMUs exporting the same fmi2 names do not see each other.

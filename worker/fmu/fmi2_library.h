@@ -6,12 +6,9 @@
 
 #include "absl/status/statusor.h"
 #include "worker/fmu/fmi2_api.h"
+#include "worker/fmu/model_instance.h"
 
 namespace mbopt::fmu {
-
-enum class Interface { kModelExchange, kCoSimulation };
-
-const char* InterfaceName(Interface interface);
 
 struct Fmi2Functions {
   fmi2GetVersionTYPE* get_version = nullptr;

@@ -7,6 +7,8 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "worker/fmu/fmi2_instance.h"
+#include "worker/fmu/fmi3_instance.h"
 
 namespace mbopt::fmu {
 namespace {
@@ -25,14 +27,36 @@ std::set<std::string> ArchivePlatforms(const UnpackedArchive& archive) {
 
 }  // namespace
 
-const char* ThisPlatform() {
-#if defined(__linux__) && (defined(__x86_64__) || defined(__aarch64__))
-  return "linux64";
-#elif defined(__linux__) && (defined(__i386__) || defined(__arm__))
-  return "linux32";
+const char* ThisPlatform(int fmi_major_version) {
+  const bool fmi3 = fmi_major_version >= 3;
+#if defined(__linux__) && defined(__x86_64__)
+  return fmi3 ? "x86_64-linux" : "linux64";
+#elif defined(__linux__) && defined(__aarch64__)
+  return fmi3 ? "aarch64-linux" : "linux64";
+#elif defined(__linux__) && defined(__i386__)
+  return fmi3 ? "x86-linux" : "linux32";
+#elif defined(__linux__) && defined(__arm__)
+  return fmi3 ? "aarch32-linux" : "linux32";
 #else
+  (void)fmi3;
   return "";
 #endif
+}
+
+std::unique_ptr<ModelInstance> Fmu::Instantiate() const {
+  const std::string& identifier = interface_type().model_identifier;
+  if (const auto* fmi3 = std::get_if<Fmi3Library>(&library_)) {
+    return Fmi3Instance::Create(fmi3->functions(), interface_, identifier, description_.guid, resource_location_);
+  }
+  return Fmi2Instance::Create(std::get<Fmi2Library>(library_).functions(), interface_, identifier, description_.guid,
+                              resource_location_);
+}
+
+bool Fmu::exports_directional_derivative() const {
+  if (const auto* fmi3 = std::get_if<Fmi3Library>(&library_)) {
+    return fmi3->functions().get_directional_derivative != nullptr;
+  }
+  return std::get<Fmi2Library>(library_).functions().get_directional_derivative != nullptr;
 }
 
 absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interface interface,
@@ -61,7 +85,8 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
                                                    interface == Interface::kModelExchange ? "ModelExchange" : "CoSimulation",
                                                    "> element)"));
   }
-  const std::string platform = ThisPlatform();
+  const int major_version = description->fmi_major_version;
+  const std::string platform = ThisPlatform(major_version);
   if (platform.empty()) {
     return absl::FailedPreconditionError("this build's platform has no FMI platform name; it loads no FMU");
   }
@@ -73,11 +98,17 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
         archive_path.string(), ": no binary ", binary_entry, " for this platform (", platform,
         "); the archive has binaries for: ", platforms.empty() ? "no platform" : absl::StrJoin(platforms, ", ")));
   }
+  const std::filesystem::path resources = archive->folder() / "resources";
+  if (major_version >= 3) {
+    auto library = Fmi3Library::Load(binary, interface);
+    if (!library.ok()) return library.status();
+    return Fmu(*std::move(archive), *std::move(description), Library(*std::move(library)), interface,
+               absl::StrCat(resources.string(), "/"));
+  }
   auto library = Fmi2Library::Load(binary, interface);
   if (!library.ok()) return library.status();
-
-  const std::string resource_uri = absl::StrCat("file://", (archive->folder() / "resources").string());
-  return Fmu(*std::move(archive), *std::move(description), *std::move(library), interface, resource_uri);
+  return Fmu(*std::move(archive), *std::move(description), Library(*std::move(library)), interface,
+             absl::StrCat("file://", resources.string()));
 }
 
 }  // namespace mbopt::fmu

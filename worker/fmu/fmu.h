@@ -1,5 +1,5 @@
-// An FMI 2.0 FMU opened for one interface type: its archive unpacked into a
-// private folder, its model description read and its binary for this
+// An FMI 2.0 or 3.0 FMU opened for one interface type: its archive unpacked
+// into a private folder, its model description read and its binary for this
 // platform loaded. One Fmu runs any number of simulations one after the
 // other (each instantiates the model afresh); it is not thread-safe.
 //
@@ -9,18 +9,22 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
+#include <variant>
 
 #include "absl/status/statusor.h"
 #include "worker/fmu/fmi2_library.h"
+#include "worker/fmu/fmi3_library.h"
 #include "worker/fmu/fmu_archive.h"
 #include "worker/fmu/model_description.h"
 
 namespace mbopt::fmu {
 
-// The FMI platform folder of binaries this build loads ("linux64" on 64-bit
-// Linux), or "" where FMI names no platform for this build.
-const char* ThisPlatform();
+// The platform folder of binaries this build loads: FMI 2.0 names it
+// "linux64" on 64-bit Linux, FMI 3.0 by a tuple such as "x86_64-linux".
+// "" where the version names no platform for this build.
+const char* ThisPlatform(int fmi_major_version = 2);
 
 class Fmu {
  public:
@@ -32,26 +36,32 @@ class Fmu {
   const InterfaceType& interface_type() const {
     return interface_ == Interface::kModelExchange ? *description_.model_exchange : *description_.co_simulation;
   }
-  const Fmi2Functions& functions() const { return library_.functions(); }
-  // The file:// URI of the unpacked resources folder, for fmi2Instantiate.
-  const std::string& resource_uri() const { return resource_uri_; }
+  // A new instance of the model, of this FMU's FMI version; see
+  // ModelInstance::instantiated() for whether the FMU made it.
+  std::unique_ptr<ModelInstance> Instantiate() const;
+  // Whether the binary exports fmi2/fmi3GetDirectionalDerivative.
+  bool exports_directional_derivative() const;
   const std::filesystem::path& archive_path() const { return archive_.archive_path(); }
 
  private:
-  Fmu(UnpackedArchive archive, ModelDescription description, Fmi2Library library, Interface interface,
-      std::string resource_uri)
+  using Library = std::variant<Fmi2Library, Fmi3Library>;
+
+  // `resource_location`: the unpacked resources folder as the FMU's
+  // version wants it (a file:// URI for 2.0, a path ending in '/' for 3.0).
+  Fmu(UnpackedArchive archive, ModelDescription description, Library library, Interface interface,
+      std::string resource_location)
       : archive_(std::move(archive)),
         description_(std::move(description)),
         library_(std::move(library)),
         interface_(interface),
-        resource_uri_(std::move(resource_uri)) {}
+        resource_location_(std::move(resource_location)) {}
 
   // Declared first so that the library is closed before its folder goes.
   UnpackedArchive archive_;
   ModelDescription description_;
-  Fmi2Library library_;
+  Library library_;
   Interface interface_;
-  std::string resource_uri_;
+  std::string resource_location_;
 };
 
 }  // namespace mbopt::fmu

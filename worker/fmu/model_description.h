@@ -1,11 +1,16 @@
-// The parts of an FMI 2.0 modelDescription.xml that mbopt uses to run an
-// FMU: its identity, which interface types it offers, its scalar variables
-// and its default experiment. Parsed from text (the archive reader passes
+// The parts of an FMI 2.0 or 3.0 modelDescription.xml that mbopt uses to
+// run an FMU: its identity, which interface types it offers, its scalar
+// variables and its default experiment. Parsed from text (the archive reader passes
 // the file's contents), so the parser is tested without an archive.
 //
 // Errors are InvalidArgument naming the file (as the caller labels it), the
-// element and the attribute, and what was expected. FMI 3.0 descriptions are
-// recognized and refused with that reason: mbopt runs FMI 2.0 FMUs only.
+// element and the attribute, and what was expected.
+//
+// FMI 3.0: the variables' types are elements of their own (<Float64>,
+// <Int32>, ...); mbopt reads Float64 scalars. Refused with the variable or
+// element named: clocks (<Clock> variables, or variables with `clocks`),
+// arrays (<Dimension>, structural parameters), parameters, inputs and
+// outputs of any type but Float64, and Scheduled Execution.
 #pragma once
 
 #include <optional>
@@ -19,7 +24,10 @@ namespace mbopt::fmu {
 
 enum class Causality { kParameter, kCalculatedParameter, kInput, kOutput, kLocal, kIndependent };
 enum class Variability { kConstant, kFixed, kTunable, kDiscrete, kContinuous };
-enum class VariableType { kReal, kInteger, kBoolean, kString, kEnumeration };
+// kReal: FMI 2.0 Real or FMI 3.0 Float64 (what fmi2GetReal / fmi3GetFloat64
+// read). kOther: FMI 3.0 types mbopt does not read (Float32, Binary), only
+// allowed for local variables.
+enum class VariableType { kReal, kInteger, kBoolean, kString, kEnumeration, kOther };
 
 struct ScalarVariable {
   std::string name;
@@ -45,15 +53,16 @@ struct DefaultExperiment {
 };
 
 struct ModelDescription {
-  std::string fmi_version;  // "2.0"
+  std::string fmi_version;  // "2.0", or "3.0" and its revisions
+  int fmi_major_version = 2;
   std::string model_name;
-  std::string guid;
+  std::string guid;  // FMI 3.0's instantiationToken
   std::optional<InterfaceType> model_exchange;
   std::optional<InterfaceType> co_simulation;
-  int number_of_event_indicators = 0;
+  int number_of_event_indicators = 0;  // 3.0: the <EventIndicator>s of <ModelStructure>
   std::vector<ScalarVariable> variables;  // in file order; index i is the file's index i + 1
   // Indices into `variables` of the continuous states (in the order of
-  // fmi2GetContinuousStates) and of their derivatives, from <ModelStructure>.
+  // fmi2/fmi3GetContinuousStates) and of their derivatives, from <ModelStructure>.
   std::vector<int> state_indices;
   std::vector<int> derivative_indices;
   DefaultExperiment default_experiment;

@@ -20,27 +20,31 @@ namespace {
 
 // What the CVODES callbacks need, through their user data.
 struct Callbacks {
-  Fmi2Instance* instance = nullptr;
+  ModelInstance* instance = nullptr;
   int num_states = 0;  // the FMU's; CVODES integrates one dummy state when 0
   int num_indicators = 0;
   std::string failure;
+  // Sensitivities: the knowns of the directional derivatives (the states,
+  // then one parameter) and their seed (the state sensitivities, then 1).
+  const SensitivityRun* sensitivities = nullptr;
+  std::vector<ValueReference> knowns;
+  std::vector<double> seed;
 };
 
-// An FMI status as a SUNDIALS callback's answer: fmi2Discard asks for a
+// An FMI status as a SUNDIALS callback's answer: a discard asks for a
 // smaller step (the FMU could not evaluate there), worse stops the run.
-int CallbackCode(Callbacks* callbacks, fmi2Status status, const char* call, double t) {
-  if (status <= fmi2Warning) return 0;
-  if (status == fmi2Discard) return 1;
+int CallbackCode(Callbacks* callbacks, CallStatus status, Call call, double t) {
+  if (Succeeded(status)) return 0;
+  if (status == CallStatus::kDiscard) return 1;
   callbacks->failure = callbacks->instance->Failure(call, status, t);
   return -1;
 }
 
 int SetTimeAndStates(Callbacks* callbacks, double t, const double* y) {
-  const Fmi2Functions& f = callbacks->instance->f();
-  fmi2Component c = callbacks->instance->component();
-  if (int code = CallbackCode(callbacks, f.set_time(c, t), "fmi2SetTime", t); code != 0) return code;
+  ModelInstance& instance = *callbacks->instance;
+  if (int code = CallbackCode(callbacks, instance.SetTime(t), Call::kSetTime, t); code != 0) return code;
   if (callbacks->num_states == 0) return 0;
-  return CallbackCode(callbacks, f.set_continuous_states(c, y, callbacks->num_states), "fmi2SetContinuousStates", t);
+  return CallbackCode(callbacks, instance.SetContinuousStates(y, callbacks->num_states), Call::kSetContinuousStates, t);
 }
 
 int Derivatives(double t, N_Vector y, N_Vector ydot, void* user_data) {
@@ -52,9 +56,8 @@ int Derivatives(double t, N_Vector y, N_Vector ydot, void* user_data) {
     }
     if (int code = SetTimeAndStates(callbacks, t, N_VGetArrayPointer(y)); code != 0) return code;
     return CallbackCode(callbacks,
-                        callbacks->instance->f().get_derivatives(callbacks->instance->component(),
-                                                                 N_VGetArrayPointer(ydot), callbacks->num_states),
-                        "fmi2GetDerivatives", t);
+                        callbacks->instance->GetDerivatives(N_VGetArrayPointer(ydot), callbacks->num_states),
+                        Call::kGetDerivatives, t);
   });
 }
 
@@ -63,44 +66,71 @@ int EventIndicators(double t, N_Vector y, double* indicators, void* user_data) {
   return sundials::GuardCallback(&callbacks->failure, "the FMU's event indicators", [&] {
     // Root functions have no recoverable errors: any failure stops the run.
     if (SetTimeAndStates(callbacks, t, N_VGetArrayPointer(y)) != 0) return -1;
-    const fmi2Status status = callbacks->instance->f().get_event_indicators(
-        callbacks->instance->component(), indicators, callbacks->num_indicators);
-    return CallbackCode(callbacks, status, "fmi2GetEventIndicators", t) == 0 ? 0 : -1;
+    const CallStatus status = callbacks->instance->GetEventIndicators(indicators, callbacks->num_indicators);
+    return CallbackCode(callbacks, status, Call::kGetEventIndicators, t) == 0 ? 0 : -1;
+  });
+}
+
+// d x' / d p_k = (d f / d x) s_k + d f / d p_k from one directional
+// derivative per parameter: the states and p_k known, seeded with s_k and 1.
+int SensitivityRhs(int count, double t, N_Vector y, N_Vector /*ydot*/, N_Vector* y_s, N_Vector* y_s_dot,
+                   void* user_data, N_Vector /*tmp1*/, N_Vector /*tmp2*/) {
+  auto* callbacks = static_cast<Callbacks*>(user_data);
+  return sundials::GuardCallback(&callbacks->failure, "the FMU's directional derivatives", [&] {
+    const int n = callbacks->num_states;
+    if (n == 0) {  // CVODES' one dummy state has no sensitivity
+      for (int k = 0; k < count; ++k) N_VConst(0.0, y_s_dot[k]);
+      return 0;
+    }
+    if (int code = SetTimeAndStates(callbacks, t, N_VGetArrayPointer(y)); code != 0) return code;
+    const SensitivityRun& run = *callbacks->sensitivities;
+    for (int k = 0; k < count; ++k) {
+      callbacks->knowns[n] = run.parameter_references[k];
+      std::copy_n(N_VGetArrayPointer(y_s[k]), n, callbacks->seed.begin());
+      callbacks->seed[n] = 1.0;
+      const CallStatus status = callbacks->instance->GetDirectionalDerivative(
+          run.derivative_references.data(), n, callbacks->knowns.data(), n + 1, callbacks->seed.data(),
+          N_VGetArrayPointer(y_s_dot[k]));
+      if (int code = CallbackCode(callbacks, status, Call::kGetDirectionalDerivative, t); code != 0) return code;
+    }
+    return 0;
   });
 }
 
 // The FMU's discrete states iterated to a fixed point at one event (the
 // FMU is in event mode). False (and `result` failed) on an error or when
 // the iteration does not settle.
-bool IterateEvent(Fmi2Instance& instance, const RunOptions& options, double t, fmi2EventInfo* info,
+bool IterateEvent(ModelInstance& instance, const RunOptions& options, double t, DiscreteStateUpdate* info,
                   RunResult* result) {
-  info->newDiscreteStatesNeeded = fmi2True;
-  info->terminateSimulation = fmi2False;
-  for (int iteration = 0; info->newDiscreteStatesNeeded == fmi2True; ++iteration) {
+  info->update_needed = true;
+  info->terminate = false;
+  for (int iteration = 0; info->update_needed; ++iteration) {
     if (iteration == options.max_event_iterations) {
       return Fail(result, RunOutcome::kModelError,
-                  absl::StrCat("the FMU's discrete states did not settle in ", options.max_event_iterations,
-                               " fmi2NewDiscreteStates calls at the event at t = ", t, " s"));
+                  absl::StrCat("the FMU's discrete states did not settle in ", options.max_event_iterations, " ",
+                               instance.FunctionName(Call::kUpdateDiscreteStates), " calls at the event at t = ", t,
+                               " s"));
     }
-    const fmi2Status status = instance.f().new_discrete_states(instance.component(), info);
-    if (status > fmi2Warning) {
-      return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2NewDiscreteStates", status, t));
+    const CallStatus status = instance.UpdateDiscreteStates(info);
+    if (!Succeeded(status)) {
+      return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kUpdateDiscreteStates, status, t));
     }
-    if (info->terminateSimulation == fmi2True) break;
+    if (info->terminate) break;
   }
   return true;
 }
 
 class ModelExchangeRun {
  public:
-  ModelExchangeRun(const Fmu& fmu, Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run)
-      : fmu_(fmu), instance_(instance), f_(instance.f()), options_(options), run_(run) {}
+  ModelExchangeRun(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run,
+                   SensitivityRun* sensitivities)
+      : fmu_(fmu), instance_(instance), options_(options), run_(run), sensitivities_(sensitivities) {}
 
   RunResult Go();
 
  private:
-  bool Check(fmi2Status status, const char* call, double t) {
-    if (status <= fmi2Warning) return true;
+  bool Check(CallStatus status, Call call, double t) {
+    if (Succeeded(status)) return true;
     return Fail(&result_, RunOutcome::kModelError, instance_.Failure(call, status, t));
   }
   bool CheckCvodes(int flag, const char* call) {
@@ -121,14 +151,23 @@ class ModelExchangeRun {
   // interpolation over the last step.
   bool OutputsUpTo(double t_reached);
   bool HandleEvent(double t);
+  // Sensitivities: the states' at t0 (in initialization mode), CVODES' set
+  // up, the outputs' at one output time, and giving them up with a reason
+  // while the run goes on.
+  bool InitialSensitivities(double t0);
+  bool SetUpSensitivities();
+  void OutputDerivatives(int time_index, double t);
+  void DropSensitivities(std::string reason);
+  bool sensitivities_on() const { return sensitivities_ != nullptr && sensitivities_->unavailable.empty(); }
 
   const Fmu& fmu_;
-  Fmi2Instance& instance_;
-  const Fmi2Functions& f_;
+  ModelInstance& instance_;
   const RunOptions& options_;
   const CheckedRun& run_;
+  SensitivityRun* sensitivities_;
+  std::vector<std::vector<double>> initial_sensitivities_;  // [k][state]
   RunResult result_;
-  fmi2EventInfo info_{};
+  DiscreteStateUpdate info_;
   Callbacks callbacks_;
   std::string cvodes_message_;
   std::size_t next_output_ = 0;
@@ -140,6 +179,7 @@ class ModelExchangeRun {
   sundials::Vector y_interpolated_;
   sundials::Matrix matrix_;
   sundials::LinearSolver linear_solver_;
+  sundials::VectorArray y_s_;
   sundials::Memory<CVodeFree> cvode_;
 };
 
@@ -148,8 +188,8 @@ bool ModelExchangeRun::ReadStates(double t) {
     N_VGetArrayPointer(y_.get())[0] = 0.0;
     return true;
   }
-  return Check(f_.get_continuous_states(instance_.component(), N_VGetArrayPointer(y_.get()), callbacks_.num_states),
-               "fmi2GetContinuousStates", t);
+  return Check(instance_.GetContinuousStates(N_VGetArrayPointer(y_.get()), callbacks_.num_states),
+               Call::kGetContinuousStates, t);
 }
 
 bool ModelExchangeRun::SetUpCvodes(double t0) {
@@ -173,7 +213,92 @@ bool ModelExchangeRun::SetUpCvodes(double t0) {
          CheckCvodes(CVodeSetLinearSolver(mem, linear_solver_.get(), matrix_.get()), "CVodeSetLinearSolver") &&
          CheckCvodes(CVodeSetMaxNumSteps(mem, static_cast<long>(options_.max_steps)), "CVodeSetMaxNumSteps") &&
          (callbacks_.num_indicators == 0 ||
-          CheckCvodes(CVodeRootInit(mem, callbacks_.num_indicators, EventIndicators), "CVodeRootInit"));
+          CheckCvodes(CVodeRootInit(mem, callbacks_.num_indicators, EventIndicators), "CVodeRootInit")) &&
+         SetUpSensitivities();
+}
+
+bool ModelExchangeRun::InitialSensitivities(double t0) {
+  // d x(t0) / d p_k: the states are initial unknowns, the parameter known.
+  const SensitivityRun& run = *sensitivities_;
+  const int n = callbacks_.num_states;
+  initial_sensitivities_.assign(run.parameter_references.size(), std::vector<double>(n, 0.0));
+  for (std::size_t k = 0; k < run.parameter_references.size() && n > 0; ++k) {
+    const double one = 1.0;
+    const CallStatus status = instance_.GetDirectionalDerivative(run.state_references.data(), n,
+                                                                 &run.parameter_references[k], 1, &one,
+                                                                 initial_sensitivities_[k].data());
+    if (!Succeeded(status)) {
+      DropSensitivities(absl::StrCat("the initial states' derivatives: ",
+                                     instance_.Failure(Call::kGetDirectionalDerivative, status, t0)));
+      return true;
+    }
+  }
+  return true;
+}
+
+bool ModelExchangeRun::SetUpSensitivities() {
+  if (!sensitivities_on()) return true;
+  const int count = static_cast<int>(sensitivities_->parameter_references.size());
+  const int n = callbacks_.num_states;
+  y_s_ = sundials::VectorArray(N_VCloneVectorArray(count, y_.get()), count);
+  if (!y_s_) return Fail(&result_, RunOutcome::kIntegratorFailure, "out of memory");
+  for (int k = 0; k < count; ++k) {
+    N_VConst(0.0, y_s_[k]);
+    std::copy_n(initial_sensitivities_[k].begin(), n, N_VGetArrayPointer(y_s_[k]));
+  }
+  callbacks_.sensitivities = sensitivities_;
+  callbacks_.knowns = sensitivities_->state_references;
+  callbacks_.knowns.push_back(0);
+  callbacks_.seed.assign(n + 1, 0.0);
+  void* mem = cvode_.get();
+  // Staggered: the states' Newton iteration is left as without
+  // sensitivities; the sensitivities are in the error test.
+  return CheckCvodes(CVodeSensInit(mem, count, CV_STAGGERED, SensitivityRhs, y_s_.get()), "CVodeSensInit") &&
+         CheckCvodes(CVodeSensEEtolerances(mem), "CVodeSensEEtolerances") &&
+         CheckCvodes(CVodeSetSensErrCon(mem, SUNTRUE), "CVodeSetSensErrCon");
+}
+
+void ModelExchangeRun::DropSensitivities(std::string reason) {
+  if (!sensitivities_on()) return;
+  sensitivities_->unavailable = std::move(reason);
+  sensitivities_->output_derivatives.clear();
+  if (cvode_) CVodeSensToggleOff(cvode_.get());
+}
+
+void ModelExchangeRun::OutputDerivatives(int time_index, double t) {
+  if (!sensitivities_on()) return;
+  SensitivityRun& run = *sensitivities_;
+  const int count = static_cast<int>(run.parameter_references.size());
+  const int n = callbacks_.num_states;
+  // CVODES' interpolation of the sensitivities, as of the states; before
+  // the first step there is nothing to interpolate (and CVODES would
+  // divide by its zero step), so the initial sensitivities.
+  const int flag = result_.integrator_steps == 0 ? 0 : CVodeGetSensDky(cvode_.get(), t, 0, y_s_.get());
+  if (flag < 0) {
+    DropSensitivities(absl::StrCat("CVodeGetSensDky failed at t = ", t, " s (flag ", flag, ")"));
+    return;
+  }
+  for (int k = 0; k < count; ++k) {
+    const double* s = N_VGetArrayPointer(y_s_[k]);
+    callbacks_.knowns[n] = run.parameter_references[k];
+    std::copy_n(s, n, callbacks_.seed.begin());
+    callbacks_.seed[n] = 1.0;
+    for (std::size_t o = 0; o < run.output_state_index.size(); ++o) {
+      double derivative = 0.0;
+      if (run.output_state_index[o] >= 0) {
+        derivative = s[run.output_state_index[o]];
+      } else {
+        const CallStatus status = instance_.GetDirectionalDerivative(
+            &run_.output_references[o], 1, callbacks_.knowns.data(), n + 1, callbacks_.seed.data(), &derivative);
+        if (!Succeeded(status)) {
+          DropSensitivities(absl::StrCat("output ", o + 1, "'s derivative: ",
+                                         instance_.Failure(Call::kGetDirectionalDerivative, status, t)));
+          return;
+        }
+      }
+      run.output_derivatives[k][o][time_index] = derivative;
+    }
+  }
 }
 
 bool ModelExchangeRun::OutputsUpTo(double t_reached) {
@@ -189,6 +314,7 @@ bool ModelExchangeRun::OutputsUpTo(double t_reached) {
       return Fail(&result_, RunOutcome::kModelError, callbacks_.failure);
     }
     if (!ReadOutputs(instance_, run_, static_cast<int>(next_output_), t, &result_)) return false;
+    OutputDerivatives(static_cast<int>(next_output_), t);
     ++next_output_;
   }
   return true;
@@ -200,10 +326,12 @@ bool ModelExchangeRun::HandleEvent(double t) {
                 absl::StrCat("more than ", options_.max_events, " events by t = ", t,
                              " s (events chattering, or max_events too small)"));
   }
-  if (!Check(f_.enter_event_mode(instance_.component()), "fmi2EnterEventMode", t)) return false;
+  // The sensitivities jump at an event in a way the FMU does not tell.
+  DropSensitivities(absl::StrCat("an event at t = ", t, " s: sensitivities across events are not computed"));
+  if (!Check(instance_.EnterEventMode(), Call::kEnterEventMode, t)) return false;
   if (!IterateEvent(instance_, options_, t, &info_, &result_)) return false;
-  if (info_.terminateSimulation == fmi2True) return Terminated(t);
-  if (!Check(f_.enter_continuous_time_mode(instance_.component()), "fmi2EnterContinuousTimeMode", t)) return false;
+  if (info_.terminate) return Terminated(t);
+  if (!Check(instance_.EnterContinuousTimeMode(), Call::kEnterContinuousTimeMode, t)) return false;
   // The states may have jumped: CVODES restarts from the FMU's states.
   if (!ReadStates(t)) return false;
   return CheckCvodes(CVodeReInit(cvode_.get(), t, y_.get()), "CVodeReInit");
@@ -218,28 +346,38 @@ RunResult ModelExchangeRun::Go() {
   const double t0 = options_.start_time_s;
   const double t_end = run_.stop_time_s;
 
-  if (!Initialize(instance_, options_, run_, options_.relative_tolerance, &result_)) return result_;
+  if (sensitivities_ != nullptr) {
+    sensitivities_->output_derivatives.assign(
+        sensitivities_->parameter_references.size(),
+        std::vector<std::vector<double>>(run_.output_references.size(),
+                                         std::vector<double>(options_.output_times_s.size(), 0.0)));
+  }
+  const std::function<bool()> in_initialization =
+      sensitivities_ == nullptr ? std::function<bool()>() : [this, t0] { return InitialSensitivities(t0); };
+  if (!Initialize(instance_, options_, run_, options_.relative_tolerance, &result_, in_initialization)) {
+    return result_;
+  }
   // Initialization is an event: discrete states settle before time runs.
   if (!IterateEvent(instance_, options_, t0, &info_, &result_)) return result_;
-  if (info_.terminateSimulation == fmi2True) {
+  if (info_.terminate) {
     Terminated(t0);
     return result_;
   }
-  if (!Check(f_.enter_continuous_time_mode(instance_.component()), "fmi2EnterContinuousTimeMode", t0)) return result_;
+  if (!Check(instance_.EnterContinuousTimeMode(), Call::kEnterContinuousTimeMode, t0)) return result_;
   if (!SetUpCvodes(t0)) return result_;
   if (!OutputsUpTo(t0)) return result_;
 
   double t = t0;
   while (next_output_ < options_.output_times_s.size()) {
     if (!WithinBudget(options_, t, &result_)) return result_;
-    const bool time_event_ahead = info_.nextEventTimeDefined == fmi2True && info_.nextEventTime <= t_end;
-    if (time_event_ahead && info_.nextEventTime <= t) {
+    const bool time_event_ahead = info_.next_event_time_defined && info_.next_event_time_s <= t_end;
+    if (time_event_ahead && info_.next_event_time_s <= t) {
       Fail(&result_, RunOutcome::kModelError,
-           absl::StrCat("the FMU asked for a time event at t = ", info_.nextEventTime,
+           absl::StrCat("the FMU asked for a time event at t = ", info_.next_event_time_s,
                         " s, not after the current time ", t, " s"));
       return result_;
     }
-    const double t_stop = time_event_ahead ? info_.nextEventTime : t_end;
+    const double t_stop = time_event_ahead ? info_.next_event_time_s : t_end;
     if (!CheckCvodes(CVodeSetStopTime(cvode_.get(), t_stop), "CVodeSetStopTime")) return result_;
     const int flag = CVode(cvode_.get(), t_stop, y_.get(), &t, CV_ONE_STEP);
     if (flag < 0) {
@@ -258,13 +396,12 @@ RunResult ModelExchangeRun::Go() {
       Fail(&result_, RunOutcome::kModelError, callbacks_.failure);
       return result_;
     }
-    fmi2Boolean step_event = fmi2False;
-    fmi2Boolean terminate = fmi2False;
-    if (!Check(f_.completed_integrator_step(instance_.component(), fmi2True, &step_event, &terminate),
-               "fmi2CompletedIntegratorStep", t)) {
+    bool step_event = false;
+    bool terminate = false;
+    if (!Check(instance_.CompletedIntegratorStep(&step_event, &terminate), Call::kCompletedIntegratorStep, t)) {
       return result_;
     }
-    if (terminate == fmi2True) {
+    if (terminate) {
       Terminated(t);
       return result_;
     }
@@ -272,16 +409,17 @@ RunResult ModelExchangeRun::Go() {
     const bool time_event = flag == CV_TSTOP_RETURN && time_event_ahead;
     if (state_event) result_.state_event_times_s.push_back(t);
     if (time_event) result_.time_event_times_s.push_back(t);
-    if ((state_event || time_event || step_event == fmi2True) && !HandleEvent(t)) return result_;
+    if ((state_event || time_event || step_event) && !HandleEvent(t)) return result_;
   }
-  f_.terminate(instance_.component());
+  instance_.Terminate();
   return result_;
 }
 
 }  // namespace
 
-RunResult RunModelExchange(const Fmu& fmu, Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run) {
-  ModelExchangeRun me(fmu, instance, options, run);
+RunResult RunModelExchange(const Fmu& fmu, ModelInstance& instance, const RunOptions& options, const CheckedRun& run,
+                           SensitivityRun* sensitivities) {
+  ModelExchangeRun me(fmu, instance, options, run, sensitivities);
   return me.Go();
 }
 

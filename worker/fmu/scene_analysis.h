@@ -11,6 +11,7 @@
 // wall-time limit kTimeLimit, a NaN kNonFiniteValue.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "spec/analysis_report.h"
@@ -23,5 +24,27 @@ namespace mbopt::fmu {
 // fmi2DoStep.
 spec::AnalysisReport AnalyzeFmuScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
                                      const budget::AnalysisBudget* budget = nullptr);
+
+// Simulator sensitivities of an `fmu` scene (sensitivities.h): with respect
+// to scene parameters, through the FMU parameters they set (a scene
+// parameter may set several, through expressions; the chain rule sums them).
+//
+// "" when the scene's FMU gives sensitivities with respect to `parameters`
+// (scene parameter indices); else why not (the FMU is opened to read its
+// description: a few milliseconds).
+std::string FmuSensitivitiesUnavailable(const spec::Scene& scene, const std::vector<int>& parameters);
+
+struct FmuSensitivityAnalysis {
+  spec::AnalysisReport report;
+  // [k][output][instant]: d output / d parameter_values_si[parameters[k]];
+  // empty when `unavailable` says why.
+  std::vector<std::vector<std::vector<double>>> output_derivatives;
+  std::string unavailable;
+};
+
+FmuSensitivityAnalysis AnalyzeFmuSceneWithSensitivities(const spec::Scene& scene,
+                                                        const std::vector<double>& parameter_values_si,
+                                                        const std::vector<int>& parameters,
+                                                        const budget::AnalysisBudget* budget = nullptr);
 
 }  // namespace mbopt::fmu

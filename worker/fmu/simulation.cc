@@ -32,7 +32,80 @@ std::string NamesOf(const ModelDescription& description, bool (*keep)(const Scal
   return names.empty() ? "none" : absl::StrJoin(names, ", ");
 }
 
-absl::StatusOr<CheckedRun> Check(const Fmu& fmu, const RunOptions& options) {
+absl::StatusOr<double> CommunicationStep(const Fmu& fmu, const RunOptions& options) {
+  const std::optional<double> step =
+      options.communication_step_s ? options.communication_step_s : fmu.description().default_experiment.step_size_s;
+  if (!step.has_value()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        fmu.archive_path().string(), ": no communication step: the model description's <DefaultExperiment> has no "
+        "stepSize and the run gives none"));
+  }
+  if (!(*step > 0.0) || !std::isfinite(*step)) {
+    return absl::InvalidArgumentError(absl::StrCat("communication step ", *step, " s; expected a step > 0 s"));
+  }
+  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
+    const double steps = (options.output_times_s[i] - options.start_time_s) / *step;
+    if (std::abs(steps - std::round(steps)) > kGridAlignmentSteps * std::max(1.0, steps)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "output time ", i, " (", options.output_times_s[i], " s) is not a whole number of communication steps (",
+          *step, " s) after the start time (", options.start_time_s,
+          " s); a co-simulation FMU is sampled only at its communication points"));
+    }
+  }
+  return *step;
+}
+
+RunResult RunCoSimulation(ModelInstance& instance, const RunOptions& options, const CheckedRun& run, double step_s) {
+  RunResult result;
+  result.values.assign(run.output_references.size(), std::vector<double>(options.output_times_s.size()));
+  const double tolerance = options.relative_tolerance;
+  if (!internal::Initialize(instance, options, run, tolerance, &result)) return result;
+  // Communication points are start + m * step, computed from m each time so
+  // that no rounding accumulates over many steps.
+  std::int64_t m = 0;
+  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
+    const auto target = static_cast<std::int64_t>(std::llround((options.output_times_s[i] - options.start_time_s) / step_s));
+    for (; m < target; ++m) {
+      const double point = options.start_time_s + static_cast<double>(m) * step_s;
+      bool terminate = false;
+      const CallStatus status = instance.DoStep(point, step_s, &terminate);
+      ++result.integrator_steps;
+      if (!Succeeded(status)) {
+        Fail(&result, RunOutcome::kModelError, instance.Failure(Call::kDoStep, status, point));
+        return result;
+      }
+      if (terminate) {
+        const std::string messages = instance.RecentMessages();
+        Fail(&result, RunOutcome::kTerminated,
+             absl::StrCat("the FMU ended the simulation at t = ", point + step_s, " s, before the last output time (",
+                          run.stop_time_s, " s)", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
+        return result;
+      }
+      if (!internal::WithinBudget(options, point + step_s, &result)) return result;
+    }
+    if (!internal::ReadOutputs(instance, run, static_cast<int>(i), options.output_times_s[i], &result)) return result;
+  }
+  instance.Terminate();
+  return result;
+}
+
+}  // namespace
+
+const char* RunOutcomeName(RunOutcome outcome) {
+  switch (outcome) {
+    case RunOutcome::kOk: return "ok";
+    case RunOutcome::kModelError: return "model error";
+    case RunOutcome::kIntegratorFailure: return "integrator failure";
+    case RunOutcome::kTerminated: return "terminated by the FMU";
+    case RunOutcome::kTimeLimit: return "time limit";
+    case RunOutcome::kCancelled: return "cancelled";
+  }
+  return "?";
+}
+
+namespace internal {
+
+absl::StatusOr<CheckedRun> CheckRequest(const Fmu& fmu, const RunOptions& options) {
   const ModelDescription& description = fmu.description();
   const std::string where = fmu.archive_path().string();
   CheckedRun run;
@@ -92,71 +165,19 @@ absl::StatusOr<CheckedRun> Check(const Fmu& fmu, const RunOptions& options) {
   return run;
 }
 
-absl::StatusOr<double> CommunicationStep(const Fmu& fmu, const RunOptions& options) {
-  const std::optional<double> step =
-      options.communication_step_s ? options.communication_step_s : fmu.description().default_experiment.step_size_s;
-  if (!step.has_value()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        fmu.archive_path().string(), ": no communication step: the model description's <DefaultExperiment> has no "
-        "stepSize and the run gives none"));
-  }
-  if (!(*step > 0.0) || !std::isfinite(*step)) {
-    return absl::InvalidArgumentError(absl::StrCat("communication step ", *step, " s; expected a step > 0 s"));
-  }
-  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
-    const double steps = (options.output_times_s[i] - options.start_time_s) / *step;
-    if (std::abs(steps - std::round(steps)) > kGridAlignmentSteps * std::max(1.0, steps)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "output time ", i, " (", options.output_times_s[i], " s) is not a whole number of communication steps (",
-          *step, " s) after the start time (", options.start_time_s,
-          " s); a co-simulation FMU is sampled only at its communication points"));
-    }
-  }
-  return *step;
+std::unique_ptr<ModelInstance> Instantiate(const Fmu& fmu, RunResult* result) {
+  std::unique_ptr<ModelInstance> instance = fmu.Instantiate();
+  if (instance->instantiated()) return instance;
+  const std::string messages = instance->RecentMessages();
+  const char* function = fmu.description().fmi_major_version >= 3
+                             ? (fmu.interface() == Interface::kModelExchange ? "fmi3InstantiateModelExchange"
+                                                                             : "fmi3InstantiateCoSimulation")
+                             : "fmi2Instantiate";
+  Fail(result, RunOutcome::kModelError,
+       absl::StrCat(function, " refused to make an instance",
+                    messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
+  return nullptr;
 }
-
-RunResult RunCoSimulation(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double step_s) {
-  RunResult result;
-  result.values.assign(run.output_references.size(), std::vector<double>(options.output_times_s.size()));
-  const double tolerance = options.relative_tolerance;
-  if (!internal::Initialize(instance, options, run, tolerance, &result)) return result;
-  const Fmi2Functions& f = instance.f();
-  // Communication points are start + m * step, computed from m each time so
-  // that no rounding accumulates over many steps.
-  std::int64_t m = 0;
-  for (std::size_t i = 0; i < options.output_times_s.size(); ++i) {
-    const auto target = static_cast<std::int64_t>(std::llround((options.output_times_s[i] - options.start_time_s) / step_s));
-    for (; m < target; ++m) {
-      const double point = options.start_time_s + static_cast<double>(m) * step_s;
-      const fmi2Status status = f.do_step(instance.component(), point, step_s, fmi2True);
-      ++result.integrator_steps;
-      if (status != fmi2OK && status != fmi2Warning) {
-        Fail(&result, RunOutcome::kModelError, instance.Failure("fmi2DoStep", status, point));
-        return result;
-      }
-      if (!internal::WithinBudget(options, point + step_s, &result)) return result;
-    }
-    if (!internal::ReadOutputs(instance, run, static_cast<int>(i), options.output_times_s[i], &result)) return result;
-  }
-  f.terminate(instance.component());
-  return result;
-}
-
-}  // namespace
-
-const char* RunOutcomeName(RunOutcome outcome) {
-  switch (outcome) {
-    case RunOutcome::kOk: return "ok";
-    case RunOutcome::kModelError: return "model error";
-    case RunOutcome::kIntegratorFailure: return "integrator failure";
-    case RunOutcome::kTerminated: return "terminated by the FMU";
-    case RunOutcome::kTimeLimit: return "time limit";
-    case RunOutcome::kCancelled: return "cancelled";
-  }
-  return "?";
-}
-
-namespace internal {
 
 bool WithinBudget(const RunOptions& options, double time_s, RunResult* result) {
   if (options.budget == nullptr) return true;
@@ -172,35 +193,38 @@ bool Fail(RunResult* result, RunOutcome outcome, std::string reason) {
   return false;
 }
 
-bool Initialize(Fmi2Instance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
-                RunResult* result) {
-  const Fmi2Functions& f = instance.f();
+bool Initialize(ModelInstance& instance, const RunOptions& options, const CheckedRun& run, double tolerance,
+                RunResult* result, const std::function<bool()>& in_initialization_mode) {
   const double t0 = options.start_time_s;
-  fmi2Status status = f.setup_experiment(instance.component(), fmi2True, tolerance, t0, fmi2True, run.stop_time_s);
-  if (status > fmi2Warning) return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2SetupExperiment", status, t0));
+  CallStatus status = instance.SetUpExperiment(tolerance, t0, run.stop_time_s);
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetUpExperiment, status, t0));
+  }
   if (!run.parameter_references.empty()) {
-    status = f.set_real(instance.component(), run.parameter_references.data(), run.parameter_references.size(),
-                        run.parameter_values.data());
-    if (status > fmi2Warning) return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2SetReal (parameters)", status, t0));
+    status = instance.SetFloat64(run.parameter_references.data(), run.parameter_references.size(),
+                                 run.parameter_values.data());
+    if (!Succeeded(status)) {
+      return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kSetFloat64, status, t0, "parameters"));
+    }
   }
-  status = f.enter_initialization_mode(instance.component());
-  if (status > fmi2Warning) {
-    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2EnterInitializationMode", status, t0));
+  status = instance.EnterInitializationMode();
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kEnterInitializationMode, status, t0));
   }
-  status = f.exit_initialization_mode(instance.component());
-  if (status > fmi2Warning) {
-    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2ExitInitializationMode", status, t0));
+  if (in_initialization_mode && !in_initialization_mode()) return false;
+  status = instance.ExitInitializationMode();
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kExitInitializationMode, status, t0));
   }
   return true;
 }
 
-bool ReadOutputs(Fmi2Instance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result) {
+bool ReadOutputs(ModelInstance& instance, const CheckedRun& run, int time_index, double time_s, RunResult* result) {
   if (run.output_references.empty()) return true;
   std::vector<double> values(run.output_references.size());
-  const fmi2Status status =
-      instance.f().get_real(instance.component(), run.output_references.data(), values.size(), values.data());
-  if (status > fmi2Warning) {
-    return Fail(result, RunOutcome::kModelError, instance.Failure("fmi2GetReal (outputs)", status, time_s));
+  const CallStatus status = instance.GetFloat64(run.output_references.data(), values.size(), values.data());
+  if (!Succeeded(status)) {
+    return Fail(result, RunOutcome::kModelError, instance.Failure(Call::kGetFloat64, status, time_s, "outputs"));
   }
   for (std::size_t k = 0; k < values.size(); ++k) result->values[k][time_index] = values[k];
   return true;
@@ -209,7 +233,7 @@ bool ReadOutputs(Fmi2Instance& instance, const CheckedRun& run, int time_index, 
 }  // namespace internal
 
 absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options) {
-  auto run = Check(fmu, options);
+  auto run = internal::CheckRequest(fmu, options);
   if (!run.ok()) return run.status();
   std::optional<double> step;
   if (fmu.interface() == Interface::kCoSimulation) {
@@ -217,14 +241,9 @@ absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options) {
     if (!checked_step.ok()) return checked_step.status();
     step = *checked_step;
   }
-  std::unique_ptr<Fmi2Instance> instance = Fmi2Instance::Create(fmu);
-  if (instance->component() == nullptr) {
-    RunResult result;
-    const std::string messages = instance->RecentMessages();
-    Fail(&result, RunOutcome::kModelError,
-         absl::StrCat("fmi2Instantiate refused to make an instance", messages.empty() ? "" : absl::StrCat(" (FMU: ", messages, ")")));
-    return result;
-  }
+  RunResult result;
+  std::unique_ptr<ModelInstance> instance = internal::Instantiate(fmu, &result);
+  if (instance == nullptr) return result;
   if (step.has_value()) return RunCoSimulation(*instance, options, *run, *step);
   return internal::RunModelExchange(fmu, *instance, options, *run);
 }

@@ -1,4 +1,4 @@
-// One simulation of an FMI 2.0 FMU: parameters set by name, the model run
+// One simulation of an FMI 2.0 or 3.0 FMU: parameters set by name, the model run
 // from its start time to the last output time, the requested variables
 // sampled on the output time grid.
 //
@@ -6,12 +6,12 @@
 // (BDF, dense Newton), state events are found by CVODES' root finding on the
 // FMU's event indicators, time events stop the integrator exactly at the
 // FMU's nextEventTime, and after every event the FMU's discrete states are
-// iterated to a fixed point (fmi2NewDiscreteStates) and CVODES restarts from
+// iterated to a fixed point (fmi2NewDiscreteStates / fmi3UpdateDiscreteStates) and CVODES restarts from
 // the new states. Outputs between steps are read from the FMU at states
 // interpolated by CVODES; an output at an event's time is the value just
 // before the event (the left limit).
 //
-// Co-Simulation: fmi2DoStep at one fixed communication step (the run's, else
+// Co-Simulation: fmi2DoStep / fmi3DoStep at one fixed communication step (the run's, else
 // the model description's DefaultExperiment stepSize), from the start time.
 // Every output time must be a whole number of steps after the start (to
 // 1e-9 of a step); the outputs are the FMU's values at those communication
@@ -52,10 +52,10 @@ struct RunOptions {
   double absolute_tolerance = 1e-10;
   std::int64_t max_steps = 1000000;         // CVODES steps over the whole run
   int max_events = 100000;                  // state and time events over the whole run
-  int max_event_iterations = 1000;          // fmi2NewDiscreteStates calls at one event
+  int max_event_iterations = 1000;          // discrete-state updates at one event
 
   // The analysis' deadline and cancel flag, checked after every integrator
-  // step and every fmi2DoStep; null: none. A call into the FMU that never
+  // step and every DoStep; null: none. A call into the FMU that never
   // returns is not interrupted (the service's lease covers that).
   const budget::AnalysisBudget* budget = nullptr;
 
@@ -65,7 +65,7 @@ struct RunOptions {
 
 enum class RunOutcome {
   kOk,
-  kModelError,         // an FMI call returned fmi2Error or fmi2Fatal (or fmi2Discard where no retry exists)
+  kModelError,         // an FMI call returned an error or fatal status (or discard where no retry exists)
   kIntegratorFailure,  // CVODES gave up (step size, error test, convergence, too many steps or events)
   kTerminated,         // the FMU ended the simulation before the last output time
   kTimeLimit,          // the budget's deadline passed
@@ -81,7 +81,7 @@ struct RunResult {
   std::vector<std::vector<double>> values;
   std::vector<double> state_event_times_s;  // Model Exchange: root-finding events, in time order
   std::vector<double> time_event_times_s;   // Model Exchange: nextEventTime events, in time order
-  std::int64_t integrator_steps = 0;        // CVODES steps, or fmi2DoStep calls
+  std::int64_t integrator_steps = 0;        // CVODES steps, or DoStep calls
 };
 
 absl::StatusOr<RunResult> Simulate(const Fmu& fmu, const RunOptions& options);

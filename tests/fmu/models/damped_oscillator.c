@@ -45,3 +45,34 @@ fmi2Boolean ModelEvent(Model* m) {
   (void)m;
   return fmi2False;
 }
+
+fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial) {
+  const fmi2Real mass = m->r[kMass];
+  *partial = 0.0;
+  switch (unknown) {
+    case kX: /* in initialization: x = x0 */
+      if (known == kX) *partial = 1.0;
+      if (known == kX0) *partial = 1.0;
+      return fmi2OK;
+    case kV: /* in initialization: v = 0 */
+      if (known == kV) *partial = 1.0;
+      return fmi2OK;
+    case kDerX:
+      if (known == kV) *partial = 1.0;
+      return fmi2OK;
+    case kDerV: /* (-k x - c v) / m */
+      if (known == kX) *partial = -m->r[kStiffness] / mass;
+      if (known == kV) *partial = -m->r[kDamping] / mass;
+      if (known == kStiffness) *partial = -m->r[kX] / mass;
+      if (known == kDamping) *partial = -m->r[kV] / mass;
+      if (known == kMass) *partial = -m->r[kDerV] / mass;
+      return fmi2OK;
+    case kSpringForce: /* -k x */
+      if (known == kX) *partial = -m->r[kStiffness];
+      if (known == kStiffness) *partial = -m->r[kX];
+      return fmi2OK;
+    default:
+      ModelLog(m, fmi2Error, "no directional derivative of the variable with value reference %g", (double)unknown);
+      return fmi2Error;
+  }
+}

@@ -1,7 +1,9 @@
-/* The test models' side of the FMI 2.0 interface: model_frame.c implements
- * the fmi2 functions once, over a model that keeps all its Real variables in
- * one array indexed by value reference and supplies the functions below.
- * Each test FMU is model_frame.c plus one model file. */
+/* The test models' side of the FMI interface: model_frame.c implements the
+ * fmi2 functions once, model_frame3.c the fmi3 ones, over a model that keeps
+ * all its Real variables in one array indexed by value reference and
+ * supplies the functions below. Each test FMU is one frame plus one model
+ * file; the FMI 3.0 frame maps the fmi2 types and statuses used here onto
+ * its own (the statuses have the same values in both versions). */
 #ifndef MBOPT_TESTS_FMU_MODELS_MODEL_H_
 #define MBOPT_TESTS_FMU_MODELS_MODEL_H_
 
@@ -40,6 +42,14 @@ void ModelEventIndicators(const Model* m, fmi2Real* indicators);
 /* At an event: discrete changes and state jumps, the next time event.
  * Returns whether a continuous state changed. */
 fmi2Boolean ModelEvent(Model* m);
+
+/* d unknown / d known at the current values, for the frames'
+ * fmi2/fmi3GetDirectionalDerivative: unknowns are derivatives and outputs
+ * (knowns: states and tunable parameters) and, in initialization, states
+ * (knowns: parameters). fmi2Error (with a message logged) for a pair the
+ * model does not differentiate; models that declare no directional
+ * derivatives answer so for every pair. */
+fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial);
 
 void ModelLog(const Model* m, fmi2Status status, const char* message, double value);
 

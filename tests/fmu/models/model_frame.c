@@ -157,6 +157,29 @@ EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean no_se
   return fmi2OK;
 }
 
+/* sensitivity = (d unknowns / d knowns) seed, from the model's partials. */
+static int DirectionalDerivative(Model* m, const unsigned int unknowns[], size_t n_unknowns,
+                                 const unsigned int knowns[], size_t n_knowns, const double seed[],
+                                 double sensitivity[]) {
+  ModelEvaluate(m);
+  for (size_t i = 0; i < n_unknowns; ++i) {
+    sensitivity[i] = 0.0;
+    for (size_t j = 0; j < n_knowns; ++j) {
+      double partial = 0.0;
+      if (ModelPartialDerivative(m, unknowns[i], knowns[j], &partial) != fmi2OK) return 0;
+      sensitivity[i] += partial * seed[j];
+    }
+  }
+  return 1;
+}
+
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference unknowns[], size_t n_unknowns,
+                                               const fmi2ValueReference knowns[], size_t n_knowns,
+                                               const fmi2Real seed[], fmi2Real sensitivity[]) {
+  return DirectionalDerivative((Model*)c, unknowns, n_unknowns, knowns, n_knowns, seed, sensitivity) ? fmi2OK
+                                                                                                      : fmi2Error;
+}
+
 /* One classical Runge-Kutta step of length h from m->time. */
 static void RungeKuttaStep(Model* m, fmi2Real h) {
   fmi2Real x0[MODEL_MAX_REALS], k[4][MODEL_MAX_REALS];

@@ -52,3 +52,20 @@ fmi2Boolean ModelEvent(Model* m) {
   /* The input is discrete; the state y does not jump. */
   return fmi2False;
 }
+
+fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial) {
+  const fmi2Real tau = m->r[kTau];
+  *partial = 0.0;
+  switch (unknown) {
+    case kY: /* in initialization: y = 0 */
+      if (known == kY) *partial = 1.0;
+      return fmi2OK;
+    case kDerY: /* (u - y) / tau */
+      if (known == kY) *partial = -1.0 / tau;
+      if (known == kTau) *partial = -m->r[kDerY] / tau;
+      return fmi2OK;
+    default:
+      ModelLog(m, fmi2Error, "no directional derivative of the variable with value reference %g", (double)unknown);
+      return fmi2Error;
+  }
+}

@@ -38,3 +38,11 @@ fmi2Boolean ModelEvent(Model* m) {
   (void)m;
   return fmi2False;
 }
+
+fmi2Status ModelPartialDerivative(Model* m, fmi2ValueReference unknown, fmi2ValueReference known, fmi2Real* partial) {
+  (void)known;
+  *partial = 0.0;
+  ModelLog(m, fmi2Error, "this model declares no directional derivatives (asked for value reference %g)",
+           (double)unknown);
+  return fmi2Error;
+}
