@@ -1,7 +1,9 @@
 #include "client/report/pareto_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "client/report/html_escape.h"
 #include "client/report/number_format.h"
@@ -30,7 +32,7 @@ std::string Cell(double value, bool violated_above_zero = false) {
 }
 
 // The points of one status as one series: the front joined by a line in
-// the order of the points, the others as markers only.
+// decreasing order of the traded value, the others as markers only.
 PlotSeries SeriesOf(const ParetoReportData& data, const std::string& status, const std::string& name,
                     const std::string& color, MarkerShape marker) {
   PlotSeries s;
@@ -39,11 +41,17 @@ PlotSeries SeriesOf(const ParetoReportData& data, const std::string& status, con
   s.marker = marker;
   s.draw_line = status == "front";
   s.marker_radius_px = 4.0;
+  std::vector<const Point*> points;
   for (const Point& p : data.points) {
-    if (p.status != status) continue;
-    s.x.push_back(p.value);
-    s.y.push_back(p.objective);
-    s.point_labels.push_back(std::to_string(p.index));
+    if (p.status == status) points.push_back(&p);
+  }
+  // Along the front, not in the points' order: points added by refinement
+  // come last in number but lie between the others.
+  std::stable_sort(points.begin(), points.end(), [](const Point* a, const Point* b) { return a->value > b->value; });
+  for (const Point* p : points) {
+    s.x.push_back(p->value);
+    s.y.push_back(p->objective);
+    s.point_labels.push_back(std::to_string(p->index));
   }
   return s;
 }

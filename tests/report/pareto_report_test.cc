@@ -72,6 +72,26 @@ TEST(ParetoReport, IsWellFormedWithTheFrontLabelledAndTheDominatedPointApart) {
   EXPECT_EQ(html.find("Chosen design"), std::string::npos);
 }
 
+// A point added by refinement (number 6) lies between points 2 and 4 on the
+// front: the front's line goes through it there, not after point 5.
+TEST(ParetoReport, JoinsTheFrontInTheOrderOfTheTradedValueNotOfThePoints) {
+  ParetoReportData data = Front();
+  ParetoReportData::Point added = data.points[1];
+  added.index = 6;
+  added.level = 0.45;
+  added.value = 0.45;
+  added.objective = 1.4;
+  data.points.push_back(added);
+  data.points_total = 6;
+  const std::vector<std::string> svgs = testing::SvgFragments(RenderParetoReportHtml(data));
+  ASSERT_EQ(svgs.size(), 1u);
+  auto label = [&](int k) { return svgs[0].find("class=\"point-label\">" + std::to_string(k) + "</text>"); };
+  ASSERT_NE(label(6), std::string::npos);
+  EXPECT_LT(label(2), label(6));
+  EXPECT_LT(label(6), label(4));
+  EXPECT_LT(label(4), label(5));
+}
+
 TEST(ParetoReport, MarksAndListsTheChosenPoint) {
   ParetoReportData data = Front();
   data.chosen = 4;
