@@ -8,6 +8,8 @@
 #include "client/report/html_escape.h"
 #include "client/report/number_format.h"
 #include "client/report/page_head.h"
+#include "client/report/response_plots.h"
+#include "client/report/scalar_bars.h"
 #include "client/report/svg_line_plot.h"
 
 namespace mbopt::report {
@@ -130,6 +132,31 @@ std::string ChosenPoint(const ParetoReportData& data) {
   return "";
 }
 
+std::string ChosenResponses(const ParetoReportData& data) {
+  if (data.chosen == 0) return "";
+  std::string out = "<h2>Responses of point " + std::to_string(data.chosen) + "</h2>\n";
+  if (data.chosen_responses.empty()) {
+    return out + "<p class=\"note\">" +
+           EscapeHtml(data.chosen_responses_note.empty() ? std::string("No responses to show.")
+                                                          : data.chosen_responses_note) +
+           "</p>\n";
+  }
+  out += "<p class=\"note\">Each objective and constraint's output over time, analysed again at the study's "
+         "initial design (grey, dashed) and at point " +
+         std::to_string(data.chosen) +
+         "'s design (blue), with the study's limits (the point's own level on the traded constraint is in the "
+         "table above).</p>\n";
+  for (const ResponsePlot& plot : data.chosen_responses) {
+    out += "<div class=\"figure\">\n" + (plot.scalar() ? RenderScalarBarsSvg(plot) : RenderLinePlotSvg(ResponsePlotSpec(plot))) +
+           "</div>\n";
+    if (!plot.note.empty()) out += "<p class=\"note\">" + EscapeHtml(plot.note) + "</p>\n";
+  }
+  if (!data.chosen_responses_note.empty()) {
+    out += "<p class=\"note\">" + EscapeHtml(data.chosen_responses_note) + "</p>\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string RenderParetoReportHtml(const ParetoReportData& data) {
@@ -148,13 +175,15 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
   } else {
     out += "<p class=\"note\">Each point is one optimization: the least F with " + EscapeHtml(data.against) +
            " held below the point's level (point 1: " + EscapeHtml(data.against) +
-           " free; the last point: its least value). Points are numbered as in the table; a point "
-           "another beats in both is dominated.</p>\n";
+           " free; at the other end: its least value; points added where the front bends are numbered "
+           "after the others). Points are numbered as in the table; a point another beats in both is "
+           "dominated.</p>\n";
     out += FrontPlot(data);
   }
   out += "<h2>Points</h2>\n";
   out += PointsTable(data);
   out += ChosenPoint(data);
+  out += ChosenResponses(data);
   out += "</body>\n</html>\n";
   return out;
 }

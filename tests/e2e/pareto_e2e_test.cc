@@ -85,6 +85,14 @@ TEST(ParetoEndToEnd, RunPrintsTheFrontResultsShowAPointAndReportDrawsIt) {
   EXPECT_NE(html.str().find("<svg"), std::string::npos);
   EXPECT_NE(html.str().find("Pareto front"), std::string::npos);
   EXPECT_NE(html.str().find("chosen: point 3"), std::string::npos);
+  // Point 3's responses, analysed by the worker program at its design: the
+  // objective's seat acceleration and each constraint's output over time.
+  EXPECT_NE(html.str().find("<h2>Responses of point 3</h2>"), std::string::npos) << html.str();
+  EXPECT_EQ(html.str().find("The responses are not shown"), std::string::npos) << html.str();
+  for (const char* plot : {"objective: ", "s1: ", "seat_settles: "}) {
+    EXPECT_NE(html.str().find(plot, html.str().find("Responses of point 3")), std::string::npos) << plot;
+  }
+  EXPECT_GE(Count(html.str(), "<svg"), 1 + 7) << "the front, the objective and six constraints";
 }
 
 // Submits the front to a fresh server with `workers` workers and returns
