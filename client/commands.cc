@@ -405,7 +405,15 @@ int ReportCommand(const Args& args) {
         return Fail(std::string(found.status().message()), kExitBadInput);
       }
     }
-    return WriteReport(path, report::RenderParetoReportHtml(ParetoReportFromJob(response, point->value_or(0))));
+    report::ParetoReportData front = ParetoReportFromJob(response, point->value_or(0));
+    if (front.chosen != 0) {
+      if (parsed->Has("--no-responses")) {
+        front.chosen_responses_note = "Not analysed (mbopt report --no-responses).";
+      } else {
+        AddChosenPointResponses(response, &front);
+      }
+    }
+    return WriteReport(path, report::RenderParetoReportHtml(front));
   }
   if (point->has_value()) {
     return Fail("--point picks a point of a Pareto front; job " + job_id + " is not one", kExitBadInput);

@@ -4,8 +4,40 @@
 #include <string>
 
 #include "client/report/report_from_proto.h"
+#include "spec/io/study_io.h"
 
 namespace mbopt::client {
+
+std::vector<report::DesignSetReportData::ConstraintInUnit> ConstraintsInUnit(const spec::Study& study,
+                                                                            const spec::StudyLayout& layout) {
+  std::vector<report::DesignSetReportData::ConstraintInUnit> out(study.constraints.size());
+  for (size_t c = 0; c < study.constraints.size(); ++c) {
+    const spec::Constraint& constraint = study.constraints[c];
+    const spec::ConstraintRow* first = nullptr;
+    bool shared = true, upper = false, lower = false;
+    for (const spec::ConstraintRow& row : layout.rows) {
+      if (row.constraint != static_cast<int>(c)) continue;
+      if (first == nullptr) first = &row;
+      shared = shared && row.limit_si == first->limit_si && row.scale == first->scale;
+      (row.value.sign < 0 ? lower : upper) = true;
+    }
+    // An equality's rows hold the middle half of its band (spec/layout.cc):
+    // their limit is not the one written, so it stays normalized.
+    if (first == nullptr || !shared || constraint.equals.has_value() || constraint.si_per_unit <= 0) continue;
+    // Rows g = sign * f <= c: the largest (g - c) / s over them is n, so the
+    // largest f is c + s n when every row bounds from above, the least f is
+    // -(c + s n) when every row bounds from below, and rows of both signs
+    // with one c bound |f| (MAX_ABS, or a band around 0).
+    const double sign = upper ? 1.0 : -1.0;
+    report::DesignSetReportData::ConstraintInUnit& in_unit = out[c];
+    in_unit.known = true;
+    in_unit.quantity = upper && lower ? "|" + constraint.name + "|" : constraint.name;
+    in_unit.unit = constraint.unit;
+    in_unit.limit = sign * first->limit_si / constraint.si_per_unit;
+    in_unit.per_normalized = sign * first->scale / constraint.si_per_unit;
+  }
+  return out;
+}
 
 report::DesignSetReportData DesignSetReportFromJob(const v1::GetJobResponse& job) {
   const v1::JobSummary& s = job.summary();
@@ -28,6 +60,13 @@ report::DesignSetReportData DesignSetReportFromJob(const v1::GetJobResponse& job
     }
   }
   for (const v1::Constraint& c : study.constraints()) data.constraint_names.push_back(c.name());
+  // The limits in the constraints' units need the study's rows; a study
+  // that cannot be laid out here is plotted normalized, as before.
+  if (absl::StatusOr<spec::Study> loaded = spec::io::StudyFromProto(study, "the job's study"); loaded.ok()) {
+    if (absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(*loaded); layout.ok()) {
+      data.constraints_in_unit = ConstraintsInUnit(*loaded, *layout);
+    }
+  }
   for (const v1::CycleRecord& r : job.cycles()) {
     report::DesignSetReportData::Design d;
     d.index = r.cycle();

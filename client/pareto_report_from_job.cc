@@ -1,7 +1,11 @@
 #include "client/pareto_report_from_job.h"
 
+#include <string>
+#include <utility>
+
 #include "client/job_format.h"
 #include "client/pareto_format.h"
+#include "client/report_responses.h"
 
 namespace mbopt::client {
 
@@ -40,6 +44,33 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
     data.points.push_back(std::move(p));
   }
   return data;
+}
+
+void AddChosenPointResponses(const v1::GetJobResponse& job, report::ParetoReportData* data) {
+  const std::string name = "point " + std::to_string(data->chosen);
+  const v1::CycleRecord* record = nullptr;
+  for (const v1::CycleRecord& r : job.cycles()) {
+    if (r.pareto() && r.cycle() == data->chosen) record = &r;
+  }
+  if (record == nullptr || record->pareto_state() == "not_run" ||
+      record->x_trial_physical_size() != job.summary().design_size()) {
+    data->chosen_responses_note = "The responses are not shown: " + name + " has no design of its own.";
+    return;
+  }
+  // The point's design stands in for a single job's final design.
+  v1::GetJobResponse as_single = job;
+  as_single.mutable_summary()->mutable_design()->Assign(record->x_trial_physical().begin(),
+                                                         record->x_trial_physical().end());
+  report::ReportData single;
+  if (absl::Status added = AddResponsePlots(as_single, {}, &single); !added.ok()) {
+    data->chosen_responses_note = "The responses are not shown: " + std::string(added.message());
+    return;
+  }
+  for (report::ResponsePlot& plot : single.responses) {
+    plot.final_label = name;
+    data->chosen_responses.push_back(std::move(plot));
+  }
+  data->chosen_responses_note = single.responses_note;
 }
 
 }  // namespace mbopt::client

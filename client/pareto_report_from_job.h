@@ -10,4 +10,11 @@ namespace mbopt::client {
 
 report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int chosen);
 
+// The chosen point's (data->chosen) responses: its design analysed as a
+// single job's final design is (client/report_responses.h, two runs of
+// `mbopt-worker eval`), each plot naming the point; or
+// data->chosen_responses_note saying why there are none (the point has no
+// design, the worker program is not found, an analysis failed).
+void AddChosenPointResponses(const v1::GetJobResponse& job, report::ParetoReportData* data);
+
 }  // namespace mbopt::client

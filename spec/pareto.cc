@@ -1,5 +1,9 @@
 #include "spec/pareto.h"
 
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
 #include "common/check.h"
 
 namespace mbopt::spec {
@@ -42,6 +46,60 @@ std::vector<bool> DominatedPoints(const std::vector<FrontPoint>& points) {
     }
   }
   return dominated;
+}
+
+std::vector<RefinementSegment> RefinementSegments(const std::vector<FrontPoint>& points, int count) {
+  const std::vector<bool> dominated = DominatedPoints(points);
+  std::vector<int> front;
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (points[k].usable && !dominated[k] && std::isfinite(points[k].first) && std::isfinite(points[k].second)) {
+      front.push_back(static_cast<int>(k));
+    }
+  }
+  // Decreasing second objective: from the first objective's own optimum.
+  std::stable_sort(front.begin(), front.end(), [&](int a, int b) {
+    return points[static_cast<size_t>(a)].second > points[static_cast<size_t>(b)].second;
+  });
+  if (front.size() < 2 || count <= 0) return {};
+  double first_low = points[static_cast<size_t>(front[0])].first, first_high = first_low;
+  double second_low = points[static_cast<size_t>(front[0])].second, second_high = second_low;
+  for (int k : front) {
+    first_low = std::min(first_low, points[static_cast<size_t>(k)].first);
+    first_high = std::max(first_high, points[static_cast<size_t>(k)].first);
+    second_low = std::min(second_low, points[static_cast<size_t>(k)].second);
+    second_high = std::max(second_high, points[static_cast<size_t>(k)].second);
+  }
+  // A flat objective (one value on the whole front) does not stretch the
+  // other: its range counts as 1.
+  const double first_range = first_high > first_low ? first_high - first_low : 1.0;
+  const double second_range = second_high > second_low ? second_high - second_low : 1.0;
+  const size_t segments = front.size() - 1;
+  std::vector<double> du(segments), dv(segments), length(segments);
+  for (size_t s = 0; s < segments; ++s) {
+    const FrontPoint& a = points[static_cast<size_t>(front[s])];
+    const FrontPoint& b = points[static_cast<size_t>(front[s + 1])];
+    du[s] = (b.first - a.first) / first_range;
+    dv[s] = (b.second - a.second) / second_range;
+    length[s] = std::hypot(du[s], dv[s]);
+  }
+  std::vector<double> turn(front.size(), 0.0);
+  for (size_t j = 1; j + 1 < front.size(); ++j) {
+    const double cross = du[j - 1] * dv[j] - dv[j - 1] * du[j];
+    const double dot = du[j - 1] * du[j] + dv[j - 1] * dv[j];
+    turn[j] = std::abs(std::atan2(cross, dot));
+  }
+  std::vector<RefinementSegment> all(segments);
+  for (size_t s = 0; s < segments; ++s) {
+    all[s] = {front[s], front[s + 1], length[s] * (1.0 + turn[s] + turn[s + 1])};
+  }
+  std::vector<size_t> order(segments);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return all[a].score > all[b].score; });
+  order.resize(std::min(order.size(), static_cast<size_t>(count)));
+  std::sort(order.begin(), order.end());
+  std::vector<RefinementSegment> chosen;
+  for (size_t s : order) chosen.push_back(all[s]);
+  return chosen;
 }
 
 }  // namespace mbopt::spec

@@ -12,6 +12,12 @@
 // from the result of the nearer end of its interval, which is already a
 // point of the front. So points of one generation run side by side, and
 // the front is the same bit for bit whatever the number of workers.
+//
+// Refinement (`refine: R`): once the N points have ended, R more points,
+// numbered N+1 to N+R, each halving one segment of the front where it bends
+// or leaves a gap (RefinementSegments). They are chosen from the first N
+// points alone, so they too run side by side and do not depend on the
+// order of results.
 #pragma once
 
 #include <vector>
@@ -25,6 +31,9 @@ inline constexpr int kMaxParetoPoints = 65;
 struct Pareto {
   int constraint = -1;  // index into Study::constraints; -1: no Pareto front
   int points = 0;       // the two anchors included
+  int refine = 0;       // points added where the front bends, 0 to points-1
+
+  int total_points() const { return points + refine; }
 
   bool enabled() const { return constraint >= 0; }
 };
@@ -50,5 +59,25 @@ struct FrontPoint {
 // dominated[k]: usable point k is dominated by another usable point (no
 // worse in both objectives and better in one). Unusable points: false.
 std::vector<bool> DominatedPoints(const std::vector<FrontPoint>& points);
+
+// A segment of the front to halve: between points `from` and `to` (indices
+// into the points given), `from` the one with the larger second objective.
+struct RefinementSegment {
+  int from = -1;
+  int to = -1;
+  double score = 0;
+};
+
+// The `count` segments of the front where a point adds the most, in the
+// front's order (decreasing second objective). The front is the usable,
+// non-dominated points in decreasing order of the second objective (ties
+// by index); both objectives normalized by their ranges over it. A
+// segment's score is its normalized length times (1 + the turn at its two
+// ends), the turn at a point being the angle in radians between the
+// segments that meet there (0 at the ends of the front): a long segment is
+// a gap, a turn is a bend, and a short segment at a sharp knee is not
+// chosen again and again. Ties go to the segment nearer the first anchor.
+// Fewer than `count` when the front has fewer segments.
+std::vector<RefinementSegment> RefinementSegments(const std::vector<FrontPoint>& points, int count);
 
 }  // namespace mbopt::spec

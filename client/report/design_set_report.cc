@@ -17,6 +17,7 @@ constexpr const char* kColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "
                                    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
 
 using Design = DesignSetReportData::Design;
+using ConstraintInUnit = DesignSetReportData::ConstraintInUnit;
 
 std::string Label(const DesignSetReportData& data, int variable) {
   const std::string& unit = data.variable_units[static_cast<size_t>(variable)];
@@ -83,18 +84,28 @@ std::string Plots(const DesignSetReportData& data) {
   if (data.swept.empty()) return out;
   const int x = data.swept[0];
   for (size_t c = 0; c < data.constraint_names.size(); ++c) {
+    const ConstraintInUnit in_unit =
+        c < data.constraints_in_unit.size() ? data.constraints_in_unit[c] : ConstraintInUnit{};
     PlotSpec constraint;
     constraint.title = "Constraint " + data.constraint_names[c] + " against " +
                        data.variable_names[static_cast<size_t>(x)];
     constraint.x_label = Label(data, x);
-    constraint.y_label = "(g - limit) / scale";
-    constraint.series = Curves(data, x, [c](const Design& d) {
-      return c < d.constraints.size() ? d.constraints[c] : std::nan("");
+    constraint.series = Curves(data, x, [c, &in_unit](const Design& d) {
+      const double n = c < d.constraints.size() ? d.constraints[c] : std::nan("");
+      return in_unit.known ? in_unit.limit + in_unit.per_normalized * n : n;
     });
     ReferenceLine limit;
-    limit.y = 0.0;
-    limit.label = "limit: above it violated";
     limit.color = "#b00020";
+    if (in_unit.known) {
+      constraint.y_label = in_unit.quantity + (in_unit.unit.empty() ? "" : " [" + in_unit.unit + "]");
+      limit.y = in_unit.limit;
+      limit.label = "limit " + FormatValue(in_unit.limit, 6) + (in_unit.unit.empty() ? "" : " " + in_unit.unit) +
+                    (in_unit.per_normalized < 0 ? ": below it violated" : ": above it violated");
+    } else {
+      constraint.y_label = "(g - limit) / scale";
+      limit.y = 0.0;
+      limit.label = "limit: above it violated";
+    }
     constraint.reference_lines.push_back(limit);
     out += Figure(constraint);
   }
@@ -145,8 +156,10 @@ std::string RenderDesignSetReportHtml(const DesignSetReportData& data) {
     out += "<p class=\"note\">No design has been analysed yet.</p>\n";
   } else {
     out += "<p class=\"note\">Each point is one design's analysis; a failed analysis leaves a gap. A "
-           "constraint's value is its largest (g - limit) / scale over its rows: above the limit line "
-           "(0) it is violated.</p>\n";
+           "constraint with one limit is drawn in its unit: its largest value (of |value| for a MAX_ABS "
+           "constraint), or its least for a lower limit, against the limit line. Any other is drawn as its "
+           "largest (g - limit) / scale over its rows, violated above the limit line at 0. The table gives "
+           "every constraint as (g - limit) / scale.</p>\n";
     out += Plots(data);
   }
   out += "<h2>Designs</h2>\n";

@@ -6,7 +6,9 @@
 //
 // Units: designs are physical values in their variable's unit; objective
 // values in `objective_unit`; constraint values normalized, (g - limit) /
-// scale, dimensionless, > 0 violated.
+// scale, dimensionless, > 0 violated. A constraint whose rows share one
+// limit and scale is plotted in its own unit with its limit there
+// (ConstraintInUnit); the table keeps the normalized values.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +31,20 @@ struct DesignSetReportData {
   // are the second one's values). Empty: a sample.
   std::vector<int> swept;
   std::vector<std::string> constraint_names;
+
+  // How a constraint's normalized value n reads in its unit: value = limit
+  // + per_normalized * n. per_normalized < 0 for a lower limit (the value
+  // is then the constraint's least, violated below the limit); otherwise
+  // the value is its largest (of |value| for a MAX_ABS constraint, whose
+  // `quantity` is then "|name|"), violated above.
+  struct ConstraintInUnit {
+    bool known = false;  // false: plotted normalized, the limit at 0
+    std::string quantity;
+    std::string unit;
+    double limit = 0;
+    double per_normalized = 1;
+  };
+  std::vector<ConstraintInUnit> constraints_in_unit;  // per constraint name, or empty
 
   struct Design {
     int index = 0;                         // 1-based

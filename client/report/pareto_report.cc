@@ -1,11 +1,15 @@
 #include "client/report/pareto_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "client/report/html_escape.h"
 #include "client/report/number_format.h"
 #include "client/report/page_head.h"
+#include "client/report/response_plots.h"
+#include "client/report/scalar_bars.h"
 #include "client/report/svg_line_plot.h"
 
 namespace mbopt::report {
@@ -30,7 +34,7 @@ std::string Cell(double value, bool violated_above_zero = false) {
 }
 
 // The points of one status as one series: the front joined by a line in
-// the order of the points, the others as markers only.
+// decreasing order of the traded value, the others as markers only.
 PlotSeries SeriesOf(const ParetoReportData& data, const std::string& status, const std::string& name,
                     const std::string& color, MarkerShape marker) {
   PlotSeries s;
@@ -39,11 +43,17 @@ PlotSeries SeriesOf(const ParetoReportData& data, const std::string& status, con
   s.marker = marker;
   s.draw_line = status == "front";
   s.marker_radius_px = 4.0;
+  std::vector<const Point*> points;
   for (const Point& p : data.points) {
-    if (p.status != status) continue;
-    s.x.push_back(p.value);
-    s.y.push_back(p.objective);
-    s.point_labels.push_back(std::to_string(p.index));
+    if (p.status == status) points.push_back(&p);
+  }
+  // Along the front, not in the points' order: points added by refinement
+  // come last in number but lie between the others.
+  std::stable_sort(points.begin(), points.end(), [](const Point* a, const Point* b) { return a->value > b->value; });
+  for (const Point* p : points) {
+    s.x.push_back(p->value);
+    s.y.push_back(p->objective);
+    s.point_labels.push_back(std::to_string(p->index));
   }
   return s;
 }
@@ -122,6 +132,31 @@ std::string ChosenPoint(const ParetoReportData& data) {
   return "";
 }
 
+std::string ChosenResponses(const ParetoReportData& data) {
+  if (data.chosen == 0) return "";
+  std::string out = "<h2>Responses of point " + std::to_string(data.chosen) + "</h2>\n";
+  if (data.chosen_responses.empty()) {
+    return out + "<p class=\"note\">" +
+           EscapeHtml(data.chosen_responses_note.empty() ? std::string("No responses to show.")
+                                                          : data.chosen_responses_note) +
+           "</p>\n";
+  }
+  out += "<p class=\"note\">Each objective and constraint's output over time, analysed again at the study's "
+         "initial design (grey, dashed) and at point " +
+         std::to_string(data.chosen) +
+         "'s design (blue), with the study's limits (the point's own level on the traded constraint is in the "
+         "table above).</p>\n";
+  for (const ResponsePlot& plot : data.chosen_responses) {
+    out += "<div class=\"figure\">\n" + (plot.scalar() ? RenderScalarBarsSvg(plot) : RenderLinePlotSvg(ResponsePlotSpec(plot))) +
+           "</div>\n";
+    if (!plot.note.empty()) out += "<p class=\"note\">" + EscapeHtml(plot.note) + "</p>\n";
+  }
+  if (!data.chosen_responses_note.empty()) {
+    out += "<p class=\"note\">" + EscapeHtml(data.chosen_responses_note) + "</p>\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string RenderParetoReportHtml(const ParetoReportData& data) {
@@ -140,13 +175,15 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
   } else {
     out += "<p class=\"note\">Each point is one optimization: the least F with " + EscapeHtml(data.against) +
            " held below the point's level (point 1: " + EscapeHtml(data.against) +
-           " free; the last point: its least value). Points are numbered as in the table; a point "
-           "another beats in both is dominated.</p>\n";
+           " free; at the other end: its least value; points added where the front bends are numbered "
+           "after the others). Points are numbered as in the table; a point another beats in both is "
+           "dominated.</p>\n";
     out += FrontPlot(data);
   }
   out += "<h2>Points</h2>\n";
   out += PointsTable(data);
   out += ChosenPoint(data);
+  out += ChosenResponses(data);
   out += "</body>\n</html>\n";
   return out;
 }

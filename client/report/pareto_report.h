@@ -3,8 +3,10 @@
 // constraint's largest value, every point labelled with its number, the
 // dominated and the failed points set apart, the chosen point (if one was
 // picked) marked; then the table of the points and, for the chosen one, its
-// design and its constraints. Plain data in, one self-contained HTML page
-// out.
+// design and its constraints, and its objective's and constraints'
+// responses over time against the initial design's (the single job's
+// page's plots, client/report/response_plots.h). Plain data in, one
+// self-contained HTML page out.
 //
 // Units: the objective in `objective_unit`, the traded constraint's value
 // and levels in `against_unit`, designs in their variables' units,
@@ -13,6 +15,8 @@
 
 #include <string>
 #include <vector>
+
+#include "client/report/report_data.h"
 
 namespace mbopt::report {
 
@@ -45,6 +49,11 @@ struct ParetoReportData {
   };
   std::vector<Point> points;  // in the points' order
   int chosen = 0;             // 1-based; 0: none picked
+  // The chosen point's responses, analysed again at its design and at the
+  // study's initial one (final_label names the point); when empty,
+  // `chosen_responses_note` says why.
+  std::vector<ResponsePlot> chosen_responses;
+  std::string chosen_responses_note;
 };
 
 std::string RenderParetoReportHtml(const ParetoReportData& data);

@@ -96,6 +96,9 @@ struct ResponsePlot {
     double to_s = std::numeric_limits<double>::infinity();
   };
   std::vector<Limit> limits;
+  // What `final` is the analysis of: a Pareto front's page plots a point's
+  // design against the initial one.
+  std::string final_label = "final design";
   bool scalar() const { return times_s.size() <= 1; }
 };
 

@@ -45,7 +45,7 @@ PlotSpec ResponsePlotSpec(const ResponsePlot& plot) {
   spec.x_label = "time [s]";
   spec.y_label = plot.unit.empty() ? "value (SI)" : "value [" + plot.unit + "]";
   spec.series = {Curve("initial design", kInitialColor, kInitialDash, plot.times_s, plot.initial),
-                 Curve("final design", kFinalColor, "", plot.times_s, plot.final)};
+                 Curve(plot.final_label.c_str(), kFinalColor, "", plot.times_s, plot.final)};
   for (const ResponsePlot::Limit& limit : plot.limits) {
     ReferenceLine line;
     line.y = limit.value;

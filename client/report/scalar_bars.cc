@@ -41,7 +41,7 @@ std::string RenderScalarBarsSvg(const ResponsePlot& plot) {
     double value;
   };
   const Bar bars[] = {{"initial design", "#7f7f7f", LastValue(plot.initial)},
-                      {"final design", "#1f77b4", LastValue(plot.final)}};
+                      {plot.final_label.c_str(), "#1f77b4", LastValue(plot.final)}};
   // Bars start at 0, so 0 is always on the axis.
   double lo = 0.0, hi = 0.0;
   for (const Bar& b : bars) {

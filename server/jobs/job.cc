@@ -125,6 +125,7 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateWith(std::shared_ptr<const spec:
     setup.num_constraints = static_cast<int>(study->constraints.size());
     setup.traded_constraint = study->pareto.constraint;
     setup.points = study->pareto.points;
+    setup.refine = study->pareto.refine;
     absl::StatusOr<std::unique_ptr<ParetoRun>> made = ParetoRun::Create(std::move(setup), make_lp_solver);
     if (!made.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(study->source_file, ": pareto: ", made.status().message()));

@@ -45,6 +45,10 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
     return absl::InvalidArgumentError(
         absl::StrFormat("a Pareto front needs at least %d points, got %d", spec::kMinParetoPoints, setup.points));
   }
+  if (setup.refine < 0 || setup.refine > setup.points - 1) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "a front of %d points can be refined by 0 to %d points, got %d", setup.points, setup.points - 1, setup.refine));
+  }
   if (!make_lp_solver) return absl::InvalidArgumentError("a Pareto front needs an LP solver for each of its points");
   std::vector<int> traded;
   for (size_t h = 0; h < setup.row_constraints.size(); ++h) {
@@ -72,10 +76,10 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
 
 ParetoRun::ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver)
     : setup_(std::move(setup)), make_lp_solver_(std::move(make_lp_solver)) {
-  points_.resize(static_cast<std::size_t>(setup_.points));
+  points_.resize(static_cast<std::size_t>(setup_.points + setup_.refine));
   const std::vector<int> parents = spec::ParetoWarmStartParents(setup_.points);
   for (std::size_t k = 0; k < points_.size(); ++k) {
-    points_[k].parent = parents[k];
+    points_[k].parent = k < parents.size() ? parents[k] : -1;
     points_[k].level_si = kNaN;
   }
 }
@@ -92,7 +96,7 @@ void ParetoRun::StartRuns() {
     }
   }
   const Point& first = points_.front();
-  const Point& least = points_.back();
+  const Point& least = points_[static_cast<std::size_t>(last)];
   if (!first.ended || !least.ended) return;
   std::string reason;
   if (!first.usable || !least.usable) {
@@ -115,6 +119,42 @@ void ParetoRun::StartRuns() {
     if (!parent.ended) continue;
     point.level_si = spec::ParetoLevel(k, setup_.points, first.record.pareto_value_si, least.record.pareto_value_si);
     Start(k, parent.record.x0);
+  }
+  StartRefinement();
+}
+
+void ParetoRun::StartRefinement() {
+  const auto base = static_cast<std::size_t>(setup_.points);
+  if (points_.size() == base || points_[base].ended || points_[base].run != nullptr) return;
+  for (std::size_t k = 0; k < base; ++k) {
+    if (!points_[k].ended) return;
+  }
+  // The first objective as the runs minimized it (their F), so that the
+  // front's shape does not depend on the sign the study reports it with.
+  std::vector<spec::FrontPoint> front;
+  for (std::size_t k = 0; k < base; ++k) {
+    const slp::CycleRecord& r = points_[k].record;
+    front.push_back({r.objective_x0, r.pareto_value_si, points_[k].usable});
+  }
+  const std::vector<spec::RefinementSegment> segments = spec::RefinementSegments(front, setup_.refine);
+  for (std::size_t j = 0; j < static_cast<std::size_t>(setup_.refine); ++j) {
+    const int k = static_cast<int>(base + j);
+    Point& point = points_[base + j];
+    if (j >= segments.size()) {
+      point.level_si = kNaN;
+      EndWithoutRun(k, absl::StrFormat("the front of the first %d points has only %d segments to refine",
+                                       setup_.points, static_cast<int>(segments.size())));
+      continue;
+    }
+    const Point& upper = points_[static_cast<std::size_t>(segments[j].from)];
+    const Point& lower = points_[static_cast<std::size_t>(segments[j].to)];
+    // From the end with the larger value, as a point between starts from
+    // the end of its interval nearer point 1: the other end may be the
+    // traded constraint's own minimum, where its gradient vanishes and its
+    // linearization says nothing of the new level.
+    point.parent = segments[j].from;
+    point.level_si = 0.5 * (upper.record.pareto_value_si + lower.record.pareto_value_si);
+    Start(k, upper.record.x0);
   }
 }
 
@@ -252,7 +292,7 @@ slp::AnalysisResult ParetoRun::ResultFor(const Point& point, const AnalysisRecor
                                                 static_cast<Eigen::Index>(record.objective_terms.size()));
   const Eigen::Map<const Eigen::VectorXd> values(record.constraint_values.data(),
                                                  static_cast<Eigen::Index>(record.constraint_values.size()));
-  const bool traded_objective = &point == &points_.back();
+  const bool traded_objective = &point == &points_[static_cast<std::size_t>(setup_.points - 1)];
   result.objective_terms = traded_objective ? Eigen::VectorXd(Pick(values, traded_rows_) / traded_scale_)
                                             : Eigen::VectorXd(terms);
   result.constraint_values = Pick(values, point.rows);

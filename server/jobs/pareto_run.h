@@ -14,6 +14,13 @@
 //    (spec::ParetoWarmStartParents) have ended. Each run's state is a
 //    function of its own results only, so runs side by side on any number
 //    of workers, answered in any order, give the same front bit for bit;
+//  - refinement (setup.refine > 0): once the first `points` have ended, the
+//    segments of their front to halve are chosen (spec::RefinementSegments)
+//    and the added points start side by side, each with its level halfway
+//    between its segment's ends' values, warm-started from the end with the
+//    larger value (nearer point 1, as the points between). Added points
+//    the front has no segment for end unrun, saying why, so a front always
+//    has points + refine records;
 //  - one record per point (a design set's record with the Pareto fields,
 //    slp::CycleRecord), emitted in the points' order: point k's once points
 //    0..k have ended, so the record log does not depend on the order of
@@ -54,6 +61,7 @@ struct ParetoSetup {
   int num_constraints = 0;
   int traded_constraint = -1;  // the constraint whose largest value is traded
   int points = 0;              // >= 3
+  int refine = 0;              // added points, 0 to points - 1
 };
 
 class ParetoRun {
@@ -87,7 +95,7 @@ class ParetoRun {
     std::vector<double> violations;       // per study constraint, against the study's limits
   };
   struct Point {
-    int parent = -1;
+    int parent = -1;                      // for an added point: set when it starts
     double level_si = 0;                  // NaN for the anchors
     slp::ProblemSpec problem;             // set when the run starts
     std::vector<int> rows;                // the run's row h -> the study's row
@@ -101,6 +109,7 @@ class ParetoRun {
 
   explicit ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
   void StartRuns();
+  void StartRefinement();
   void Start(int k, const Eigen::VectorXd& initial);
   void EndWithoutRun(int k, const std::string& reason);
   void End(int k);

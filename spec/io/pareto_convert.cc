@@ -1,5 +1,6 @@
 #include "spec/io/pareto_convert.h"
 
+#include <algorithm>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -46,6 +47,13 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
                 absl::StrFormat("must be between %d and %d (the two ends included), got %d", kMinParetoPoints,
                                 kMaxParetoPoints, p.points()));
   }
+  pareto.refine = p.refine();
+  if (pareto.refine < 0 || (pareto.points >= kMinParetoPoints && pareto.refine > pareto.points - 1)) {
+    errors->Add(w, "refine",
+                absl::StrFormat("must be between 0 and %d (one point in each segment of the %d points' front at "
+                                "most), got %d",
+                                std::max(pareto.points - 1, 0), pareto.points, p.refine()));
+  }
   if (p.against().empty()) {
     errors->Add(w, "against",
                 absl::StrCat("name the constraint whose largest value is the second objective; the study's "
@@ -75,7 +83,10 @@ std::string DescribePareto(const Study& study) {
   const Constraint& c = study.constraints[static_cast<size_t>(study.pareto.constraint)];
   return absl::StrCat("a Pareto front of the objective against the largest value of ", c.name,
                       c.unit.empty() ? "" : absl::StrCat(" (", c.unit, ")"), ", ", study.pareto.points,
-                      " points (epsilon-constraint method)");
+                      " points",
+                      study.pareto.refine == 0 ? ""
+                                               : absl::StrCat(" and ", study.pareto.refine, " more where it bends"),
+                      " (epsilon-constraint method)");
 }
 
 }  // namespace mbopt::spec::io

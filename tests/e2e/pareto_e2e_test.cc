@@ -85,11 +85,19 @@ TEST(ParetoEndToEnd, RunPrintsTheFrontResultsShowAPointAndReportDrawsIt) {
   EXPECT_NE(html.str().find("<svg"), std::string::npos);
   EXPECT_NE(html.str().find("Pareto front"), std::string::npos);
   EXPECT_NE(html.str().find("chosen: point 3"), std::string::npos);
+  // Point 3's responses, analysed by the worker program at its design: the
+  // objective's seat acceleration and each constraint's output over time.
+  EXPECT_NE(html.str().find("<h2>Responses of point 3</h2>"), std::string::npos) << html.str();
+  EXPECT_EQ(html.str().find("The responses are not shown"), std::string::npos) << html.str();
+  for (const char* plot : {"objective: ", "s1: ", "seat_settles: "}) {
+    EXPECT_NE(html.str().find(plot, html.str().find("Responses of point 3")), std::string::npos) << plot;
+  }
+  EXPECT_GE(Count(html.str(), "<svg"), 1 + 7) << "the front, the objective and six constraints";
 }
 
 // Submits the front to a fresh server with `workers` workers and returns
 // `results --json` at its end.
-std::string FrontResults(int workers) {
+std::string FrontResults(int workers, const std::string& study = ParetoStudy()) {
   ScratchDir dir;
   auto server = StartServer(dir.File("jobs.db"), {}, "127.0.0.1:0", dir.File("server.log"));
   EXPECT_TRUE(server.ok()) << server.status();
@@ -98,7 +106,7 @@ std::string FrontResults(int workers) {
   for (int i = 0; i < workers; ++i) {
     pool.push_back(StartWorker(server->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
   }
-  auto submitted = Mbopt({"submit", ParetoStudy(), "--server", server->address});
+  auto submitted = Mbopt({"submit", study, "--server", server->address});
   EXPECT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto watched = Mbopt({"watch", job, "--server", server->address});
@@ -110,25 +118,25 @@ std::string FrontResults(int workers) {
   return results.stdout_text;
 }
 
-// The server is killed (SIGKILL) once it has logged two points; the
-// restarted server replays the logged analyses (the runs of the points not
-// yet ended among them) and continues: the front is that of an undisturbed
-// run with another number of workers, bit for bit.
-TEST(ParetoEndToEnd, ServerKilledMidFrontResumesWithTheSameFront) {
-  const std::string reference = Comparable(FrontResults(3));
+// The server is killed (SIGKILL) once it has logged `crash_after` points;
+// the restarted server replays the logged analyses (the runs of the points
+// not yet ended among them) and continues: the front is that of an
+// undisturbed run with another number of workers, bit for bit.
+void KillAndResume(const std::string& study, int points, int crash_after) {
+  const std::string reference = Comparable(FrontResults(3, study));
   ASSERT_FALSE(reference.empty());
-  EXPECT_EQ(JsonField(reference, "points_done"), std::to_string(kPoints)) << reference;
+  EXPECT_EQ(JsonField(reference, "points_done"), std::to_string(points)) << reference;
   ScratchDir dir;
   const std::string db = dir.File("jobs.db");
   std::vector<std::string> crash_args = kFastLeases;
-  crash_args.insert(crash_args.end(), {"--crash-after-cycles", "2"});
+  crash_args.insert(crash_args.end(), {"--crash-after-cycles", std::to_string(crash_after)});
   auto first = StartServer(db, crash_args, "127.0.0.1:0", dir.File("server1.log"));
   ASSERT_TRUE(first.ok()) << first.status();
   std::vector<Subprocess> pool;
   for (int i = 0; i < 2; ++i) {
     pool.push_back(StartWorker(first->address, {}, dir.File(absl::StrCat("worker", i, ".log"))));
   }
-  auto submitted = Mbopt({"submit", ParetoStudy(), "--server", first->address});
+  auto submitted = Mbopt({"submit", study, "--server", first->address});
   ASSERT_EQ(submitted.exit_code, kExitOk) << Describe(submitted);
   const std::string job = Trim(submitted.stdout_text);
   auto crashed = first->process->Wait(kGuard);
@@ -142,8 +150,8 @@ TEST(ParetoEndToEnd, ServerKilledMidFrontResumesWithTheSameFront) {
   const size_t at = status.stdout_text.find("points:");
   ASSERT_NE(at, std::string::npos) << status.stdout_text;
   const int points_at_restart = std::atoi(status.stdout_text.c_str() + at + 7);
-  EXPECT_GE(points_at_restart, 2) << status.stdout_text;
-  std::cout << "points logged when the server was killed: " << points_at_restart << " of " << kPoints << "\n";
+  EXPECT_GE(points_at_restart, crash_after) << status.stdout_text;
+  std::cout << "points logged when the server was killed: " << points_at_restart << " of " << points << "\n";
   if (status.stdout_text.find("interrupted") != std::string::npos) {
     auto resumed = Mbopt({"resume", job, "--server", second->address});
     ASSERT_EQ(resumed.exit_code, kExitOk) << Describe(resumed);
@@ -154,6 +162,28 @@ TEST(ParetoEndToEnd, ServerKilledMidFrontResumesWithTheSameFront) {
   EXPECT_EQ(Comparable(results.stdout_text), reference);
   for (auto& w : pool) EXPECT_EQ(w.Stop(kGuard), 0);
   EXPECT_EQ(second->process->Stop(kGuard), 0);
+}
+
+TEST(ParetoEndToEnd, ServerKilledMidFrontResumesWithTheSameFront) { KillAndResume(ParetoStudy(), kPoints, 2); }
+
+// The example with `refine: 2`, killed once the first five points and one
+// added point are logged: the other added point's run is replayed and
+// continued, and the refined front is that of an undisturbed run.
+TEST(ParetoEndToEnd, ServerKilledWhileRefiningResumesWithTheSameFront) {
+  ScratchDir dir;
+  const std::string examples = std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/vehicle/";
+  std::ifstream scene(examples + "vehicle.scene.textproto");
+  std::ifstream pareto(ParetoStudy());
+  std::stringstream scene_text, study_text;
+  scene_text << scene.rdbuf();
+  study_text << pareto.rdbuf();
+  std::string study = study_text.str();
+  const std::string section = "pareto { against: \"s1\" points: 5 }";
+  const size_t at = study.find(section);
+  ASSERT_NE(at, std::string::npos) << "the example's pareto section changed";
+  study.replace(at, section.size(), "pareto { against: \"s1\" points: 5 refine: 2 }");
+  dir.Write("vehicle.scene.textproto", scene_text.str());
+  KillAndResume(dir.Write("vehicle_pareto_refined.study.textproto", study), kPoints + 2, kPoints + 1);
 }
 
 TEST(ParetoEndToEnd, ValidateNamesTheFront) {

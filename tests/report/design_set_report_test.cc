@@ -64,6 +64,27 @@ TEST(DesignSetReport, IsWellFormedWithAPlotOfTheObjectiveAndOnePerConstraint) {
   EXPECT_EQ(html.find("a <sweep>"), std::string::npos);
 }
 
+// "travel" read in millimetres with its limit at 10 mm (scale 10 mm); the
+// lower limit "stroke" at 2 mm; a constraint without a unit reading stays
+// normalized.
+TEST(DesignSetReport, DrawsEachConstraintInItsUnitWithItsLimitThere) {
+  DesignSetReportData data = LineSweep();
+  data.constraint_names.push_back("band");
+  for (auto& d : data.designs) d.constraints.push_back(0.0);
+  data.constraints_in_unit = {{true, "|travel|", "mm", 10.0, 10.0}, {true, "stroke", "mm", 2.0, -2.0}, {}};
+  const std::vector<std::string> svgs = testing::SvgFragments(RenderDesignSetReportHtml(data));
+  ASSERT_EQ(svgs.size(), 4u);
+  EXPECT_NE(svgs[1].find("|travel| [mm]"), std::string::npos);
+  EXPECT_NE(svgs[1].find("limit 10 mm: above it violated"), std::string::npos);
+  EXPECT_EQ(svgs[1].find("(g - limit) / scale"), std::string::npos);
+  EXPECT_NE(svgs[2].find("stroke [mm]"), std::string::npos);
+  EXPECT_NE(svgs[2].find("limit 2 mm: below it violated"), std::string::npos);
+  EXPECT_NE(svgs[3].find("(g - limit) / scale"), std::string::npos);
+  EXPECT_NE(svgs[3].find("limit: above it violated"), std::string::npos);
+  // travel's normalized -0.2 .. 0.1 is 8 .. 11 mm: the axis reaches 11, not 0.1.
+  EXPECT_NE(svgs[1].find(">11<"), std::string::npos) << svgs[1];
+}
+
 TEST(DesignSetReport, TableMarksFailedDesignsAndViolatedValues) {
   const std::string html = RenderDesignSetReportHtml(LineSweep());
   EXPECT_EQ(testing::CountOccurrences(html, "<tr class=\"failed\">"), 1);

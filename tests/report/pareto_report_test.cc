@@ -72,6 +72,26 @@ TEST(ParetoReport, IsWellFormedWithTheFrontLabelledAndTheDominatedPointApart) {
   EXPECT_EQ(html.find("Chosen design"), std::string::npos);
 }
 
+// A point added by refinement (number 6) lies between points 2 and 4 on the
+// front: the front's line goes through it there, not after point 5.
+TEST(ParetoReport, JoinsTheFrontInTheOrderOfTheTradedValueNotOfThePoints) {
+  ParetoReportData data = Front();
+  ParetoReportData::Point added = data.points[1];
+  added.index = 6;
+  added.level = 0.45;
+  added.value = 0.45;
+  added.objective = 1.4;
+  data.points.push_back(added);
+  data.points_total = 6;
+  const std::vector<std::string> svgs = testing::SvgFragments(RenderParetoReportHtml(data));
+  ASSERT_EQ(svgs.size(), 1u);
+  auto label = [&](int k) { return svgs[0].find("class=\"point-label\">" + std::to_string(k) + "</text>"); };
+  ASSERT_NE(label(6), std::string::npos);
+  EXPECT_LT(label(2), label(6));
+  EXPECT_LT(label(6), label(4));
+  EXPECT_LT(label(4), label(5));
+}
+
 TEST(ParetoReport, MarksAndListsTheChosenPoint) {
   ParetoReportData data = Front();
   data.chosen = 4;
@@ -84,6 +104,51 @@ TEST(ParetoReport, MarksAndListsTheChosenPoint) {
   // is met: no red cell).
   EXPECT_NE(html.find("<tr><th>k [N/m]</th><td class=\"num\">400</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("<tr><th>s1</th><td class=\"num\">-0.1</td></tr>"), std::string::npos);
+}
+
+// The chosen point's responses over time against the initial design's, as
+// a single job's page draws them, the point named where "final design"
+// would be; a scalar response as bars.
+TEST(ParetoReport, DrawsTheChosenPointsResponsesAgainstTheInitialDesign) {
+  ParetoReportData data = Front();
+  data.chosen = 4;
+  ResponsePlot travel;
+  travel.title = "s1: max_abs <= 0.5 in";
+  travel.unit = "in";
+  travel.times_s = {0.0, 0.5, 1.0};
+  travel.initial = {0.0, 0.7, 0.2};
+  travel.final = {0.0, 0.3, 0.1};
+  travel.final_label = "point 4";
+  travel.limits.push_back({0.5, "limit"});
+  ResponsePlot mass;
+  mass.title = "mass";
+  mass.unit = "kg";
+  mass.times_s = {0.0};
+  mass.initial = {2.0};
+  mass.final = {1.5};
+  mass.final_label = "point 4";
+  data.chosen_responses = {travel, mass};
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  EXPECT_NE(html.find("<h2>Responses of point 4</h2>"), std::string::npos);
+  const std::vector<std::string> svgs = testing::SvgFragments(html);
+  ASSERT_EQ(svgs.size(), 3u);  // the front, the travel over time, the mass as bars
+  EXPECT_NE(svgs[1].find("s1: max_abs &lt;= 0.5 in"), std::string::npos);
+  EXPECT_NE(svgs[1].find("point 4"), std::string::npos);
+  EXPECT_NE(svgs[1].find("initial design"), std::string::npos);
+  EXPECT_EQ(svgs[1].find("final design"), std::string::npos);
+  EXPECT_NE(svgs[2].find("point 4"), std::string::npos);
+  for (const std::string& svg : svgs) EXPECT_EQ(testing::CheckMarkup(svg, /*xml_strict=*/true), "");
+}
+
+TEST(ParetoReport, SaysWhyTheChosenPointHasNoResponses) {
+  ParetoReportData data = Front();
+  data.chosen = 2;
+  data.chosen_responses_note = "The responses are not shown: point 2 has no design of its own.";
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_NE(html.find("<h2>Responses of point 2</h2>"), std::string::npos);
+  EXPECT_NE(html.find("point 2 has no design of its own."), std::string::npos);
+  EXPECT_EQ(RenderParetoReportHtml(Front()).find("Responses of point"), std::string::npos);
 }
 
 TEST(ParetoReport, UnrunPointsAreListedWithTheirReasonAndNotDrawn) {

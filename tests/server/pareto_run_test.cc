@@ -89,9 +89,9 @@ AnalysisRecord Answer(const slp::AnalysisRequest& request) {
 // Drives the front to its end as `workers` workers would: each round answers
 // at most `workers` of the pending requests, picked and ordered by `seed`.
 // Returns the encoded records in the order they came out.
-std::vector<std::string> RunFront(bool gradients, int workers, unsigned seed, std::vector<slp::CycleRecord>* out) {
+std::vector<std::string> RunFront(ParetoSetup setup, int workers, unsigned seed, std::vector<slp::CycleRecord>* out) {
   absl::StatusOr<std::unique_ptr<ParetoRun>> run =
-      ParetoRun::Create(TwoSpheres(gradients), [] { return lp::MakeClpLpSolver(); });
+      ParetoRun::Create(std::move(setup), [] { return lp::MakeClpLpSolver(); });
   EXPECT_TRUE(run.ok()) << run.status();
   if (!run.ok()) return {};
   std::mt19937 random(seed);
@@ -112,6 +112,16 @@ std::vector<std::string> RunFront(bool gradients, int workers, unsigned seed, st
   }
   EXPECT_TRUE((*run)->done());
   return encoded;
+}
+
+std::vector<std::string> RunFront(bool gradients, int workers, unsigned seed, std::vector<slp::CycleRecord>* out) {
+  return RunFront(TwoSpheres(gradients), workers, seed, out);
+}
+
+ParetoSetup RefinedTwoSpheres(int refine) {
+  ParetoSetup setup = TwoSpheres(/*gradients=*/true);
+  setup.refine = refine;
+  return setup;
 }
 
 TEST(ParetoRun, ReproducesTheClosedFormFrontOfTheTwoSpheres) {
@@ -232,6 +242,134 @@ TEST(ParetoRun, AFailedEndLeavesThePointsBetweenUnrunAndSaysWhy) {
               std::string::npos)
         << records[static_cast<size_t>(k)].rejection_reason;
   }
+}
+
+// With the levels evenly spread in f2, the sampled SCH front bends most
+// towards its f2 = 1 end, where f1 climbs from 1.84 to 3 over the last
+// segment: the turns at points 6, 7 and 8 are 0.20, 0.26 and 0.43 rad
+// against 0.15 or less before, so the three added points halve the last
+// three segments (f2 from 1.75 down to 1).
+TEST(ParetoRun, RefinedPointsHalveTheSegmentsWhereTheFrontBends) {
+  constexpr int kRefine = 3;
+  std::vector<slp::CycleRecord> records;
+  RunFront(RefinedTwoSpheres(kRefine), /*workers=*/4, /*seed=*/5, &records);
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints + kRefine));
+  std::vector<spec::FrontPoint> first;
+  for (int k = 0; k < kPoints; ++k) {
+    const slp::CycleRecord& r = records[static_cast<size_t>(k)];
+    first.push_back({r.objective_x0, r.pareto_value_si, r.accepted});
+  }
+  const std::vector<spec::RefinementSegment> segments = spec::RefinementSegments(first, kRefine);
+  ASSERT_EQ(segments.size(), static_cast<size_t>(kRefine));
+  for (int j = 0; j < kRefine; ++j) {
+    const slp::CycleRecord& r = records[static_cast<size_t>(kPoints + j)];
+    SCOPED_TRACE(::testing::Message() << "added point " << kPoints + j + 1 << " (" << r.pareto_state << ")");
+    EXPECT_EQ(r.cycle, kPoints + j + 1);
+    EXPECT_TRUE(r.accepted) << r.rejection_reason;
+    // The last three segments of the first nine points, in the front's order.
+    EXPECT_EQ(segments[static_cast<size_t>(j)].from, kPoints - kRefine - 1 + j);
+    EXPECT_EQ(segments[static_cast<size_t>(j)].to, kPoints - kRefine + j);
+    const double upper = records[static_cast<size_t>(segments[static_cast<size_t>(j)].from)].pareto_value_si;
+    const double lower = records[static_cast<size_t>(segments[static_cast<size_t>(j)].to)].pareto_value_si;
+    EXPECT_EQ(r.pareto_level_si, 0.5 * (upper + lower));
+    EXPECT_LT(r.pareto_level_si, 1.75 + kAnchorTolerance);
+    EXPECT_LE(r.pareto_value_si, r.pareto_level_si * (1 + 1e-5));
+    EXPECT_GT(r.pareto_value_si, lower);
+    const double f1 = F1(r.x0);
+    EXPECT_DOUBLE_EQ(r.objective_x0, f1);
+    EXPECT_NEAR(f1, FrontF1(F2(r.x0)), kFrontTolerance);
+  }
+  // The analyses count on through the added points.
+  EXPECT_GT(records.back().analyses_total, records[kPoints - 1].analyses_total);
+}
+
+TEST(ParetoRun, RefinedFrontIsTheSameWhateverTheWorkersAndTheOrderOfResults) {
+  const std::vector<std::string> one = RunFront(RefinedTwoSpheres(4), 1, 7, nullptr);
+  ASSERT_EQ(one.size(), static_cast<size_t>(kPoints + 4));
+  EXPECT_EQ(RunFront(RefinedTwoSpheres(4), 3, 11, nullptr), one);
+  EXPECT_EQ(RunFront(RefinedTwoSpheres(4), 64, 12345, nullptr), one);
+}
+
+// A resumed job is a new ParetoRun given the logged results again in the
+// order they were logged; it must then go on as the first one would have.
+TEST(ParetoRun, ARefinedFrontResumedFromItsLoggedResultsEndsTheSame) {
+  const std::vector<std::string> reference = RunFront(RefinedTwoSpheres(2), 2, 21, nullptr);
+  ASSERT_EQ(reference.size(), static_cast<size_t>(kPoints + 2));
+  auto make = [] {
+    absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+        ParetoRun::Create(RefinedTwoSpheres(2), [] { return lp::MakeClpLpSolver(); });
+    EXPECT_TRUE(run.ok()) << run.status();
+    return *std::move(run);
+  };
+  // Killed once the first nine points and part of the added ones are in.
+  std::unique_ptr<ParetoRun> first = make();
+  std::vector<AnalysisRecord> logged;
+  std::vector<std::string> encoded;
+  std::mt19937 random(21);
+  bool refinement_started = false;
+  for (int round = 0; round < kMaxRounds && !first->done(); ++round) {
+    std::vector<slp::AnalysisRequest> pending = first->PendingRequests();
+    std::shuffle(pending.begin(), pending.end(), random);
+    for (const slp::AnalysisRequest& r : pending) refinement_started |= r.id / ParetoRun::kRequestStride >= kPoints;
+    if (refinement_started && logged.size() % 3 == 0) break;
+    const AnalysisRecord answer = Answer(pending.front());
+    ASSERT_TRUE(first->Submit(answer).ok());
+    logged.push_back(answer);
+    for (slp::CycleRecord& r : first->TakeNewRecords()) encoded.push_back(EncodeCycleRecord(r));
+  }
+  ASSERT_TRUE(refinement_started);
+  ASSERT_FALSE(first->done());
+  std::unique_ptr<ParetoRun> resumed = make();
+  std::vector<std::string> replayed;
+  for (const AnalysisRecord& record : logged) {
+    ASSERT_TRUE(resumed->Submit(record).ok());
+    for (slp::CycleRecord& r : resumed->TakeNewRecords()) replayed.push_back(EncodeCycleRecord(r));
+  }
+  EXPECT_EQ(replayed, encoded);
+  for (int round = 0; round < kMaxRounds && !resumed->done(); ++round) {
+    for (const slp::AnalysisRequest& request : resumed->PendingRequests()) {
+      ASSERT_TRUE(resumed->Submit(Answer(request)).ok());
+      for (slp::CycleRecord& r : resumed->TakeNewRecords()) replayed.push_back(EncodeCycleRecord(r));
+    }
+  }
+  EXPECT_EQ(replayed, reference);
+}
+
+TEST(ParetoRun, AddedPointsWithoutASegmentEndUnrunAndSayWhy) {
+  ParetoSetup setup = RefinedTwoSpheres(2);
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(std::move(setup), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  std::vector<slp::CycleRecord> records;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    for (const slp::AnalysisRequest& request : (*run)->PendingRequests()) {
+      AnalysisRecord record = Answer(request);
+      // The last anchor fails: the points between are not run, and the
+      // front of the first nine points is the first anchor alone.
+      if (request.id / ParetoRun::kRequestStride == kPoints - 1) {
+        record.objective_terms.clear();
+        record.constraint_values.clear();
+        record.objective_gradients.clear();
+        record.constraint_gradients.clear();
+        record.failure = spec::AnalysisFailure::Of(spec::FailureKind::kIntegrator, "step size too small");
+      }
+      ASSERT_TRUE((*run)->Submit(record).ok());
+    }
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+  }
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints + 2));
+  for (int k = kPoints; k < kPoints + 2; ++k) {
+    EXPECT_EQ(records[static_cast<size_t>(k)].pareto_state, "not_run");
+    EXPECT_EQ(records[static_cast<size_t>(k)].rejection_reason,
+              "the front of the first 9 points has only 0 segments to refine");
+  }
+}
+
+TEST(ParetoRun, RefusesMoreAddedPointsThanSegments) {
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(RefinedTwoSpheres(kPoints), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.status().message(), "a front of 9 points can be refined by 0 to 8 points, got 9");
 }
 
 TEST(ParetoRunRecords, ArePointRecordsAfterAnEncodeAndDecode) {

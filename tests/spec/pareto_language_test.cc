@@ -87,5 +87,20 @@ TEST_F(ParetoLanguage, PointsOutOfRangeAndSweepsAreRefused) {
               HasSubstr("a Pareto front or a sweep or sample, not both"));
 }
 
+TEST_F(ParetoLanguage, RefineAddsPointsUpToOnePerSegment) {
+  absl::StatusOr<Study> study = Load("pareto { against: \"travel\" points: 5 refine: 4 }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->pareto.refine, 4);
+  EXPECT_EQ(study->pareto.total_points(), 9);
+  EXPECT_EQ(DescribeStudyForm(*study),
+            "a Pareto front of the objective against the largest value of travel (m), 5 points and 4 more where it "
+            "bends (epsilon-constraint method)");
+  const std::string error = LoadError("pareto {\n  against: \"travel\"\n  points: 5\n  refine: 5\n}\n");
+  EXPECT_THAT(error, HasSubstr("oscillator.study.textproto:11:"));
+  EXPECT_THAT(error, HasSubstr("pareto.refine: must be between 0 and 4 (one point in each segment of the 5 points' "
+                               "front at most), got 5"));
+  EXPECT_THAT(LoadError("pareto { against: \"travel\" refine: -1 }\n"), HasSubstr("got -1"));
+}
+
 }  // namespace
 }  // namespace mbopt::spec::io

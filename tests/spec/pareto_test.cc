@@ -28,5 +28,52 @@ TEST(DominatedPoints, MarksAPointAnotherBeatsInOneObjectiveAndMatchesInTheOther)
   EXPECT_EQ(DominatedPoints(points), (std::vector<bool>{false, false, true, false, false}));
 }
 
+// An L-shaped front with its knee at (0.1, 0.1): the turn there is nearly a
+// right angle, the turns elsewhere a few hundredths of a radian, so the two
+// segments that meet at the knee score about 0.95 and the outer ones, though
+// longer, about 0.52.
+const std::vector<FrontPoint> kKneeFront = {
+    {0.0, 1.0, true}, {0.05, 0.5, true}, {0.1, 0.1, true}, {0.5, 0.05, true}, {1.0, 0.0, true}};
+
+TEST(RefinementSegments, HalveTheSegmentsThatMeetAtTheKnee) {
+  const std::vector<RefinementSegment> chosen = RefinementSegments(kKneeFront, 2);
+  ASSERT_EQ(chosen.size(), 2u);
+  EXPECT_EQ(chosen[0].from, 1);
+  EXPECT_EQ(chosen[0].to, 2);
+  EXPECT_EQ(chosen[1].from, 2);
+  EXPECT_EQ(chosen[1].to, 3);
+  EXPECT_GT(chosen[0].score, 0.9);
+}
+
+TEST(RefinementSegments, ATieGoesToTheSegmentNearerTheFirstAnchor) {
+  const std::vector<FrontPoint> even = {{0.0, 1.0, true}, {0.5, 0.5, true}, {1.0, 0.0, true}};
+  const std::vector<RefinementSegment> chosen = RefinementSegments(even, 1);
+  ASSERT_EQ(chosen.size(), 1u);
+  EXPECT_EQ(chosen[0].from, 0);
+  EXPECT_EQ(chosen[0].to, 1);
+}
+
+TEST(RefinementSegments, AStraightFrontIsHalvedWhereItsGapIsLargest) {
+  const std::vector<FrontPoint> line = {{0.0, 1.0, true}, {0.2, 0.8, true}, {0.9, 0.1, true}, {1.0, 0.0, true}};
+  const std::vector<RefinementSegment> chosen = RefinementSegments(line, 1);
+  ASSERT_EQ(chosen.size(), 1u);
+  EXPECT_EQ(chosen[0].from, 1);
+  EXPECT_EQ(chosen[0].to, 2);
+}
+
+TEST(RefinementSegments, LeaveOutUnusableAndDominatedPointsAndFollowTheFrontsOrder) {
+  // Given out of order, with a failed point and a dominated one: the front
+  // is points 4, 0, 2 in decreasing second objective.
+  const std::vector<FrontPoint> points = {
+      {0.5, 0.5, true}, {0.3, 0.3, false}, {1.0, 0.0, true}, {0.6, 0.6, true}, {0.0, 1.0, true}};
+  const std::vector<RefinementSegment> chosen = RefinementSegments(points, 5);
+  ASSERT_EQ(chosen.size(), 2u);
+  EXPECT_EQ(chosen[0].from, 4);
+  EXPECT_EQ(chosen[0].to, 0);
+  EXPECT_EQ(chosen[1].from, 0);
+  EXPECT_EQ(chosen[1].to, 2);
+  EXPECT_TRUE(RefinementSegments({{0.0, 1.0, true}}, 3).empty());
+}
+
 }  // namespace
 }  // namespace mbopt::spec

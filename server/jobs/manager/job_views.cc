@@ -65,7 +65,7 @@ JobSummaryData JobManager::SummaryLocked(const Entry& entry) const {
     if (entry.study->pareto.enabled()) {
       s.design_set = true;
       s.pareto = true;
-      s.max_cycles = entry.study->pareto.points;
+      s.max_cycles = entry.study->pareto.total_points();
     }
     design.resize(static_cast<Eigen::Index>(entry.study->variables.size()));
     for (size_t i = 0; i < entry.study->variables.size(); ++i) {
