@@ -54,17 +54,28 @@ std::string TaskNeeds::Describe() const {
   return loads_fmus ? "FMU support (a platform it loads FMUs for)" : "";
 }
 
-std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities) {
+std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities,
+                                      const std::string& holder) {
   std::lock_guard<std::mutex> lock(mutex_);
   const std::int64_t number = next_worker_++;
   std::string id = absl::StrCat("w-", number, kSecretSeparator, RandomHex64());
   Worker& worker = workers_[id];
   worker.name = name;
+  worker.holder = holder;
   worker.slots = std::max(1, slots);
   worker.last_seen_ms = clock_->NowMs();
   worker.capabilities = std::move(capabilities);
   worker.number = number;
   return id;
+}
+
+std::vector<std::string> Scheduler::WorkerIdsHeldBy(const std::string& holder) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> ids;
+  for (const auto& [id, worker] : workers_) {
+    if (worker.holder == holder) ids.push_back(id);
+  }
+  return ids;
 }
 
 void Scheduler::SetJobNeeds(const std::string& job_id, TaskNeeds needs) {
@@ -107,6 +118,7 @@ std::vector<WorkerView> Scheduler::Workers() const {
     WorkerView view;
     view.public_id = PublicWorkerId(id);
     view.name = worker.name;
+    view.holder = worker.holder;
     view.slots = worker.slots;
     view.capabilities = worker.capabilities;
     view.analyses_done = worker.analyses_done;

@@ -79,6 +79,7 @@ struct TaskNeeds {
 struct WorkerView {
   std::string public_id;  // "w-<n>"
   std::string name;
+  std::string holder;     // the name of the token it registered with; "" without tokens
   int slots = 1;
   WorkerCapabilities capabilities;
   std::int64_t analyses_done = 0;  // results taken from it
@@ -132,7 +133,12 @@ class Scheduler {
   // of the (shared) worker token cannot guess another worker's id, and so
   // cannot answer the tasks leased to it. Only PublicWorkerId(id) goes into
   // messages, events and the job log.
-  std::string RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities = {});
+  // `holder`: the name of the token it registered with (per-worker tokens
+  // are revoked one by one: WorkerIdsHeldBy finds the workers to drop).
+  std::string RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities = {},
+                             const std::string& holder = "");
+  // The (full) ids of the registered workers whose token holder is `holder`.
+  std::vector<std::string> WorkerIdsHeldBy(const std::string& holder) const;
 
   // Every task of `job_id` (queued now or later) goes only to a worker
   // that can run it; DropJob forgets it.
@@ -232,6 +238,7 @@ class Scheduler {
   using Key = std::pair<std::string, std::int64_t>;  // job id, request id
   struct Worker {
     std::string name;
+    std::string holder;
     int slots = 1;
     std::int64_t last_seen_ms = 0;
     WorkerCapabilities capabilities;

@@ -39,7 +39,7 @@ namespace mbopt::store {
 // The schema version this code writes. A database with a newer version is
 // refused; older versions are migrated on open (docs/store.md lists the
 // versions and their migrations).
-inline constexpr int kSchemaVersion = 7;
+inline constexpr int kSchemaVersion = 8;
 // PRAGMA application_id of an mbopt database ("mbop").
 inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 
@@ -145,6 +145,10 @@ class Store {
   // a test can kill the process in the middle of a group commit.
   void SetBeforeCommitHook(std::function<void(std::int64_t transaction)> hook);
   absl::StatusOr<std::vector<jobs::AnalysisRecord>> LoadAnalyses(const std::string& job_id);  // by request id
+  // How many of the job's logged analyses each token holder's workers
+  // computed, by holder name ("" for analyses of a server without tokens,
+  // of the server itself, or logged before schema version 8).
+  absl::StatusOr<std::vector<AnalysesByHolder>> CountAnalysesByHolder(const std::string& job_id);
 
   // Commits `records` (appended to the job's record log, indices assigned in
   // order after the existing ones) and `progress` in ONE transaction (Commit

@@ -704,6 +704,7 @@ absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked
   // Only the public part: the job log must not hold what proves a
   // worker's registration.
   report.record.worker = scheduler::PublicWorkerId(report.worker_id);
+  report.record.holder = report.holder;
   absl::StatusOr<jobs::AnalysisRecord> record = entry.job->Intake(std::move(report.record));
   if (!record.ok()) {
     // A result that does not fit its task counts as a failed attempt; the

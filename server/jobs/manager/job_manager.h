@@ -89,6 +89,7 @@ struct JobManagerOptions {
 // scheduler's).
 struct WorkerReport {
   std::string worker_id;
+  std::string holder;  // the name of the reporting call's token ("" without tokens)
   std::string task_id;
   std::string job_id;
   jobs::AnalysisRecord record;
@@ -192,6 +193,9 @@ class JobManager {
 
   // The stored study of a job (for workers). NotFound for an unknown job.
   absl::StatusOr<std::string> StudyBytes(const std::string& job_id);
+  // How many of the job's logged analyses each token holder's workers
+  // delivered (`mbopt results`' "computed by"). NotFound for an unknown job.
+  absl::StatusOr<std::vector<store::AnalysesByHolder>> ComputedBy(const std::string& job_id);
 
   // Marks running jobs INTERRUPTED (they resume on the next start), wakes
   // watchers and refuses further results. Idempotent.
