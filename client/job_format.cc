@@ -194,6 +194,8 @@ std::string WorkersRow(const v1::WorkerSummary& w) {
   std::string can_run = "built-in scenes";
   for (const std::string& driver : w.drivers()) can_run += ", driver " + driver;
   if (!w.fmu_platform().empty()) can_run += ", FMUs for " + w.fmu_platform();
+  // A spot check caught it: it runs nothing until the server restarts.
+  if (w.quarantined()) can_run = "QUARANTINED (a spot check caught a wrong result): nothing";
   return absl::StrFormat("%-8s %-24s %-16s %5d %9d %5d %7.1fs  %s", w.id(), w.name(),
                          w.holder().empty() ? "-" : w.holder(), w.slots(), w.analyses_done(), w.tasks_held(),
                          static_cast<double>(w.silent_ms()) / 1000.0, can_run);

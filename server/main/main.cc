@@ -37,7 +37,7 @@ constexpr const char* kUsage =
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N] [--max-result-mb N]\n"
     "                    [--durability full|cycles|normal]\n"
     "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
-    "                    [--max-calls-per-second-per-user N]\n"
+    "                    [--max-calls-per-second-per-user N] [--verify-fraction F]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
     "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]... [--worker NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
@@ -84,6 +84,9 @@ constexpr const char* kUsage =
     "  --max-calls-per-second-per-user N  job calls a user token may make per\n"
     "                         second, in bursts of twice that (default 100; 0: no\n"
     "                         limit; admins and workers are not limited)\n"
+    "  --verify-fraction F    spot checks: the share of analyses (0 to 1) computed\n"
+    "                         again by another worker and compared bit for bit; a\n"
+    "                         worker two others contradict is quarantined (default 0)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -217,6 +220,14 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
         return false;
       }
       flags->server.max_calls_per_second_per_user = rate;
+    } else if (name == "--verify-fraction") {
+      double fraction = 0;
+      if (!absl::SimpleAtod(value, &fraction) || !(fraction >= 0) || fraction > 1) {
+        std::cerr << "mbopt-server: --verify-fraction is a number from 0 to 1 (the share of analyses checked), got '"
+                  << value << "'\n";
+        return false;
+      }
+      flags->server.manager.verify_fraction = fraction;
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

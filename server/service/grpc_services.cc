@@ -129,6 +129,7 @@ grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context, const v1:
     out->set_analyses_done(w.analyses_done);
     out->set_tasks_held(w.tasks_held);
     out->set_silent_ms(w.silent_ms);
+    out->set_quarantined(w.quarantined);
   }
   return grpc::Status::OK;
 }

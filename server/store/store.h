@@ -165,6 +165,12 @@ class Store {
   // one transaction; its id is never given to another job. NotFound for an
   // unknown id.
   absl::Status DeleteJob(const std::string& job_id);
+  // Takes back part of a running job's log in one transaction
+  // (store_rewind.cc): the analyses of `request_ids` and the cycle records
+  // from index `keep_records` on. For spot checks: the answers of a
+  // quarantined worker and what followed them.
+  absl::Status RewindJob(const std::string& job_id, const std::vector<std::int64_t>& request_ids,
+                         std::int64_t keep_records);
   // Copies the jobs, with every row logged for them, into the mbopt
   // database at `path` (created if missing, migrated if older), in one
   // transaction. AlreadyExists naming the job when `path` holds its id.

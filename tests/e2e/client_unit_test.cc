@@ -200,6 +200,9 @@ TEST(WorkersTable, EachWorkerShowsItsToken) {
   worker.clear_holder();
   EXPECT_NE(client::WorkersRow(worker).find("node07                   -  "), std::string::npos)
       << client::WorkersRow(worker);
+  EXPECT_EQ(client::WorkersRow(worker).find("QUARANTINED"), std::string::npos);
+  worker.set_quarantined(true);
+  EXPECT_NE(client::WorkersRow(worker).find("QUARANTINED"), std::string::npos) << client::WorkersRow(worker);
 }
 
 TEST(ResultsCsv, OneRowPerLpSolveWithDesignColumns) {
