@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "client/design_set_format.h"
 #include "client/pareto_format.h"
 #include "client/exit_codes.h"
@@ -183,8 +185,8 @@ std::string ListRow(const v1::JobSummary& s) {
 }
 
 std::string WorkersHeader() {
-  return absl::StrFormat("%-8s %-24s %5s %9s %5s %8s  %s", "WORKER", "NAME", "SLOTS", "ANALYSES", "HELD", "SILENT",
-                "CAN RUN");
+  return absl::StrFormat("%-8s %-24s %-16s %5s %9s %5s %8s  %s", "WORKER", "NAME", "TOKEN", "SLOTS", "ANALYSES", "HELD",
+                         "SILENT", "CAN RUN");
 }
 
 std::string WorkersRow(const v1::WorkerSummary& w) {
@@ -192,14 +194,30 @@ std::string WorkersRow(const v1::WorkerSummary& w) {
   std::string can_run = "built-in scenes";
   for (const std::string& driver : w.drivers()) can_run += ", driver " + driver;
   if (!w.fmu_platform().empty()) can_run += ", FMUs for " + w.fmu_platform();
-  return absl::StrFormat("%-8s %-24s %5d %9d %5d %7.1fs  %s", w.id(), w.name(), w.slots(), w.analyses_done(),
-                         w.tasks_held(), static_cast<double>(w.silent_ms()) / 1000.0, can_run);
+  // A spot check caught it: it runs nothing until the server restarts.
+  if (w.quarantined()) can_run = "QUARANTINED (a spot check caught a wrong result): nothing";
+  return absl::StrFormat("%-8s %-24s %-16s %5d %9d %5d %7.1fs  %s", w.id(), w.name(),
+                         w.holder().empty() ? "-" : w.holder(), w.slots(), w.analyses_done(), w.tasks_held(),
+                         static_cast<double>(w.silent_ms()) / 1000.0, can_run);
+}
+
+std::string ComputedByText(const v1::GetJobResponse& job) {
+  // Analyses no token delivered (a server without tokens, the server's own
+  // failures) are not a machine worth naming.
+  std::vector<std::string> parts;
+  for (const v1::AnalysesByHolder& count : job.computed_by()) {
+    if (count.holder().empty()) continue;
+    parts.push_back(absl::StrCat(count.holder(), " (", count.analyses(), count.analyses() == 1 ? " analysis)" : " analyses)"));
+  }
+  if (parts.empty()) return "";
+  return absl::StrCat("computed by:   ", absl::StrJoin(parts, ", "), "\n");
 }
 
 std::string ResultsTable(const v1::GetJobResponse& job) {
   if (IsParetoJob(job)) return ParetoTable(job);
   if (IsDesignSetJob(job)) return DesignSetTable(job);
   std::string out = SummaryText(job.summary(), job.has_study() ? &job.study() : nullptr);
+  out += ComputedByText(job);
   // Appended piece by piece: GCC 12 at -O3 reports a false -Wrestrict for
   // "\n" + std::string temporaries here.
   out += '\n';
@@ -254,6 +272,14 @@ std::string ResultsJson(const v1::GetJobResponse& job, const std::string& databa
   w.Field("objective", s.objective());
   w.Field("objective_unit", s.objective_unit());
   w.Field("max_violation", s.max_violation());
+  if (!ComputedByText(job).empty()) {
+    w.Key("computed_by");
+    w.BeginObject();
+    for (const v1::AnalysesByHolder& count : job.computed_by()) {
+      if (!count.holder().empty()) w.Field(count.holder(), static_cast<long long>(count.analyses()));
+    }
+    w.EndObject();
+  }
   w.Key("design");
   w.BeginObject();
   for (int i = 0; i < s.design_names_size() && i < s.design_size(); ++i) {

@@ -32,6 +32,10 @@ std::string ListRow(const v1::JobSummary& summary);
 // `mbopt workers`: one row per registered worker.
 std::string WorkersHeader();
 std::string WorkersRow(const v1::WorkerSummary& worker);
+// "computed by:   rack1 (12 analyses), rack2 (3 analyses)\n": the worker
+// tokens whose workers delivered the job's analyses; "" when no token did
+// (a server without tokens).
+std::string ComputedByText(const v1::GetJobResponse& job);
 
 // `results` formats. The JSON is one object: status, cycles, analyses,
 // objective, objective_unit, max_violation, design (name -> physical value),

@@ -70,6 +70,13 @@ absl::StatusOr<TokenTable> TokenTable::Load(const std::string& path) {
   return Parse(*text, path);
 }
 
+bool TokenTable::HasHolder(const Principal& principal) const {
+  for (const auto& [hash, holder] : by_hash_) {
+    if (holder.role == principal.role && holder.name == principal.name) return true;
+  }
+  return false;
+}
+
 std::optional<Principal> TokenTable::Find(std::string_view token) const {
   const auto it = by_hash_.find(HashToken(token));
   if (it == by_hash_.end()) return std::nullopt;

@@ -31,6 +31,10 @@ class TokenTable {
   // The holder of `token`, or nothing for a token not in the table.
   std::optional<Principal> Find(std::string_view token) const;
   std::size_t size() const { return by_hash_.size(); }
+  // Whether a token of the table belongs to `principal` (its role and name):
+  // a worker registered under a holder whose every token was removed is
+  // dropped when the table is read again (per-worker tokens).
+  bool HasHolder(const Principal& principal) const;
 
   // The line of the file that admits `token` for `principal`.
   static std::string Line(const Principal& principal, std::string_view token);

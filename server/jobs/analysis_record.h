@@ -36,6 +36,9 @@ struct AnalysisRecord {
   std::vector<double> constraint_gradients;
   std::string gradients_unavailable;
   std::string worker;              // worker id; "" for the server or an in-process run
+  // The name of the token whose worker delivered it (per-worker tokens say
+  // which machine); "" on a server without tokens and for the server's own.
+  std::string holder;
   std::int32_t attempts = 1;       // attempts it took (leases given out)
   // From the task's queueing on the server to its result's arrival there
   // (real time, s); 0 where nothing was measured (in-process runs).

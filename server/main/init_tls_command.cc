@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <climits>
 #include <cstring>
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -25,33 +26,39 @@ namespace mbopt::server_main {
 namespace {
 
 constexpr const char* kInitTlsUsage =
-    "usage: mbopt-server init-tls DIR [--host NAME]... [--user NAME]... [--days N]\n"
+    "usage: mbopt-server init-tls DIR [--host NAME]... [--user NAME]... [--worker NAME]... [--days N]\n"
     "  Makes DIR (mode 0700) with what a server reachable from other machines\n"
     "  needs, then prints the commands that use it:\n"
     "    ca.pem, ca.key          the installation's certificate authority\n"
     "    server.pem, server.key  the server's certificate for the --host names\n"
     "    worker.pem, worker.key  a client certificate for workers (--worker-ca)\n"
     "    tokens                  the server's token table (hashes only)\n"
-    "    worker.token            the workers' token\n"
+    "    worker.token            the workers' token (without --worker)\n"
+    "    worker-NAME.token       a worker token for each --worker NAME\n"
     "    admin.token             an admin's token (sees every job)\n"
     "    NAME.token              a user's token for each --user NAME\n"
-    "  --host NAME  a name or address clients give in --server (repeatable);\n"
-    "               default: localhost, 127.0.0.1 and this machine's host name\n"
-    "  --user NAME  a user with a token of their own (repeatable)\n"
-    "  --days N     how long the certificates are valid (default 825)\n"
+    "  --host NAME    a name or address clients give in --server (repeatable);\n"
+    "                 default: localhost, 127.0.0.1 and this machine's host name\n"
+    "  --user NAME    a user with a token of their own (repeatable)\n"
+    "  --worker NAME  a worker token of its own for a machine or a Slurm array\n"
+    "                 (repeatable): revoked alone, named in the log of its results\n"
+    "  --days N       how long the certificates are valid (default 825)\n"
     "  Keys and tokens are created readable by their owner only. DIR must not\n"
     "  hold any of these files already.\n";
 
 constexpr const char* kAddTokenUsage =
-    "usage: mbopt-server add-token --tokens FILE --role worker|user|admin --name NAME --out TOKEN_FILE\n"
+    "usage: mbopt-server add-token [ROLE NAME] --tokens FILE [--role worker|user|admin --name NAME] --out TOKEN_FILE\n"
     "  Makes a new token, writes it to TOKEN_FILE (created, mode 0600) and adds\n"
     "  its hash to the server's token table FILE. A running server reads the\n"
-    "  table again on SIGHUP. Revoke a token by deleting its line.\n";
+    "  table again on SIGHUP. Revoke a token by deleting its line. Each token\n"
+    "  has a name of its own within its role (`add-token worker rack2 ...` for\n"
+    "  a machine's workers), so one can be revoked without the others.\n";
 
 struct InitTlsFlags {
   std::string dir;
   std::vector<std::string> hosts;
   std::vector<std::string> users;
+  std::vector<std::string> workers;
   std::int64_t days = 825;
 };
 
@@ -115,6 +122,16 @@ bool ParseInitTlsFlags(int argc, char** argv, InitTlsFlags* flags, int* exit_cod
         return false;
       }
       flags->users.push_back(value);
+    } else if (name == "--worker") {
+      if (!auth::TokenTable::ValidName(value)) {
+        *exit_code = Usage(kInitTlsUsage, "--worker takes a name of 1 to 64 of A-Z a-z 0-9 . _ @ -, got '" + value + "'");
+        return false;
+      }
+      if (std::find(flags->workers.begin(), flags->workers.end(), value) != flags->workers.end()) {
+        *exit_code = Usage(kInitTlsUsage, "--worker '" + value + "' is given twice: each worker token has a name of its own");
+        return false;
+      }
+      flags->workers.push_back(value);
     } else if (name == "--days") {
       if (!absl::SimpleAtoi(value, &flags->days) || flags->days < 1 || flags->days > 36500) {
         *exit_code = Usage(kInitTlsUsage, "--days needs a whole number of days from 1 to 36500, got '" + value + "'");
@@ -166,8 +183,14 @@ int RunInitTlsCommand(int argc, char** argv) {
     auth::Principal principal;
     std::string file;
   };
-  std::vector<Holder> holders = {{{auth::Role::kWorker, "workers"}, "worker.token"},
-                                 {{auth::Role::kAdmin, "admin"}, "admin.token"}};
+  // One shared worker token, or one per --worker (a machine, a Slurm array):
+  // those are revoked one by one and name who computed each result.
+  std::vector<Holder> holders;
+  if (flags.workers.empty()) holders.push_back({{auth::Role::kWorker, "workers"}, "worker.token"});
+  for (const std::string& worker : flags.workers) {
+    holders.push_back({{auth::Role::kWorker, worker}, "worker-" + worker + ".token"});
+  }
+  holders.push_back({{auth::Role::kAdmin, "admin"}, "admin.token"});
   for (const std::string& user : flags.users) holders.push_back({{auth::Role::kUser, user}, user + ".token"});
   std::string table = "# mbopt-server token table: ROLE NAME SHA256-OF-TOKEN (docs/server.md, \"Security\")\n";
   std::vector<std::string> tokens;
@@ -199,14 +222,16 @@ int RunInitTlsCommand(int argc, char** argv) {
   const std::string dir = std::filesystem::absolute(flags.dir).lexically_normal().string();
   const std::string host = flags.hosts.back();
   std::cout << "made " << dir << ": a CA, a server certificate for " << absl::StrJoin(flags.hosts, ", ")
-            << " (valid " << flags.days << " days), a worker certificate, and tokens for the workers, an admin"
+            << " (valid " << flags.days << " days), a worker certificate, and tokens for the workers"
+            << (flags.workers.empty() ? "" : " (" + absl::StrJoin(flags.workers, ", ") + ")") << ", an admin"
             << (flags.users.empty() ? "" : " and " + absl::StrJoin(flags.users, ", ")) << ".\n"
             << "Keep ca.key where only you can read it: renew-cert needs it, and whoever has it can make\n"
             << "certificates this installation trusts.\n\n"
             << "server:  mbopt-server --listen 0.0.0.0:50051 --tls-dir " << dir << "\n"
             << "           (add --worker-ca " << dir << "/ca.pem to require worker certificates)\n"
             << "worker:  mbopt-worker --server " << host << ":50051 --tls-ca " << dir << "/ca.pem --token-file "
-            << dir << "/worker.token\n"
+            << dir << "/" << holders.front().file
+            << (flags.workers.size() > 1 ? "   (each machine its own worker-NAME.token)" : "") << "\n"
             << "           (with --tls-cert " << dir << "/worker.pem --tls-key " << dir << "/worker.key)\n"
             << "client:  export MBOPT_SERVER=" << host << ":50051 MBOPT_TLS_CA=" << dir << "/ca.pem MBOPT_TOKEN_FILE="
             << dir << "/" << holders.back().file << "\n"
@@ -217,11 +242,16 @@ int RunInitTlsCommand(int argc, char** argv) {
 
 int RunAddTokenCommand(int argc, char** argv) {
   std::string tokens_path, role_name, name, out;
+  std::vector<std::string> positional;
   for (int i = 0; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       std::cout << kAddTokenUsage;
       return 0;
+    }
+    if (arg.rfind("--", 0) != 0) {
+      positional.push_back(arg);
+      continue;
     }
     std::string option, value;
     if (!FlagValue(argc, argv, &i, &option, &value)) return Usage(kAddTokenUsage, arg + " needs a value");
@@ -237,6 +267,14 @@ int RunAddTokenCommand(int argc, char** argv) {
       return Usage(kAddTokenUsage, "unknown option '" + option + "'");
     }
   }
+  if (!positional.empty()) {
+    if (positional.size() != 2 || !role_name.empty() || !name.empty()) {
+      return Usage(kAddTokenUsage, "add-token takes a role and a name, as `add-token worker NAME` or with --role "
+                                   "and --name, not both");
+    }
+    role_name = positional[0];
+    name = positional[1];
+  }
   if (tokens_path.empty() || role_name.empty() || name.empty() || out.empty()) {
     return Usage(kAddTokenUsage, "add-token needs --tokens, --role, --name and --out");
   }
@@ -249,6 +287,13 @@ int RunAddTokenCommand(int argc, char** argv) {
     absl::StatusOr<auth::TokenTable> table = auth::TokenTable::Load(tokens_path);
     if (!table.ok()) {
       std::cerr << "mbopt-server add-token: " << table.status().message() << "\n";
+      return 1;
+    }
+    // Revoking is deleting a holder's line; a second token of the same name
+    // would survive it and keep that holder's workers in (server.cc).
+    if (table->HasHolder({*role, name})) {
+      std::cerr << "mbopt-server add-token: " << tokens_path << " already has a " << role_name << " token named '"
+                << name << "': give this one a name of its own, so that each can be revoked alone\n";
       return 1;
     }
   }

@@ -37,12 +37,13 @@ constexpr const char* kUsage =
     "                    [--lease-ms N] [--heartbeat-ms N] [--max-message-mb N] [--max-result-mb N]\n"
     "                    [--durability full|cycles|normal]\n"
     "                    [--max-running-jobs N] [--max-running-jobs-per-user N] [--max-queued-jobs-per-user N]\n"
-    "                    [--max-calls-per-second-per-user N]\n"
+    "                    [--max-calls-per-second-per-user N] [--verify-fraction F]\n"
     "                    [--max-call-threads N] [--max-streams-per-connection N] [--max-held-calls-per-peer N]\n"
     "                    [--crash-after-cycles N] [--crash-in-commit N]\n"
-    "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]...\n"
+    "       mbopt-server init-tls DIR [--host NAME]... [--user NAME]... [--worker NAME]...\n"
     "                    (a CA, certificates and tokens; `mbopt-server init-tls --help`)\n"
     "       mbopt-server add-token --tokens F --role worker|user|admin --name N --out F\n"
+    "       mbopt-server add-token worker|user|admin NAME --tokens F --out F\n"
     "       mbopt-server renew-cert DIR [--host NAME]... [--days N]\n"
     "       mbopt-server gc --db PATH [--keep N] [--older-than-days D] [--export FILE]\n"
     "                    (prunes finished jobs; `mbopt-server gc --help`)\n"
@@ -93,6 +94,9 @@ constexpr const char* kUsage =
     "  --max-held-calls-per-peer N  calls one address may hold open (watches, attach\n"
     "                         streams, long polls; default 512, 0: no limit); a\n"
     "                         worker holds about 2\n"
+    "  --verify-fraction F    spot checks: the share of analyses (0 to 1) computed\n"
+    "                         again by another worker and compared bit for bit; a\n"
+    "                         worker two others contradict is quarantined (default 0)\n"
     "  --crash-after-cycles N testing: kill the server (SIGKILL) right after it\n"
     "                         commits its N-th cycle record\n"
     "  --crash-in-commit N    testing: kill the server (SIGKILL) in the middle of\n"
@@ -236,6 +240,14 @@ bool ParseFlags(int argc, char** argv, Flags* flags) {
     } else if (name == "--max-held-calls-per-peer") {
       if (!ParseInt(name, value, 0, &number)) return false;
       flags->server.max_held_calls_per_peer = static_cast<int>(std::min<std::int64_t>(number, 1 << 20));
+    } else if (name == "--verify-fraction") {
+      double fraction = 0;
+      if (!absl::SimpleAtod(value, &fraction) || !(fraction >= 0) || fraction > 1) {
+        std::cerr << "mbopt-server: --verify-fraction is a number from 0 to 1 (the share of analyses checked), got '"
+                  << value << "'\n";
+        return false;
+      }
+      flags->server.manager.verify_fraction = fraction;
     } else if (name == "--crash-after-cycles") {
       if (!ParseInt(name, value, 1, &number)) return false;
       flags->crash_after_records = number;

@@ -54,17 +54,28 @@ std::string TaskNeeds::Describe() const {
   return loads_fmus ? "FMU support (a platform it loads FMUs for)" : "";
 }
 
-std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities) {
+std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities,
+                                      const std::string& holder) {
   std::lock_guard<std::mutex> lock(mutex_);
   const std::int64_t number = next_worker_++;
   std::string id = absl::StrCat("w-", number, kSecretSeparator, RandomHex64());
   Worker& worker = workers_[id];
   worker.name = name;
+  worker.holder = holder;
   worker.slots = std::max(1, slots);
   worker.last_seen_ms = clock_->NowMs();
   worker.capabilities = std::move(capabilities);
   worker.number = number;
   return id;
+}
+
+std::vector<std::string> Scheduler::WorkerIdsHeldBy(const std::string& holder) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> ids;
+  for (const auto& [id, worker] : workers_) {
+    if (worker.holder == holder) ids.push_back(id);
+  }
+  return ids;
 }
 
 void Scheduler::SetJobNeeds(const std::string& job_id, TaskNeeds needs) {
@@ -107,11 +118,13 @@ std::vector<WorkerView> Scheduler::Workers() const {
     WorkerView view;
     view.public_id = PublicWorkerId(id);
     view.name = worker.name;
+    view.holder = worker.holder;
     view.slots = worker.slots;
     view.capabilities = worker.capabilities;
     view.analyses_done = worker.analyses_done;
     view.tasks_held = held.count(id) != 0 ? held.at(id) : 0;
     view.silent_ms = std::max<std::int64_t>(0, now - worker.last_seen_ms);
+    view.quarantined = worker.quarantined;
     numbered.emplace_back(worker.number, std::move(view));
   }
   std::sort(numbered.begin(), numbered.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -176,6 +189,7 @@ int Scheduler::FairShareLocked(const std::string& worker_id) const {
 
 std::vector<Task> Scheduler::AcquireLocked(const std::string& worker_id, int max_tasks) {
   std::vector<Task> tasks;
+  if (workers_.at(worker_id).quarantined) return tasks;
   if (max_tasks > 1) max_tasks = std::min(max_tasks, FairShareLocked(worker_id));
   const std::int64_t now = clock_->NowMs();
   while (static_cast<int>(tasks.size()) < max_tasks && !queues_.empty()) {
@@ -192,6 +206,8 @@ std::vector<Task> Scheduler::AcquireLocked(const std::string& worker_id, int max
           needs == job_needs_.end() || needs->second.RunnableBy(workers_.at(worker_id).capabilities);
       for (auto it = queue.begin(); runnable && it != queue.end(); ++it) {
         Entry& entry = entries_.at(Key{job_id, *it});
+        // A spot check's second opinion comes from another worker, always.
+        if (entry.answered_workers.count(worker_id) != 0) continue;
         // A retry goes to a worker that has not failed it yet, if one is around.
         if (entry.failed_workers.count(worker_id) != 0 && HasOtherLiveWorker(worker_id, entry.failed_workers)) {
           continue;
@@ -257,10 +273,8 @@ void Scheduler::RemoveFromQueue(const Key& key) {
   if (ids.empty()) queues_.erase(queue);
 }
 
-absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, const std::string& task_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto worker = workers_.find(worker_id);
-  if (worker != workers_.end()) worker->second.last_seen_ms = clock_->NowMs();
+absl::StatusOr<std::map<Scheduler::Key, Scheduler::Entry>::iterator> Scheduler::AnswerableLocked(
+    const std::string& worker_id, const std::string& task_id) {
   // The task id names its analysis; an older attempt's id is still good.
   const size_t slash2 = task_id.rfind('/');
   const size_t slash1 = slash2 == std::string::npos || slash2 == 0 ? std::string::npos : task_id.rfind('/', slash2 - 1);
@@ -271,18 +285,36 @@ absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, c
   }
   const Key key{slash1 == std::string::npos ? std::string() : task_id.substr(0, slash1), request_id};
   auto entry = entries_.find(key);
-  if (request_id < 0 || entry == entries_.end() || entry->second.attempts == 0) {
+  if (request_id < 0 || entry == entries_.end() || entry->second.attempts == 0 ||
+      entry->second.answered_workers.count(worker_id) != 0) {
     return absl::NotFoundError(absl::StrCat("task '", task_id, "' is not outstanding (unknown, finished, "
                                                                "given up, or its job ended)"));
   }
   // Only a worker that holds or held a lease of this analysis may answer
-  // it: a worker token is shared, and without this any holder could answer
-  // every user's analyses with values of its choosing.
+  // it: without this any holder of a worker token could answer every
+  // user's analyses with values of its choosing.
   const Entry& wanted = entry->second;
   if (!(wanted.leased && wanted.worker_id == worker_id) && wanted.failed_workers.count(worker_id) == 0) {
     return absl::PermissionDeniedError(absl::StrCat("task '", task_id, "' was never leased to worker ",
                                                     PublicWorkerId(worker_id), "; its result is refused"));
   }
+  auto worker = workers_.find(worker_id);
+  if (worker != workers_.end() && worker->second.quarantined) {
+    return absl::PermissionDeniedError(absl::StrCat("worker ", PublicWorkerId(worker_id),
+                                                    " is quarantined (a spot check caught a wrong result); its "
+                                                    "result of task '", task_id, "' is refused"));
+  }
+  return entry;
+}
+
+absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, const std::string& task_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto worker = workers_.find(worker_id);
+  if (worker != workers_.end()) worker->second.last_seen_ms = clock_->NowMs();
+  absl::StatusOr<std::map<Key, Entry>::iterator> found = AnswerableLocked(worker_id, task_id);
+  if (!found.ok()) return found.status();
+  auto entry = *found;
+  const Key key = entry->first;
   FinishedTask done{entry->second.job_id, entry->second.request_id, std::move(entry->second.x_scaled),
                     entry->second.attempts, worker_id, ""};
   done.latency_seconds =
@@ -296,6 +328,57 @@ absl::StatusOr<FinishedTask> Scheduler::Complete(const std::string& worker_id, c
   finished_.insert(key);
   if (worker != workers_.end()) ++worker->second.analyses_done;
   return done;
+}
+
+absl::Status Scheduler::AskAnotherWorker(const std::string& worker_id, const std::string& task_id) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto worker = workers_.find(worker_id);
+    if (worker != workers_.end()) worker->second.last_seen_ms = clock_->NowMs();
+    absl::StatusOr<std::map<Key, Entry>::iterator> found = AnswerableLocked(worker_id, task_id);
+    if (!found.ok()) return found.status();
+    Entry& entry = (*found)->second;
+    const Key key = (*found)->first;
+    if (entry.leased) {
+      leases_.erase(entry.task_id);
+      entry.leased = false;
+    } else {
+      RemoveFromQueue(key);
+    }
+    entry.answered_workers.insert(worker_id);
+    queues_[key.first].push_front(key.second);
+    if (worker != workers_.end()) ++worker->second.analyses_done;
+  }
+  task_available_.notify_all();
+  return absl::OkStatus();
+}
+
+bool Scheduler::HasLiveWorkerBesides(const std::set<std::string>& worker_ids) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::set<std::string> excluded = worker_ids;
+  for (const auto& [id, worker] : workers_) {
+    if (worker.quarantined) excluded.insert(id);
+  }
+  return HasOtherLiveWorker("", excluded);
+}
+
+std::optional<std::vector<FinishedTask>> Scheduler::Quarantine(const std::string& worker_id) {
+  std::vector<FinishedTask> given_up;
+  bool requeued = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto worker = workers_.find(worker_id);
+    if (worker == workers_.end() || worker->second.quarantined) return std::nullopt;
+    worker->second.quarantined = true;
+    given_up = FailLeasesLocked(
+        [&worker_id](const Entry& e) { return e.worker_id == worker_id; },
+        [&](const Entry& e) {
+          return absl::StrCat("worker ", PublicWorkerId(worker_id), " was quarantined holding task ", e.task_id);
+        },
+        &requeued);
+  }
+  if (requeued) task_available_.notify_all();
+  return given_up;
 }
 
 std::optional<FinishedTask> Scheduler::FailLocked(Key key, const std::string& reason) {

@@ -79,11 +79,13 @@ struct TaskNeeds {
 struct WorkerView {
   std::string public_id;  // "w-<n>"
   std::string name;
+  std::string holder;     // the name of the token it registered with; "" without tokens
   int slots = 1;
   WorkerCapabilities capabilities;
   std::int64_t analyses_done = 0;  // results taken from it
   int tasks_held = 0;              // leased to it now
   std::int64_t silent_ms = 0;      // on the scheduler's clock
+  bool quarantined = false;        // a spot check caught it: it gets no more tasks
 };
 
 // A task as handed to a worker.
@@ -132,7 +134,12 @@ class Scheduler {
   // of the (shared) worker token cannot guess another worker's id, and so
   // cannot answer the tasks leased to it. Only PublicWorkerId(id) goes into
   // messages, events and the job log.
-  std::string RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities = {});
+  // `holder`: the name of the token it registered with (per-worker tokens
+  // are revoked one by one: WorkerIdsHeldBy finds the workers to drop).
+  std::string RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities = {},
+                             const std::string& holder = "");
+  // The (full) ids of the registered workers whose token holder is `holder`.
+  std::vector<std::string> WorkerIdsHeldBy(const std::string& holder) const;
 
   // Every task of `job_id` (queued now or later) goes only to a worker
   // that can run it; DropJob forgets it.
@@ -181,6 +188,20 @@ class Scheduler {
   // another's task): refused, and the task stays as it was.
   absl::StatusOr<FinishedTask> Complete(const std::string& worker_id, const std::string& task_id);
 
+  // Spot checks. The worker answered `task_id`, and its answer is to be
+  // checked against another worker's: the lease ends without finishing the
+  // task, which is queued again (first in its job's queue) for a worker that
+  // has not answered it yet. Its answer stays the caller's to keep. Errors
+  // as Complete; a worker that already answered the task cannot Complete it.
+  absl::Status AskAnotherWorker(const std::string& worker_id, const std::string& task_id);
+  // Whether a live worker other than these (full ids) could take a task.
+  bool HasLiveWorkerBesides(const std::set<std::string>& worker_ids) const;
+  // The worker gets no more tasks and its results are refused; the tasks
+  // it holds are failed attempts (queued again, or given up and returned as
+  // WorkerLost does). It stays listed (WorkerView::quarantined). Returns
+  // the tasks given up; nullopt for a worker unknown or already quarantined.
+  std::optional<std::vector<FinishedTask>> Quarantine(const std::string& worker_id);
+
   // The worker could not run `task_id` (not a failure of the analysis
   // itself). Returns the task if this used up its attempts (give up: report
   // a failed analysis), nullopt if it was queued again. NotFound as Complete.
@@ -222,6 +243,7 @@ class Scheduler {
     int attempts = 0;                  // leases handed out
     int failures = 0;                  // failed attempts
     std::set<std::string> failed_workers;
+    std::set<std::string> answered_workers;  // spot checks: whose answers are held
     std::string last_failure;
     bool leased = false;
     std::string worker_id;             // while leased
@@ -232,17 +254,23 @@ class Scheduler {
   using Key = std::pair<std::string, std::int64_t>;  // job id, request id
   struct Worker {
     std::string name;
+    std::string holder;
     int slots = 1;
     std::int64_t last_seen_ms = 0;
     WorkerCapabilities capabilities;
     std::int64_t number = 0;         // n of "w-<n>"
     std::int64_t analyses_done = 0;
+    bool quarantined = false;
   };
 
   std::vector<Task> AcquireLocked(const std::string& worker_id, int max_tasks);
   // How many more tasks `worker_id` may hold now (Acquire); may be <= 0.
   int FairShareLocked(const std::string& worker_id) const;
   bool HasOtherLiveWorker(const std::string& worker_id, const std::set<std::string>& excluded) const;
+  // The entry of `task_id`'s analysis if `worker_id` may answer it (holds or
+  // held one of its leases); NotFound and PermissionDenied as Complete.
+  absl::StatusOr<std::map<Key, Entry>::iterator> AnswerableLocked(const std::string& worker_id,
+                                                                  const std::string& task_id);
   // Records a failed attempt; returns the finished task if it is given up.
   // The key by value: a caller's may live in the lease this erases.
   std::optional<FinishedTask> FailLocked(Key key, const std::string& reason);

@@ -90,6 +90,13 @@ grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef*
     *response->add_cycles() = ToProto(r, view->layout.get(), view->variable_scales, view->objective_sign);
   }
   SetSerializedMessageField(v1::GetJobResponse::kStudyFieldNumber, view->study_bytes, response);
+  absl::StatusOr<std::vector<store::AnalysesByHolder>> computed_by = manager_->ComputedBy(request->job_id());
+  if (!computed_by.ok()) return ToGrpcStatus(computed_by.status());
+  for (const store::AnalysesByHolder& count : *computed_by) {
+    v1::AnalysesByHolder* out = response->add_computed_by();
+    out->set_holder(count.holder);
+    out->set_analyses(count.analyses);
+  }
   return grpc::Status::OK;
 }
 
@@ -115,12 +122,14 @@ grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context, const v1:
     v1::WorkerSummary* out = response->add_workers();
     out->set_id(w.public_id);
     out->set_name(w.name);
+    out->set_holder(w.holder);
     out->set_slots(w.slots);
     for (const std::string& driver : w.capabilities.drivers) out->add_drivers(driver);
     out->set_fmu_platform(w.capabilities.fmu_platform);
     out->set_analyses_done(w.analyses_done);
     out->set_tasks_held(w.tasks_held);
     out->set_silent_ms(w.silent_ms);
+    out->set_quarantined(w.quarantined);
   }
   return grpc::Status::OK;
 }
@@ -223,7 +232,8 @@ grpc::Status WorkerServiceImpl::Register(grpc::ServerContext* context, const v1:
     capabilities.drivers.push_back(request->drivers(i).substr(0, 100));
   }
   capabilities.fmu_platform = request->fmu_platform().substr(0, 100);
-  const std::string worker_id = scheduler_->RegisterWorker(request->name(), request->slots(), capabilities);
+  const std::string worker_id =
+      scheduler_->RegisterWorker(request->name(), request->slots(), capabilities, caller->name);
   // Ties the id in the job log's analyses to a name and an address.
   AuditLog(absl::StrCat("worker ", scheduler::PublicWorkerId(worker_id), " registered by ",
                         CallAuthorizer::Caller(*context, &*caller), ", name '", request->name().substr(0, 256), "', ",
@@ -285,15 +295,29 @@ grpc::Status WorkerServiceImpl::ReportResult(grpc::ServerContext* context, const
                                              v1::ReportResultResponse* response) {
   absl::StatusOr<auth::Principal> caller = authorizer_->ForWorkers(*context, "ReportResult");
   if (!caller.ok()) return ToGrpcStatus(caller.status());
-  const absl::StatusOr<bool> accepted = request->retry() ? ReportRetry(*request)
-                                                         : manager_->ReportResult(WorkerReportFromProto(*request));
+  const absl::StatusOr<bool> accepted =
+      request->retry() ? ReportRetry(*request) : manager_->ReportResult(WorkerReportFromProto(*request, caller->name));
   if (absl::IsPermissionDenied(accepted.status())) {
     return ToGrpcStatus(CallAuthorizer::Refuse(*context, "ReportResult", &*caller, accepted.status()));
   }
   if (!accepted.ok()) return ToGrpcStatus(accepted.status());
+  if (*accepted && !request->retry()) LogResultsTaken(*context, *caller, request->worker_id(), {request->job_id()});
   response->set_accepted(*accepted);
   LeaseNextTasks(request->worker_id(), request->next_tasks(), response->mutable_tasks());
   return grpc::Status::OK;
+}
+
+void WorkerServiceImpl::LogResultsTaken(const grpc::ServerContext& context, const auth::Principal& caller,
+                                        const std::string& worker_id, std::vector<std::string> job_ids) const {
+  // Only where tokens name the machines: a loopback server's log (and
+  // `mbopt run`'s terminal) would gain a line per batch and learn nothing.
+  if (!authorizer_->needs_tokens()) return;
+  const std::size_t results = job_ids.size();
+  std::sort(job_ids.begin(), job_ids.end());
+  job_ids.erase(std::unique(job_ids.begin(), job_ids.end()), job_ids.end());
+  AuditLog(absl::StrCat(results, results == 1 ? " result" : " results", " of ", absl::StrJoin(job_ids, ", "),
+                        " taken from ", scheduler::PublicWorkerId(worker_id), ", sent by ",
+                        CallAuthorizer::Caller(context, &caller)));
 }
 
 absl::StatusOr<bool> WorkerServiceImpl::ReportRetry(const v1::TaskResult& result) const {
@@ -382,14 +406,16 @@ grpc::Status WorkerServiceImpl::TakeResults(const grpc::ServerContext& context, 
       }
       continue;
     }
-    reports.push_back(WorkerReportFromProto(result));
+    reports.push_back(WorkerReportFromProto(result, caller.name));
     report_index.push_back(i);
   }
   const std::vector<absl::StatusOr<bool>> taken = manager_->ReportResults(std::move(reports));
+  std::vector<std::string> taken_jobs;
   for (size_t k = 0; k < taken.size(); ++k) {
     v1::ResultAnswer* answer = response->mutable_answers(report_index[k]);
     if (taken[k].ok()) {
       answer->set_accepted(*taken[k]);
+      if (*taken[k]) taken_jobs.push_back(request.results(report_index[k]).job_id());
     } else if (absl::IsUnavailable(taken[k].status())) {
       return ToGrpcStatus(taken[k].status());  // the server is stopping: the worker retries the call
     } else if (absl::IsPermissionDenied(taken[k].status())) {
@@ -398,6 +424,7 @@ grpc::Status WorkerServiceImpl::TakeResults(const grpc::ServerContext& context, 
       answer->set_error(std::string(taken[k].status().message()));
     }
   }
+  if (!taken_jobs.empty()) LogResultsTaken(context, caller, request.worker_id(), taken_jobs);
   LeaseNextTasks(request.worker_id(), request.next_tasks(), response->mutable_tasks());
   return grpc::Status::OK;
 }

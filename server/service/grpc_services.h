@@ -99,6 +99,10 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   // A worker could not run a task (TaskResult.retry): its attempt fails.
   // Whether that was taken (false: the task was not outstanding any more).
   absl::StatusOr<bool> ReportRetry(const v1::TaskResult& result) const;
+  // One audit line per call whose results were taken, naming the worker,
+  // its token's holder and the jobs (on a server with tokens).
+  void LogResultsTaken(const grpc::ServerContext& context, const auth::Principal& caller,
+                       const std::string& worker_id, std::vector<std::string> job_ids) const;
   // ReportResults after `caller` was authorized for `method`. A result
   // for another worker's task is refused (its answer says why) and logged.
   grpc::Status TakeResults(const grpc::ServerContext& context, const auth::Principal& caller, const char* method,

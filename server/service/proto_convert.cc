@@ -38,9 +38,10 @@ v1::JobSummary ToProto(const jobs::manager::JobSummaryData& s) {
   return out;
 }
 
-jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result) {
+jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result, const std::string& holder) {
   jobs::manager::WorkerReport report;
   report.worker_id = result.worker_id();
+  report.holder = holder;
   report.task_id = result.task_id();
   report.job_id = result.job_id();
   jobs::AnalysisRecord& record = report.record;

@@ -22,8 +22,8 @@ v1::CycleRecord ToProto(const slp::CycleRecord& record, const spec::StudyLayout*
                         const std::vector<double>& variable_scales, double objective_sign);
 
 // A worker's result as the job manager takes it (the job's intake then
-// validates the record).
-jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result);
+// validates the record). `holder`: the name of the token that sent it.
+jobs::manager::WorkerReport WorkerReportFromProto(const v1::TaskResult& result, const std::string& holder);
 
 // Sets the message-typed field `field_number` of `out` (left unset there) to
 // `serialized`, a message of the field's type serialized already, without

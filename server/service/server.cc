@@ -6,6 +6,8 @@
 #include <chrono>
 #include <filesystem>
 #include <optional>
+#include <set>
+#include <string>
 #include <utility>
 
 #include <grpcpp/resource_quota.h>
@@ -17,6 +19,7 @@
 #include "server/auth/certificates.h"
 #include "server/auth/token_table.h"
 #include "server/lp/make_clp_lp_solver.h"
+#include "server/service/audit_log.h"
 #include "server/service/listen_address.h"
 #include "server/service/proto_convert.h"
 #include "server/service/token_metadata_processor.h"
@@ -190,14 +193,35 @@ absl::StatusOr<std::size_t> MboptServer::ReloadTokens() {
   std::error_code error;
   if (!std::filesystem::exists(options_.tokens_file, error) && !error) {
     authorizer_->ReplaceTokens(auth::TokenTable());
+    DropWorkersOfRevokedTokens(auth::TokenTable());
     return std::size_t{0};
   }
   MBOPT_ASSIGN_OR_RETURN(auth::TokenTable tokens, auth::TokenTable::Load(options_.tokens_file));
   // A table others may write could hold a token an attacker added.
   MBOPT_RETURN_IF_ERROR(CheckSecretFileMode(options_.tokens_file, "the token table"));
   const std::size_t count = tokens.size();
-  authorizer_->ReplaceTokens(std::move(tokens));
+  authorizer_->ReplaceTokens(tokens);
+  DropWorkersOfRevokedTokens(tokens);
   return count;
+}
+
+void MboptServer::DropWorkersOfRevokedTokens(const auth::TokenTable& tokens) {
+  // A revoked worker's calls are refused from now on, so the tasks it holds
+  // would wait out their leases: they are queued again at once, as for a
+  // worker whose connection closed. Workers of the other tokens go on.
+  std::set<std::string> revoked;
+  for (const scheduler::WorkerView& worker : scheduler_->Workers()) {
+    if (!worker.holder.empty() && !tokens.HasHolder({auth::Role::kWorker, worker.holder})) {
+      revoked.insert(worker.holder);
+    }
+  }
+  for (const std::string& holder : revoked) {
+    for (const std::string& worker_id : scheduler_->WorkerIdsHeldBy(holder)) {
+      AuditLog(absl::StrCat("worker ", scheduler::PublicWorkerId(worker_id), " dropped: its token (worker ", holder,
+                            ") was revoked; the tasks it held are queued again"));
+      manager_->WorkerLost(worker_id);
+    }
+  }
 }
 
 std::shared_ptr<grpc::Channel> MboptServer::InProcessChannel() {

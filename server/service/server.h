@@ -21,6 +21,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/status/statusor.h"
+#include "server/auth/token_table.h"
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
 #include "server/service/grpc_services.h"
@@ -107,6 +108,8 @@ class MboptServer {
   // is accepted until a table with tokens is read. On error (the file does
   // not parse, cannot be read, or others may read or write it) the table in
   // use stays.
+  // Workers registered with a worker token that is no longer in the table
+  // are dropped and their tasks queued again; the others go on.
   absl::StatusOr<std::size_t> ReloadTokens();
 
   // Graceful stop (see above). Idempotent.
@@ -118,6 +121,7 @@ class MboptServer {
   absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> LoadSecurity();
   void ReaperLoop(std::int64_t interval_ms);
   void StopThreads();
+  void DropWorkersOfRevokedTokens(const auth::TokenTable& tokens);
 
   ServerOptions options_;
   std::unique_ptr<scheduler::SteadyClock> own_clock_;

@@ -65,4 +65,10 @@ struct EventRow {
   std::string message;
 };
 
+// How many of a job's analyses one token holder's workers delivered.
+struct AnalysesByHolder {
+  std::string holder;  // "" for analyses attributed to no token
+  std::int64_t analyses = 0;
+};
+
 }  // namespace mbopt::store

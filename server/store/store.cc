@@ -135,6 +135,13 @@ UPDATE schema_version SET version = 6;
 ALTER TABLE analyses ADD COLUMN values_packed INTEGER NOT NULL DEFAULT 0;
 UPDATE schema_version SET version = 7;
 )sql",
+    // 7 -> 8: the name of the token whose worker delivered each analysis
+    // (per-worker tokens: a job's results say which machines computed
+    // them). Rows of version 7 were not attributed: ''.
+    R"sql(
+ALTER TABLE analyses ADD COLUMN holder TEXT NOT NULL DEFAULT '';
+UPDATE schema_version SET version = 8;
+)sql",
 };
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kSchemaVersion - 1,
               "one migration step per schema version after the first");
@@ -436,8 +443,8 @@ absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::
                      "constraint_values, worker, wall_seconds, attempts, time_steps, rhs_evaluations, "
                      "jacobian_evaluations, newton_iterations, position_solves, committed_unix_ms, "
                      "objective_gradients, constraint_gradients, gradients_unavailable, failure_kind, "
-                     "latency_seconds, values_packed) "
-                     "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,1)"));
+                     "latency_seconds, values_packed, holder) "
+                     "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,1,?)"));
   Statement& stmt = *insert;
   stmt.BindText(1, job_id);
   stmt.BindInt(2, a.request_id);
@@ -463,6 +470,7 @@ absl::Status Store::InsertAnalysisLocked(const std::string& job_id, const jobs::
   stmt.BindText(19, a.gradients_unavailable);
   stmt.BindText(20, spec::FailureKindName(a.failure.kind));
   stmt.BindDouble(21, a.latency_seconds);
+  stmt.BindText(22, a.holder);
   absl::Status status = stmt.Run();
   // Ready for the next analysis, and holding nothing of this one (its blobs
   // were copied in) while it waits.
@@ -482,8 +490,8 @@ absl::StatusOr<std::vector<jobs::AnalysisRecord>> Store::LoadAnalyses(const std:
                          "SELECT request_id, x_scaled, ok, failure_reason, objective_terms, constraint_values, "
                          "worker, wall_seconds, attempts, time_steps, rhs_evaluations, jacobian_evaluations, "
                          "newton_iterations, position_solves, committed_unix_ms, objective_gradients, "
-                         "constraint_gradients, gradients_unavailable, failure_kind, latency_seconds, values_packed "
-                         "FROM analyses WHERE job_id = ? ORDER BY request_id"));
+                         "constraint_gradients, gradients_unavailable, failure_kind, latency_seconds, values_packed, "
+                         "holder FROM analyses WHERE job_id = ? ORDER BY request_id"));
   stmt.BindText(1, job_id);
   std::vector<jobs::AnalysisRecord> rows;
   while (true) {
@@ -514,9 +522,25 @@ absl::StatusOr<std::vector<jobs::AnalysisRecord>> Store::LoadAnalyses(const std:
     MBOPT_ASSIGN_OR_RETURN(a.constraint_gradients, DecodeDoubles(stmt.ColumnBlob(16)));
     a.gradients_unavailable = stmt.ColumnText(17);
     a.latency_seconds = stmt.ColumnDouble(19);
+    a.holder = stmt.ColumnText(21);
     rows.push_back(std::move(a));
   }
   return rows;
+}
+
+absl::StatusOr<std::vector<AnalysesByHolder>> Store::CountAnalysesByHolder(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MBOPT_ASSIGN_OR_RETURN(
+      Statement stmt,
+      Statement::Prepare(db_, "SELECT holder, count(*) FROM analyses WHERE job_id = ? GROUP BY holder ORDER BY holder"));
+  stmt.BindText(1, job_id);
+  std::vector<AnalysesByHolder> counts;
+  while (true) {
+    MBOPT_ASSIGN_OR_RETURN(bool more, stmt.Step());
+    if (!more) break;
+    counts.push_back(AnalysesByHolder{stmt.ColumnText(0), stmt.ColumnInt(1)});
+  }
+  return counts;
 }
 
 absl::Status Store::CommitCycle(const std::string& job_id, const std::vector<CycleRow>& records,

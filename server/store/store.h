@@ -39,7 +39,7 @@ namespace mbopt::store {
 // The schema version this code writes. A database with a newer version is
 // refused; older versions are migrated on open (docs/store.md lists the
 // versions and their migrations).
-inline constexpr int kSchemaVersion = 7;
+inline constexpr int kSchemaVersion = 8;
 // PRAGMA application_id of an mbopt database ("mbop").
 inline constexpr std::int32_t kApplicationId = 0x6d626f70;
 
@@ -145,6 +145,10 @@ class Store {
   // a test can kill the process in the middle of a group commit.
   void SetBeforeCommitHook(std::function<void(std::int64_t transaction)> hook);
   absl::StatusOr<std::vector<jobs::AnalysisRecord>> LoadAnalyses(const std::string& job_id);  // by request id
+  // How many of the job's logged analyses each token holder's workers
+  // computed, by holder name ("" for analyses of a server without tokens,
+  // of the server itself, or logged before schema version 8).
+  absl::StatusOr<std::vector<AnalysesByHolder>> CountAnalysesByHolder(const std::string& job_id);
 
   // Commits `records` (appended to the job's record log, indices assigned in
   // order after the existing ones) and `progress` in ONE transaction (Commit
@@ -161,6 +165,12 @@ class Store {
   // one transaction; its id is never given to another job. NotFound for an
   // unknown id.
   absl::Status DeleteJob(const std::string& job_id);
+  // Takes back part of a running job's log in one transaction
+  // (store_rewind.cc): the analyses of `request_ids` and the cycle records
+  // from index `keep_records` on. For spot checks: the answers of a
+  // quarantined worker and what followed them.
+  absl::Status RewindJob(const std::string& job_id, const std::vector<std::int64_t>& request_ids,
+                         std::int64_t keep_records);
   // Copies the jobs, with every row logged for them, into the mbopt
   // database at `path` (created if missing, migrated if older), in one
   // transaction. AlreadyExists naming the job when `path` holds its id.

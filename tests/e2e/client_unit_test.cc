@@ -165,6 +165,46 @@ TEST(ResultsJson, HistoryHoldsOnlyAcceptedCyclesAndDesignIsByName) {
   EXPECT_EQ(entries, 2u) << json;
 }
 
+// Which worker tokens computed a job's analyses: named in the table and
+// the JSON; analyses no token delivered (a server without tokens) are not.
+TEST(ResultsTable, ComputedBySaysWhichWorkerTokensDeliveredTheAnalyses) {
+  v1::GetJobResponse job = SampleJob();
+  EXPECT_EQ(client::ResultsTable(job).find("computed by"), std::string::npos);
+  v1::AnalysesByHolder* unattributed = job.add_computed_by();
+  unattributed->set_analyses(4);
+  EXPECT_EQ(client::ResultsTable(job).find("computed by"), std::string::npos) << "no token, no name";
+  EXPECT_EQ(client::ResultsJson(job).find("computed_by"), std::string::npos);
+  v1::AnalysesByHolder* rack1 = job.add_computed_by();
+  rack1->set_holder("rack1");
+  rack1->set_analyses(12);
+  v1::AnalysesByHolder* rack2 = job.add_computed_by();
+  rack2->set_holder("rack2");
+  rack2->set_analyses(1);
+  const std::string table = client::ResultsTable(job);
+  EXPECT_NE(table.find("computed by:   rack1 (12 analyses), rack2 (1 analysis)\n"), std::string::npos) << table;
+  const std::string json = client::ResultsJson(job);
+  EXPECT_NE(json.find("\"computed_by\": {"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"rack1\": 12"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"rack2\": 1"), std::string::npos) << json;
+}
+
+// `mbopt workers` names the token each worker registered with.
+TEST(WorkersTable, EachWorkerShowsItsToken) {
+  EXPECT_NE(client::WorkersHeader().find(" TOKEN "), std::string::npos);
+  v1::WorkerSummary worker;
+  worker.set_id("w-3");
+  worker.set_name("node07");
+  worker.set_holder("rack1");
+  EXPECT_NE(client::WorkersRow(worker).find("node07                   rack1 "), std::string::npos)
+      << client::WorkersRow(worker);
+  worker.clear_holder();
+  EXPECT_NE(client::WorkersRow(worker).find("node07                   -  "), std::string::npos)
+      << client::WorkersRow(worker);
+  EXPECT_EQ(client::WorkersRow(worker).find("QUARANTINED"), std::string::npos);
+  worker.set_quarantined(true);
+  EXPECT_NE(client::WorkersRow(worker).find("QUARANTINED"), std::string::npos) << client::WorkersRow(worker);
+}
+
 TEST(ResultsCsv, OneRowPerLpSolveWithDesignColumns) {
   const std::string csv = client::ResultsCsv(SampleJob());
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);  // header + 4 records

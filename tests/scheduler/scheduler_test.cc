@@ -6,6 +6,7 @@
 #include <future>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -52,6 +53,50 @@ TEST(Scheduler, HandsOutTasksRoundRobinBetweenJobs) {
     EXPECT_EQ((*rest)[i].job_id, "job-1");
     EXPECT_EQ((*rest)[i].request_id, static_cast<std::int64_t>(i + 2));
   }
+}
+
+// Spot checks: an answer held for a check sends its task to a worker that
+// has not answered it (never back to the one that did), which may then
+// complete it; the first worker cannot complete it. A quarantined worker
+// gets no task, its lease is queued again, and its results are refused.
+TEST(Scheduler, ACheckedTaskGoesToAnotherWorkerAndAQuarantinedWorkerGetsNothing) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  scheduler.Enqueue("job-1", 0, {1.0});
+  scheduler.Enqueue("job-1", 1, {2.0});
+  const std::string first = scheduler.RegisterWorker("first", 1);
+  const std::string second = scheduler.RegisterWorker("second", 1);
+  auto task = scheduler.Acquire(first, 1);
+  ASSERT_TRUE(task.ok() && task->size() == 1u);
+  EXPECT_TRUE(scheduler.HasLiveWorkerBesides({first}));
+  EXPECT_FALSE(scheduler.HasLiveWorkerBesides({first, second}));
+  ASSERT_TRUE(scheduler.AskAnotherWorker(first, (*task)[0].task_id).ok());
+  // The first worker is offered the other request only.
+  auto again = scheduler.Acquire(first, 5);
+  ASSERT_TRUE(again.ok());
+  ASSERT_EQ(again->size(), 1u);
+  EXPECT_EQ((*again)[0].request_id, 1);
+  EXPECT_EQ(scheduler.Complete(first, (*task)[0].task_id).status().code(), absl::StatusCode::kNotFound);
+  auto checked = scheduler.Acquire(second, 1);
+  ASSERT_TRUE(checked.ok() && checked->size() == 1u);
+  EXPECT_EQ((*checked)[0].request_id, 0);
+  EXPECT_EQ((*checked)[0].attempt, 2);
+  EXPECT_TRUE(scheduler.Complete(second, (*checked)[0].task_id).ok());
+
+  // The first worker holds request 1 when it is quarantined.
+  const std::optional<std::vector<FinishedTask>> given_up = scheduler.Quarantine(first);
+  ASSERT_TRUE(given_up.has_value());
+  EXPECT_TRUE(given_up->empty());
+  EXPECT_FALSE(scheduler.Quarantine(first).has_value()) << "already quarantined";
+  EXPECT_TRUE(scheduler.Acquire(first, 5)->empty());
+  EXPECT_EQ(scheduler.Complete(first, (*again)[0].task_id).status().code(), absl::StatusCode::kPermissionDenied);
+  auto requeued = scheduler.Acquire(second, 1);
+  ASSERT_TRUE(requeued.ok() && requeued->size() == 1u);
+  EXPECT_EQ((*requeued)[0].request_id, 1);
+  const std::vector<WorkerView> workers = scheduler.Workers();
+  ASSERT_EQ(workers.size(), 2u);
+  EXPECT_TRUE(workers[0].quarantined);
+  EXPECT_FALSE(workers[1].quarantined);
 }
 
 // A job whose scene names an analysis driver goes only to workers that

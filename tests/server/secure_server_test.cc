@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -368,6 +369,82 @@ TEST_F(SecureServerTest, MissingOrWrongTokensAreRefusedAndReloadingTheTableRevok
   Write("tokens", "user carol not-a-hash\n");
   EXPECT_THAT(std::string(server_->ReloadTokens().status().message()), HasSubstr("tokens:1:"));
   EXPECT_TRUE(Submit(*Jobs(carol), &job_id).ok());
+}
+
+// Per-worker tokens: each machine (or Slurm array) has its own, so one can
+// be revoked alone. The revoked worker's calls are refused and the tasks it
+// held are queued again at once (not when their leases run out), while the
+// other token's worker goes on and ends the job; every accepted batch of
+// results is logged with the token's holder, and the job's analyses are
+// counted by holder ("computed by").
+TEST_F(SecureServerTest, EachWorkerTokenIsRevokedAloneAndTheJobSaysWhichTokensComputedIt) {
+  const std::string rack1 = *auth::NewToken();
+  const std::string rack2 = *auth::NewToken();
+  const std::string users = auth::TokenTable::Line({auth::Role::kUser, "alice"}, alice_) +
+                            auth::TokenTable::Line({auth::Role::kAdmin, "ops"}, admin_);
+  Write("tokens", users + auth::TokenTable::Line({auth::Role::kWorker, "rack1"}, rack1) +
+                      auth::TokenTable::Line({auth::Role::kWorker, "rack2"}, rack2));
+  StartSecureServer();
+  std::string job_id;
+  ASSERT_TRUE(Submit(*Jobs(alice_), &job_id).ok());
+  ::testing::internal::CaptureStderr();
+  FakeWorker first(Channel(Client(rack1, ca_.certificate_pem)), 1, "node-a");
+  FakeWorker second(Channel(Client(rack2, ca_.certificate_pem)), 2, "node-b");
+  ASSERT_EQ(first.Run(2), 2);
+  const std::vector<v1::AnalysisTask> held = first.Acquire(100);
+  ASSERT_FALSE(held.empty()) << "the first worker must hold tasks when its token is revoked";
+  {
+    grpc::ClientContext context;
+    v1::ListWorkersResponse listed;
+    ASSERT_TRUE(Jobs(admin_)->ListWorkers(&context, v1::ListWorkersRequest(), &listed).ok());
+    ASSERT_EQ(listed.workers_size(), 2);
+    EXPECT_EQ(listed.workers(0).holder(), "rack1");
+    EXPECT_EQ(listed.workers(1).holder(), "rack2");
+  }
+
+  Write("tokens", users + auth::TokenTable::Line({auth::Role::kWorker, "rack2"}, rack2));
+  absl::StatusOr<std::size_t> reloaded = server_->ReloadTokens();
+  ASSERT_TRUE(reloaded.ok()) << reloaded.status();
+  EXPECT_EQ(*reloaded, 3u);
+  bool accepted = true;
+  EXPECT_EQ(first.Answer(held.front(), &accepted).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  // The lease is 30 s: the second worker gets the revoked one's tasks only
+  // because they were queued again on the reload.
+  second.Run();
+  std::set<std::int64_t> answered_by_second(second.answered_request_ids().begin(),
+                                            second.answered_request_ids().end());
+  for (const v1::AnalysisTask& task : held) {
+    EXPECT_TRUE(answered_by_second.count(task.request_id()) != 0) << "request " << task.request_id();
+  }
+  const std::string log = ::testing::internal::GetCapturedStderr();
+
+  v1::GetJobResponse job;
+  ASSERT_TRUE(Get(*Jobs(alice_), job_id, &job).ok());
+  EXPECT_EQ(job.summary().state(), v1::JOB_STATE_CONVERGED) << job.summary().message();
+  absl::StatusOr<std::vector<jobs::AnalysisRecord>> logged = server_->store().LoadAnalyses(job_id);
+  ASSERT_TRUE(logged.ok()) << logged.status();
+  std::map<std::string, std::int64_t> by_holder;
+  for (const jobs::AnalysisRecord& analysis : *logged) ++by_holder[analysis.holder];
+  EXPECT_EQ(by_holder, (std::map<std::string, std::int64_t>{{"rack1", 2}, {"rack2", static_cast<std::int64_t>(logged->size()) - 2}}));
+  ASSERT_EQ(job.computed_by_size(), 2);
+  EXPECT_EQ(job.computed_by(0).holder(), "rack1");
+  EXPECT_EQ(job.computed_by(0).analyses(), 2);
+  EXPECT_EQ(job.computed_by(1).holder(), "rack2");
+  EXPECT_EQ(job.computed_by(1).analyses(), static_cast<std::int64_t>(logged->size()) - 2);
+
+  const std::string first_id = scheduler::PublicWorkerId(first.worker_id());
+  const std::string second_id = scheduler::PublicWorkerId(second.worker_id());
+  EXPECT_THAT(log, HasSubstr(" of " + job_id + " taken from " + first_id + ", sent by worker rack1 (peer ipv4:"));
+  EXPECT_THAT(log, HasSubstr(" taken from " + second_id + ", sent by worker rack2 (peer ipv4:"));
+  EXPECT_THAT(log, HasSubstr("audit: worker " + first_id + " dropped: its token (worker rack1) was revoked"));
+  EXPECT_THAT(log, ::testing::Not(HasSubstr("worker " + second_id + " dropped")));
+  {
+    grpc::ClientContext context;
+    v1::ListWorkersResponse listed;
+    ASSERT_TRUE(Jobs(admin_)->ListWorkers(&context, v1::ListWorkersRequest(), &listed).ok());
+    ASSERT_EQ(listed.workers_size(), 1);
+    EXPECT_EQ(listed.workers(0).id(), second_id);
+  }
 }
 
 TEST_F(SecureServerTest, ATokenTableOrKeyOthersMayReadOrWriteIsRefusedAtStart) {

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,7 @@
 #include <gtest/gtest.h>
 
 #include "mbopt/v1/service.grpc.pb.h"
+#include "server/auth/token_table.h"
 #include "server/service/server.h"
 #include "server/store/store.h"
 #include "tests/server/fake_worker.h"
@@ -366,6 +368,42 @@ TEST_F(ServerProcessTest, ALargeCallWithoutATokenIsRefusedBeforeItsMessageIsRead
   EXPECT_LT(peak - before, kAllowedGrowthBytes)
       << "resident before " << before / 1048576 << " MB, peak after " << peak / 1048576 << " MB";
   EXPECT_THAT(ReadText(log), HasSubstr("audit: refused /mbopt.v1.JobService/Submit before reading its message"));
+}
+
+// `init-tls --worker NAME` makes one worker token per machine or Slurm
+// array instead of the shared one, and `add-token worker NAME` adds one;
+// a second token of a name already in the table is refused, so that
+// removing a name's line revokes that worker alone.
+TEST_F(ServerProcessTest, InitTlsAndAddTokenMakeOneWorkerTokenPerName) {
+  const std::string pki = (dir_ / "pki").string();
+  ASSERT_EQ(RunServerCommand({"init-tls", pki, "--host", "127.0.0.1", "--worker", "rack1", "--worker", "rack2"}), 0);
+  EXPECT_FALSE(std::filesystem::exists(pki + "/worker.token")) << "no shared worker token with --worker";
+  absl::StatusOr<auth::TokenTable> table = auth::TokenTable::Load(pki + "/tokens");
+  ASSERT_TRUE(table.ok()) << table.status();
+  EXPECT_EQ(table->size(), 3u);  // rack1, rack2, admin
+  for (const char* name : {"rack1", "rack2"}) {
+    const std::string token_file = pki + "/worker-" + name + ".token";
+    ASSERT_TRUE(std::filesystem::exists(token_file)) << token_file;
+    std::string token = ReadText(token_file);
+    while (!token.empty() && token.back() == '\n') token.pop_back();
+    const std::optional<auth::Principal> holder = table->Find(token);
+    ASSERT_TRUE(holder.has_value()) << name;
+    EXPECT_EQ(holder->role, auth::Role::kWorker);
+    EXPECT_EQ(holder->name, name);
+  }
+  EXPECT_EQ(RunServerCommand({"init-tls", (dir_ / "twice").string(), "--worker", "rack1", "--worker", "rack1"}), 2);
+
+  const std::string rack3 = (dir_ / "rack3.token").string();
+  ASSERT_EQ(RunServerCommand({"add-token", "worker", "rack3", "--tokens", pki + "/tokens", "--out", rack3}), 0);
+  table = auth::TokenTable::Load(pki + "/tokens");
+  ASSERT_TRUE(table.ok()) << table.status();
+  EXPECT_TRUE(table->HasHolder({auth::Role::kWorker, "rack3"}));
+  EXPECT_EQ(table->size(), 4u);
+  EXPECT_EQ(RunServerCommand({"add-token", "worker", "rack1", "--tokens", pki + "/tokens", "--out",
+                              (dir_ / "again.token").string()}),
+            1);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "again.token"));
+  EXPECT_EQ(auth::TokenTable::Load(pki + "/tokens")->size(), 4u);
 }
 
 TEST_F(ServerProcessTest, KilledMidJobResumesOnRestartWithBitIdenticalRecords) {

@@ -400,7 +400,8 @@ void RunSql(const std::string& path, const std::string& sql) {
 }
 
 // Rewrites every analysis' values as schema versions before 7 stored them,
-// 8 bytes each, and drops the column that says they are packed.
+// 8 bytes each, and drops the columns of version 7 on (packed values, the
+// token holder of version 8).
 void UnpackValuesAsBeforeVersion7(const std::string& path) {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
@@ -433,7 +434,7 @@ void UnpackValuesAsBeforeVersion7(const std::string& path) {
     sqlite3_finalize(update);
   }
   sqlite3_close(db);
-  RunSql(path, "ALTER TABLE analyses DROP COLUMN values_packed;");
+  RunSql(path, "ALTER TABLE analyses DROP COLUMN values_packed; ALTER TABLE analyses DROP COLUMN holder;");
 }
 
 TEST_F(StoreTest, NewerSchemaVersionIsRefused) {
@@ -598,6 +599,56 @@ TEST_F(StoreTest, FailureKindRoundTrips) {
   ASSERT_EQ(rows->size(), 1u);
   EXPECT_EQ((*rows)[0].failure.kind, spec::FailureKind::kAssembly);
   EXPECT_EQ((*rows)[0].failure.reason, a.failure.reason);
+}
+
+// Each analysis names the token whose worker delivered it, and a job's
+// analyses are counted by holder; a database of version 7 (before holders)
+// opens, its analyses attributed to no token, and takes new ones with theirs.
+TEST_F(StoreTest, AnalysesNameTheirTokenHolderAndVersionSevenRowsHaveNone) {
+  std::string job_id;
+  auto analysis = [](std::int64_t request_id, const std::string& holder) {
+    jobs::AnalysisRecord a;
+    a.request_id = request_id;
+    a.x_scaled = {0.5};
+    a.objective_terms = {1.0};
+    a.worker = "w-1";
+    a.holder = holder;
+    return a;
+  };
+  {
+    auto store = Store::Open(path_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    job_id = (*store)->CreateJob(SampleJob())->id;
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, analysis(1, "rack1")).ok());
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, analysis(2, "rack2")).ok());
+    ASSERT_TRUE((*store)->AddAnalysis(job_id, analysis(3, "rack1")).ok());
+    EXPECT_EQ((*store)->LoadAnalyses(job_id)->at(1).holder, "rack2");
+    absl::StatusOr<std::vector<AnalysesByHolder>> counts = (*store)->CountAnalysesByHolder(job_id);
+    ASSERT_TRUE(counts.ok()) << counts.status();
+    ASSERT_EQ(counts->size(), 2u);
+    EXPECT_EQ((*counts)[0].holder, "rack1");
+    EXPECT_EQ((*counts)[0].analyses, 2);
+    EXPECT_EQ((*counts)[1].holder, "rack2");
+    EXPECT_EQ((*counts)[1].analyses, 1);
+  }
+  // Exactly the version 7 layout.
+  RunSql(path_, "ALTER TABLE analyses DROP COLUMN holder; UPDATE schema_version SET version = 7;");
+  auto store = Store::Open(path_);
+  ASSERT_TRUE(store.ok()) << store.status();
+  absl::StatusOr<std::vector<jobs::AnalysisRecord>> rows = (*store)->LoadAnalyses(job_id);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 3u);
+  for (const jobs::AnalysisRecord& row : *rows) EXPECT_EQ(row.holder, "") << row.request_id;
+  ASSERT_TRUE((*store)->AddAnalysis(job_id, analysis(4, "rack3")).ok());
+  absl::StatusOr<std::vector<AnalysesByHolder>> counts = (*store)->CountAnalysesByHolder(job_id);
+  ASSERT_TRUE(counts.ok()) << counts.status();
+  ASSERT_EQ(counts->size(), 2u);
+  EXPECT_EQ((*counts)[0].holder, "");
+  EXPECT_EQ((*counts)[0].analyses, 3);
+  EXPECT_EQ((*counts)[1].holder, "rack3");
+  EXPECT_EQ((*counts)[1].analyses, 1);
+  store->reset();
+  EXPECT_EQ(SchemaVersionOf(path_), kSchemaVersion);
 }
 
 TEST_F(StoreTest, NewDatabaseHasTheCurrentSchemaVersion) {

@@ -17,6 +17,7 @@
 #include "server/jobs/job.h"
 #include "server/jobs/job_state.h"
 #include "server/jobs/manager/job_manager.h"
+#include "server/jobs/manager/spot_check.h"
 #include "server/scheduler/scheduler.h"
 #include "server/store/store.h"
 #include "spec/layout.h"
@@ -39,6 +40,9 @@ struct JobManager::Entry {
   // While resident; shared with the job and with views, never copied.
   std::shared_ptr<const spec::StudyLayout> layout;
   std::unique_ptr<jobs::Job> job;  // the optimizer of the current run; none once it stopped
+  // Spot checks: answers held until another worker's agrees, by request id
+  // (of the current run).
+  std::map<std::int64_t, std::vector<SpotCheckOpinion>> opinions;
   // Failed analyses by kind, kept when the optimizer is released.
   std::map<std::string, std::int64_t> failed_analyses_by_kind;
 

@@ -17,6 +17,7 @@
 #include "server/jobs/problem_from_study.h"
 #include "server/jobs/record_codec.h"
 #include "server/jobs/manager/job_entry.h"
+#include "server/jobs/manager/spot_check.h"
 #include "spec/layout.h"
 
 namespace mbopt::jobs::manager {
@@ -405,6 +406,8 @@ absl::Status JobManager::ResumeLocked(Entry& entry, const std::string& why, cons
     FailJobLocked(entry, absl::StrCat("cannot resume: ", job.status().message()));
     return job.status();
   }
+  // Answers held for spot checks belong to the run that asked for them.
+  entry.opinions.clear();
   absl::StatusOr<std::vector<jobs::AnalysisRecord>> analyses = store_->LoadAnalyses(id);
   absl::StatusOr<std::vector<store::CycleRow>> cycles =
       analyses.ok() ? store_->LoadCycles(id) : absl::StatusOr<std::vector<store::CycleRow>>(analyses.status());
@@ -608,6 +611,7 @@ absl::StatusOr<JobManager::Delivery> JobManager::PrepareDeliveryLocked(Entry& en
 
 void JobManager::DeliverGivenUpLocked(Entry& entry, const scheduler::FinishedTask& task) {
   if (entry.job == nullptr || entry.state != JobState::kRunning) return;
+  if (TakeHeldAnswerLocked(entry, task)) return;
   jobs::AnalysisRecord candidate;
   candidate.request_id = task.request_id;
   candidate.failure = spec::AnalysisFailure::Of(spec::FailureKind::kService, task.failure_reason);
@@ -628,12 +632,15 @@ absl::StatusOr<bool> JobManager::ReportResult(WorkerReport report) {
 }
 
 std::vector<absl::StatusOr<bool>> JobManager::ReportResults(std::vector<WorkerReport> reports) {
-  std::vector<absl::StatusOr<bool>> answers = IntakeResults(std::move(reports));
+  std::vector<Contradicted> contradicted;
+  std::vector<absl::StatusOr<bool>> answers = IntakeResults(std::move(reports), &contradicted);
+  if (!contradicted.empty()) QuarantineContradicted(contradicted);
   AdmitWaiting();
   return answers;
 }
 
-std::vector<absl::StatusOr<bool>> JobManager::IntakeResults(std::vector<WorkerReport> reports) {
+std::vector<absl::StatusOr<bool>> JobManager::IntakeResults(std::vector<WorkerReport> reports,
+                                                            std::vector<Contradicted>* contradicted) {
   std::vector<absl::StatusOr<bool>> answers(reports.size(), false);
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -665,9 +672,13 @@ std::vector<absl::StatusOr<bool>> JobManager::IntakeResults(std::vector<WorkerRe
     JobBatch& batch = batches.emplace_back(JobBatch{*entry, std::unique_lock<std::mutex>((*entry)->mutex), {}, {},
                                                     Delivery{}});
     for (size_t i : indices) {
-      absl::StatusOr<std::optional<jobs::AnalysisRecord>> record = TakeResultLocked(*batch.entry, std::move(reports[i]));
+      bool held = false;
+      absl::StatusOr<std::optional<jobs::AnalysisRecord>> record =
+          TakeResultLocked(*batch.entry, std::move(reports[i]), &held, contradicted);
       if (!record.ok()) {
         answers[i] = record.status();
+      } else if (held) {
+        answers[i] = true;  // taken, for a spot check: the worker's part is done
       } else if (record->has_value()) {
         batch.records.push_back(**std::move(record));
         batch.indices.push_back(i);
@@ -691,8 +702,8 @@ std::vector<absl::StatusOr<bool>> JobManager::IntakeResults(std::vector<WorkerRe
   return answers;
 }
 
-absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked(Entry& entry,
-                                                                                 WorkerReport report) {
+absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked(
+    Entry& entry, WorkerReport report, bool* held, std::vector<Contradicted>* contradicted) {
   const std::int64_t request_id = report.record.request_id;
   const std::string expected_prefix = absl::StrCat(report.job_id, "/", request_id, "/");
   if (report.task_id.rfind(expected_prefix, 0) != 0) {
@@ -704,6 +715,7 @@ absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked
   // Only the public part: the job log must not hold what proves a
   // worker's registration.
   report.record.worker = scheduler::PublicWorkerId(report.worker_id);
+  report.record.holder = report.holder;
   absl::StatusOr<jobs::AnalysisRecord> record = entry.job->Intake(std::move(report.record));
   if (!record.ok()) {
     // A result that does not fit its task counts as a failed attempt; the
@@ -713,6 +725,15 @@ absl::StatusOr<std::optional<jobs::AnalysisRecord>> JobManager::TakeResultLocked
         scheduler_->Fail(report.worker_id, report.task_id, reason);
     if (failed.ok() && failed->has_value()) DeliverGivenUpLocked(entry, **failed);
     return absl::InvalidArgumentError(reason);
+  }
+  if (SpotChecked(entry.row.id, request_id, options_.verify_fraction)) {
+    absl::StatusOr<bool> held_now = SpotCheckLocked(entry, report, &*record, contradicted);
+    if (absl::IsPermissionDenied(held_now.status())) return held_now.status();
+    if (!held_now.ok()) return std::nullopt;
+    if (*held_now) {
+      *held = true;
+      return std::nullopt;
+    }
   }
   absl::StatusOr<scheduler::FinishedTask> finished = scheduler_->Complete(report.worker_id, report.task_id);
   // Another worker's task: refused, and the caller is told (and logs it).

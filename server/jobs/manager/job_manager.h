@@ -82,6 +82,10 @@ struct JobManagerOptions {
   bool inspect_only = false;
   // Named in the messages of inspect_only ("mbopt resume JOB --db PATH").
   std::string db_path_for_messages;
+  // Spot checks (spot_check.h): the share of analyses, 0 to 1, answered by
+  // two workers that must agree bit for bit before the optimizer sees them.
+  // 0: none.
+  double verify_fraction = 0;
 };
 
 // One result from a worker: where it goes, and the candidate record the
@@ -89,6 +93,7 @@ struct JobManagerOptions {
 // scheduler's).
 struct WorkerReport {
   std::string worker_id;
+  std::string holder;  // the name of the reporting call's token ("" without tokens)
   std::string task_id;
   std::string job_id;
   jobs::AnalysisRecord record;
@@ -192,6 +197,9 @@ class JobManager {
 
   // The stored study of a job (for workers). NotFound for an unknown job.
   absl::StatusOr<std::string> StudyBytes(const std::string& job_id);
+  // How many of the job's logged analyses each token holder's workers
+  // delivered (`mbopt results`' "computed by"). NotFound for an unknown job.
+  absl::StatusOr<std::vector<store::AnalysesByHolder>> ComputedBy(const std::string& job_id);
 
   // Marks running jobs INTERRUPTED (they resume on the next start), wakes
   // watchers and refuses further results. Idempotent.
@@ -204,8 +212,19 @@ class JobManager {
   // Starts queued jobs while the limits allow, oldest first. Called with no
   // lock held, after every call that may have stopped a job.
   void AdmitWaiting();
-  // The body of ReportResults (AdmitWaiting follows it, outside its locks).
-  std::vector<absl::StatusOr<bool>> IntakeResults(std::vector<WorkerReport> reports);
+  // A worker whose answer to a spot check two others contradicted.
+  struct Contradicted {
+    std::string worker_id;  // full id
+    std::string public_id;
+    std::string holder;
+    std::string job_id;
+    std::int64_t request_id = 0;
+    std::string agreed_by;  // the public ids of the workers that agree
+  };
+  // The body of ReportResults (AdmitWaiting and the quarantine of
+  // contradicted workers follow it, outside its locks).
+  std::vector<absl::StatusOr<bool>> IntakeResults(std::vector<WorkerReport> reports,
+                                                  std::vector<Contradicted>* contradicted);
   // The following run under the entry's mutex.
   // How EnterStateLocked records a state: SetJobState, or already stored
   // by the caller in the same transaction as other rows.
@@ -238,7 +257,31 @@ class JobManager {
   // pending, the job's intake) and completes its task: the record to
   // deliver; nullopt when it is to be dropped (not outstanding any more);
   // InvalidArgument for a result that does not fit its task.
-  absl::StatusOr<std::optional<jobs::AnalysisRecord>> TakeResultLocked(Entry& entry, WorkerReport report);
+  // A result held for a spot check sets *held and returns nullopt.
+  absl::StatusOr<std::optional<jobs::AnalysisRecord>> TakeResultLocked(Entry& entry, WorkerReport report, bool* held,
+                                                                       std::vector<Contradicted>* contradicted);
+  // Spot checks (job_spot_checks.cc). A checked analysis' answer: true when
+  // it is held until another worker's answer agrees (its task was queued
+  // again); false when *record is now the answer to take (two agreed, no
+  // other worker could check it, or too many disagreed: a failure), whose
+  // task the caller completes. Errors of Scheduler::AskAnotherWorker.
+  absl::StatusOr<bool> SpotCheckLocked(Entry& entry, const WorkerReport& report, jobs::AnalysisRecord* record,
+                                       std::vector<Contradicted>* contradicted);
+  // A checked analysis whose second opinion could not be had (`task` was
+  // given up): its held answer is delivered. False when none is held.
+  bool TakeHeldAnswerLocked(Entry& entry, const scheduler::FinishedTask& task);
+  // Quarantines the workers (Scheduler::Quarantine), drops their held
+  // answers, and writes an event to each job concerned and a line to the
+  // log. Takes the jobs' locks: called with none held.
+  void QuarantineContradicted(const std::vector<Contradicted>& contradicted);
+  // Takes back the analyses of the running job that the worker (public id)
+  // answered unchecked, with everything logged after the first of them
+  // (records, later analyses), and runs the job on from there: what it
+  // computes again the other workers answer. Returns how many analyses
+  // were taken back (0: none of its unchecked answers here) and the records
+  // kept in *kept_records.
+  absl::StatusOr<std::int64_t> RecomputeUncheckedLocked(Entry& entry, const std::string& public_id,
+                                                        std::size_t* kept_records);
   // What a batch of a job's results (or the records of a replay) makes the
   // job write, in one transaction, and do once that is committed.
   struct Delivery {

@@ -223,4 +223,9 @@ absl::StatusOr<std::string> JobManager::StudyBytes(const std::string& job_id) {
   return entry->row.study;
 }
 
+absl::StatusOr<std::vector<store::AnalysesByHolder>> JobManager::ComputedBy(const std::string& job_id) {
+  MBOPT_ASSIGN_OR_RETURN(std::shared_ptr<Entry> entry, Find(job_id));
+  return store_->CountAnalysesByHolder(entry->row.id);
+}
+
 }  // namespace mbopt::jobs::manager
