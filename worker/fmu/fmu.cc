@@ -39,13 +39,25 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
                               const std::filesystem::path& temporary_parent) {
   auto archive = UnpackedArchive::Unpack(archive_path, temporary_parent);
   if (!archive.ok()) return archive.status();
+  return Load(*std::move(archive), interface);
+}
 
-  const std::filesystem::path description_path = archive->folder() / "modelDescription.xml";
+absl::StatusOr<Fmu> Fmu::OpenUnpacked(const std::filesystem::path& archive_path, const std::filesystem::path& folder,
+                                      Interface interface) {
+  auto archive = UnpackedArchive::Borrow(archive_path, folder);
+  if (!archive.ok()) return archive.status();
+  return Load(*std::move(archive), interface);
+}
+
+absl::StatusOr<Fmu> Fmu::Load(UnpackedArchive archive, Interface interface) {
+  const std::filesystem::path archive_path = archive.archive_path();
+
+  const std::filesystem::path description_path = archive.folder() / "modelDescription.xml";
   std::ifstream in(description_path, std::ios::binary);
   if (!in) {
     return absl::InvalidArgumentError(absl::StrCat(
         archive_path.string(), ": no modelDescription.xml at the archive's top level (entries: ",
-        archive->entries().empty() ? "none" : absl::StrJoin(archive->entries(), ", "), ")"));
+        archive.entries().empty() ? "none" : absl::StrJoin(archive.entries(), ", "), ")"));
   }
   std::ostringstream text;
   text << in.rdbuf();
@@ -66,9 +78,9 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
     return absl::FailedPreconditionError("this build's platform has no FMI platform name; it loads no FMU");
   }
   const std::string binary_entry = absl::StrCat("binaries/", platform, "/", type->model_identifier, ".so");
-  const std::filesystem::path binary = archive->folder() / binary_entry;
+  const std::filesystem::path binary = archive.folder() / binary_entry;
   if (!std::filesystem::is_regular_file(binary)) {
-    const std::set<std::string> platforms = ArchivePlatforms(*archive);
+    const std::set<std::string> platforms = ArchivePlatforms(archive);
     return absl::InvalidArgumentError(absl::StrCat(
         archive_path.string(), ": no binary ", binary_entry, " for this platform (", platform,
         "); the archive has binaries for: ", platforms.empty() ? "no platform" : absl::StrJoin(platforms, ", ")));
@@ -76,8 +88,8 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
   auto library = Fmi2Library::Load(binary, interface);
   if (!library.ok()) return library.status();
 
-  const std::string resource_uri = absl::StrCat("file://", (archive->folder() / "resources").string());
-  return Fmu(*std::move(archive), *std::move(description), *std::move(library), interface, resource_uri);
+  const std::string resource_uri = absl::StrCat("file://", (archive.folder() / "resources").string());
+  return Fmu(std::move(archive), *std::move(description), *std::move(library), interface, resource_uri);
 }
 
 }  // namespace mbopt::fmu

@@ -26,6 +26,11 @@ class Fmu {
  public:
   static absl::StatusOr<Fmu> Open(const std::filesystem::path& archive_path, Interface interface,
                                   const std::filesystem::path& temporary_parent = {});
+  // The same from an archive unpacked earlier into `folder` (a study's
+  // carried FMU in the worker's cache, archive_cache.h), which stays when
+  // the Fmu goes; `archive_path` names it in messages.
+  static absl::StatusOr<Fmu> OpenUnpacked(const std::filesystem::path& archive_path,
+                                          const std::filesystem::path& folder, Interface interface);
 
   Interface interface() const { return interface_; }
   const ModelDescription& description() const { return description_; }
@@ -38,6 +43,7 @@ class Fmu {
   const std::filesystem::path& archive_path() const { return archive_.archive_path(); }
 
  private:
+  static absl::StatusOr<Fmu> Load(UnpackedArchive archive, Interface interface);
   Fmu(UnpackedArchive archive, ModelDescription description, Fmi2Library library, Interface interface,
       std::string resource_uri)
       : archive_(std::move(archive)),
