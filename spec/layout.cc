@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <variant>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -356,7 +357,11 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
   std::int64_t series_values = 0;
   for (int signal = 0; signal < num_signals; ++signal) series_values += values(signal);
   f.series_bytes = 8 * series_values * (study.optimizer.simulator_sensitivities ? n + 1 : 1);
-  f.memory_bytes = (f.objective_terms + f.constraint_rows) * per_value + row_name_bytes + f.series_bytes;
+  if (const auto* fmu = std::get_if<FmuModel>(&study.scene.model); fmu != nullptr && fmu->archive != nullptr) {
+    f.archive_bytes = static_cast<std::int64_t>(fmu->archive->size());
+  }
+  f.memory_bytes =
+      (f.objective_terms + f.constraint_rows) * per_value + row_name_bytes + f.series_bytes + f.archive_bytes;
   return f;
 }
 

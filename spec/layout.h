@@ -153,7 +153,9 @@ struct StudyFootprint {
   // The series one analysis holds: every output of every load case and
   // every response (and their derivatives with simulator sensitivities).
   std::int64_t series_bytes = 0;
-  std::int64_t memory_bytes = 0;  // all of it, series included
+  // The FMU archive the study carries, held with it by server and workers.
+  std::int64_t archive_bytes = 0;
+  std::int64_t memory_bytes = 0;  // all of it, series and archive included
 };
 StudyFootprint EstimateStudyFootprint(const Study& study);
 

@@ -17,6 +17,8 @@ inline constexpr std::int64_t kMaxInputFileBytes = 16 << 20;
 // costs its length a million times; other strings (expressions, units,
 // descriptions, references) are copied once.
 inline constexpr int kMaxNameBytes = 256;
+// An FMU archive a study carries (FmuModel::archive): a model, not a data set.
+inline constexpr std::int64_t kMaxFmuArchiveBytes = std::int64_t{64} << 20;
 inline constexpr int kMaxStringBytes = 64 << 10;
 
 // Counts.

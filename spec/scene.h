@@ -238,6 +238,13 @@ struct FmuParameterBinding {
 };
 struct FmuModel {
   std::string path;  // the .fmu archive, absolute once the scene file was read
+  // The archive's bytes when the study carries them (null otherwise), shared
+  // by every copy of the scene; their SHA-256 (lowercase hex) and the
+  // platforms they have binaries for (binaries/<platform>/, sorted), both
+  // read from the bytes where the study was converted.
+  std::shared_ptr<const std::string> archive;
+  std::string archive_sha256;
+  std::vector<std::string> platforms;
   bool co_simulation = false;
   std::vector<FmuParameterBinding> parameters;
   double communication_step_s = 0.0;  // co-simulation; 0: the FMU's default

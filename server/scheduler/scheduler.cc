@@ -8,6 +8,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 
 namespace mbopt::scheduler {
 namespace {
@@ -45,13 +46,20 @@ Scheduler::Scheduler(const Clock* clock, SchedulerOptions options)
 
 bool TaskNeeds::RunnableBy(const WorkerCapabilities& capabilities) const {
   if (loads_fmus && capabilities.fmu_platform.empty()) return false;
+  if (loads_fmus && !fmu_platforms.empty() &&
+      std::find(fmu_platforms.begin(), fmu_platforms.end(), capabilities.fmu_platform) == fmu_platforms.end()) {
+    return false;
+  }
   return driver.empty() ||
          std::find(capabilities.drivers.begin(), capabilities.drivers.end(), driver) != capabilities.drivers.end();
 }
 
 std::string TaskNeeds::Describe() const {
   if (!driver.empty()) return absl::StrCat("driver \"", driver, "\"");
-  return loads_fmus ? "FMU support (a platform it loads FMUs for)" : "";
+  if (!loads_fmus) return "";
+  if (fmu_platforms.empty()) return "FMU support (a platform it loads FMUs for)";
+  return absl::StrCat("FMU support for ", absl::StrJoin(fmu_platforms, " or "),
+                      " (the platforms the FMU has binaries for)");
 }
 
 std::string Scheduler::RegisterWorker(const std::string& name, int slots, WorkerCapabilities capabilities,

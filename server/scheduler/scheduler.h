@@ -67,9 +67,11 @@ struct WorkerCapabilities {
 // What every task of a job needs of its worker; default: any worker.
 struct TaskNeeds {
   std::string driver;  // non-empty: a worker declaring this driver
-  // A worker that loads FMUs (a non-empty fmu_platform): which platforms an
-  // FMU carries binaries for is known only where it is opened.
+  // A worker that loads FMUs (a non-empty fmu_platform), and when
+  // fmu_platforms is not empty (the study carries its FMU, whose
+  // binaries/<platform>/ folders were read) one whose platform is among them.
   bool loads_fmus = false;
+  std::vector<std::string> fmu_platforms = {};
   bool RunnableBy(const WorkerCapabilities& capabilities) const;
   // "driver \"x\"", for messages; "" when any worker will do.
   std::string Describe() const;

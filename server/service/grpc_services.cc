@@ -54,7 +54,7 @@ grpc::Status JobServiceImpl::Submit(grpc::ServerContext* context, const v1::Subm
   if (!caller.ok()) return ToGrpcStatus(caller.status());
   if (request->study().empty()) return ToGrpcStatus(absl::InvalidArgumentError("SubmitJobRequest.study is missing"));
   // A study comes from files of at most kMaxInputFileBytes each (its own and
-  // its scene's); a larger message did not, and is refused before it is
+  // its scene's) and an FMU of at most kMaxFmuArchiveBytes; a larger message did not, and is refused before it is
   // decoded, stored or sent to workers.
   const std::size_t study_bytes = request->study().size();
   if (study_bytes > kMaxStudyMessageBytes) {

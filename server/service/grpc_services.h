@@ -23,9 +23,11 @@ class JobServiceImpl final : public v1::JobService::Service {
   JobServiceImpl(jobs::manager::JobManager* manager, const CallAuthorizer* authorizer, const scheduler::Clock* clock)
       : manager_(manager), authorizer_(authorizer), clock_(clock) {}
 
-  // What Submit takes: a study message no larger than its two files may be
-  // (spec/limits.h), and a source name of a path's length.
-  static constexpr std::size_t kMaxStudyMessageBytes = 2 * static_cast<std::size_t>(spec::kMaxInputFileBytes);
+  // What Submit takes: a study message no larger than its two files and the
+  // FMU archive it may carry may be (spec/limits.h), and a source name of a
+  // path's length.
+  static constexpr std::size_t kMaxStudyMessageBytes =
+      2 * static_cast<std::size_t>(spec::kMaxInputFileBytes) + static_cast<std::size_t>(spec::kMaxFmuArchiveBytes);
   static constexpr std::size_t kMaxSourceNameBytes = 4096;
 
   grpc::Status Submit(grpc::ServerContext* context, const v1::SubmitJobRequest* request,

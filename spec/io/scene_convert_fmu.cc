@@ -2,11 +2,15 @@
 #include "spec/io/scene_converter.h"
 
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <set>
 #include <string>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "spec/io/fmu_archive_contents.h"
+#include "spec/limits.h"
 
 namespace mbopt::spec::io {
 
@@ -32,6 +36,25 @@ FmuModel SceneConverter::ConvertFmu(const v1::FmuModel& m, const Where& w) {
     errors_.Add(w, "communication_step_s", "applies to `interface: FMU_CO_SIMULATION` only");
   }
   out.communication_step_s = m.communication_step_s();
+  if (!m.archive().empty()) {
+    // Read from the bytes here, never taken from the message: what the
+    // server matches and what workers cache under is what the bytes hold.
+    if (static_cast<std::int64_t>(m.archive().size()) > kMaxFmuArchiveBytes) {
+      errors_.Add(w, "archive",
+                  absl::StrCat(m.archive().size(), " bytes; an FMU a study carries may have ",
+                               kMaxFmuArchiveBytes >> 20, " MiB at most"));
+    } else if (absl::StatusOr<FmuArchiveContents> contents = ReadFmuArchiveContents(m.archive()); !contents.ok()) {
+      errors_.Add(w, "archive", absl::StrCat("the bytes of ", out.path, ": ", contents.status().message()));
+    } else if (contents->platforms.empty()) {
+      errors_.Add(w, "archive",
+                  absl::StrCat(out.path, " has no binaries (no binaries/<platform>/ folder holding a file): no "
+                               "worker can load it"));
+    } else {
+      out.archive = std::make_shared<const std::string>(m.archive());
+      out.archive_sha256 = contents->sha256;
+      out.platforms = contents->platforms;
+    }
+  }
   std::set<std::string> seen;
   for (int i = 0; i < m.parameters_size(); ++i) {
     const v1::FmuParameter& p = m.parameters(i);

@@ -14,6 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "common/status_macros.h"
+#include "spec/io/fmu_archive_contents.h"
 #include "spec/io/locator.h"
 #include "spec/io/scene_convert.h"
 #include "spec/io/study_convert.h"
@@ -119,11 +120,15 @@ struct ParsedStudy {
 };
 
 // An FMU scene's relative `fmu.path` made absolute from `folder` (the scene
-// file's), so that the scene means the same file once it is inlined into a
-// study and sent on; and the file checked to exist here, where a mistake is
-// still the user's to fix (`scene_source` names the file in the message).
+// file's), and the file's bytes put into `fmu.archive`, so that the study
+// carries its FMU wherever it is sent (no worker needs the file); checked
+// here, where a mistake is still the user's to fix (`scene_source` names
+// the file in the message).
 absl::Status AnchorFmuPath(const std::filesystem::path& folder, const std::string& scene_source, v1::Scene* scene) {
   if (!scene->has_fmu() || scene->fmu().path().empty()) return absl::OkStatus();
+  // A study written back out with its FMU (a report analysing a job's
+  // designs) already carries it: the file may be long gone.
+  if (!scene->fmu().archive().empty()) return absl::OkStatus();
   std::filesystem::path fmu_path(scene->fmu().path());
   if (fmu_path.is_relative()) fmu_path = folder / fmu_path;
   fmu_path = fmu_path.lexically_normal();
@@ -134,6 +139,9 @@ absl::Status AnchorFmuPath(const std::filesystem::path& folder, const std::strin
                                                    " is taken from the scene file's folder)"));
   }
   scene->mutable_fmu()->set_path(fmu_path.string());
+  absl::StatusOr<std::string> bytes = ReadFmuArchive(fmu_path);
+  if (!bytes.ok()) return absl::InvalidArgumentError(absl::StrCat(scene_source, ": fmu.path: ", bytes.status().message()));
+  scene->mutable_fmu()->set_archive(*std::move(bytes));
   return absl::OkStatus();
 }
 

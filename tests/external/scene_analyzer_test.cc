@@ -164,6 +164,140 @@ TEST_F(ExternalSceneAnalysis, AResultTheSceneNamesButTheDriverDidNotWriteNamesTh
               AllOf(HasSubstr("results.json: no value \"f\" (output \"f\")"), HasSubstr("the file's values: \"g\"")));
 }
 
+// Gradients the driver writes (docs/external.md, "Gradients"). The driver
+// computes f = a b and y = (a, b, a b) with their derivatives in its own
+// parameters a and b; the scene gives it a = p and b = c p through an
+// expression, and the design variable x sets p = 2 x. So at x the study
+// sees f = c (2x)^2 with df/dx = 8 c x, and y's rows (2x, 2cx, 4cx^2) with
+// derivatives (2, 2c, 8cx): the chain rule through the expression and the
+// variable's scale.
+const char kProductStudy[] = R"pb(name: "product study"
+scene {
+  name: "product"
+  parameters { name: "p" value: 0.1 }
+  parameters { name: "c" value: -3 }
+  external {
+    driver: "product"
+    inputs { name: "a" value { param: "p" } }
+    inputs { name: "b" value { expr: "c * p" } }
+  }
+  outputs { name: "f" external_value { name: "f" } }
+  outputs { name: "y" external_series { name: "y" } }
+  time_grid { start_s: 0 end_s: 1 points: 3 }
+}
+variables { name: "x" parameter: "p" scale: 2 initial: 0.1 lower: -1 upper: 1 }
+objective { minimize: "f" }
+constraints { name: "y" output: "y" reduction: REDUCTION_MAX limit: 10 }
+optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }
+)pb";
+
+const char kProductJsonScript[] = R"(. ./input.sh
+awk -v a="$a" -v b="$b" 'BEGIN {
+  printf "{\"values\": {\"f\": %.17g}, \"series\": {\"y\": [%.17g, %.17g, %.17g]},\n", a * b, a, b, a * b
+  printf " \"gradients\": {\"values\": {\"f\": {\"a\": %.17g, \"b\": %.17g}},\n", b, a
+  printf "   \"series\": {\"y\": {\"a\": [1, 0, %.17g], \"b\": [0, 1, %.17g]}}}}\n", b, a
+}' > results.json
+)";
+
+// The same model without the series, in Dakota's format: f = a b and
+// g = a + b, then their gradients in the order the driver declares a, b.
+const char kProductDakotaScript[] = R"(. ./input.sh
+awk -v a="$a" -v b="$b" 'BEGIN {
+  printf "%.17g f\n%.17g g\n[ %.17g %.17g ]\n[ 1 1 ]\n", a * b, a + b, b, a
+}' > results.out
+)";
+
+DriverDeclaration ProductDriver(const TempDir& base, const std::string& script, ResultsFormat format) {
+  DriverDeclaration d = EchoDriver(base, script);
+  d.name = "product";
+  d.results_format = format;
+  d.results_file = format == ResultsFormat::kJson ? "results.json" : "results.out";
+  return d;
+}
+
+TEST_F(ExternalSceneAnalysis, TheDriversGradientsAreTheStudysGradientsThroughTheChainRule) {
+  settings_.drivers = {ProductDriver(base_, kProductJsonScript, ResultsFormat::kJson)};
+  const spec::Study study = ReadStudy(kProductStudy);
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const ExternalSceneAnalyzer analyzer(settings_, "t");
+  const double x = 0.7, c = -3.0;
+  absl::StatusOr<engine::StudyEvaluation> evaluation =
+      engine::EvaluateStudy(study, *layout, {x}, /*want_gradients=*/true, &analyzer);
+  ASSERT_TRUE(evaluation.ok()) << evaluation.status();
+  ASSERT_TRUE(evaluation->ok()) << evaluation->failure.reason;
+  ASSERT_TRUE(evaluation->gradients.has_value()) << evaluation->gradients_unavailable;
+  ASSERT_EQ(evaluation->values->objective_terms.size(), 1u);
+  EXPECT_DOUBLE_EQ(evaluation->values->objective_terms[0], c * (2 * x) * (2 * x));
+  ASSERT_EQ(evaluation->gradients->objective_terms.size(), 1u);
+  ASSERT_EQ(evaluation->gradients->objective_terms[0].size(), 1u);
+  EXPECT_DOUBLE_EQ(evaluation->gradients->objective_terms[0][0], 8 * c * x);
+  const std::vector<double> expected_rows = {2.0, 2 * c, 8 * c * x};
+  ASSERT_EQ(evaluation->gradients->constraint_rows.size(), expected_rows.size());
+  for (size_t r = 0; r < expected_rows.size(); ++r) {
+    EXPECT_DOUBLE_EQ(evaluation->gradients->constraint_rows[r][0], expected_rows[r]) << "row " << r;
+  }
+}
+
+TEST_F(ExternalSceneAnalysis, DakotaGradientLinesGiveTheSameGradientsBitForBit) {
+  std::string dakota_study = kProductStudy;
+  dakota_study.replace(dakota_study.find(R"(outputs { name: "y" external_series { name: "y" } })"),
+                       std::string(R"(outputs { name: "y" external_series { name: "y" } })").size(),
+                       R"(outputs { name: "g" external_value { name: "g" } })");
+  dakota_study.replace(dakota_study.find(R"(output: "y" reduction: REDUCTION_MAX)"),
+                       std::string(R"(output: "y" reduction: REDUCTION_MAX)").size(),
+                       R"(output: "g" reduction: REDUCTION_FINAL)");
+  settings_.drivers = {ProductDriver(base_, kProductDakotaScript, ResultsFormat::kDakota)};
+  const spec::Study study = ReadStudy(dakota_study);
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const ExternalSceneAnalyzer analyzer(settings_, "t");
+  const double x = 0.7, c = -3.0;
+  absl::StatusOr<engine::StudyEvaluation> evaluation =
+      engine::EvaluateStudy(study, *layout, {x}, /*want_gradients=*/true, &analyzer);
+  ASSERT_TRUE(evaluation.ok()) << evaluation.status();
+  ASSERT_TRUE(evaluation->ok()) << evaluation->failure.reason;
+  ASSERT_TRUE(evaluation->gradients.has_value()) << evaluation->gradients_unavailable;
+  EXPECT_DOUBLE_EQ(evaluation->gradients->objective_terms[0][0], 8 * c * x);
+  // g = p + c p: dg/dx = 2 (1 + c).
+  ASSERT_EQ(evaluation->gradients->constraint_rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(evaluation->gradients->constraint_rows[0][0], 2 * (1 + c));
+
+  // And the same objective gradient, bit for bit, as from the JSON driver.
+  ExternalWorkerSettings json_settings;
+  TempDir json_base;
+  json_settings.drivers = {ProductDriver(json_base, kProductJsonScript, ResultsFormat::kJson)};
+  json_settings.work_directory = work_.path() / "json-runs";
+  const spec::Study json_study = ReadStudy(kProductStudy);
+  const ExternalSceneAnalyzer json_analyzer(json_settings, "t");
+  absl::StatusOr<engine::StudyEvaluation> from_json =
+      engine::EvaluateStudy(json_study, *spec::MakeStudyLayout(json_study), {x}, true, &json_analyzer);
+  ASSERT_TRUE(from_json.ok() && from_json->gradients.has_value());
+  EXPECT_EQ(from_json->gradients->objective_terms[0][0], evaluation->gradients->objective_terms[0][0]);
+}
+
+TEST_F(ExternalSceneAnalysis, ADriverWithoutTheGradientsAStudyAsksForFailsNamingDriverAndFile) {
+  settings_.drivers = {ProductDriver(base_, R"(. ./input.sh
+printf '{"values": {"f": 1}, "series": {"y": [1, 2, 3]}}' > results.json
+)", ResultsFormat::kJson)};
+  const spec::Study study = ReadStudy(kProductStudy);
+  absl::StatusOr<spec::StudyLayout> layout = spec::MakeStudyLayout(study);
+  ASSERT_TRUE(layout.ok()) << layout.status();
+  const ExternalSceneAnalyzer analyzer(settings_, "t");
+  absl::StatusOr<engine::StudyEvaluation> evaluation =
+      engine::EvaluateStudy(study, *layout, {0.7}, /*want_gradients=*/true, &analyzer);
+  ASSERT_TRUE(evaluation.ok()) << evaluation.status();
+  EXPECT_EQ(evaluation->failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_THAT(evaluation->failure.reason,
+              AllOf(HasSubstr("driver \"product\""), HasSubstr("results.json: no gradient of value \"f\""),
+                    HasSubstr("with respect to parameter \"a\""), HasSubstr("SENSITIVITY_METHOD_SIMULATOR")));
+  // Without gradients asked for, the same driver is fine.
+  absl::StatusOr<engine::StudyEvaluation> plain =
+      engine::EvaluateStudy(study, *layout, {0.7}, /*want_gradients=*/false, &analyzer);
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_TRUE(plain->ok()) << plain->failure.reason;
+}
+
 TEST(ExternalOutputs, ASeriesWithItsOwnTimeIsInterpolatedOntoTheGrid) {
   const spec::Study study = ReadStudy();
   ExternalResults results;

@@ -126,6 +126,36 @@ TEST(Scheduler, FmuTasksGoOnlyToWorkersThatLoadFmus) {
   EXPECT_EQ((*tasks)[0].job_id, "job-fmu");
 }
 
+// An FMU the study carries has binaries for some platforms only: its tasks
+// go to a worker that loads one of those, never to one that loads FMUs for
+// another platform, and until such a worker registers the job waits.
+TEST(Scheduler, FmuTasksGoOnlyToWorkersThatLoadOneOfTheFmusPlatforms) {
+  FakeClock clock;
+  Scheduler scheduler(&clock, Options());
+  TaskNeeds needs;
+  needs.loads_fmus = true;
+  needs.fmu_platforms = {"darwin64", "win64"};
+  EXPECT_EQ(needs.Describe(), "FMU support for darwin64 or win64 (the platforms the FMU has binaries for)");
+  scheduler.SetJobNeeds("job-fmu", needs);
+  scheduler.Enqueue("job-fmu", 0, {1.0});
+  const std::string linux_worker = scheduler.RegisterWorker("linux", 1, WorkerCapabilities{{}, "linux64"});
+  EXPECT_FALSE(scheduler.SomeWorkerCan(needs));
+  auto none = scheduler.Acquire(linux_worker, 10);
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->empty()) << "a linux64 worker cannot load an FMU without linux64 binaries";
+  const std::string windows_worker = scheduler.RegisterWorker("windows", 1, WorkerCapabilities{{}, "win64"});
+  EXPECT_TRUE(scheduler.SomeWorkerCan(needs));
+  auto tasks = scheduler.Acquire(windows_worker, 10);
+  ASSERT_TRUE(tasks.ok());
+  ASSERT_EQ(tasks->size(), 1u);
+  EXPECT_EQ((*tasks)[0].job_id, "job-fmu");
+  // Without the FMU's platforms (a study that names the file only), any
+  // worker that loads FMUs will do.
+  needs.fmu_platforms.clear();
+  EXPECT_TRUE(needs.RunnableBy(WorkerCapabilities{{}, "linux64"}));
+  EXPECT_FALSE(needs.RunnableBy(WorkerCapabilities{{}, ""}));
+}
+
 TEST(Scheduler, TasksThatNeedADriverGoOnlyToWorkersThatDeclareIt) {
   FakeClock clock;
   Scheduler scheduler(&clock, Options());

@@ -133,9 +133,12 @@ TEST(ExternalScene, EffectsAreTheDriversNotTheScenes) {
               HasSubstr("an external scene's effects are its driver's"));
 }
 
-TEST(ExternalScene, SimulatorSensitivitiesAreRefusedUntilDriversGradientsAreRead) {
-  EXPECT_THAT(ParseError(std::string(kStudy) + "optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }\n"),
-              HasSubstr("not available for external scenes yet"));
+// The driver's gradients are the simulator's sensitivities
+// (worker/external); whether it writes them shows in its results.
+TEST(ExternalScene, SimulatorSensitivitiesAreAcceptedAsTheDriversGradients) {
+  absl::StatusOr<Study> study = Read(std::string(kStudy) + "optimizer { sensitivity: SENSITIVITY_METHOD_SIMULATOR }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_TRUE(study->optimizer.simulator_sensitivities);
 }
 
 }  // namespace

@@ -23,6 +23,14 @@ class ExternalAnalyzer {
   // at once when the worker has several slots.
   virtual spec::AnalysisReport AnalyzeExternal(const spec::Scene& scene,
                                                const std::vector<double>& parameter_values_si) const = 0;
+  // The same analysis, with the derivatives of its outputs with respect to
+  // the scene parameters `parameters` in `output_derivatives`
+  // ([k][output][instant], one series per output), from the gradients the
+  // simulation code writes. A code that writes none the study needs makes
+  // the analysis fail saying so: the study asked for them.
+  virtual spec::AnalysisReport AnalyzeExternalWithSensitivities(
+      const spec::Scene& scene, const std::vector<double>& parameter_values_si, const std::vector<int>& parameters,
+      std::vector<std::vector<std::vector<double>>>* output_derivatives) const = 0;
 };
 
 }  // namespace mbopt::engine

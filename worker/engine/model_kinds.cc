@@ -41,7 +41,7 @@ spec::AnalysisReport AnalyzeLumped(const spec::Scene& scene, const std::vector<d
 
 SensitivityAnalysis AnalyzeLumpedWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
                                                    const std::vector<int>& parameters,
-                                                   budget::AnalysisBudget* budget) {
+                                                   budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
   lumped::LumpedSensitivityOptions options;
   options.budget = budget;
   lumped::LumpedSensitivityResult result = lumped::SimulateLumpedWithSensitivities(scene, p, parameters, options);
@@ -60,7 +60,7 @@ spec::AnalysisReport AnalyzeMultibody(const spec::Scene& scene, const std::vecto
 
 SensitivityAnalysis AnalyzeMultibodyWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
                                                       const std::vector<int>& parameters,
-                                                      budget::AnalysisBudget* budget) {
+                                                      budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
   multibody::MultibodySensitivityResult result =
       multibody::AnalyzeMultibodySceneWithSensitivities(scene, p, parameters, budget);
   return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
@@ -90,6 +90,23 @@ spec::AnalysisReport AnalyzeExternal(const spec::Scene& scene, const std::vector
                                            "declares them (mbopt-worker --drivers FILE)"));
   report.formulation = spec::Formulation::kExternal;
   return report;
+}
+
+SensitivityAnalysis AnalyzeExternalWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
+                                                     const std::vector<int>& parameters,
+                                                     budget::AnalysisBudget* budget, const ExternalAnalyzer* external) {
+  SensitivityAnalysis out;
+  if (external == nullptr) {
+    out.report = AnalyzeExternal(scene, p, budget, external);
+    out.unavailable = "no analysis drivers in this program";
+    return out;
+  }
+  if (spec::AnalysisFailure spent = budget->Check(0.0); !spent.ok()) {
+    out.report = FailedAtStart(scene, std::move(spent));
+    return out;
+  }
+  out.report = external->AnalyzeExternalWithSensitivities(scene, p, parameters, &out.output_derivatives);
+  return out;
 }
 
 std::vector<ModelKind> MakeTable() {
@@ -131,10 +148,10 @@ std::vector<ModelKind> MakeTable() {
       "a simulation code the worker declares, run in its own folder and process group (worker/external)",
       "wall_seconds only: the driver's work is its own",
       &AnalyzeExternal,
-      [](const spec::Scene&, const std::vector<int>&) {
-        return Never("an external driver's gradients are not read yet");
-      },
-      nullptr};
+      // Whether the driver writes gradients shows only in its results: one
+      // that writes none fails the analysis saying so.
+      [](const spec::Scene&, const std::vector<int>&) { return std::string(); },
+      &AnalyzeExternalWithSensitivities};
   table[IndexOf<spec::FmuModel>()] = {
       "fmu",
       "an FMI 2.0 or 3.0 FMU: Model Exchange integrated by CVODES with its events, or Co-Simulation stepped "

@@ -46,10 +46,12 @@ struct ModelKind {
 
   // The analysis with sensitivities; only called when
   // sensitivities_unavailable said "". Null for kinds that never have them.
+  // `external` as for `analyze`.
   SensitivityAnalysis (*analyze_with_sensitivities)(const spec::Scene& scene,
                                                     const std::vector<double>& parameter_values_si,
                                                     const std::vector<int>& parameters,
-                                                    budget::AnalysisBudget* budget);
+                                                    budget::AnalysisBudget* budget,
+                                                    const ExternalAnalyzer* external);
 };
 
 // The entry of `scene`'s model kind.

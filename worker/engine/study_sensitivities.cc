@@ -41,7 +41,7 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
     budget::AnalysisBudget case_budget =
         budget.ForAnalysis(study.scene.integrator.max_wall_seconds, study.scene.integrator.max_steps);
     const double start_s = budget.NowSeconds();
-    SensitivityAnalysis result = kind.analyze_with_sensitivities(study.scene, case_si, parameters, &case_budget);
+    SensitivityAnalysis result = kind.analyze_with_sensitivities(study.scene, case_si, parameters, &case_budget, external);
     spec::AnalysisReport report = std::move(result.report);
     report.counters.wall_seconds = budget.NowSeconds() - start_s;
     if (out.gradients_unavailable.empty()) out.gradients_unavailable = std::move(result.unavailable);

@@ -30,8 +30,8 @@ struct StudyAnalysisWithGradients {
 };
 
 // `x_scaled` has one entry per study variable; `layout` is
-// MakeStudyLayout(study). An external scene has no gradients here: it is
-// analysed by `external` and gradients_unavailable says so. Each load case
+// MakeStudyLayout(study). An external scene is analysed by `external`, its
+// gradients those its driver writes. Each load case
 // is one analysis within `budget`, as engine::Analyze.
 StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
                                                      const spec::StudyLayout& layout,

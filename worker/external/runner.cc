@@ -337,7 +337,7 @@ absl::StatusOr<ExternalOutcome> RunInFolder(const DriverDeclaration& driver, con
   }
   std::ifstream in(results_path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  absl::StatusOr<ExternalResults> results = ParseResults(driver.results_format, text, driver.results_file);
+  absl::StatusOr<ExternalResults> results = ParseResults(driver.results_format, text, driver.results_file, driver.parameters);
   if (!results.ok()) {
     outcome.failure = spec::AnalysisFailure::Of(
         spec::FailureKind::kInvalidModel,

@@ -158,11 +158,114 @@ absl::StatusOr<std::vector<spec::OutputValues>> OutputsFromResults(const spec::S
   return outputs;
 }
 
+absl::StatusOr<std::vector<std::vector<std::vector<double>>>> OutputDerivativesFromResults(
+    const spec::Scene& scene, const ExternalResults& results, const std::vector<double>& parameter_values_si,
+    const std::vector<int>& parameters, const std::string& results_file) {
+  const auto* model = std::get_if<spec::ExternalModel>(&scene.model);
+  if (model == nullptr) return absl::InvalidArgumentError("not an external scene");
+  // input_partials[i][k] = d input i / d scene parameter parameters[k].
+  std::vector<std::vector<double>> input_partials(model->inputs.size(), std::vector<double>(parameters.size(), 0.0));
+  for (size_t i = 0; i < model->inputs.size(); ++i) {
+    const spec::Number& value = model->inputs[i].value;
+    if (value.expression != nullptr) {
+      std::vector<double> partials;
+      value.expression->EvaluateWithPartials(parameter_values_si, &partials);
+      const std::vector<int>& read = value.expression->parameters();
+      for (size_t r = 0; r < read.size(); ++r) {
+        for (size_t k = 0; k < parameters.size(); ++k) {
+          if (parameters[k] == read[r]) input_partials[i][k] += partials[r];
+        }
+      }
+    } else {
+      for (size_t k = 0; k < parameters.size(); ++k) {
+        if (value.param >= 0 && parameters[k] == value.param) input_partials[i][k] = 1.0;
+      }
+    }
+  }
+  auto depends = [&](size_t i) {
+    return std::any_of(input_partials[i].begin(), input_partials[i].end(), [](double d) { return d != 0.0; });
+  };
+  auto missing = [&](const char* kind, const std::string& name, const std::string& output,
+                     const std::string& parameter, const std::string& given) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        results_file, ": no gradient of ", kind, " \"", name, "\" (output \"", output,
+        "\") with respect to parameter \"", parameter,
+        "\": the study asks for simulator sensitivities (SENSITIVITY_METHOD_SIMULATOR), so the driver must write "
+        "them (docs/external.md, \"Gradients\"); the file's gradients of it: ", given));
+  };
+  const std::vector<double> instants_s = scene.time_grid.Instants();
+  std::vector<std::vector<std::vector<double>>> derivatives(parameters.size());
+  for (const spec::Output& output : scene.outputs) {
+    const auto* wanted = std::get_if<spec::ExternalResultOutput>(&output.kind);
+    if (wanted == nullptr) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("output \"", output.name, "\" is not an external_value or external_series output"));
+    }
+    const size_t length = wanted->series ? instants_s.size() : 1;
+    std::vector<std::vector<double>> of_output(parameters.size(), std::vector<double>(length, 0.0));
+    for (size_t i = 0; i < model->inputs.size(); ++i) {
+      if (!depends(i)) continue;
+      const std::string& parameter = model->inputs[i].name;
+      std::vector<double> d_output_d_input;
+      if (!wanted->series) {
+        const auto of_value = results.value_gradients.find(wanted->name);
+        const double* found = nullptr;
+        if (of_value != results.value_gradients.end()) {
+          const auto it = of_value->second.find(parameter);
+          if (it != of_value->second.end()) found = &it->second;
+        }
+        if (found == nullptr) {
+          return missing("value", wanted->name, output.name, parameter,
+                         of_value == results.value_gradients.end() ? "none" : NamesOf(of_value->second));
+        }
+        d_output_d_input = {*found};
+      } else {
+        const auto of_series = results.series_gradients.find(wanted->name);
+        const std::vector<double>* found = nullptr;
+        if (of_series != results.series_gradients.end()) {
+          const auto it = of_series->second.find(parameter);
+          if (it != of_series->second.end()) found = &it->second;
+        }
+        if (found == nullptr) {
+          return missing("series", wanted->name, output.name, parameter,
+                         of_series == results.series_gradients.end() ? "none" : NamesOf(of_series->second));
+        }
+        // Linear interpolation weights do not depend on the values: the
+        // derivative goes onto the grid as the series does.
+        absl::StatusOr<std::vector<double>> on_grid =
+            SeriesOnGrid(absl::StrCat("gradient of ", wanted->name, " with respect to ", parameter), *found,
+                         results.time_s, instants_s, results_file);
+        if (!on_grid.ok()) return on_grid.status();
+        d_output_d_input = *std::move(on_grid);
+      }
+      for (size_t k = 0; k < parameters.size(); ++k) {
+        const double chain = input_partials[i][k];
+        if (chain == 0.0) continue;
+        for (size_t t = 0; t < length; ++t) of_output[k][t] += chain * d_output_d_input[t];
+      }
+    }
+    for (size_t k = 0; k < parameters.size(); ++k) derivatives[k].push_back(std::move(of_output[k]));
+  }
+  return derivatives;
+}
+
 ExternalSceneAnalyzer::ExternalSceneAnalyzer(const ExternalWorkerSettings& settings, const std::string& label)
     : settings_(settings), label_(SafeLabel(label)) {}
 
 spec::AnalysisReport ExternalSceneAnalyzer::AnalyzeExternal(const spec::Scene& scene,
                                                             const std::vector<double>& parameter_values_si) const {
+  return Analyze(scene, parameter_values_si, {}, nullptr);
+}
+
+spec::AnalysisReport ExternalSceneAnalyzer::AnalyzeExternalWithSensitivities(
+    const spec::Scene& scene, const std::vector<double>& parameter_values_si, const std::vector<int>& parameters,
+    std::vector<std::vector<std::vector<double>>>* output_derivatives) const {
+  return Analyze(scene, parameter_values_si, parameters, output_derivatives);
+}
+
+spec::AnalysisReport ExternalSceneAnalyzer::Analyze(
+    const spec::Scene& scene, const std::vector<double>& parameter_values_si, const std::vector<int>& parameters,
+    std::vector<std::vector<std::vector<double>>>* output_derivatives) const {
   spec::AnalysisReport report;
   report.formulation = spec::Formulation::kExternal;
   report.times_s = scene.time_grid.Instants();
@@ -211,6 +314,16 @@ spec::AnalysisReport ExternalSceneAnalyzer::AnalyzeExternal(const spec::Scene& s
     report.Fail(spec::FailureKind::kInvalidModel,
                 absl::StrCat("driver \"", driver->name, "\": ", outputs.status().message()));
     return report;
+  }
+  if (output_derivatives != nullptr) {
+    absl::StatusOr<std::vector<std::vector<std::vector<double>>>> derivatives = OutputDerivativesFromResults(
+        scene, outcome->results, parameter_values_si, parameters, driver->results_file);
+    if (!derivatives.ok()) {
+      report.Fail(spec::FailureKind::kInvalidModel,
+                  absl::StrCat("driver \"", driver->name, "\": ", derivatives.status().message()));
+      return report;
+    }
+    *output_derivatives = *std::move(derivatives);
   }
   report.outputs = *std::move(outputs);
   return report;

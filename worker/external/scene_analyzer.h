@@ -12,6 +12,11 @@
 //     without a "time" array in the results, the series has one number per
 //     grid instant and is taken as it is; with one, it is interpolated
 //     linearly onto the grid instants, which must lie within its span.
+// With sensitivities, the results' gradients (d result / d driver
+// parameter) are carried to the scene's parameters through the inputs:
+// d output / d p = sum over inputs of d output / d input * d input / d p
+// (1 for an input that is the parameter, the expression's own partials for
+// an expression); a series' gradient is put on the grid as the series is.
 // Everything that goes wrong is a failed analysis with its reason: a driver
 // this worker does not declare, an input the driver does not take, a
 // parameter of the driver no input gives, a name missing from the results
@@ -61,6 +66,13 @@ absl::StatusOr<std::vector<spec::OutputValues>> OutputsFromResults(const spec::S
                                                                     const ExternalResults& results,
                                                                     const std::string& results_file);
 
+// d output / d scene parameter `parameters[k]`, [k][output][instant], from
+// the results' gradients (see above). InvalidArgument names the output, the
+// results file and the driver parameter whose derivative is missing.
+absl::StatusOr<std::vector<std::vector<std::vector<double>>>> OutputDerivativesFromResults(
+    const spec::Scene& scene, const ExternalResults& results, const std::vector<double>& parameter_values_si,
+    const std::vector<int>& parameters, const std::string& results_file);
+
 class ExternalSceneAnalyzer final : public engine::ExternalAnalyzer {
  public:
   // `settings` outlives the analyzer. `label` begins every analysis id
@@ -70,8 +82,16 @@ class ExternalSceneAnalyzer final : public engine::ExternalAnalyzer {
 
   spec::AnalysisReport AnalyzeExternal(const spec::Scene& scene,
                                        const std::vector<double>& parameter_values_si) const override;
+  spec::AnalysisReport AnalyzeExternalWithSensitivities(
+      const spec::Scene& scene, const std::vector<double>& parameter_values_si, const std::vector<int>& parameters,
+      std::vector<std::vector<std::vector<double>>>* output_derivatives) const override;
 
  private:
+  // Both of the above: derivatives only when `output_derivatives` is set.
+  spec::AnalysisReport Analyze(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
+                               const std::vector<int>& parameters,
+                               std::vector<std::vector<std::vector<double>>>* output_derivatives) const;
+
   const ExternalWorkerSettings& settings_;
   std::string label_;
 };

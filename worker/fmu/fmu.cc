@@ -63,13 +63,25 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
                               const std::filesystem::path& temporary_parent) {
   auto archive = UnpackedArchive::Unpack(archive_path, temporary_parent);
   if (!archive.ok()) return archive.status();
+  return Load(*std::move(archive), interface);
+}
 
-  const std::filesystem::path description_path = archive->folder() / "modelDescription.xml";
+absl::StatusOr<Fmu> Fmu::OpenUnpacked(const std::filesystem::path& archive_path, const std::filesystem::path& folder,
+                                      Interface interface) {
+  auto archive = UnpackedArchive::Borrow(archive_path, folder);
+  if (!archive.ok()) return archive.status();
+  return Load(*std::move(archive), interface);
+}
+
+absl::StatusOr<Fmu> Fmu::Load(UnpackedArchive archive, Interface interface) {
+  const std::filesystem::path archive_path = archive.archive_path();
+
+  const std::filesystem::path description_path = archive.folder() / "modelDescription.xml";
   std::ifstream in(description_path, std::ios::binary);
   if (!in) {
     return absl::InvalidArgumentError(absl::StrCat(
         archive_path.string(), ": no modelDescription.xml at the archive's top level (entries: ",
-        archive->entries().empty() ? "none" : absl::StrJoin(archive->entries(), ", "), ")"));
+        archive.entries().empty() ? "none" : absl::StrJoin(archive.entries(), ", "), ")"));
   }
   std::ostringstream text;
   text << in.rdbuf();
@@ -91,23 +103,23 @@ absl::StatusOr<Fmu> Fmu::Open(const std::filesystem::path& archive_path, Interfa
     return absl::FailedPreconditionError("this build's platform has no FMI platform name; it loads no FMU");
   }
   const std::string binary_entry = absl::StrCat("binaries/", platform, "/", type->model_identifier, ".so");
-  const std::filesystem::path binary = archive->folder() / binary_entry;
+  const std::filesystem::path binary = archive.folder() / binary_entry;
   if (!std::filesystem::is_regular_file(binary)) {
-    const std::set<std::string> platforms = ArchivePlatforms(*archive);
+    const std::set<std::string> platforms = ArchivePlatforms(archive);
     return absl::InvalidArgumentError(absl::StrCat(
         archive_path.string(), ": no binary ", binary_entry, " for this platform (", platform,
         "); the archive has binaries for: ", platforms.empty() ? "no platform" : absl::StrJoin(platforms, ", ")));
   }
-  const std::filesystem::path resources = archive->folder() / "resources";
+  const std::filesystem::path resources = archive.folder() / "resources";
   if (major_version >= 3) {
     auto library = Fmi3Library::Load(binary, interface);
     if (!library.ok()) return library.status();
-    return Fmu(*std::move(archive), *std::move(description), Library(*std::move(library)), interface,
+    return Fmu(std::move(archive), *std::move(description), Library(*std::move(library)), interface,
                absl::StrCat(resources.string(), "/"));
   }
   auto library = Fmi2Library::Load(binary, interface);
   if (!library.ok()) return library.status();
-  return Fmu(*std::move(archive), *std::move(description), Library(*std::move(library)), interface,
+  return Fmu(std::move(archive), *std::move(description), Library(*std::move(library)), interface,
              absl::StrCat("file://", resources.string()));
 }
 

@@ -30,6 +30,11 @@ class Fmu {
  public:
   static absl::StatusOr<Fmu> Open(const std::filesystem::path& archive_path, Interface interface,
                                   const std::filesystem::path& temporary_parent = {});
+  // The same from an archive unpacked earlier into `folder` (a study's
+  // carried FMU in the worker's cache, archive_cache.h), which stays when
+  // the Fmu goes; `archive_path` names it in messages.
+  static absl::StatusOr<Fmu> OpenUnpacked(const std::filesystem::path& archive_path,
+                                          const std::filesystem::path& folder, Interface interface);
 
   Interface interface() const { return interface_; }
   const ModelDescription& description() const { return description_; }
@@ -45,6 +50,8 @@ class Fmu {
 
  private:
   using Library = std::variant<Fmi2Library, Fmi3Library>;
+
+  static absl::StatusOr<Fmu> Load(UnpackedArchive archive, Interface interface);
 
   // `resource_location`: the unpacked resources folder as the FMU's
   // version wants it (a file:// URI for 2.0, a path ending in '/' for 3.0).

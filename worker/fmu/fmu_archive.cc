@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <zip.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -143,20 +144,42 @@ absl::StatusOr<UnpackedArchive> UnpackedArchive::Unpack(const std::filesystem::p
   return unpacked;
 }
 
+absl::StatusOr<UnpackedArchive> UnpackedArchive::Borrow(const std::filesystem::path& archive_path,
+                                                        const std::filesystem::path& folder) {
+  std::error_code code;
+  if (!std::filesystem::is_directory(folder, code)) {
+    return absl::InternalError(absl::StrCat(archive_path.string(), ": no unpacked folder ", folder.string()));
+  }
+  UnpackedArchive borrowed(archive_path, folder);
+  borrowed.owned_ = false;
+  // The entry names as the archive had them: files, and folders with '/'.
+  for (auto it = std::filesystem::recursive_directory_iterator(folder, code);
+       !code && it != std::filesystem::recursive_directory_iterator(); it.increment(code)) {
+    std::string name = it->path().lexically_relative(folder).generic_string();
+    if (it->is_directory(code)) name += '/';
+    borrowed.entries_.push_back(std::move(name));
+  }
+  if (code) return absl::InternalError(absl::StrCat("cannot list ", folder.string(), ": ", code.message()));
+  std::sort(borrowed.entries_.begin(), borrowed.entries_.end());
+  return borrowed;
+}
+
 UnpackedArchive::UnpackedArchive(UnpackedArchive&& other) noexcept
     : archive_path_(std::move(other.archive_path_)),
       folder_(std::move(other.folder_)),
-      entries_(std::move(other.entries_)) {
+      entries_(std::move(other.entries_)),
+      owned_(other.owned_) {
   other.folder_.clear();
 }
 
 UnpackedArchive& UnpackedArchive::operator=(UnpackedArchive&& other) noexcept {
   if (this != &other) {
     std::error_code ignored;
-    if (!folder_.empty()) std::filesystem::remove_all(folder_, ignored);
+    if (owned_ && !folder_.empty()) std::filesystem::remove_all(folder_, ignored);
     archive_path_ = std::move(other.archive_path_);
     folder_ = std::move(other.folder_);
     entries_ = std::move(other.entries_);
+    owned_ = other.owned_;
     other.folder_.clear();
   }
   return *this;
@@ -164,7 +187,7 @@ UnpackedArchive& UnpackedArchive::operator=(UnpackedArchive&& other) noexcept {
 
 UnpackedArchive::~UnpackedArchive() {
   std::error_code ignored;
-  if (!folder_.empty()) std::filesystem::remove_all(folder_, ignored);
+  if (owned_ && !folder_.empty()) std::filesystem::remove_all(folder_, ignored);
 }
 
 }  // namespace mbopt::fmu

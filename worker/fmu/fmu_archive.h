@@ -22,12 +22,16 @@ class UnpackedArchive {
   // system's temporary folder when empty).
   static absl::StatusOr<UnpackedArchive> Unpack(const std::filesystem::path& archive_path,
                                                 const std::filesystem::path& temporary_parent = {});
+  // An archive unpacked earlier into `folder` (archive_cache.h), which this
+  // object neither owns nor removes; `archive_path` names it in messages.
+  static absl::StatusOr<UnpackedArchive> Borrow(const std::filesystem::path& archive_path,
+                                                const std::filesystem::path& folder);
 
   UnpackedArchive(UnpackedArchive&& other) noexcept;
   UnpackedArchive& operator=(UnpackedArchive&& other) noexcept;
   UnpackedArchive(const UnpackedArchive&) = delete;
   UnpackedArchive& operator=(const UnpackedArchive&) = delete;
-  ~UnpackedArchive();  // removes the folder
+  ~UnpackedArchive();  // removes the folder, unless borrowed
 
   const std::filesystem::path& archive_path() const { return archive_path_; }
   const std::filesystem::path& folder() const { return folder_; }
@@ -41,6 +45,7 @@ class UnpackedArchive {
   std::filesystem::path archive_path_;
   std::filesystem::path folder_;
   std::vector<std::string> entries_;
+  bool owned_ = true;
 };
 
 // Whether a zip entry name stays inside the folder it is unpacked into:

@@ -1,11 +1,13 @@
 #include "worker/fmu/scene_analysis.h"
 
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <variant>
 
 #include "absl/strings/str_cat.h"
+#include "worker/fmu/archive_cache.h"
 #include "worker/fmu/fmu.h"
 #include "worker/fmu/sensitivities.h"
 #include "worker/fmu/simulation.h"
@@ -62,7 +64,16 @@ PreparedRun Prepare(const spec::Scene& scene, const std::vector<double>& paramet
   options.budget = budget;
   if (model->communication_step_s > 0.0) options.communication_step_s = model->communication_step_s;
 
-  auto fmu = Fmu::Open(model->path, model->co_simulation ? Interface::kCoSimulation : Interface::kModelExchange);
+  const Interface interface = model->co_simulation ? Interface::kCoSimulation : Interface::kModelExchange;
+  absl::StatusOr<Fmu> fmu = absl::UnknownError("not opened");
+  if (model->archive != nullptr) {
+    // The study carries the FMU: unpacked once per content on this machine.
+    absl::StatusOr<std::filesystem::path> folder =
+        UnpackedArchiveFolder(*model->archive, model->archive_sha256, model->path);
+    fmu = folder.ok() ? Fmu::OpenUnpacked(model->path, *folder, interface) : absl::StatusOr<Fmu>(folder.status());
+  } else {
+    fmu = Fmu::Open(model->path, interface);
+  }
   if (!fmu.ok()) {
     report->Fail(spec::FailureKind::kInvalidModel, std::string(fmu.status().message()));
     return prepared;

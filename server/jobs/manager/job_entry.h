@@ -74,7 +74,10 @@ inline bool Running(jobs::JobState state) {
 inline scheduler::TaskNeeds NeedsOf(const spec::Study& study) {
   scheduler::TaskNeeds needs;
   if (const auto* external = std::get_if<spec::ExternalModel>(&study.scene.model)) needs.driver = external->driver;
-  needs.loads_fmus = std::holds_alternative<spec::FmuModel>(study.scene.model);
+  if (const auto* fmu = std::get_if<spec::FmuModel>(&study.scene.model)) {
+    needs.loads_fmus = true;
+    needs.fmu_platforms = fmu->platforms;
+  }
   return needs;
 }
 
