@@ -6,57 +6,39 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "worker/fmu/binary_symbols.h"
 
 namespace mbopt::fmu {
-namespace {
-
-template <typename Function>
-absl::Status Resolve(void* handle, const std::filesystem::path& binary, const char* name, Function** out,
-                     bool required = true) {
-  dlerror();
-  void* symbol = dlsym(handle, name);
-  if (symbol == nullptr && required) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(binary.string(), ": the FMU's binary has no function ", name));
-  }
-  *out = reinterpret_cast<Function*>(symbol);
-  return absl::OkStatus();
-}
-
-}  // namespace
 
 absl::StatusOr<Fmi2Library> Fmi2Library::Load(const std::filesystem::path& binary, Interface interface) {
   Fmi2Library library;
-  // RTLD_LOCAL: two FMUs exporting the same fmi2 names do not see each other.
-  library.handle_ = dlopen(binary.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (library.handle_ == nullptr) {
-    const char* reason = dlerror();
-    return absl::InvalidArgumentError(
-        absl::StrCat(binary.string(), ": the FMU's binary cannot be loaded: ", reason ? reason : "unknown"));
-  }
+  absl::StatusOr<void*> handle = OpenBinary(binary);
+  if (!handle.ok()) return handle.status();
+  library.handle_ = *handle;
   Fmi2Functions& f = library.functions_;
+  void* h = library.handle_;
   const bool me = interface == Interface::kModelExchange;
   const absl::Status statuses[] = {
-      Resolve(library.handle_, binary, "fmi2GetVersion", &f.get_version),
-      Resolve(library.handle_, binary, "fmi2Instantiate", &f.instantiate),
-      Resolve(library.handle_, binary, "fmi2FreeInstance", &f.free_instance),
-      Resolve(library.handle_, binary, "fmi2SetupExperiment", &f.setup_experiment),
-      Resolve(library.handle_, binary, "fmi2EnterInitializationMode", &f.enter_initialization_mode),
-      Resolve(library.handle_, binary, "fmi2ExitInitializationMode", &f.exit_initialization_mode),
-      Resolve(library.handle_, binary, "fmi2Terminate", &f.terminate),
-      Resolve(library.handle_, binary, "fmi2GetReal", &f.get_real),
-      Resolve(library.handle_, binary, "fmi2SetReal", &f.set_real),
-      Resolve(library.handle_, binary, "fmi2GetDirectionalDerivative", &f.get_directional_derivative, false),
-      Resolve(library.handle_, binary, "fmi2EnterEventMode", &f.enter_event_mode, me),
-      Resolve(library.handle_, binary, "fmi2NewDiscreteStates", &f.new_discrete_states, me),
-      Resolve(library.handle_, binary, "fmi2EnterContinuousTimeMode", &f.enter_continuous_time_mode, me),
-      Resolve(library.handle_, binary, "fmi2CompletedIntegratorStep", &f.completed_integrator_step, me),
-      Resolve(library.handle_, binary, "fmi2SetTime", &f.set_time, me),
-      Resolve(library.handle_, binary, "fmi2SetContinuousStates", &f.set_continuous_states, me),
-      Resolve(library.handle_, binary, "fmi2GetDerivatives", &f.get_derivatives, me),
-      Resolve(library.handle_, binary, "fmi2GetEventIndicators", &f.get_event_indicators, me),
-      Resolve(library.handle_, binary, "fmi2GetContinuousStates", &f.get_continuous_states, me),
-      Resolve(library.handle_, binary, "fmi2DoStep", &f.do_step, !me),
+      ResolveFunction(h, binary, "fmi2GetVersion", &f.get_version),
+      ResolveFunction(h, binary, "fmi2Instantiate", &f.instantiate),
+      ResolveFunction(h, binary, "fmi2FreeInstance", &f.free_instance),
+      ResolveFunction(h, binary, "fmi2SetupExperiment", &f.setup_experiment),
+      ResolveFunction(h, binary, "fmi2EnterInitializationMode", &f.enter_initialization_mode),
+      ResolveFunction(h, binary, "fmi2ExitInitializationMode", &f.exit_initialization_mode),
+      ResolveFunction(h, binary, "fmi2Terminate", &f.terminate),
+      ResolveFunction(h, binary, "fmi2GetReal", &f.get_real),
+      ResolveFunction(h, binary, "fmi2SetReal", &f.set_real),
+      ResolveFunction(h, binary, "fmi2GetDirectionalDerivative", &f.get_directional_derivative, false),
+      ResolveFunction(h, binary, "fmi2EnterEventMode", &f.enter_event_mode, me),
+      ResolveFunction(h, binary, "fmi2NewDiscreteStates", &f.new_discrete_states, me),
+      ResolveFunction(h, binary, "fmi2EnterContinuousTimeMode", &f.enter_continuous_time_mode, me),
+      ResolveFunction(h, binary, "fmi2CompletedIntegratorStep", &f.completed_integrator_step, me),
+      ResolveFunction(h, binary, "fmi2SetTime", &f.set_time, me),
+      ResolveFunction(h, binary, "fmi2SetContinuousStates", &f.set_continuous_states, me),
+      ResolveFunction(h, binary, "fmi2GetDerivatives", &f.get_derivatives, me),
+      ResolveFunction(h, binary, "fmi2GetEventIndicators", &f.get_event_indicators, me),
+      ResolveFunction(h, binary, "fmi2GetContinuousStates", &f.get_continuous_states, me),
+      ResolveFunction(h, binary, "fmi2DoStep", &f.do_step, !me),
   };
   for (const absl::Status& status : statuses) {
     if (!status.ok()) return status;
