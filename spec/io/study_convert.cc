@@ -809,6 +809,11 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "SENSITIVITY_METHOD_SIMULATOR is not available for external scenes yet: their drivers' "
                   "gradients are not read; use finite differences");
     }
+    if (s.simulator_sensitivities && std::holds_alternative<SpatialModel>(scene.model)) {
+      errors->Add(w, "sensitivity",
+                  "SENSITIVITY_METHOD_SIMULATOR is not available for spatial scenes yet (their forward dynamics "
+                  "has no sensitivity equations); use finite differences");
+    }
     if (s.simulator_sensitivities && std::holds_alternative<FmuModel>(scene.model)) {
       errors->Add(w, "sensitivity",
                   "SENSITIVITY_METHOD_SIMULATOR is not available for FMU scenes yet (directional derivatives are "
