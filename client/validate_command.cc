@@ -24,6 +24,7 @@ const char* ModelName(const spec::Scene& scene) {
   if (std::holds_alternative<spec::LumpedModel>(scene.model)) return "lumped";
   if (std::holds_alternative<spec::ExternalModel>(scene.model)) return "external";
   if (std::holds_alternative<spec::FmuModel>(scene.model)) return "fmu";
+  if (std::holds_alternative<spec::SpatialModel>(scene.model)) return "spatial";
   return "multibody";
 }
 

@@ -269,6 +269,24 @@ Dimension OutputDimension(const Output& output) {
                         [](const ExternalResultOutput&) { return Dimension::kAny; },
                         // The FMU's own units, unknown here: a limit is written in SI.
                         [](const FmuVariableOutput&) { return Dimension::kAny; },
+                        [](const SpatialOutput& s) {
+                          using Q = SpatialOutput::Quantity;
+                          switch (s.quantity) {
+                            case Q::kMarkerPosition: return Dimension::kLength;
+                            case Q::kMarkerVelocity: return Dimension::kVelocity;
+                            case Q::kMarkerAcceleration: return Dimension::kAcceleration;
+                            case Q::kBodyOrientation: return Dimension::kAngle;
+                            case Q::kJointCoordinate: return s.linear ? Dimension::kLength : Dimension::kAngle;
+                            case Q::kJointRate: return s.linear ? Dimension::kVelocity : Dimension::kAngularVelocity;
+                            case Q::kJointSlide: return Dimension::kLength;
+                            case Q::kJointSlideRate: return Dimension::kVelocity;
+                            case Q::kSpringLength: return Dimension::kLength;
+                            case Q::kSpringForce: return Dimension::kForce;
+                            case Q::kKineticEnergy:
+                            case Q::kPotentialEnergy: return Dimension::kEnergy;
+                          }
+                          return Dimension::kAny;
+                        },
                         [](const MultibodyOutput& m) {
                           using Q = MultibodyOutput::Quantity;
                           switch (m.quantity) {

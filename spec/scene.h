@@ -215,6 +215,61 @@ struct MultibodyModel {
   std::vector<MultibodyTorque> torques;
 };
 
+// ---- spatial (rigid bodies in 3-D; worker/spatial)
+struct Vec3 {
+  Number x, y, z;
+};
+// A rotation as written (proto/mbopt/v1/scene.proto Orientation): from a
+// frame's own axes to its parent's.
+struct Orientation {
+  enum class Form { kIdentity, kAxisAngle, kEulerAngles } form = Form::kIdentity;
+  double axis[3] = {0.0, 0.0, 1.0};  // kAxisAngle: literal, unit length
+  // kEulerAngles: the axes (0 x, 1 y, 2 z) of the three successive
+  // rotations about the rotated axes.
+  int sequence[3] = {2, 1, 0};
+  Number angles_rad[3];  // kAxisAngle: angles_rad[0] only
+};
+struct SpatialMarker {
+  std::string name;
+  Vec3 position_m;
+  Orientation orientation;
+};
+struct SpatialBody {
+  std::string name;
+  Number mass_kg;
+  // Principal moments along `principal_axes` (body axes when identity), or,
+  // with `components`, the tensor's six entries xx, yy, zz, xy, xz, yz.
+  bool components = false;
+  Vec3 principal_moments_kg_m2;
+  Orientation principal_axes;
+  Number inertia_components_kg_m2[6];
+  Vec3 position_m;
+  Orientation orientation;
+  Vec3 velocity_m_per_s, angular_velocity_rad_per_s;
+  std::vector<SpatialMarker> markers;
+};
+enum class SpatialJointKind {
+  kSpherical, kRevolute, kUniversal, kFixed, kPrismatic, kCylindrical, kPlanar, kPointOnLine, kPointOnPlane
+};
+struct SpatialJoint {
+  std::string name;
+  SpatialJointKind kind = SpatialJointKind::kSpherical;
+  MarkerRef a, b;  // body (-1: ground) and marker index
+};
+struct SpatialSpring {
+  std::string name;
+  MarkerRef a, b;
+  Number free_length_m, stiffness_n_per_m, damping_n_s_per_m;
+};
+struct SpatialModel {
+  std::vector<SpatialMarker> ground_markers;
+  std::vector<SpatialBody> bodies;
+  std::vector<SpatialJoint> joints;
+  std::vector<MultibodyDriver> drivers;  // joint: a revolute or cylindrical joint's angle
+  std::vector<SpatialSpring> springs;
+  std::optional<Vec3> gravity_m_per_s2;
+};
+
 // ---- external (an analysis by a simulation code the worker declares as a
 // driver; worker/external runs it, docs/external.md)
 // A value given to one of the driver's declared parameters.
@@ -251,7 +306,7 @@ struct FmuModel {
 };
 
 // ---- outputs
-enum class Axis { kX, kY };
+enum class Axis { kX, kY, kZ };  // kZ: spatial scenes
 struct PointPositionOutput { int link = -1; int point = -1; int joint = -1; Axis axis = Axis::kX; };  // link point, or joint if joint >= 0
 struct LinkRotationOutput { int link = -1; };
 struct ElementDeflectionOutput { int element = -1; };
@@ -291,11 +346,28 @@ struct MultibodyOutput {
   bool linear = false;  // joint outputs of a prismatic or point-on-line joint (m, N)
 };
 
+// An output of a spatial scene (world axes, SI). Joint coordinates: the
+// angle of a revolute or cylindrical joint, the slide of a prismatic one;
+// kJointSlide(Rate): a cylindrical or prismatic joint's slide.
+struct SpatialOutput {
+  enum class Quantity {
+    kMarkerPosition, kMarkerVelocity, kMarkerAcceleration, kBodyOrientation,
+    kJointCoordinate, kJointRate, kJointSlide, kJointSlideRate,
+    kSpringLength, kSpringForce, kKineticEnergy, kPotentialEnergy,
+  } quantity = Quantity::kMarkerPosition;
+  MarkerRef marker;
+  int body = -1, joint = -1, spring = -1;
+  Axis axis = Axis::kX;
+  int sequence[3] = {2, 1, 0};  // kBodyOrientation: as Orientation::sequence
+  int angle = 0;                // kBodyOrientation: 0, 1 or 2
+  bool linear = false;          // joint outputs in m (a prismatic joint's coordinate, slides)
+};
+
 struct Output {
   std::string name;
   std::variant<PointPositionOutput, LinkRotationOutput, ElementDeflectionOutput,
                BodyAccelerationOutput, BendingStressOutput, DriveTorqueOutput, MassOutput, MultibodyOutput,
-               ExternalResultOutput, FmuVariableOutput>
+               ExternalResultOutput, FmuVariableOutput, SpatialOutput>
       kind;
 };
 
@@ -319,7 +391,7 @@ struct Scene {
   std::string source_file;  // for messages
   std::vector<Parameter> parameters;
   Effects effects;
-  std::variant<LinkageModel, LumpedModel, MultibodyModel, ExternalModel, FmuModel> model;
+  std::variant<LinkageModel, LumpedModel, MultibodyModel, ExternalModel, FmuModel, SpatialModel> model;
   std::vector<Output> outputs;
   TimeGrid time_grid;
   // The parameters the time grid's start_expr / end_expr read (sorted): the

@@ -34,10 +34,13 @@ Scene SceneConverter::Run() {
     case v1::Scene::kFmu:
       scene_.model = ConvertFmu(msg_.fmu(), where_.Child("fmu"));
       break;
+    case v1::Scene::kSpatial:
+      scene_.model = ConvertSpatial(msg_.spatial(), where_.Child("spatial"));
+      break;
     case v1::Scene::MODEL_NOT_SET:
       errors_.Add(where_, "",
                   "the scene has no model: expected `linkage { ... }`, `lumped { ... }`, "
-                  "`multibody { ... }`, `external { ... }` or `fmu { ... }`");
+                  "`multibody { ... }`, `spatial { ... }`, `external { ... }` or `fmu { ... }`");
       return scene_;
   }
   if (msg_.model_case() == v1::Scene::kLumped && msg_.has_effects()) {
@@ -65,6 +68,12 @@ Scene SceneConverter::Run() {
   if (msg_.model_case() == v1::Scene::kFmu && msg_.has_effects()) {
     errors_.Add(where_.Child("effects"), "",
                 "an FMU scene's physics is the FMU's: it takes no effects (set them as FMU parameters)");
+  }
+  if (msg_.model_case() == v1::Scene::kSpatial && msg_.has_effects()) {
+    // Effects' gravity is a planar vector: a spatial model declares its own.
+    errors_.Add(where_, "effects",
+                "a spatial scene takes no `effects`: declare gravity in the model, "
+                "`spatial { gravity { acceleration_m_per_s2 { z { value: -9.81 } } } }`");
   }
   if (const auto* mb = std::get_if<MultibodyModel>(&scene_.model);
       mb != nullptr && mb->flexible_links.empty() && msg_.effects().has_structural_damping()) {

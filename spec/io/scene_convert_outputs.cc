@@ -17,6 +17,7 @@ void SceneConverter::ConvertOutputs() {
   const bool linkage = std::holds_alternative<LinkageModel>(scene_.model);
   const bool multibody = std::holds_alternative<MultibodyModel>(scene_.model);
   const bool external = std::holds_alternative<ExternalModel>(scene_.model);
+  const bool spatial = std::holds_alternative<SpatialModel>(scene_.model);
   auto lookup = [&](const std::map<std::string, int>& table, const Where& w,
                     const std::string& field, const std::string& name, const char* what) {
     auto it = table.find(name);
@@ -115,19 +116,35 @@ void SceneConverter::ConvertOutputs() {
         needs = "linkage";
         out.kind = MassOutput{};
         break;
+      case v1::Output::kJointReaction:
+      case v1::Output::kDriverEffort:
+        // Reactions and efforts need inverse dynamics, which spatial scenes
+        // do not have yet: "needs a multibody model".
+        needs = "multibody";
+        out.kind = multibody ? MultibodyOutputOf(o, ow) : MultibodyOutput{};
+        break;
       case v1::Output::kMarkerPosition:
       case v1::Output::kMarkerVelocity:
       case v1::Output::kMarkerAcceleration:
       case v1::Output::kJointCoordinate:
       case v1::Output::kJointRate:
-      case v1::Output::kJointReaction:
-      case v1::Output::kDriverEffort:
       case v1::Output::kSpringLength:
       case v1::Output::kSpringForce:
       case v1::Output::kKineticEnergy:
       case v1::Output::kPotentialEnergy:
+        if (spatial) {
+          needs = "spatial";
+          out.kind = SpatialOutputOf(o, ow);
+          break;
+        }
         needs = "multibody";
         out.kind = multibody ? MultibodyOutputOf(o, ow) : MultibodyOutput{};
+        break;
+      case v1::Output::kBodyOrientation:
+      case v1::Output::kJointSlide:
+      case v1::Output::kJointSlideRate:
+        needs = "spatial";
+        out.kind = spatial ? SpatialOutputOf(o, ow) : SpatialOutput{};
         break;
       case v1::Output::kExternalValue:
       case v1::Output::kExternalSeries: {
@@ -156,6 +173,7 @@ void SceneConverter::ConvertOutputs() {
                              : linkage   ? "linkage"
                              : multibody ? "multibody"
                              : external  ? "external"
+                             : spatial   ? "spatial"
                                          : "fmu";
     if (needs != nullptr && std::string(needs) != model_kind) {
       errors_.Add(ow, "",

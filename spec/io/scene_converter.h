@@ -9,6 +9,7 @@
 //   scene_convert_multibody.cc  `multibody`, and its outputs
 //   scene_convert_external.cc   `external`
 //   scene_convert_fmu.cc        `fmu`
+//   scene_convert_spatial.cc    `spatial`, and its outputs
 //   scene_convert_outputs.cc    `outputs`, each checked against the model kind
 // Problems go to `errors`; the scene Run() returns is meaningful only if
 // none were added.
@@ -100,6 +101,17 @@ class SceneConverter {
   // ------------------------------------------- scene_convert_fmu.cc --
   FmuModel ConvertFmu(const v1::FmuModel& m, const Where& w);
 
+  // -------------------------------------- scene_convert_spatial.cc --
+  Vec3 Vec3Of(const Where& w, const std::string& field, bool present, const v1::Vector3& v, Dimension dimension);
+  Orientation OrientationOf(const Where& w, const std::string& field, bool present, const v1::Orientation& o);
+  std::vector<SpatialMarker> SpatialMarkers(const Where& w, const std::string& field,
+                                            const google::protobuf::RepeatedPtrField<v1::SpatialMarker>& markers);
+  // "body.marker" or "ground.marker" of the spatial model.
+  MarkerRef SpatialMarkerOf(const Where& w, const std::string& field, const std::string& ref);
+  int SpatialJointIndex(const Where& w, const std::string& field, const std::string& name);
+  SpatialModel ConvertSpatial(const v1::SpatialModel& m, const Where& w);
+  SpatialOutput SpatialOutputOf(const v1::Output& o, const Where& ow);
+
   // --------------------------------------- scene_convert_outputs.cc --
   void ConvertOutputs();
   void ResolvePoint(const Where& w, const std::string& name, PointPositionOutput* k);
@@ -118,6 +130,8 @@ class SceneConverter {
   bool cycle_reported_ = false;
   std::map<std::string, int> lumped_bodies_, lumped_elements_;
   std::map<std::string, int> linkage_links_, linkage_joints_;
+  SpatialModel spatial_;
+  std::map<std::string, int> spatial_bodies_, spatial_joints_, spatial_springs_;
 };
 
 }  // namespace mbopt::spec::io

@@ -270,7 +270,7 @@ TEST(ModelKinds, EveryKindHasItsEntry) {
     EXPECT_NE(std::string(kind.counters), "") << kind.name;
     EXPECT_NE(std::string(kind.analysis), "") << kind.name;
   }
-  EXPECT_THAT(names, ::testing::UnorderedElementsAre("lumped", "linkage", "multibody", "external", "fmu"));
+  EXPECT_THAT(names, ::testing::UnorderedElementsAre("lumped", "linkage", "multibody", "external", "fmu", "spatial"));
   EXPECT_STREQ(ModelKindOf(Vehicle()).name, "lumped");
   EXPECT_STREQ(ModelKindOf(Press()).name, "multibody");
   for (const ModelKind& kind : ModelKinds()) {

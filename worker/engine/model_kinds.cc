@@ -9,6 +9,7 @@
 #include "worker/lumped/lumped_sensitivity.h"
 #include "worker/multibody/linkage_analysis.h"
 #include "worker/multibody/scene_analysis.h"
+#include "worker/spatial/spatial_scene_analysis.h"
 
 namespace mbopt::engine {
 namespace {
@@ -64,6 +65,11 @@ SensitivityAnalysis AnalyzeMultibodyWithSensitivities(const spec::Scene& scene, 
   multibody::MultibodySensitivityResult result =
       multibody::AnalyzeMultibodySceneWithSensitivities(scene, p, parameters, budget);
   return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
+}
+
+spec::AnalysisReport AnalyzeSpatial(const spec::Scene& scene, const std::vector<double>& p,
+                                    budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  return spatial::AnalyzeSpatialScene(scene, p, budget);
 }
 
 spec::AnalysisReport AnalyzeFmu(const spec::Scene& scene, const std::vector<double>& p,
@@ -162,6 +168,18 @@ std::vector<ModelKind> MakeTable() {
         return fmu::FmuSensitivitiesUnavailable(scene, parameters);
       },
       &AnalyzeFmuWithSensitivities};
+  table[IndexOf<spec::SpatialModel>()] = {
+      "spatial",
+      "forward dynamics (IDAS, the GGL form) of a spatial multibody system in absolute coordinates with Euler "
+      "parameters, driven or free (worker/spatial/spatial_scene_analysis.h)",
+      "newton_iterations of assembly and IDAS; time_steps, rhs_evaluations (residuals) and jacobian_evaluations "
+      "of IDAS",
+      &AnalyzeSpatial,
+      [](const spec::Scene&, const std::vector<int>&) {
+        return Never("a spatial analysis has no simulator sensitivities yet: its forward dynamics is not "
+                     "differentiated");
+      },
+      nullptr};
   for (const ModelKind& kind : table) MBOPT_CHECK(kind.analyze != nullptr, "a scene model kind has no table entry");
   return table;
 }

@@ -21,7 +21,7 @@ absl::StatusOr<spec::SceneDrawing> DrawScene(const spec::Scene& scene, const std
   if (std::holds_alternative<spec::LumpedModel>(scene.model)) return lumped::LumpedSchematic(scene, p);
   return absl::InvalidArgumentError(absl::StrFormat(
       "scene '%s' (%s): only multibody, linkage and lumped scenes can be drawn; an external or FMU scene's "
-      "geometry is not known to mbopt",
+      "geometry is not known to mbopt, and spatial scenes are not drawn yet",
       scene.name, scene.source_file));
 }
 

@@ -365,6 +365,32 @@ double SpatialSystem::JointTranslation(int joint, const VectorXd& q) const {
   return a.z.x.dot(b.origin.x - a.origin.x);
 }
 
+double SpatialSystem::JointAngleRate(int joint, const VectorXd& q, const VectorXd& v) const {
+  const Joint& j = model_.joints[static_cast<size_t>(joint)];
+  const FrameVectors a = FrameOf(j.a, 0, q, &v), b = FrameOf(j.b, 1, q, &v);
+  // d/dt atan2(s, c) = (c s' - s c') / (c^2 + s^2).
+  const double sine = b.x.x.dot(a.y.x), cosine = b.x.x.dot(a.x.x);
+  const double sine_dot = b.x.x_dot.dot(a.y.x) + b.x.x.dot(a.y.x_dot);
+  const double cosine_dot = b.x.x_dot.dot(a.x.x) + b.x.x.dot(a.x.x_dot);
+  return (cosine * sine_dot - sine * cosine_dot) / (cosine * cosine + sine * sine);
+}
+
+double SpatialSystem::JointTranslationRate(int joint, const VectorXd& q, const VectorXd& v) const {
+  const Joint& j = model_.joints[static_cast<size_t>(joint)];
+  const FrameVectors a = FrameOf(j.a, 0, q, &v), b = FrameOf(j.b, 1, q, &v);
+  return a.z.x_dot.dot(b.origin.x - a.origin.x) + a.z.x.dot(b.origin.x_dot - a.origin.x_dot);
+}
+
+Vector3d SpatialSystem::PointAcceleration(const Point& p, const VectorXd& q, const VectorXd& v,
+                                          const VectorXd& a) const {
+  if (p.body == kGround) return Vector3d::Zero();
+  const BodyCoordinates c = CoordinatesOf(p.body, q, &v);
+  const int at = kBlock * p.body;
+  // A(p) s is quadratic in p: d2(A s)/dt2 = (d(A s)/dp) p'' + 2 A(p') s.
+  return a.segment<3>(at) + RotatedVectorJacobian(c.p, p.position_m) * a.segment<4>(at + 3) +
+         2.0 * RotationOf(c.p_dot) * p.position_m;
+}
+
 double SpatialSystem::KineticEnergy(const VectorXd& q, const VectorXd& v) const {
   double energy = 0.0;
   for (size_t i = 0; i < model_.bodies.size(); ++i) {

@@ -89,6 +89,12 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   double JointAngle(int joint, const Eigen::VectorXd& q) const;
   // Prismatic or cylindrical joint: the translation coordinate (m).
   double JointTranslation(int joint, const Eigen::VectorXd& q) const;
+  // Their rates (rad/s, m/s).
+  double JointAngleRate(int joint, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  double JointTranslationRate(int joint, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
+  // From the coordinates' second derivatives `a` (world axes, m/s^2).
+  Eigen::Vector3d PointAcceleration(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                    const Eigen::VectorXd& a) const;
   double KineticEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
   // Gravity (zero at the world origin) and the springs' strain energy.
   double PotentialEnergy(const Eigen::VectorXd& q) const;

@@ -1,0 +1,273 @@
+#include "worker/spatial/spatial_scene_analysis.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+#include <variant>
+
+#include "absl/strings/str_format.h"
+#include "spec/layout.h"
+#include "worker/multibody/forward_dynamics.h"
+#include "worker/spatial/euler_angles.h"
+#include "worker/spatial/euler_parameters.h"
+#include "worker/spatial/spatial_assembly.h"
+#include "worker/spatial/spatial_system.h"
+
+namespace mbopt::spatial {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+using Quantity = spec::SpatialOutput::Quantity;
+
+Vector3d Resolve(const spec::Vec3& v, const std::vector<double>& p) {
+  return Vector3d(v.x.Resolve(p), v.y.Resolve(p), v.z.Resolve(p));
+}
+
+EulerSequence SequenceOf(const int axes[3]) { return {axes[0], axes[1], axes[2]}; }
+
+Matrix3d OrientationMatrix(const spec::Orientation& o, const std::vector<double>& p) {
+  switch (o.form) {
+    case spec::Orientation::Form::kIdentity: return Matrix3d::Identity();
+    case spec::Orientation::Form::kAxisAngle:
+      return AxisAngle(Vector3d(o.axis[0], o.axis[1], o.axis[2]), o.angles_rad[0].Resolve(p));
+    case spec::Orientation::Form::kEulerAngles:
+      return RotationOfEulerAngles(SequenceOf(o.sequence), Vector3d(o.angles_rad[0].Resolve(p),
+                                                                    o.angles_rad[1].Resolve(p),
+                                                                    o.angles_rad[2].Resolve(p)));
+  }
+  return Matrix3d::Identity();
+}
+
+const spec::SpatialMarker& MarkerOf(const spec::SpatialModel& sm, const spec::MarkerRef& ref) {
+  const std::vector<spec::SpatialMarker>& markers =
+      ref.body < 0 ? sm.ground_markers : sm.bodies[static_cast<size_t>(ref.body)].markers;
+  return markers[static_cast<size_t>(ref.marker)];
+}
+
+Frame FrameOf(const spec::SpatialModel& sm, const spec::MarkerRef& ref, const std::vector<double>& p) {
+  const spec::SpatialMarker& marker = MarkerOf(sm, ref);
+  Frame f;
+  f.body = ref.body < 0 ? kGround : ref.body;
+  f.position_m = Resolve(marker.position_m, p);
+  f.axes = OrientationMatrix(marker.orientation, p);
+  return f;
+}
+
+Point PointOf(const spec::SpatialModel& sm, const spec::MarkerRef& ref, const std::vector<double>& p) {
+  const Frame f = FrameOf(sm, ref, p);
+  return Point{f.body, f.position_m};
+}
+
+multibody::Profile ProfileOf(const spec::MultibodyDriver& d, const std::vector<double>& p) {
+  multibody::Profile profile;
+  using K = multibody::Profile::Kind;
+  switch (d.profile) {
+    case spec::MultibodyDriver::Profile::kConstantRate:
+      profile.kind = K::kConstantRate;
+      profile.start = d.start.Resolve(p);
+      profile.rate = d.rate.Resolve(p);
+      break;
+    case spec::MultibodyDriver::Profile::kPolynomial:
+      profile.kind = K::kPolynomial;
+      for (const spec::Number& c : d.coefficients) profile.coefficients.push_back(c.Resolve(p));
+      break;
+    case spec::MultibodyDriver::Profile::kTabulated:
+      profile.kind = K::kTabulated;
+      profile.table = multibody::CubicSpline(d.times_s, d.values);
+      break;
+    case spec::MultibodyDriver::Profile::kHarmonic:
+      profile.kind = K::kHarmonic;
+      profile.start = d.start.Resolve(p);
+      profile.amplitude = d.amplitude.Resolve(p);
+      profile.angular_frequency_rad_per_s = d.angular_frequency_rad_per_s.Resolve(p);
+      profile.phase_rad = d.phase_rad.Resolve(p);
+      break;
+  }
+  return profile;
+}
+
+Joint::Kind JointKindOf(spec::SpatialJointKind kind) {
+  using S = spec::SpatialJointKind;
+  switch (kind) {
+    case S::kSpherical: return Joint::Kind::kSpherical;
+    case S::kRevolute: return Joint::Kind::kRevolute;
+    case S::kUniversal: return Joint::Kind::kUniversal;
+    case S::kFixed: return Joint::Kind::kFixed;
+    case S::kPrismatic: return Joint::Kind::kPrismatic;
+    case S::kCylindrical: return Joint::Kind::kCylindrical;
+    case S::kPlanar: return Joint::Kind::kPlanar;
+    case S::kPointOnLine: return Joint::Kind::kPointOnLine;
+    case S::kPointOnPlane: return Joint::Kind::kPointOnPlane;
+  }
+  return Joint::Kind::kSpherical;
+}
+
+// The value of output `o` in the state `s`.
+double OutputValue(const SpatialSystem& system, const Model& model, const spec::SpatialModel& sm,
+                   const spec::SpatialOutput& o, const std::vector<double>& p, const multibody::MotionSample& s) {
+  const int axis = static_cast<int>(o.axis);
+  switch (o.quantity) {
+    case Quantity::kMarkerPosition: return system.PointPosition(PointOf(sm, o.marker, p), s.q)[axis];
+    case Quantity::kMarkerVelocity: return system.PointVelocity(PointOf(sm, o.marker, p), s.q, s.v)[axis];
+    case Quantity::kMarkerAcceleration:
+      return system.PointAcceleration(PointOf(sm, o.marker, p), s.q, s.v, s.a)[axis];
+    case Quantity::kBodyOrientation: {
+      // The integrator holds |p| = 1 to its tolerance; A(p) / |p|^2 is the
+      // rotation of the unit parameters p / |p|.
+      const Eigen::Vector4d e = s.q.segment<4>(SpatialSystem::kCoordinatesPerBody * o.body + 3);
+      return EulerAnglesOf(SequenceOf(o.sequence), system.BodyRotation(o.body, s.q) / e.squaredNorm())[o.angle];
+    }
+    case Quantity::kJointCoordinate:
+      return o.linear ? system.JointTranslation(o.joint, s.q) : system.JointAngle(o.joint, s.q);
+    case Quantity::kJointRate:
+      return o.linear ? system.JointTranslationRate(o.joint, s.q, s.v) : system.JointAngleRate(o.joint, s.q, s.v);
+    case Quantity::kJointSlide: return system.JointTranslation(o.joint, s.q);
+    case Quantity::kJointSlideRate: return system.JointTranslationRate(o.joint, s.q, s.v);
+    case Quantity::kSpringLength:
+    case Quantity::kSpringForce: {
+      const SpringDamper& spring = model.springs[static_cast<size_t>(o.spring)];
+      const Vector3d d = system.PointPosition(spring.b, s.q) - system.PointPosition(spring.a, s.q);
+      const double length = d.norm();
+      if (o.quantity == Quantity::kSpringLength) return length;
+      const Vector3d d_dot = system.PointVelocity(spring.b, s.q, s.v) - system.PointVelocity(spring.a, s.q, s.v);
+      return spring.stiffness_n_per_m * (length - spring.free_length_m) +
+             spring.damping_n_s_per_m * d.dot(d_dot) / length;
+    }
+    case Quantity::kKineticEnergy: return system.KineticEnergy(s.q, s.v);
+    case Quantity::kPotentialEnergy: return system.PotentialEnergy(s.q);
+  }
+  return NAN;
+}
+
+}  // namespace
+
+absl::StatusOr<Model> CompileSpatialModel(const spec::Scene& scene, const std::vector<double>& p) {
+  const auto& sm = std::get<spec::SpatialModel>(scene.model);
+  Model m;
+  for (const spec::SpatialBody& b : sm.bodies) {
+    Body body;
+    body.name = b.name;
+    body.mass_kg = b.mass_kg.Resolve(p);
+    if (b.components) {
+      const spec::Number* c = b.inertia_components_kg_m2;
+      const double xy = c[3].Resolve(p), xz = c[4].Resolve(p), yz = c[5].Resolve(p);
+      body.inertia_kg_m2 << c[0].Resolve(p), xy, xz, xy, c[1].Resolve(p), yz, xz, yz, c[2].Resolve(p);
+    } else {
+      const Matrix3d axes = OrientationMatrix(b.principal_axes, p);
+      body.inertia_kg_m2 = axes * Resolve(b.principal_moments_kg_m2, p).asDiagonal() * axes.transpose();
+      // Exactly symmetric, whatever the rounding of the products above.
+      body.inertia_kg_m2 = 0.5 * (body.inertia_kg_m2 + body.inertia_kg_m2.transpose()).eval();
+    }
+    body.position_m = Resolve(b.position_m, p);
+    body.orientation = OrientationMatrix(b.orientation, p);
+    body.velocity_m_per_s = Resolve(b.velocity_m_per_s, p);
+    body.angular_velocity_rad_per_s = Resolve(b.angular_velocity_rad_per_s, p);
+    m.bodies.push_back(std::move(body));
+  }
+  for (const spec::SpatialJoint& j : sm.joints) {
+    m.joints.push_back(Joint{j.name, JointKindOf(j.kind), FrameOf(sm, j.a, p), FrameOf(sm, j.b, p)});
+  }
+  for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p)});
+  for (const spec::SpatialSpring& s : sm.springs) {
+    SpringDamper spring;
+    spring.name = s.name;
+    spring.a = PointOf(sm, s.a, p);
+    spring.b = PointOf(sm, s.b, p);
+    spring.stiffness_n_per_m = s.stiffness_n_per_m.Resolve(p);
+    spring.free_length_m = s.free_length_m.Resolve(p);
+    spring.damping_n_s_per_m = s.damping_n_s_per_m.Resolve(p);
+    m.springs.push_back(std::move(spring));
+  }
+  if (sm.gravity_m_per_s2) m.gravity_m_per_s2 = Resolve(*sm.gravity_m_per_s2, p);
+  if (absl::Status valid = m.Validate(); !valid.ok()) return valid;
+  return m;
+}
+
+spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::vector<double>& p,
+                                         budget::AnalysisBudget* budget) {
+  spec::AnalysisReport report;
+  report.times_s = scene.time_grid.Instants();
+  report.formulation = spec::Formulation::kDynamic;
+  if (!std::holds_alternative<spec::SpatialModel>(scene.model) || p.size() != scene.parameters.size()) {
+    report.Fail(spec::FailureKind::kInvalidModel,
+                absl::StrFormat("expected a spatial scene and %d parameter values", scene.parameters.size()));
+    return report;
+  }
+  const auto& sm = std::get<spec::SpatialModel>(scene.model);
+  for (size_t k = 0; k < scene.outputs.size(); ++k) {
+    const spec::Output& o = scene.outputs[k];
+    if (!std::holds_alternative<spec::SpatialOutput>(o.kind)) {
+      report.Fail(spec::FailureKind::kInvalidModel, absl::StrFormat("output '%s' is not a spatial output", o.name));
+      return report;
+    }
+    const spec::OutputShape shape = spec::OutputShapeOf(scene, static_cast<int>(k));
+    spec::OutputValues values;
+    values.name = o.name;
+    values.series_labels = shape.series_labels;
+    values.series.assign(1, std::vector<double>());
+    values.series[0].reserve(report.times_s.size());
+    report.outputs.push_back(std::move(values));
+  }
+  if (report.outputs.empty()) return report;  // nothing requested: nothing computed
+  absl::StatusOr<Model> model = CompileSpatialModel(scene, p);
+  if (!model.ok()) {
+    report.Fail(spec::FailureKind::kInvalidModel, std::string(model.status().message()));
+    return report;
+  }
+  const SpatialSystem system(*model);
+  const SpatialAssembly assembled = AssembleSpatial(system, 0.0);
+  report.counters.newton_iterations += assembled.newton_iterations;
+  if (!assembled.failure.ok()) {
+    report.Fail(assembled.failure.kind, assembled.failure.reason);
+    return report;
+  }
+  if (assembled.redundant_rows > 0) {
+    // The GGL integrator's augmented matrix is singular with redundant
+    // rows: refused until they are handled.
+    report.Fail(spec::FailureKind::kInvalidModel,
+                absl::StrFormat("%d redundant constraint equation(s) at the assembled start: the joints fix some "
+                                "motion twice (replace a joint by one that constrains less, e.g. a revolute by a "
+                                "spherical or a spherical by a point-on-plane joint); redundant joints are not "
+                                "handled yet",
+                                assembled.redundant_rows));
+    return report;
+  }
+  // The motion starts at t = 0; the grid may start later.
+  std::vector<double> times;
+  if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
+  times.insert(times.end(), report.times_s.begin(), report.times_s.end());
+  size_t next_instant = 0;
+  const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
+    if (budget != nullptr) {
+      if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
+    }
+    if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
+      return spec::AnalysisFailure::Ok();
+    }
+    ++next_instant;
+    for (size_t k = 0; k < scene.outputs.size(); ++k) {
+      const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
+      const double value = OutputValue(system, *model, sm, o, p, s);
+      if (!std::isfinite(value)) {
+        return spec::AnalysisFailure::Of(
+            spec::FailureKind::kNonFiniteValue,
+            absl::StrFormat("output '%s' is not finite at t = %.6g s", scene.outputs[k].name, s.t_s));
+      }
+      report.outputs[k].series[0].push_back(value);
+    }
+    return spec::AnalysisFailure::Ok();
+  };
+  const multibody::ForwardDynamicsOptions options = multibody::ForwardDynamicsOptions::Of(scene.integrator, budget);
+  multibody::ForwardDynamicsCounters counters;
+  const spec::AnalysisFailure outcome =
+      multibody::IntegrateForward(system, 0.0, assembled.q, assembled.v, times, options, record, &counters);
+  report.counters.time_steps = counters.steps;
+  report.counters.rhs_evaluations = counters.residual_evaluations;
+  report.counters.jacobian_evaluations = counters.jacobian_evaluations;
+  report.counters.newton_iterations += counters.nonlinear_iterations;
+  if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
+  return report;
+}
+
+}  // namespace mbopt::spatial
