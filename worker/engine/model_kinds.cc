@@ -78,7 +78,8 @@ spec::AnalysisReport AnalyzeFmu(const spec::Scene& scene, const std::vector<doub
 }
 
 SensitivityAnalysis AnalyzeFmuWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
-                                                const std::vector<int>& parameters, budget::AnalysisBudget* budget) {
+                                                const std::vector<int>& parameters, budget::AnalysisBudget* budget,
+                                                const ExternalAnalyzer*) {
   fmu::FmuSensitivityAnalysis result = fmu::AnalyzeFmuSceneWithSensitivities(scene, p, parameters, budget);
   return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
 }
