@@ -150,7 +150,7 @@ std::vector<absl::StatusOr<bool>> Deliver(jobs::manager::JobManager& manager, co
                                                                    : absl::StatusOr<bool>(reported);
       continue;
     }
-    reports.push_back(service::WorkerReportFromProto(result));
+    reports.push_back(service::WorkerReportFromProto(result, /*holder=*/""));
     report_index.push_back(static_cast<size_t>(i));
   }
   std::vector<absl::StatusOr<bool>> taken = manager.ReportResults(std::move(reports));
