@@ -493,9 +493,9 @@ TEST(EndToEnd, ExternalStudyIsRefusedWithoutItsDriverAndRunsOnlyWhereDeclared) {
   int checked = 0;
   while (std::getline(rows, line)) {
     std::istringstream fields(line);
-    std::string id, name;
+    std::string id, name, token;
     long long slots = 0, analyses = -1;
-    fields >> id >> name >> slots >> analyses;
+    fields >> id >> name >> token >> slots >> analyses;
     if (name == "plain") {
       EXPECT_EQ(analyses, 0) << after.stdout_text;
     }

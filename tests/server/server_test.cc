@@ -30,6 +30,7 @@
 #include "mbopt/v1/service.grpc.pb.h"
 #include "server/scheduler/clock.h"
 #include "server/scheduler/scheduler.h"
+#include "server/service/grpc_services.h"
 #include "server/service/listen_address.h"
 #include "server/store/store.h"
 #include "tests/server/fake_worker.h"
@@ -842,8 +843,13 @@ TEST_F(ServerTest, OversizedStudyOrSourceNameIsRefusedNamingTheLimit) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << limit;
     EXPECT_THAT(status.error_message(), HasSubstr(limit));
   };
+  // One MiB over what Submit takes (two input files and a carried FMU).
+  constexpr std::size_t kOver = JobServiceImpl::kMaxStudyMessageBytes + (std::size_t{1} << 20);
+  expect_refused([](v1::Study& s, v1::SubmitJobRequest&) { s.set_description(std::string(kOver, 'x')); },
+                 absl::StrCat("more than the limit of ", JobServiceImpl::kMaxStudyMessageBytes >> 20, " MB"));
+  // Under that limit, a field over its own bound is refused by the study's reader, naming the field.
   expect_refused([](v1::Study& s, v1::SubmitJobRequest&) { s.set_description(std::string(33 << 20, 'x')); },
-                 "more than the limit of 32 MB");
+                 "description: text of 34603008 bytes, more than the limit of 65536");
   expect_refused([](v1::Study&, v1::SubmitJobRequest& r) { r.set_source_name(std::string(5000, 'p')); },
                  "source_name has 5000 bytes");
   // A 100 KB study whose constraint name has 100,000 characters: each of its
