@@ -23,6 +23,7 @@
 #include "worker/fmu/archive_cache.h"
 #include "worker/fmu/fmu.h"
 #include "worker/fmu/scene_analysis.h"
+#include "worker/fmu/simulation.h"
 
 namespace mbopt::fmu {
 namespace {
@@ -80,6 +81,41 @@ TEST_F(FmuArchiveCache, UnpacksEachContentOnceAndKeepsItWhenTheFmuGoes) {
   EXPECT_TRUE(std::filesystem::exists(*second / "modelDescription.xml"));
   // Nothing else is left in the cache: no incoming file, no half folder.
   EXPECT_EQ(Names(cache_), std::vector<std::string>{sha256_});
+}
+
+// The instances two loads of one cached folder make: the count each saw.
+std::vector<double> InstancesSeenByTwoLoads(const std::filesystem::path& archive, const std::filesystem::path& cache) {
+  const std::string bytes = ReadBytes(archive);
+  auto contents = spec::io::ReadFmuArchiveContents(bytes);
+  EXPECT_TRUE(contents.ok()) << contents.status();
+  auto folder = UnpackedArchiveFolder(bytes, contents->sha256, archive.string(), cache);
+  EXPECT_TRUE(folder.ok()) << folder.status();
+  // Both loaded at once, as on a worker's two slots.
+  auto first = Fmu::OpenUnpacked(archive, *folder, Interface::kModelExchange);
+  auto second = Fmu::OpenUnpacked(archive, *folder, Interface::kModelExchange);
+  EXPECT_TRUE(first.ok()) << first.status();
+  EXPECT_TRUE(second.ok()) << second.status();
+  RunOptions options;
+  options.outputs = {"instances_seen"};
+  options.output_times_s = {0.0, 1.0};
+  std::vector<double> seen;
+  for (const Fmu* fmu : {&*first, &*second}) {
+    auto result = Simulate(*fmu, options);
+    EXPECT_TRUE(result.ok()) << result.status();
+    EXPECT_EQ(result->outcome, RunOutcome::kOk) << result->reason;
+    seen.push_back(result->values.at(0).at(1));
+  }
+  return seen;
+}
+
+TEST_F(FmuArchiveCache, AnFmuInstantiatedOnlyOncePerProcessGetsALibraryOfItsOwnOnEachLoad) {
+  EXPECT_EQ(InstancesSeenByTwoLoads(TestFmu("instance_counter"), cache_), (std::vector<double>{1.0, 1.0}));
+  // The private copies are gone once loaded: the folder is as unpacked.
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(cache_)) {
+    EXPECT_THAT(entry.path().filename().string(), ::testing::Not(HasSubstr(".instance-"))) << entry.path();
+  }
+  // Without the declaration both loads share one library, and its globals.
+  EXPECT_EQ(InstancesSeenByTwoLoads(TestFmu("instance_counter_shared"), cache_), (std::vector<double>{1.0, 2.0}));
 }
 
 TEST_F(FmuArchiveCache, RefusesACacheOthersMayWriteInto) {

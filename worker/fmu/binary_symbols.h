@@ -5,6 +5,7 @@
 #include <dlfcn.h>
 
 #include <filesystem>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -12,16 +13,45 @@
 
 namespace mbopt::fmu {
 
-// The handle of `binary` opened with RTLD_LOCAL (two FMUs exporting the
-// same names do not see each other), or InvalidArgument naming it.
-inline absl::StatusOr<void*> OpenBinary(const std::filesystem::path& binary) {
+// An opened shared library, closed when the last owner goes; move-only so
+// the functions resolved from it never outlive it by a copy.
+class OpenedBinary {
+ public:
+  OpenedBinary() = default;
+  explicit OpenedBinary(void* handle) : handle_(handle) {}
+  OpenedBinary(OpenedBinary&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+  OpenedBinary& operator=(OpenedBinary&& other) noexcept {
+    if (this != &other) {
+      Close();
+      handle_ = std::exchange(other.handle_, nullptr);
+    }
+    return *this;
+  }
+  OpenedBinary(const OpenedBinary&) = delete;
+  OpenedBinary& operator=(const OpenedBinary&) = delete;
+  ~OpenedBinary() { Close(); }
+
+  void* handle() const { return handle_; }
+
+ private:
+  void Close() {
+    if (handle_ != nullptr) dlclose(handle_);
+    handle_ = nullptr;
+  }
+
+  void* handle_ = nullptr;
+};
+
+// `binary` opened with RTLD_LOCAL (two FMUs exporting the same names do not
+// see each other), or InvalidArgument naming it.
+inline absl::StatusOr<OpenedBinary> OpenBinary(const std::filesystem::path& binary) {
   void* handle = dlopen(binary.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* reason = dlerror();
     return absl::InvalidArgumentError(
         absl::StrCat(binary.string(), ": the FMU's binary cannot be loaded: ", reason ? reason : "unknown"));
   }
-  return handle;
+  return OpenedBinary(handle);
 }
 
 // Sets `*out` to the function `name` of the opened binary (null when it has

@@ -1,8 +1,7 @@
 #include "worker/fmu/fmi2_library.h"
 
-#include <dlfcn.h>
-
 #include <string>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -12,11 +11,11 @@ namespace mbopt::fmu {
 
 absl::StatusOr<Fmi2Library> Fmi2Library::Load(const std::filesystem::path& binary, Interface interface) {
   Fmi2Library library;
-  absl::StatusOr<void*> handle = OpenBinary(binary);
-  if (!handle.ok()) return handle.status();
-  library.handle_ = *handle;
+  absl::StatusOr<OpenedBinary> opened = OpenBinary(binary);
+  if (!opened.ok()) return opened.status();
+  library.binary_ = *std::move(opened);
   Fmi2Functions& f = library.functions_;
-  void* h = library.handle_;
+  void* h = library.binary_.handle();
   const bool me = interface == Interface::kModelExchange;
   const absl::Status statuses[] = {
       ResolveFunction(h, binary, "fmi2GetVersion", &f.get_version),
@@ -49,20 +48,6 @@ absl::StatusOr<Fmi2Library> Fmi2Library::Load(const std::filesystem::path& binar
         absl::StrCat(binary.string(), ": fmi2GetVersion says \"", version, "\", expected \"2.0\""));
   }
   return library;
-}
-
-Fmi2Library& Fmi2Library::operator=(Fmi2Library&& other) noexcept {
-  if (this != &other) {
-    if (handle_ != nullptr) dlclose(handle_);
-    handle_ = other.handle_;
-    functions_ = other.functions_;
-    other.handle_ = nullptr;
-  }
-  return *this;
-}
-
-Fmi2Library::~Fmi2Library() {
-  if (handle_ != nullptr) dlclose(handle_);
 }
 
 }  // namespace mbopt::fmu

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "absl/status/statusor.h"
+#include "worker/fmu/binary_symbols.h"
 #include "worker/fmu/fmi2_api.h"
 #include "worker/fmu/model_instance.h"
 
@@ -41,20 +42,15 @@ class Fmi2Library {
   // names the binary and the first missing function, or dlopen's reason.
   static absl::StatusOr<Fmi2Library> Load(const std::filesystem::path& binary, Interface interface);
 
-  Fmi2Library(Fmi2Library&& other) noexcept : handle_(other.handle_), functions_(other.functions_) {
-    other.handle_ = nullptr;
-  }
-  Fmi2Library& operator=(Fmi2Library&& other) noexcept;
-  Fmi2Library(const Fmi2Library&) = delete;
-  Fmi2Library& operator=(const Fmi2Library&) = delete;
-  ~Fmi2Library();
+  Fmi2Library(Fmi2Library&&) noexcept = default;
+  Fmi2Library& operator=(Fmi2Library&&) noexcept = default;
 
   const Fmi2Functions& functions() const { return functions_; }
 
  private:
   Fmi2Library() = default;
 
-  void* handle_ = nullptr;
+  OpenedBinary binary_;
   Fmi2Functions functions_;
 };
 

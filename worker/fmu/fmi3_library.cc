@@ -1,8 +1,7 @@
 #include "worker/fmu/fmi3_library.h"
 
-#include <dlfcn.h>
-
 #include <string>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -12,11 +11,11 @@ namespace mbopt::fmu {
 
 absl::StatusOr<Fmi3Library> Fmi3Library::Load(const std::filesystem::path& binary, Interface interface) {
   Fmi3Library library;
-  absl::StatusOr<void*> handle = OpenBinary(binary);
-  if (!handle.ok()) return handle.status();
-  library.handle_ = *handle;
+  absl::StatusOr<OpenedBinary> opened = OpenBinary(binary);
+  if (!opened.ok()) return opened.status();
+  library.binary_ = *std::move(opened);
   Fmi3Functions& f = library.functions_;
-  void* h = library.handle_;
+  void* h = library.binary_.handle();
   const bool me = interface == Interface::kModelExchange;
   const absl::Status statuses[] = {
       ResolveFunction(h, binary, "fmi3GetVersion", &f.get_version),
@@ -50,20 +49,6 @@ absl::StatusOr<Fmi3Library> Fmi3Library::Load(const std::filesystem::path& binar
         absl::StrCat(binary.string(), ": fmi3GetVersion says \"", version, "\", expected \"3.0\""));
   }
   return library;
-}
-
-Fmi3Library& Fmi3Library::operator=(Fmi3Library&& other) noexcept {
-  if (this != &other) {
-    if (handle_ != nullptr) dlclose(handle_);
-    handle_ = other.handle_;
-    functions_ = other.functions_;
-    other.handle_ = nullptr;
-  }
-  return *this;
-}
-
-Fmi3Library::~Fmi3Library() {
-  if (handle_ != nullptr) dlclose(handle_);
 }
 
 }  // namespace mbopt::fmu

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "absl/status/statusor.h"
+#include "worker/fmu/binary_symbols.h"
 #include "worker/fmu/fmi3_api.h"
 #include "worker/fmu/model_instance.h"
 
@@ -41,20 +42,15 @@ class Fmi3Library {
   // names the binary and the first missing function, or dlopen's reason.
   static absl::StatusOr<Fmi3Library> Load(const std::filesystem::path& binary, Interface interface);
 
-  Fmi3Library(Fmi3Library&& other) noexcept : handle_(other.handle_), functions_(other.functions_) {
-    other.handle_ = nullptr;
-  }
-  Fmi3Library& operator=(Fmi3Library&& other) noexcept;
-  Fmi3Library(const Fmi3Library&) = delete;
-  Fmi3Library& operator=(const Fmi3Library&) = delete;
-  ~Fmi3Library();
+  Fmi3Library(Fmi3Library&&) noexcept = default;
+  Fmi3Library& operator=(Fmi3Library&&) noexcept = default;
 
   const Fmi3Functions& functions() const { return functions_; }
 
  private:
   Fmi3Library() = default;
 
-  void* handle_ = nullptr;
+  OpenedBinary binary_;
   Fmi3Functions functions_;
 };
 

@@ -112,15 +112,8 @@ absl::StatusOr<ModelDescription> ParseFmi3ModelDescription(const Locator& at, co
   if (description.guid.empty()) {
     return at.Error(root, "attribute instantiationToken: expected the FMU's token, got nothing");
   }
-  if (const pugi::xml_node node = root.child("ModelExchange"); node) {
-    auto type = ParseInterfaceType(at, node, "providesDirectionalDerivatives");
-    if (!type.ok()) return type.status();
-    description.model_exchange = *std::move(type);
-  }
-  if (const pugi::xml_node node = root.child("CoSimulation"); node) {
-    auto type = ParseInterfaceType(at, node, "providesDirectionalDerivatives");
-    if (!type.ok()) return type.status();
-    description.co_simulation = *std::move(type);
+  if (absl::Status status = ParseInterfaceTypes(at, root, "providesDirectionalDerivatives", &description); !status.ok()) {
+    return status;
   }
   if (!description.model_exchange && !description.co_simulation) {
     if (const pugi::xml_node node = root.child("ScheduledExecution"); node) {

@@ -1,14 +1,17 @@
 #include "worker/fmu/fmu.h"
 
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 #include "worker/fmu/fmi2_instance.h"
 #include "worker/fmu/fmi3_instance.h"
+#include "worker/fmu/private_binary_copy.h"
 
 namespace mbopt::fmu {
 namespace {
@@ -23,6 +26,13 @@ std::set<std::string> ArchivePlatforms(const UnpackedArchive& archive) {
     if (end != std::string::npos && end > prefix.size()) platforms.insert(entry.substr(prefix.size(), end - prefix.size()));
   }
   return platforms;
+}
+
+// Errors of a load from a private copy name the FMU's own binary.
+absl::Status NamingTheBinary(const absl::Status& status, const std::optional<PrivateBinaryCopy>& copy,
+                             const std::filesystem::path& binary) {
+  if (!copy) return status;
+  return absl::Status(status.code(), absl::StrReplaceAll(status.message(), {{copy->path().string(), binary.string()}}));
 }
 
 }  // namespace
@@ -110,15 +120,23 @@ absl::StatusOr<Fmu> Fmu::Load(UnpackedArchive archive, Interface interface) {
         archive_path.string(), ": no binary ", binary_entry, " for this platform (", platform,
         "); the archive has binaries for: ", platforms.empty() ? "no platform" : absl::StrJoin(platforms, ", ")));
   }
+  // Loaded, the copy's file can go: the process keeps its mapping.
+  std::optional<PrivateBinaryCopy> private_copy;
+  if (type->instantiated_once_per_process) {
+    absl::StatusOr<PrivateBinaryCopy> copy = PrivateBinaryCopy::Make(binary);
+    if (!copy.ok()) return copy.status();
+    private_copy.emplace(*std::move(copy));
+  }
+  const std::filesystem::path& load_path = private_copy ? private_copy->path() : binary;
   const std::filesystem::path resources = archive.folder() / "resources";
   if (major_version >= 3) {
-    auto library = Fmi3Library::Load(binary, interface);
-    if (!library.ok()) return library.status();
+    auto library = Fmi3Library::Load(load_path, interface);
+    if (!library.ok()) return NamingTheBinary(library.status(), private_copy, binary);
     return Fmu(std::move(archive), *std::move(description), Library(*std::move(library)), interface,
                absl::StrCat(resources.string(), "/"));
   }
-  auto library = Fmi2Library::Load(binary, interface);
-  if (!library.ok()) return library.status();
+  auto library = Fmi2Library::Load(load_path, interface);
+  if (!library.ok()) return NamingTheBinary(library.status(), private_copy, binary);
   return Fmu(std::move(archive), *std::move(description), Library(*std::move(library)), interface,
              absl::StrCat("file://", resources.string()));
 }

@@ -127,15 +127,8 @@ absl::StatusOr<ModelDescription> ParseModelDescription(std::string_view xml_text
     if (!count.ok()) return count.status();
     description.number_of_event_indicators = static_cast<int>(*count);
   }
-  if (const pugi::xml_node node = root.child("ModelExchange"); node) {
-    auto type = ParseInterfaceType(at, node, "providesDirectionalDerivative");
-    if (!type.ok()) return type.status();
-    description.model_exchange = *std::move(type);
-  }
-  if (const pugi::xml_node node = root.child("CoSimulation"); node) {
-    auto type = ParseInterfaceType(at, node, "providesDirectionalDerivative");
-    if (!type.ok()) return type.status();
-    description.co_simulation = *std::move(type);
+  if (absl::Status status = ParseInterfaceTypes(at, root, "providesDirectionalDerivative", &description); !status.ok()) {
+    return status;
   }
   if (!description.model_exchange && !description.co_simulation) {
     return at.Error(root, "expected a <ModelExchange> or <CoSimulation> element, got neither");

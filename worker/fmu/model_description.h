@@ -43,6 +43,9 @@ struct InterfaceType {
   std::string model_identifier;  // the binary's base name
   bool provides_directional_derivative = false;
   bool can_handle_variable_communication_step_size = false;  // co-simulation only
+  // The binary keeps an instance's state in its globals: two instances need
+  // two copies of the library in the process (fmu.cc).
+  bool instantiated_once_per_process = false;
 };
 
 struct DefaultExperiment {

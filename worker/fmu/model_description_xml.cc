@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -101,7 +103,26 @@ absl::StatusOr<InterfaceType> ParseInterfaceType(const Locator& at, const pugi::
   auto variable_step = ParseBoolean(at, node, "canHandleVariableCommunicationStepSize");
   if (!variable_step.ok()) return variable_step.status();
   type.can_handle_variable_communication_step_size = *variable_step;
+  auto once = ParseBoolean(at, node, "canBeInstantiatedOnlyOncePerProcess");
+  if (!once.ok()) return once.status();
+  type.instantiated_once_per_process = *once;
   return type;
+}
+
+absl::Status ParseInterfaceTypes(const Locator& at, const pugi::xml_node& root,
+                                 const char* directional_derivative_attribute, ModelDescription* out) {
+  const std::pair<const char*, std::optional<InterfaceType>*> blocks[] = {
+      {"ModelExchange", &out->model_exchange},
+      {"CoSimulation", &out->co_simulation},
+  };
+  for (const auto& [element, slot] : blocks) {
+    const pugi::xml_node node = root.child(element);
+    if (!node) continue;
+    absl::StatusOr<InterfaceType> type = ParseInterfaceType(at, node, directional_derivative_attribute);
+    if (!type.ok()) return type.status();
+    *slot = *std::move(type);
+  }
+  return absl::OkStatus();
 }
 
 absl::Status ParseDefaultExperiment(const Locator& at, const pugi::xml_node& node, DefaultExperiment* out) {

@@ -42,6 +42,9 @@ absl::StatusOr<Variability> ParseVariability(const Locator& at, const pugi::xml_
 // providesDirectionalDerivatives in 3.0).
 absl::StatusOr<InterfaceType> ParseInterfaceType(const Locator& at, const pugi::xml_node& node,
                                                  const char* directional_derivative_attribute);
+// Both interface blocks of `root` that are present, into `out`.
+absl::Status ParseInterfaceTypes(const Locator& at, const pugi::xml_node& root,
+                                 const char* directional_derivative_attribute, ModelDescription* out);
 absl::Status ParseDefaultExperiment(const Locator& at, const pugi::xml_node& node, DefaultExperiment* out);
 
 // The FMI 3.0 part of ParseModelDescription, from the root element on.
