@@ -22,7 +22,18 @@ struct OracleRun {
   bool ok = false;
   std::string error;                       // when !ok
   std::vector<std::vector<double>> values;  // [instant][quantity]
+  // The integration alone (stepping and reading, not building the model):
+  // process CPU time and Simbody's step count, for the work-precision
+  // benchmark (bench/multibody).
+  double cpu_seconds = 0.0;
+  long steps = 0;
 };
+
+// Simbody's integrator for the runs that follow: "rkm" (Runge-Kutta-Merson,
+// the default and what the comparison tests use) or "cpodes" (CPodes' BDF
+// with Newton iterations, Simbody's implicit choice). Returns false for an
+// unknown name.
+bool UseIntegrator(const std::string& name);
 
 // Two bars pinned in a chain at the origin (upper: mass m1, length l1;
 // lower: m2, l2), released from absolute angles phi1, phi2 of their axes
@@ -72,5 +83,19 @@ struct TenBodyChain {
 };
 OracleRun SimulateTenBodyChain(const TenBodyChain& p, const std::vector<double>& times_s, double accuracy,
                                double* wall_seconds);
+
+// A closed chain of `rods` uniform rods (1 kg, 1 m) between ground pins at
+// (0, 0) and (rods - 2, 0): the first two rods start 60 degrees below the
+// horizontal, the last two 60 degrees above it, the rest horizontal (a
+// closed start), released at rest under gravity (tests/multibody's
+// RodChain). Values: each rod's absolute angle.
+OracleRun SimulateRodChain(int rods, const std::vector<double>& times_s, double accuracy);
+
+// Andrews' squeezing mechanism (Hairer and Wanner, the Test Set for IVP
+// solvers; examples/andrews has the same model as an mbopt scene): seven
+// bodies, constant drive torque, a spring, no gravity, from the published
+// consistent initial angles at rest. Values: the seven published angles
+// beta, Theta, gamma, Phi, delta, Omega, epsilon (rad).
+OracleRun SimulateAndrews(const std::vector<double>& times_s, double accuracy);
 
 }  // namespace mbopt::oracle
