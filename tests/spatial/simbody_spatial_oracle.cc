@@ -5,17 +5,26 @@
 //   mbopt_simbody_spatial_oracle MECHANISM ACCURACY END_S INTERVALS
 //
 // MECHANISM is double_pendulum (released at rest) or
-// spinning_double_pendulum (spatial_oracle.h).
+// spinning_double_pendulum (spatial_oracle.h), or one of the closed loops
+// of spatial_mechanisms.h: bricard, rssr, cardan. A closed loop becomes a
+// tree of mobilizers (each joint whose second body is not yet placed) and
+// constraints closing it: Constraint::Ball for a spherical joint, a ball
+// and two right angles (Constraint::ConstantAngle) for a revolute one,
+// Constraint::PointOnLine. Simbody solves its constraint equations with
+// rank-revealing factorizations, so a redundant closure (Bricard's) is
+// given to it as it is.
 //
 // Prints one line per instant: the time and the values with 17 significant
 // digits; exit status 1 and the reason on stderr when Simbody fails.
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "Simbody.h"
+#include "tests/spatial/spatial_mechanisms.h"
 #include "tests/spatial/spatial_oracle.h"
 
 namespace {
@@ -71,6 +80,109 @@ int DoublePendulum(bool spinning, double accuracy, const std::vector<double>& ti
   return 0;
 }
 
+
+Vec3 V(const mbopt::oracle::Vec& v) { return Vec3(v[0], v[1], v[2]); }
+
+Rotation R(const mbopt::oracle::Mat& m) {
+  return Rotation(Mat33(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8]));
+}
+
+// Simulates a mechanism of spatial_mechanisms.h and prints its values.
+int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::vector<double>& times) {
+  MultibodySystem system;
+  SimbodyMatterSubsystem matter(system);
+  GeneralForceSubsystem forces(system);
+  Force::UniformGravity gravity(forces, matter, V(m.gravity_m_per_s2));
+  std::vector<MobilizedBody> bodies(m.bodies.size());
+  std::vector<bool> placed(m.bodies.size(), false);
+  // A joint's frame W at its point, in body `b`'s axes (ground: world).
+  auto frame_in = [&](int b, const mbopt::oracle::MechanismJoint& j) {
+    const Transform world(R(j.axes), V(j.point_m));
+    if (b < 0) return world;
+    const Transform body(R(m.bodies[b].orientation), V(m.bodies[b].position_m));
+    return Transform(~body * world);
+  };
+  auto mobod = [&](int b) -> MobilizedBody& { return b < 0 ? matter.updGround() : bodies[b]; };
+  std::vector<const mbopt::oracle::MechanismJoint*> closures;
+  std::vector<int> driven;  // the mobilizer of the driven joint
+  for (size_t k = 0; k < m.joints.size(); ++k) {
+    const mbopt::oracle::MechanismJoint& j = m.joints[k];
+    const bool parent_ready = j.a < 0 || placed[j.a];
+    if (!parent_ready || j.b < 0 || placed[j.b]) {
+      if (static_cast<int>(k) == m.driven_joint) throw std::runtime_error("a driven joint must be a mobilizer");
+      closures.push_back(&j);
+      continue;
+    }
+    const mbopt::oracle::MechanismBody& mb = m.bodies[j.b];
+    const Body::Rigid info(MassProperties(mb.mass_kg, Vec3(0), Inertia(mb.principal_moments_kg_m2[0], mb.principal_moments_kg_m2[1], mb.principal_moments_kg_m2[2])));
+    MobilizedBody& parent = mobod(j.a);
+    const Transform x_pf = frame_in(j.a, j), x_bm = frame_in(j.b, j);
+    switch (j.kind) {
+      case mbopt::oracle::MechanismJointKind::kRevolute:
+        bodies[j.b] = MobilizedBody::Pin(parent, x_pf, info, x_bm);
+        break;
+      case mbopt::oracle::MechanismJointKind::kSpherical:
+        bodies[j.b] = MobilizedBody::Ball(parent, x_pf, info, x_bm);
+        break;
+      case mbopt::oracle::MechanismJointKind::kUniversal:
+        bodies[j.b] = MobilizedBody::Universal(parent, x_pf, info, x_bm);
+        break;
+      case mbopt::oracle::MechanismJointKind::kPointOnLine:
+        throw std::runtime_error("a point-on-line joint must close a loop");
+    }
+    placed[j.b] = true;
+    if (static_cast<int>(k) == m.driven_joint) Motion::Steady(bodies[j.b], m.driver_rate_rad_per_s);
+  }
+  for (const mbopt::oracle::MechanismJoint* j : closures) {
+    MobilizedBody& a = mobod(j->a);
+    MobilizedBody& b = mobod(j->b);
+    const Transform fa = frame_in(j->a, *j), fb = frame_in(j->b, *j);
+    switch (j->kind) {
+      case mbopt::oracle::MechanismJointKind::kSpherical:
+        Constraint::Ball(a, fa.p(), b, fb.p());
+        break;
+      case mbopt::oracle::MechanismJointKind::kRevolute:
+        Constraint::Ball(a, fa.p(), b, fb.p());
+        Constraint::ConstantAngle(a, fa.z(), b, fb.x(), Pi / 2);
+        Constraint::ConstantAngle(a, fa.z(), b, fb.y(), Pi / 2);
+        break;
+      case mbopt::oracle::MechanismJointKind::kUniversal:
+        Constraint::Ball(a, fa.p(), b, fb.p());
+        Constraint::ConstantAngle(a, fa.x(), b, fb.y(), Pi / 2);
+        break;
+      case mbopt::oracle::MechanismJointKind::kPointOnLine:
+        Constraint::PointOnLine(a, fa.z(), fa.p(), b, fb.p());
+        break;
+    }
+  }
+  State state = system.realizeTopology();
+  // Every mobilizer at q = 0 is the initial pose; the driven one's rate and
+  // the velocities the loops then need come from the projection below.
+  system.realize(state, Stage::Position);
+  system.project(state, 1e-14);
+  RungeKuttaMersonIntegrator integrator(system);
+  integrator.setAccuracy(accuracy);
+  integrator.setConstraintTolerance(1e-12);
+  TimeStepper stepper(system, integrator);
+  stepper.initialize(state);
+  for (double t : times) {
+    if (t > 0.0) stepper.stepTo(t);
+    const State& s = integrator.getState();
+    system.realize(s, Stage::Position);
+    std::printf("%.17g", t);
+    for (const MobilizedBody& b : bodies) {
+      const Vec3 c = b.getBodyOriginLocation(s);
+      std::printf(" %.17g %.17g %.17g", c[0], c[1], c[2]);
+      const Rotation& r = b.getBodyRotation(s);
+      for (int i = 0; i < 3; ++i) {
+        for (int k = 0; k < 3; ++k) std::printf(" %.17g", r[i][k]);
+      }
+    }
+    std::printf("\n");
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -86,6 +198,9 @@ int main(int argc, char** argv) {
   try {
     if (mechanism == "double_pendulum") return DoublePendulum(false, accuracy, times);
     if (mechanism == "spinning_double_pendulum") return DoublePendulum(true, accuracy, times);
+    if (mechanism == "bricard") return ClosedLoop(mbopt::oracle::Bricard(), accuracy, times);
+    if (mechanism == "rssr") return ClosedLoop(mbopt::oracle::Rssr(), accuracy, times);
+    if (mechanism == "cardan") return ClosedLoop(mbopt::oracle::CardanShaft(), accuracy, times);
     std::fprintf(stderr, "unknown mechanism '%s'\n", mechanism.c_str());
     return 2;
   } catch (const std::exception& e) {

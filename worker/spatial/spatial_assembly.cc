@@ -1,6 +1,7 @@
 #include "worker/spatial/spatial_assembly.h"
 
 #include "absl/strings/str_format.h"
+#include "worker/spatial/redundant_constraints.h"
 
 namespace mbopt::spatial {
 namespace {
@@ -96,8 +97,15 @@ SpatialAssembly AssembleSpatial(const SpatialSystem& system, double t, const Spa
   Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod(phi_q);
   cod.setThreshold(options.rank_tolerance);
   out.v -= cod.solve(phi_q * out.v + phi_t);
-  out.degrees_of_freedom = n - static_cast<int>(cod.rank());
-  out.redundant_rows = m - static_cast<int>(cod.rank());
+  const IndependentConstraints independent = IndependentCombination(system, t, out.q);
+  if (!independent.ok) {
+    out.failure = not_finite();
+    return out;
+  }
+  out.independent_combination = independent.combination;
+  const int rank = independent.rank;
+  out.degrees_of_freedom = n - rank;
+  out.redundant_rows = m - rank;
   return out;
 }
 

@@ -8,8 +8,9 @@
 // ConstrainedSystem equations and the initial guesses of a SpatialSystem.
 //
 // The degrees of freedom are n minus the rank of Phi_q at the assembled
-// configuration (column-pivoted QR), so redundant rows are counted, not
-// refused. Failures are data: a loop that cannot close is a kAssembly
+// configuration (column-pivoted QR, IndependentCombination in
+// redundant_constraints.h), so redundant rows are counted, not refused,
+// and the independent combinations to integrate with are given. Failures are data: a loop that cannot close is a kAssembly
 // failure naming the row with the largest residual and the time.
 #pragma once
 
@@ -35,6 +36,10 @@ struct SpatialAssembly {
   Eigen::VectorXd q, v;
   int degrees_of_freedom = 0;  // with the drivers
   int redundant_rows = 0;      // rows beyond the rank of Phi_q
+  // r x m, r the rank of Phi_q at q: the normalization rows and
+  // orthonormal combinations of the others, what forward dynamics
+  // integrates with when redundant_rows > 0 (CombinedConstraintSystem).
+  Eigen::MatrixXd independent_combination;
   int newton_iterations = 0;
 };
 

@@ -10,6 +10,7 @@
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/spatial/euler_angles.h"
 #include "worker/spatial/euler_parameters.h"
+#include "worker/spatial/redundant_constraints.h"
 #include "worker/spatial/spatial_assembly.h"
 #include "worker/spatial/spatial_system.h"
 
@@ -222,17 +223,6 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
     report.Fail(assembled.failure.kind, assembled.failure.reason);
     return report;
   }
-  if (assembled.redundant_rows > 0) {
-    // The GGL integrator's augmented matrix is singular with redundant
-    // rows: refused until they are handled.
-    report.Fail(spec::FailureKind::kInvalidModel,
-                absl::StrFormat("%d redundant constraint equation(s) at the assembled start: the joints fix some "
-                                "motion twice (replace a joint by one that constrains less, e.g. a revolute by a "
-                                "spherical or a spherical by a point-on-plane joint); redundant joints are not "
-                                "handled yet",
-                                assembled.redundant_rows));
-    return report;
-  }
   // The motion starts at t = 0; the grid may start later.
   std::vector<double> times;
   if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
@@ -260,8 +250,14 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
   };
   const multibody::ForwardDynamicsOptions options = multibody::ForwardDynamicsOptions::Of(scene.integrator, budget);
   multibody::ForwardDynamicsCounters counters;
+  // Redundant joints: integrated as independent combinations of their rows
+  // (redundant_constraints.h), every row checked along the way.
+  RedundantIntegrationCounters redundant;
   const spec::AnalysisFailure outcome =
-      multibody::IntegrateForward(system, 0.0, assembled.q, assembled.v, times, options, record, &counters);
+      assembled.redundant_rows > 0
+          ? IntegrateWithRedundantRows(system, assembled.independent_combination, 0.0, assembled.q, assembled.v, times,
+                                       options, record, &counters, &redundant)
+          : multibody::IntegrateForward(system, 0.0, assembled.q, assembled.v, times, options, record, &counters);
   report.counters.time_steps = counters.steps;
   report.counters.rhs_evaluations = counters.residual_evaluations;
   report.counters.jacobian_evaluations = counters.jacobian_evaluations;
