@@ -314,9 +314,9 @@ TEST(SpatialScene, LoadingErrorsNameFileLineFieldAndExpectation) {
 
   text = kDrivenCrank;
   text.replace(text.find("outputs { name: \"tip_x\""), 0,
-               "outputs { name: \"pull\" joint_reaction { joint: \"motor\" axis: AXIS_X } }\n");
+               "outputs { name: \"pull\" joint_reaction { joint: \"mot\" axis: AXIS_X } }\n");
   error = LoadError(text);
-  EXPECT_NE(error.find("output \"pull\" needs a multibody model; this scene's model is spatial"), std::string::npos)
+  EXPECT_NE(error.find("outputs[0].joint_reaction.joint: unknown joint \"mot\" (joints: motor)"), std::string::npos)
       << error;
 }
 
