@@ -284,6 +284,13 @@ Dimension OutputDimension(const Output& output) {
                             case Q::kSpringForce: return Dimension::kForce;
                             case Q::kKineticEnergy:
                             case Q::kPotentialEnergy: return Dimension::kEnergy;
+                            case Q::kBodyAngularVelocity: return Dimension::kAngularVelocity;
+                            case Q::kJointReaction:
+                            case Q::kBushingForce: return Dimension::kForce;
+                            case Q::kJointReactionMoment:
+                            case Q::kDriverEffort:
+                            case Q::kBushingMoment:
+                            case Q::kRotationalSpringTorque: return Dimension::kTorque;
                           }
                           return Dimension::kAny;
                         },

@@ -260,6 +260,38 @@ struct SpatialSpring {
   std::string name;
   MarkerRef a, b;
   Number free_length_m, stiffness_n_per_m, damping_n_s_per_m;
+  // As MultibodySpring's: literal force curves (empty: the linear
+  // coefficient) and a constant actuator force.
+  std::vector<double> deflection_m, deflection_force_n, velocity_m_per_s, velocity_force_n;
+  Number actuator_force_n;
+};
+// Loads: a force at a marker's origin, a torque on a body; components in
+// world axes or in the axes of the body they act on.
+struct SpatialPointForce {
+  std::string name;
+  MarkerRef at;
+  Vec3 force_n;
+  bool body_axes = false;
+  std::optional<TimeFactor> factor;
+};
+struct SpatialTorque {
+  std::string name;
+  int body = -1;
+  Vec3 torque_n_m;
+  bool body_axes = false;
+  std::optional<TimeFactor> factor;
+};
+// At a revolute or cylindrical joint's angle.
+struct SpatialRotationalSpring {
+  std::string name;
+  int joint = -1;
+  Number stiffness_n_m_per_rad, damping_n_m_s_per_rad, free_angle_rad;
+};
+// Between two markers, in marker a's axes.
+struct SpatialBushing {
+  std::string name;
+  MarkerRef a, b;
+  Vec3 stiffness_n_per_m, damping_n_s_per_m, rotational_stiffness_n_m_per_rad, rotational_damping_n_m_s_per_rad;
 };
 struct SpatialModel {
   std::vector<SpatialMarker> ground_markers;
@@ -268,6 +300,10 @@ struct SpatialModel {
   std::vector<MultibodyDriver> drivers;  // joint: a revolute or cylindrical joint's angle
   std::vector<SpatialSpring> springs;
   std::optional<Vec3> gravity_m_per_s2;
+  std::vector<SpatialPointForce> point_forces;
+  std::vector<SpatialTorque> torques;
+  std::vector<SpatialRotationalSpring> rotational_springs;
+  std::vector<SpatialBushing> bushings;
 };
 
 // ---- external (an analysis by a simulation code the worker declares as a
@@ -354,9 +390,14 @@ struct SpatialOutput {
     kMarkerPosition, kMarkerVelocity, kMarkerAcceleration, kBodyOrientation,
     kJointCoordinate, kJointRate, kJointSlide, kJointSlideRate,
     kSpringLength, kSpringForce, kKineticEnergy, kPotentialEnergy,
+    // Of the force elements and the multipliers (spatial_force_outputs.h):
+    kBodyAngularVelocity, kJointReaction, kJointReactionMoment, kDriverEffort, kBushingForce, kBushingMoment,
+    kRotationalSpringTorque,
   } quantity = Quantity::kMarkerPosition;
   MarkerRef marker;
   int body = -1, joint = -1, spring = -1;
+  int bushing = -1;          // kBushingForce, kBushingMoment
+  bool body_axes = false;    // kBodyAngularVelocity: in the body's axes, else world
   Axis axis = Axis::kX;
   int sequence[3] = {2, 1, 0};  // kBodyOrientation: as Orientation::sequence
   int angle = 0;                // kBodyOrientation: 0, 1 or 2

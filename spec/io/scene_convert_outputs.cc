@@ -118,11 +118,6 @@ void SceneConverter::ConvertOutputs() {
         break;
       case v1::Output::kJointReaction:
       case v1::Output::kDriverEffort:
-        // Reactions and efforts need inverse dynamics, which spatial scenes
-        // do not have yet: "needs a multibody model".
-        needs = "multibody";
-        out.kind = multibody ? MultibodyOutputOf(o, ow) : MultibodyOutput{};
-        break;
       case v1::Output::kMarkerPosition:
       case v1::Output::kMarkerVelocity:
       case v1::Output::kMarkerAcceleration:
@@ -143,6 +138,10 @@ void SceneConverter::ConvertOutputs() {
       case v1::Output::kBodyOrientation:
       case v1::Output::kJointSlide:
       case v1::Output::kJointSlideRate:
+      case v1::Output::kBodyAngularVelocity:
+      case v1::Output::kJointReactionMoment:
+      case v1::Output::kBushingForce:
+      case v1::Output::kRotationalSpringTorque:
         needs = "spatial";
         out.kind = spatial ? SpatialOutputOf(o, ow) : SpatialOutput{};
         break;

@@ -360,12 +360,14 @@ SpatialModel SceneConverter::ConvertSpatial(const v1::SpatialModel& m, const Whe
     spatial_.gravity_m_per_s2 = Vec3Of(gw, "acceleration_m_per_s2", m.gravity().has_acceleration_m_per_s2(),
                                        m.gravity().acceleration_m_per_s2(), Dimension::kAcceleration);
   }
+  ConvertSpatialForces(m, w);
   return spatial_;
 }
 
 SpatialOutput SceneConverter::SpatialOutputOf(const v1::Output& o, const Where& ow) {
   using Q = SpatialOutput::Quantity;
   SpatialOutput out;
+  if (SpatialForceOutputOf(o, ow, &out)) return out;
   auto axis_of = [&](const Where& kw, v1::Axis axis) {
     switch (axis) {
       case v1::AXIS_X: return Axis::kX;

@@ -10,6 +10,7 @@
 //   scene_convert_external.cc   `external`
 //   scene_convert_fmu.cc        `fmu`
 //   scene_convert_spatial.cc    `spatial`, and its outputs
+//   scene_convert_spatial_forces.cc  `spatial` loads, rotational springs, bushings and their outputs
 //   scene_convert_outputs.cc    `outputs`, each checked against the model kind
 // Problems go to `errors`; the scene Run() returns is meaningful only if
 // none were added.
@@ -112,6 +113,15 @@ class SceneConverter {
   SpatialModel ConvertSpatial(const v1::SpatialModel& m, const Where& w);
   SpatialOutput SpatialOutputOf(const v1::Output& o, const Where& ow);
 
+  // --------------------------------- scene_convert_spatial_forces.cc --
+  // Point forces, torques, rotational springs and bushings into spatial_
+  // (after its bodies and joints).
+  void ConvertSpatialForces(const v1::SpatialModel& m, const Where& w);
+  template <class Message>
+  std::optional<TimeFactor> SpatialLoadFactor(const Where& w, const Message& m);
+  // The outputs of force elements and multipliers: false for another kind.
+  bool SpatialForceOutputOf(const v1::Output& o, const Where& ow, SpatialOutput* out);
+
   // --------------------------------------- scene_convert_outputs.cc --
   void ConvertOutputs();
   void ResolvePoint(const Where& w, const std::string& name, PointPositionOutput* k);
@@ -132,6 +142,7 @@ class SceneConverter {
   std::map<std::string, int> linkage_links_, linkage_joints_;
   SpatialModel spatial_;
   std::map<std::string, int> spatial_bodies_, spatial_joints_, spatial_springs_;
+  std::map<std::string, int> spatial_rotational_springs_, spatial_bushings_;
 };
 
 }  // namespace mbopt::spec::io

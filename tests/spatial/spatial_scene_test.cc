@@ -285,6 +285,21 @@ TEST(SpatialScene, RedundantHingesAreHandledNotRefused) {
             << worst_energy << " J\n";
 }
 
+// A redundant mechanism's multipliers belong to combinations of rows: its
+// reactions are not unique, so asking for one fails the analysis naming it.
+TEST(SpatialScene, ReactionsOfARedundantMechanismAreRefusedNamingTheOutput) {
+  std::string text = kDoorOnTwoHinges;
+  const std::string kinetic = R"(outputs { name: "kinetic" kinetic_energy {} })";
+  text.replace(text.find(kinetic), kinetic.size(),
+               R"(outputs { name: "lower_fx" joint_reaction { joint: "lower" axis: AXIS_X } })");
+  const spec::Scene scene = Load(text);
+  const spec::AnalysisReport r = engine::Analyze(scene, scene.DefaultParameterValues());
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kInvalidModel);
+  EXPECT_NE(r.failure.reason.find("output 'lower_fx'"), std::string::npos) << r.failure.reason;
+  EXPECT_NE(r.failure.reason.find("redundant constraint equation"), std::string::npos) << r.failure.reason;
+}
+
 TEST(SpatialScene, OnlyRequestedOutputsAreComputed) {
   std::string text = kHangingBlock;
   text = text.substr(0, text.find("  outputs")) + "time_grid { start_s: 0 end_s: 1 points: 3 }";
@@ -365,9 +380,9 @@ TEST(SpatialScene, LoadingErrorsNameFileLineFieldAndExpectation) {
 
   text = kDrivenCrank;
   text.replace(text.find("outputs { name: \"tip_x\""), 0,
-               "outputs { name: \"pull\" joint_reaction { joint: \"motor\" axis: AXIS_X } }\n");
+               "outputs { name: \"pull\" joint_reaction { joint: \"mot\" axis: AXIS_X } }\n");
   error = LoadError(text);
-  EXPECT_NE(error.find("output \"pull\" needs a multibody model; this scene's model is spatial"), std::string::npos)
+  EXPECT_NE(error.find("outputs[0].joint_reaction.joint: unknown joint \"mot\" (joints: motor)"), std::string::npos)
       << error;
 }
 

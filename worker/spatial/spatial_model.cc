@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "worker/spatial/spatial_force_elements.h"
 
 namespace mbopt::spatial {
 namespace {
@@ -162,7 +163,7 @@ absl::Status Model::Validate() const {
   if (gravity_m_per_s2 && !gravity_m_per_s2->allFinite()) {
     return absl::InvalidArgumentError("gravity is not finite");
   }
-  return absl::OkStatus();
+  return ValidateForceElements(*this);
 }
 
 }  // namespace mbopt::spatial

@@ -1,6 +1,7 @@
 // A spatial multibody model as the engine computes with it: rigid bodies,
 // frames (markers) on them, joints between frames, drivers, translational
-// spring-dampers and gravity, every number a plain SI double. Immutable
+// spring-dampers, gravity and the force elements of spatial_force_elements.h,
+// every number a plain SI double. Immutable
 // during an analysis (the model/data split of the planar kernel,
 // worker/multibody/model.h); the equations live in SpatialSystem.
 //
@@ -85,14 +86,61 @@ struct Driver {
   multibody::Profile profile;
 };
 
-// Tension T = k (L - L0) + c dL/dt between two points, pulling them
-// together when positive.
+// Tension T = k (L - L0) + c dL/dt + actuator between two points, pulling
+// them together when positive. With a deflection curve, its force at
+// L - L0 replaces k (L - L0); with a velocity curve, its force at dL/dt
+// replaces c dL/dt (multibody::SpringDamper's curves).
 struct SpringDamper {
   std::string name;
   Point a, b;
   double stiffness_n_per_m = 0.0;
   double free_length_m = 0.0;
   double damping_n_s_per_m = 0.0;
+  double actuator_force_n = 0.0;
+  multibody::LinearTable deflection_curve;  // force (N) against L - L0 (m)
+  multibody::LinearTable velocity_curve;    // force (N) against dL/dt (m/s)
+};
+
+// A force at a body point, constant or times a time factor's q(t); its
+// components in world axes or in its body's axes (turning with the body).
+struct PointForce {
+  std::string name;
+  Point at;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  bool body_axes = false;
+  std::optional<multibody::Profile> factor;
+};
+
+// A couple on a body, as a point force.
+struct BodyTorque {
+  std::string name;
+  int body = 0;
+  Eigen::Vector3d torque_n_m = Eigen::Vector3d::Zero();
+  bool body_axes = false;
+  std::optional<multibody::Profile> factor;
+};
+
+// Torque -k (theta - theta0) - c dtheta/dt on body b of a revolute or
+// cylindrical joint about its axis (the opposite on body a), theta the
+// joint's angle and theta - theta0 taken in (-pi, pi].
+struct RotationalSpringDamper {
+  std::string name;
+  int joint = -1;
+  double stiffness_n_m_per_rad = 0.0;
+  double damping_n_m_s_per_rad = 0.0;
+  double free_angle_rad = 0.0;
+};
+
+// Six stiffnesses and dampings between frame a and frame b, in frame a's
+// axes (spatial_force_elements.h states the measures of displacement and
+// rotation).
+struct Bushing {
+  std::string name;
+  Frame a, b;
+  Eigen::Vector3d stiffness_n_per_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d damping_n_s_per_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rotational_stiffness_n_m_per_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rotational_damping_n_m_s_per_rad = Eigen::Vector3d::Zero();
 };
 
 struct Model {
@@ -101,6 +149,10 @@ struct Model {
   std::vector<Driver> drivers;
   std::vector<SpringDamper> springs;
   std::optional<Eigen::Vector3d> gravity_m_per_s2;  // absent: no gravity computed
+  std::vector<PointForce> point_forces;
+  std::vector<BodyTorque> torques;
+  std::vector<RotationalSpringDamper> rotational_springs;
+  std::vector<Bushing> bushings;
 
   // InvalidArgument naming the body, joint or element and what was expected.
   absl::Status Validate() const;

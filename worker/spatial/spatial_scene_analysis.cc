@@ -12,6 +12,8 @@
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/redundant_constraints.h"
 #include "worker/spatial/spatial_assembly.h"
+#include "worker/spatial/spatial_force_elements.h"
+#include "worker/spatial/spatial_reactions.h"
 #include "worker/spatial/spatial_system.h"
 
 namespace mbopt::spatial {
@@ -132,11 +134,19 @@ double OutputValue(const SpatialSystem& system, const Model& model, const spec::
       const double length = d.norm();
       if (o.quantity == Quantity::kSpringLength) return length;
       const Vector3d d_dot = system.PointVelocity(spring.b, s.q, s.v) - system.PointVelocity(spring.a, s.q, s.v);
-      return spring.stiffness_n_per_m * (length - spring.free_length_m) +
-             spring.damping_n_s_per_m * d.dot(d_dot) / length;
+      return SpringTension(spring, length, d.dot(d_dot) / length, false);
     }
     case Quantity::kKineticEnergy: return system.KineticEnergy(s.q, s.v);
     case Quantity::kPotentialEnergy: return system.PotentialEnergy(s.q);
+    case Quantity::kBodyAngularVelocity:
+      return (o.body_axes ? system.BodyAngularVelocity(o.body, s.q, s.v) : system.AngularVelocity(o.body, s.q, s.v))[axis];
+    case Quantity::kJointReaction: return JointReactionOf(system, o.joint, s.t_s, s.q, s.lambda).force_n[axis];
+    case Quantity::kJointReactionMoment:
+      return JointReactionOf(system, o.joint, s.t_s, s.q, s.lambda).moment_n_m[axis];
+    case Quantity::kDriverEffort: return DriverEffort(system, o.joint, s.lambda);
+    case Quantity::kBushingForce: return BushingLoadOf(model, o.bushing, s.q, s.v).force_n[axis];
+    case Quantity::kBushingMoment: return BushingLoadOf(model, o.bushing, s.q, s.v).moment_n_m[axis];
+    case Quantity::kRotationalSpringTorque: return RotationalSpringTorque(model, o.spring, s.q, s.v);
   }
   return NAN;
 }
@@ -178,9 +188,32 @@ absl::StatusOr<Model> CompileSpatialModel(const spec::Scene& scene, const std::v
     spring.stiffness_n_per_m = s.stiffness_n_per_m.Resolve(p);
     spring.free_length_m = s.free_length_m.Resolve(p);
     spring.damping_n_s_per_m = s.damping_n_s_per_m.Resolve(p);
+    spring.actuator_force_n = s.actuator_force_n.Resolve(p);
+    spring.deflection_curve = multibody::LinearTable{s.deflection_m, s.deflection_force_n};
+    spring.velocity_curve = multibody::LinearTable{s.velocity_m_per_s, s.velocity_force_n};
     m.springs.push_back(std::move(spring));
   }
   if (sm.gravity_m_per_s2) m.gravity_m_per_s2 = Resolve(*sm.gravity_m_per_s2, p);
+  auto factor_of = [&](const std::optional<spec::TimeFactor>& f) {
+    return f ? std::optional<multibody::Profile>(ProfileOf(*f, p)) : std::nullopt;
+  };
+  for (const spec::SpatialPointForce& f : sm.point_forces) {
+    m.point_forces.push_back(
+        PointForce{f.name, PointOf(sm, f.at, p), Resolve(f.force_n, p), f.body_axes, factor_of(f.factor)});
+  }
+  for (const spec::SpatialTorque& t : sm.torques) {
+    m.torques.push_back(BodyTorque{t.name, t.body, Resolve(t.torque_n_m, p), t.body_axes, factor_of(t.factor)});
+  }
+  for (const spec::SpatialRotationalSpring& r : sm.rotational_springs) {
+    m.rotational_springs.push_back(RotationalSpringDamper{r.name, r.joint, r.stiffness_n_m_per_rad.Resolve(p),
+                                                          r.damping_n_m_s_per_rad.Resolve(p),
+                                                          r.free_angle_rad.Resolve(p)});
+  }
+  for (const spec::SpatialBushing& b : sm.bushings) {
+    m.bushings.push_back(Bushing{b.name, FrameOf(sm, b.a, p), FrameOf(sm, b.b, p), Resolve(b.stiffness_n_per_m, p),
+                                 Resolve(b.damping_n_s_per_m, p), Resolve(b.rotational_stiffness_n_m_per_rad, p),
+                                 Resolve(b.rotational_damping_n_m_s_per_rad, p)});
+  }
   if (absl::Status valid = m.Validate(); !valid.ok()) return valid;
   return m;
 }
@@ -222,6 +255,23 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
   if (!assembled.failure.ok()) {
     report.Fail(assembled.failure.kind, assembled.failure.reason);
     return report;
+  }
+  // With redundant joints the multipliers belong to combinations of rows
+  // (redundant_constraints.h): a joint's reaction is not unique.
+  if (assembled.redundant_rows > 0) {
+    for (const spec::Output& output : scene.outputs) {
+      const auto quantity = std::get<spec::SpatialOutput>(output.kind).quantity;
+      if (quantity == Quantity::kJointReaction || quantity == Quantity::kJointReactionMoment ||
+          quantity == Quantity::kDriverEffort) {
+        report.Fail(spec::FailureKind::kInvalidModel,
+                    absl::StrFormat("output '%s': the mechanism has %d redundant constraint equation(s), so its "
+                                    "joints' reactions and drivers' efforts are not unique; ask for them in a "
+                                    "mechanism without redundant joints (e.g. a spherical joint made a "
+                                    "point-on-line one)",
+                                    output.name, assembled.redundant_rows));
+        return report;
+      }
+    }
   }
   // The motion starts at t = 0; the grid may start later.
   std::vector<double> times;

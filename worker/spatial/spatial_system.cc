@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_format.h"
 #include "worker/spatial/euler_parameters.h"
+#include "worker/spatial/spatial_force_elements.h"
 
 namespace mbopt::spatial {
 namespace {
@@ -214,7 +215,7 @@ int SpatialSystem::MassMatrix(const VectorXd& q, Eigen::MatrixXd* mass) const {
   return mass->allFinite() ? 0 : 1;
 }
 
-int SpatialSystem::AppliedForces(double /*t*/, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
+int SpatialSystem::AppliedForces(double t, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
   forces->setZero(num_coordinates());
   for (size_t i = 0; i < model_.bodies.size(); ++i) {
     const Body& b = model_.bodies[i];
@@ -231,13 +232,14 @@ int SpatialSystem::AppliedForces(double /*t*/, const VectorXd& q, const VectorXd
     // The force's direction is undefined at zero length: the step is cut.
     if (!(length > 0.0)) return 1;
     const Vector3d unit = d.x / length;
-    const double tension = s.stiffness_n_per_m * (length - s.free_length_m) + s.damping_n_s_per_m * unit.dot(d.x_dot);
+    const double tension = SpringTension(s, length, unit.dot(d.x_dot), continue_past_bounds_);
     Eigen::Map<Eigen::RowVectorXd> row(forces->data(), forces->size());
     Eigen::Matrix<double, 1, kPairColumns> pair = -tension * unit.transpose() * d.jacobian;
     Eigen::MatrixXd scattered = Eigen::MatrixXd::Zero(1, num_coordinates());
     Scatter(pair, s.a.body, s.b.body, scattered);
     row += scattered.row(0);
   }
+  if (AddForceElementForces(model_, t, q, v, forces) != 0) return 1;
   return AllFinite(*forces) ? 0 : 1;
 }
 
@@ -410,10 +412,19 @@ double SpatialSystem::PotentialEnergy(const VectorXd& q) const {
     }
   }
   for (const SpringDamper& s : model_.springs) {
-    const double stretch = (PointPosition(s.b, q) - PointPosition(s.a, q)).norm() - s.free_length_m;
-    energy += 0.5 * s.stiffness_n_per_m * stretch * stretch;
+    energy += SpringStrainEnergy(s, (PointPosition(s.b, q) - PointPosition(s.a, q)).norm());
   }
-  return energy;
+  return energy + ForceElementPotentialEnergy(model_, q);
+}
+
+int SpatialSystem::num_validity_bounds() const { return SpringCurveBoundCount(model_); }
+
+void SpatialSystem::ValidityBounds(double /*t*/, const VectorXd& q, const VectorXd& v, double* g) const {
+  SpringCurveBounds(model_, q, v, g);
+}
+
+std::string SpatialSystem::BoundReason(int bound, double t, const VectorXd& q, const VectorXd& v) const {
+  return SpringCurveBoundReason(model_, bound, t, q, v);
 }
 
 Vector3d SpatialSystem::AngularMomentum(const VectorXd& q, const VectorXd& v) const {

@@ -62,8 +62,9 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   std::string RowOwner(int row) const;
 
   int MassMatrix(const Eigen::VectorXd& q, Eigen::MatrixXd* mass) const override;
-  // Gravity, spring-dampers and the quadratic velocity terms of the Euler
-  // parameters' equations (8 L(p')^T J L(p') p).
+  // Gravity, spring-dampers, the force elements (spatial_force_elements.h)
+  // and the quadratic velocity terms of the Euler parameters' equations
+  // (8 L(p')^T J L(p') p).
   int AppliedForces(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                     Eigen::VectorXd* forces) const override;
   int Constraints(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi) const override;
@@ -71,6 +72,13 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   int ConstraintTimeDerivative(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi_t) const override;
   int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                             Eigen::VectorXd* gamma) const override;
+
+  // The springs' force curves' tables (spatial_force_elements.h): past one,
+  // the analysis ends naming the spring.
+  int num_validity_bounds() const override;
+  void ValidityBounds(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, double* g) const override;
+  std::string BoundReason(int bound, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const override;
+  void ContinuePastBounds(bool on) const override { continue_past_bounds_ = on; }
 
   // The bodies' initial poses and velocities as coordinates (not yet
   // consistent with the joints: see AssembleSpatial).
@@ -96,7 +104,8 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   Eigen::Vector3d PointAcceleration(const Point& p, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                     const Eigen::VectorXd& a) const;
   double KineticEnergy(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
-  // Gravity (zero at the world origin) and the springs' strain energy.
+  // Gravity (zero at the world origin) and the springs', rotational
+  // springs' and bushings' strain energy.
   double PotentialEnergy(const Eigen::VectorXd& q) const;
   // Of all bodies about the world origin, world axes (kg m^2/s).
   Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
@@ -106,6 +115,7 @@ class SpatialSystem : public multibody::ConstrainedSystem {
                     Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
 
   const Model& model_;
+  mutable bool continue_past_bounds_ = false;  // ContinuePastBounds
   int num_rows_ = 0;
   std::vector<int> joint_row_, driver_row_;
 };
