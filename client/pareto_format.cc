@@ -55,14 +55,43 @@ std::string ParetoWatchRow(const v1::CycleRecord& r) {
                          r.pareto_cycles());
 }
 
+std::string SecondObjectiveLabel(const v1::Objective& o) {
+  switch (o.form_case()) {
+    case v1::Objective::kMinimize: return absl::StrCat("F2: ", o.minimize());
+    case v1::Objective::kMaximize: return absl::StrCat("F2: ", o.maximize(), " (maximized)");
+    case v1::Objective::kMinimizeMaxOf:
+      return absl::StrCat("F2: max ", o.reduction() == v1::REDUCTION_MAX_ABS ? "|" : "", o.minimize_max_of(),
+                          o.reduction() == v1::REDUCTION_MAX_ABS ? "|" : "");
+    case v1::Objective::kMinimizeMaxOver:
+      return absl::StrCat("F2: largest of ", o.minimize_max_over().terms_size(), " terms");
+    case v1::Objective::kMinimizeSum: return absl::StrCat("F2: sum of ", o.minimize_sum().terms_size(), " terms");
+    default: return "F2";
+  }
+}
+
 ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
   ParetoFront front;
-  front.against = job.study().pareto().against();
-  for (const auto& c : job.study().constraints()) {
-    if (c.name() == front.against) front.unit = c.unit();
+  const v1::Pareto& pareto = job.study().pareto();
+  // The second objective as the runs minimized it (a maximized value's
+  // negative) is what the records hold; it is shown as the study writes it.
+  double second_sign = 1.0;
+  if (pareto.has_objective()) {
+    front.against_objective = true;
+    front.against = SecondObjectiveLabel(pareto.objective());
+    front.unit = pareto.objective().unit();
+    if (pareto.objective().form_case() == v1::Objective::kMaximize) {
+      second_sign = -1.0;
+      front.against_maximized = true;
+    }
+  } else {
+    front.against = pareto.against();
+    for (const auto& c : job.study().constraints()) {
+      if (c.name() == front.against) front.unit = c.unit();
+    }
   }
   double si_per_unit = 1.0;
-  if (!front.unit.empty()) {
+  // An objective's values are in its unit already.
+  if (!front.unit.empty() && !front.against_objective) {
     if (absl::StatusOr<spec::Unit> unit = spec::FindUnit(front.unit); unit.ok()) {
       si_per_unit = unit->si_per_unit;
     } else {
@@ -78,14 +107,14 @@ ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
     row.point = r.cycle();
     row.record = &r;
     row.objective = r.objective_trial();
-    row.value = r.pareto_value_si() / si_per_unit;
-    row.level = r.pareto_level_si() / si_per_unit;
+    row.value = second_sign * r.pareto_value_si() / si_per_unit;
+    row.level = second_sign * r.pareto_level_si() / si_per_unit;
     if (r.pareto_state() == "not_run") {
       row.status = "not run";
     } else if (!r.accepted()) {
       row.status = r.pareto_state() == "failed" || !std::isfinite(r.objective_trial()) ? "failed" : "infeasible";
     }
-    usable.push_back({sign * row.objective, row.value, row.status.empty()});
+    usable.push_back({sign * row.objective, second_sign * row.value, row.status.empty()});
     front.points.push_back(std::move(row));
   }
   const std::vector<bool> dominated = spec::DominatedPoints(usable);
@@ -134,7 +163,9 @@ std::string ParetoCsv(const v1::GetJobResponse& job) {
   const v1::JobSummary& s = job.summary();
   const ParetoFront front = FrontOfJob(job);
   auto cell = [](double v) { return std::isfinite(v) ? JsonWriter::FormatDouble(v) : std::string(); };
-  std::string out = absl::StrCat("point,level,objective,", front.against, ",max_violation,run_state,cycles,analyses");
+  // A label with spaces is no column name: an objective's column is "second_objective".
+  std::string out = absl::StrCat("point,level,objective,", front.against_objective ? "second_objective" : front.against,
+                                 ",max_violation,run_state,cycles,analyses");
   for (const auto& name : s.design_names()) out += "," + name;
   out += ",status,reason\n";
   for (const ParetoPointRow& p : front.points) {
@@ -217,7 +248,8 @@ absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int p
   std::string out = absl::StrFormat("job %s, %s: point %d of %d (%s)\n", s.job_id(), s.study_name(), point,
                                     s.max_cycles(), p->status);
   const std::string unit = front.unit.empty() ? "" : " " + front.unit;
-  out += std::isfinite(p->level) ? absl::StrFormat("level:       %s <= %.9g%s\n", front.against, p->level, unit)
+  out += std::isfinite(p->level) ? absl::StrFormat("level:       %s %s %.9g%s\n", front.against,
+                                                    front.against_maximized ? ">=" : "<=", p->level, unit)
                                   : absl::StrFormat("level:       none (an end of the front)\n");
   out += absl::StrFormat("objective:   %s%s\n", CellValue(p->objective, "-"),
                          s.objective_unit().empty() ? "" : " " + s.objective_unit());

@@ -36,12 +36,20 @@ std::string ParetoWatchRow(const v1::CycleRecord& record);
 
 // The traded constraint's name and unit ("" for SI), and the points in
 // their order with dominance decided among the usable ones.
+// A second objective that is an objective (`pareto { objective {...} }`)
+// is named by SecondObjectiveLabel, in the objective's `unit` ("" when it
+// has none), a maximized value shown as itself.
 struct ParetoFront {
   std::string against;
   std::string unit;
+  bool against_objective = false;
+  bool against_maximized = false;  // its level is a least value, not a largest
   std::vector<ParetoPointRow> points;
 };
 ParetoFront FrontOfJob(const v1::GetJobResponse& job);
+
+// "F2: max s1", "F2: sum of 2 terms", ...: a second objective's label.
+std::string SecondObjectiveLabel(const v1::Objective& objective);
 
 std::string ParetoTable(const v1::GetJobResponse& job);
 std::string ParetoCsv(const v1::GetJobResponse& job);

@@ -21,6 +21,7 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
   data.objective_unit = s.objective_unit();
   data.against = front.against;
   data.against_unit = front.unit;
+  data.against_objective = front.against_objective;
   data.points_total = s.max_cycles();
   data.variable_names.assign(s.design_names().begin(), s.design_names().end());
   data.variable_units.assign(s.design_units().begin(), s.design_units().end());

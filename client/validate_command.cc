@@ -138,7 +138,9 @@ int ValidateCommand(const Args& args) {
   std::printf("objective:   %s\n", ObjectiveText(*study, *layout).c_str());
   std::map<int, int> rows_per_constraint;
   for (const spec::ConstraintRow& row : layout->rows) ++rows_per_constraint[row.constraint];
-  std::printf("constraints: %zu, %d rows\n", study->constraints.size(), layout->num_constraints());
+  // A front's second objective's rows are the objective's, not the constraints'.
+  std::printf("constraints: %zu, %d rows\n", study->constraints.size(),
+              layout->num_constraints() - static_cast<int>(layout->second_objective_factors.size()));
   for (size_t k = 0; k < study->constraints.size(); ++k) {
     const spec::Constraint& c = study->constraints[k];
     std::string bound;

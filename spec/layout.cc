@@ -5,6 +5,7 @@
 #include <limits>
 #include <variant>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "common/status_macros.h"
@@ -390,6 +391,70 @@ StudyFootprint EstimateStudyFootprint(const Study& study) {
   return f;
 }
 
+namespace {
+
+// The rows of a Pareto front's second objective (StudyLayout::
+// second_objective_factors), laid out as the study's objective would be
+// were it the second: a study that is the same but for its objective, and
+// without constraints or front, gives the terms, which become rows.
+absl::Status AppendSecondObjectiveRows(const Study& study, StudyLayout* layout) {
+  Study alone = study;
+  alone.objective = study.second_objective;
+  alone.constraints.clear();
+  alone.pareto = Pareto{};
+  alone.design_set = DesignSet{};
+  absl::StatusOr<StudyLayout> laid = MakeStudyLayout(alone);
+  if (!laid.ok()) {
+    // Its errors name the study's objective's fields; they are the front's.
+    const std::string prefix = absl::StrCat(study.source_file.empty() ? "study" : study.source_file, ": ");
+    std::string what(laid.status().message());
+    if (absl::StartsWith(what, prefix)) what = what.substr(prefix.size());
+    return LayoutError(study, "pareto." + what.substr(0, what.find(": ")),
+                       what.find(": ") == std::string::npos ? what : what.substr(what.find(": ") + 2));
+  }
+  std::vector<ValueRef> refs;
+  std::vector<double> factors;
+  const Objective& second = study.second_objective;
+  if (laid->objective_form == ObjectiveForm::kMinMax) {
+    refs = laid->objective_terms;
+    factors = laid->objective_term_factors;
+  } else if (laid->objective_form == ObjectiveForm::kScalar && second.form == Objective::Form::kWeightedSum) {
+    refs = laid->sum_refs;
+    for (const WeightedTerm& term : second.sum_terms) factors.push_back(term.weight / term.si_per_unit);
+    layout->second_objective_sums = true;
+  } else if (laid->objective_form == ObjectiveForm::kScalar && second.form == Objective::Form::kMinimize) {
+    refs = laid->objective_terms;
+    factors = laid->objective_term_factors;
+  } else {
+    return LayoutError(study, "pareto.objective",
+                       "a second objective is a largest of values or a sum of one-value terms (not a distance to "
+                       "targets, nor a sum of peaks)");
+  }
+  for (size_t k = 0; k < refs.size(); ++k) {
+    ValueRef ref = refs[k];
+    double factor = factors[k];
+    // A largest of values is bounded row by row, factor * g <= level, so a
+    // factor below 0 (maximize) is folded into the row's sign.
+    if (!layout->second_objective_sums && factor < 0) {
+      ref.sign = -ref.sign;
+      factor = -factor;
+    }
+    ConstraintRow row;
+    row.name = absl::StrCat("second objective[", k, "]");
+    row.constraint = kSecondObjectiveRow;
+    row.value = ref;
+    row.limit_si = 0;
+    row.scale = 1;
+    const auto instant = static_cast<size_t>(std::clamp(ref.instant, 0, static_cast<int>(layout->instants_s.size()) - 1));
+    row.time_s = layout->instants_s.empty() ? 0.0 : layout->instants_s[instant];
+    layout->rows.push_back(std::move(row));
+    layout->second_objective_factors.push_back(factor);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
   const Scene& scene = study.scene;
   const StudyFootprint f = EstimateStudyFootprint(study);
@@ -653,6 +718,7 @@ absl::StatusOr<StudyLayout> MakeStudyLayout(const Study& study) {
       }
     }
   }
+  if (study.pareto.trades_objective) MBOPT_RETURN_IF_ERROR(AppendSecondObjectiveRows(study, &layout));
   if (layout.rows.capacity() > layout.rows.size() + layout.rows.size() / 4) layout.rows.shrink_to_fit();
   if (layout.objective_terms.capacity() > layout.objective_terms.size() + layout.objective_terms.size() / 4) {
     layout.objective_terms.shrink_to_fit();
@@ -730,11 +796,16 @@ absl::StatusOr<StudyValues> ComputeStudyValues(
   }
 
   values.constraint_values.reserve(layout.rows.size());
-  values.max_violation = layout.rows.empty() ? 0.0 : -std::numeric_limits<double>::infinity();
+  const bool bounded = std::any_of(layout.rows.begin(), layout.rows.end(),
+                                   [](const ConstraintRow& row) { return row.constraint >= 0; });
+  values.max_violation = bounded ? -std::numeric_limits<double>::infinity() : 0.0;
   for (size_t h = 0; h < layout.rows.size(); ++h) {
     const ConstraintRow& row = layout.rows[h];
     const double g = value(row.value);
     values.constraint_values.push_back(g);
+    // A second objective's row has no limit of the study's: only a front's
+    // points bound it, each at its own level.
+    if (row.constraint < 0) continue;
     const double normalized = (g - row.limit_si) / row.scale;
     if (values.worst_row < 0 || normalized > values.max_violation || std::isnan(normalized)) {
       if (!std::isnan(values.max_violation)) {

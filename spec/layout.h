@@ -99,9 +99,16 @@ struct ValueRef {
 double RefValue(const ValueRef& ref, const std::vector<double>& series, const std::vector<double>& instants_s,
                 std::vector<double>* weights = nullptr);
 
+// ConstraintRow::constraint of the rows of a Pareto front's second
+// objective (StudyLayout::second_objective_factors).
+inline constexpr int kSecondObjectiveRow = -2;
+
 struct ConstraintRow {
   std::string name;     // e.g. "s1@t=1.750s upper"
-  int constraint = -1;  // index into study.constraints
+  // Index into study.constraints; kSecondObjectiveRow for a row of a
+  // Pareto front's second objective, which has no limit of the study's
+  // (limit_si 0, scale 1, left out of StudyValues::max_violation).
+  int constraint = -1;
   ValueRef value;       // g_h = sign * f, or sign * a reduction of f (SI)
   double limit_si = 0;  // c_h
   double scale = 1;     // > 0
@@ -133,6 +140,14 @@ struct StudyLayout {
   // whole-series term, the window's instants and series for a peak).
   std::vector<int> objective_group_sizes;
   std::vector<ConstraintRow> rows;
+  // A Pareto front's second objective (Study::pareto.trades_objective): the
+  // last rows of `rows`, one factor each, the second objective being
+  // F2 = sum_h factor_h * g_h (second_objective_sums: a weighted sum of
+  // one-value terms) or F2 = max_h factor_h * g_h (every other form; then
+  // each factor is > 0, a maximized value's row has sign -1), in the
+  // objective's unit. Empty for other studies.
+  std::vector<double> second_objective_factors;
+  bool second_objective_sums = false;
   // One per signal: the scene's outputs, then the study's responses.
   std::vector<OutputShape> outputs;
   std::vector<double> instants_s;    // the grid

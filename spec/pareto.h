@@ -1,9 +1,10 @@
 // A Pareto front (docs/study.md, "Pareto fronts"): the trade-off between a
-// study's objective and the largest value of one of its constraints, by the
-// epsilon-constraint method. Point 0 minimizes the objective without the
-// traded constraint, point N-1 minimizes the traded constraint's largest
-// value (the anchors); point k between minimizes the objective with that
-// constraint's limit at the level ParetoLevel(k). Each point is an SLP run.
+// study's objective and a second objective (the largest value of one of its
+// constraints, or an objective of its own), by the epsilon-constraint
+// method. Point 0 minimizes the objective without the second, point N-1
+// minimizes the second (the anchors); point k between minimizes the
+// objective with the second bounded at the level ParetoLevel(k). Each point
+// is an SLP run.
 //
 // The warm-start chain is a function of the study alone, never of which run
 // ends first: the anchors start from the study's initial design; the other
@@ -29,13 +30,16 @@ inline constexpr int kMinParetoPoints = 3;
 inline constexpr int kMaxParetoPoints = 65;
 
 struct Pareto {
-  int constraint = -1;  // index into Study::constraints; -1: no Pareto front
+  // The second objective: constraint `constraint`'s largest value, or
+  // (trades_objective) Study::second_objective.
+  int constraint = -1;  // index into Study::constraints; -1: none
+  bool trades_objective = false;
   int points = 0;       // the two anchors included
   int refine = 0;       // points added where the front bends, 0 to points-1
 
   int total_points() const { return points + refine; }
 
-  bool enabled() const { return constraint >= 0; }
+  bool enabled() const { return constraint >= 0 || trades_objective; }
 };
 
 // The level of the traded constraint for point k of `points` (0 < k <

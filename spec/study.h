@@ -185,6 +185,9 @@ struct Study {
   DesignSet design_set;
   // A Pareto front instead of one optimum (spec/pareto.h).
   Pareto pareto;
+  // The front's second objective when pareto.trades_objective (any form
+  // but kFeasible and kTargetDistance, and no peaks in a kWeightedSum).
+  Objective second_objective;
   std::vector<XyPlot> plots;
 
   // SI parameter values of the scene at scaled design x (others at default).

@@ -58,9 +58,14 @@ PlotSeries SeriesOf(const ParetoReportData& data, const std::string& status, con
   return s;
 }
 
+// What the front trades the objective against, as a sentence names it.
+std::string SecondObjectivePhrase(const ParetoReportData& data) {
+  return (data.against_objective ? "the second objective " : "the largest value of ") + data.against;
+}
+
 std::string FrontPlot(const ParetoReportData& data) {
   PlotSpec spec;
-  spec.title = "Pareto front: objective F against the largest value of " + data.against;
+  spec.title = "Pareto front: objective F against " + SecondObjectivePhrase(data);
   spec.x_label = WithUnit(data.against, data.against_unit);
   spec.y_label = WithUnit("F", data.objective_unit);
   spec.height_px = 420.0;
@@ -166,7 +171,7 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
   out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";
   out += "<tr><th>points computed</th><td>" + std::to_string(data.points.size()) + " of " +
          std::to_string(data.points_total) + "</td></tr>\n";
-  out += "<tr><th>traded against</th><td>the largest value of " + EscapeHtml(data.against) + "</td></tr>\n";
+  out += "<tr><th>traded against</th><td>" + EscapeHtml(SecondObjectivePhrase(data)) + "</td></tr>\n";
   if (!data.message.empty()) out += "<tr><th>message</th><td>" + EscapeHtml(data.message) + "</td></tr>\n";
   out += "</tbody>\n</table>\n";
   out += "<h2>Pareto front</h2>\n";

@@ -27,7 +27,8 @@ struct ParetoReportData {
   std::string state;
   std::string message;
   std::string objective_unit;
-  std::string against;       // the traded constraint's name
+  std::string against;       // the traded constraint's name, or the second objective's label
+  bool against_objective = false;  // the second objective is an objective, not a constraint's value
   std::string against_unit;
   int points_total = 0;
   std::vector<std::string> variable_names;

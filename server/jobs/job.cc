@@ -123,7 +123,13 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateWith(std::shared_ptr<const spec:
     setup.options = settings;
     for (const spec::ConstraintRow& row : layout.rows) setup.row_constraints.push_back(row.constraint);
     setup.num_constraints = static_cast<int>(study->constraints.size());
-    setup.traded_constraint = study->pareto.constraint;
+    if (study->pareto.trades_objective) {
+      setup.traded_constraint = spec::kSecondObjectiveRow;
+      setup.traded_factors = layout.second_objective_factors;
+      setup.traded_sum = layout.second_objective_sums;
+    } else {
+      setup.traded_constraint = study->pareto.constraint;
+    }
     setup.points = study->pareto.points;
     setup.refine = study->pareto.refine;
     absl::StatusOr<std::unique_ptr<ParetoRun>> made = ParetoRun::Create(std::move(setup), make_lp_solver);

@@ -21,12 +21,6 @@ bool SameBits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
 }
 
-Eigen::VectorXd Pick(const Eigen::VectorXd& values, const std::vector<int>& rows) {
-  Eigen::VectorXd picked(static_cast<Eigen::Index>(rows.size()));
-  for (size_t j = 0; j < rows.size(); ++j) picked[static_cast<Eigen::Index>(j)] = values[rows[j]];
-  return picked;
-}
-
 // Rows `rows` of a row-major matrix of `columns` columns, each times `factor`.
 std::vector<double> PickRows(const std::vector<double>& matrix, std::size_t columns, const std::vector<int>& rows,
                              double factor) {
@@ -58,6 +52,19 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
     return absl::InvalidArgumentError(
         absl::StrCat("the traded constraint ", setup.traded_constraint, " has no constraint rows"));
   }
+  if (setup.traded_factors.empty()) setup.traded_factors.assign(traded.size(), 1.0);
+  if (setup.traded_factors.size() != traded.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("the second objective has ", traded.size(), " rows but ",
+                                                   setup.traded_factors.size(), " factors"));
+  }
+  for (double factor : setup.traded_factors) {
+    // Bounding factor * g <= level row by row needs factor > 0; a sum is
+    // one row whatever its weights' signs.
+    if (!std::isfinite(factor) || (!setup.traded_sum && !(factor > 0))) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "a factor of the second objective's rows is %g; a largest of values needs factors above 0", factor));
+    }
+  }
   const slp::ProblemSpec& p = setup.problem;
   for (int h : traded) {
     if (p.constraint_limits[h] != p.constraint_limits[traded[0]] ||
@@ -88,6 +95,24 @@ bool ParetoRun::IsTraded(int row) const {
   return setup_.row_constraints[static_cast<std::size_t>(row)] == setup_.traded_constraint;
 }
 
+double ParetoRun::TradedValue(const std::vector<double>& row_values) const {
+  double value = setup_.traded_sum ? 0.0 : -std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
+    const double term = setup_.traded_factors[j] * row_values[static_cast<std::size_t>(traded_rows_[j])];
+    value = setup_.traded_sum ? value + term : std::max(value, term);
+  }
+  return value;
+}
+
+std::vector<double> ParetoRun::SumGradient(const std::vector<double>& row_gradients, std::size_t columns) const {
+  std::vector<double> gradient(columns, 0.0);
+  for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
+    const std::size_t first = static_cast<std::size_t>(traded_rows_[j]) * columns;
+    for (std::size_t c = 0; c < columns; ++c) gradient[c] += setup_.traded_factors[j] * row_gradients[first + c];
+  }
+  return gradient;
+}
+
 void ParetoRun::StartRuns() {
   const int last = setup_.points - 1;
   for (int k : {0, last}) {
@@ -104,8 +129,8 @@ void ParetoRun::StartRuns() {
                           " (an anchor) has no feasible result");
   } else if (!(first.record.pareto_value_si > least.record.pareto_value_si)) {
     reason = absl::StrFormat(
-        "the objectives do not conflict: where the objective is least, the traded constraint's largest value "
-        "(%.9g SI) is already no more than its least value (%.9g SI)",
+        "the objectives do not conflict: where the objective is least, the second objective (%.9g) is already "
+        "no more than its least value (%.9g)",
         first.record.pareto_value_si, least.record.pareto_value_si);
   }
   for (int k = 1; k < last; ++k) {
@@ -164,31 +189,47 @@ void ParetoRun::Start(int k, const Eigen::VectorXd& initial) {
   slp::ProblemSpec problem = study;
   slp::SlpOptions options = setup_.options;
   problem.initial = initial;
-  const bool leaves_out_traded = k == 0 || k == setup_.points - 1;
+  const bool anchor = k == 0 || k == setup_.points - 1;
+  // A sum is bounded by one row of its own in place of its terms' rows.
+  const bool leaves_out_traded = anchor || setup_.traded_sum;
   point.rows.clear();
   for (int h = 0; h < study.num_constraints(); ++h) {
     if (!leaves_out_traded || !IsTraded(h)) point.rows.push_back(h);
   }
+  // An ordinary limit at the level, scaled as the study's layout scales a
+  // limit (spec/layout.cc), so a single run with this limit written in
+  // the study is the same problem.
+  auto scale_of = [](double limit) { return limit != 0.0 ? std::abs(limit) : 1.0; };
+  if (!anchor && setup_.traded_sum) point.rows.push_back(kSumRow);
   if (leaves_out_traded) {
     problem.constraint_names.clear();
-    for (int h : point.rows) problem.constraint_names.push_back(study.constraint_names[static_cast<std::size_t>(h)]);
-    problem.constraint_limits = Pick(study.constraint_limits, point.rows);
-    problem.constraint_scales = Pick(study.constraint_scales, point.rows);
+    problem.constraint_limits.resize(static_cast<Eigen::Index>(point.rows.size()));
+    problem.constraint_scales.resize(static_cast<Eigen::Index>(point.rows.size()));
+    for (std::size_t j = 0; j < point.rows.size(); ++j) {
+      const int h = point.rows[j];
+      const auto row = static_cast<Eigen::Index>(j);
+      if (h == kSumRow) {
+        problem.constraint_names.push_back("second objective");
+        problem.constraint_limits[row] = point.level_si;
+        problem.constraint_scales[row] = scale_of(point.level_si);
+        continue;
+      }
+      problem.constraint_names.push_back(study.constraint_names[static_cast<std::size_t>(h)]);
+      problem.constraint_limits[row] = study.constraint_limits[h];
+      problem.constraint_scales[row] = study.constraint_scales[h];
+    }
   } else {
-    // An ordinary limit at the level, scaled as the study's layout scales a
-    // limit (spec/layout.cc), so a single run with this limit written in
-    // the study is the same problem.
-    const double scale = point.level_si != 0.0 ? std::abs(point.level_si) : 1.0;
-    for (int h : traded_rows_) {
-      problem.constraint_limits[h] = point.level_si;
-      problem.constraint_scales[h] = scale;
+    for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
+      const double limit = point.level_si / setup_.traded_factors[j];
+      problem.constraint_limits[traded_rows_[j]] = limit;
+      problem.constraint_scales[traded_rows_[j]] = scale_of(limit);
     }
   }
   if (k == setup_.points - 1) {
-    // The traded constraint's largest value, in the study's scale of its
-    // rows so that F is of order one near the study's limit.
-    problem.num_objective_terms = static_cast<int>(traded_rows_.size());
-    problem.objective_form = traded_rows_.size() == 1 ? slp::ObjectiveForm::kScalar : slp::ObjectiveForm::kMinMax;
+    // The second objective, in the study's scale of its rows so that F is
+    // of order one near a constraint's limit.
+    problem.num_objective_terms = setup_.traded_sum ? 1 : static_cast<int>(traded_rows_.size());
+    problem.objective_form = problem.num_objective_terms == 1 ? slp::ObjectiveForm::kScalar : slp::ObjectiveForm::kMinMax;
     problem.objective_group_sizes.clear();
     options.objective_target.reset();  // the study's target is for its own objective
   }
@@ -266,12 +307,11 @@ ParetoRun::Analysed ParetoRun::Analyse(const AnalysisRecord& record) const {
   const Eigen::Map<const Eigen::VectorXd> terms(record.objective_terms.data(),
                                                 static_cast<Eigen::Index>(record.objective_terms.size()));
   a.objective = slp::ObjectiveValue(p, terms);
-  a.traded_value_si = -std::numeric_limits<double>::infinity();
+  a.traded_value_si = TradedValue(record.constraint_values);
   a.violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
   for (std::size_t h = 0; h < record.constraint_values.size(); ++h) {
     const double g = record.constraint_values[h];
     const auto row = static_cast<Eigen::Index>(h);
-    if (IsTraded(static_cast<int>(h))) a.traded_value_si = std::max(a.traded_value_si, g);
     const int c = setup_.row_constraints[h];
     if (c >= 0 && c < setup_.num_constraints) {
       const double normalized = (g - p.constraint_limits[row]) / p.constraint_scales[row];
@@ -293,15 +333,45 @@ slp::AnalysisResult ParetoRun::ResultFor(const Point& point, const AnalysisRecor
   const Eigen::Map<const Eigen::VectorXd> values(record.constraint_values.data(),
                                                  static_cast<Eigen::Index>(record.constraint_values.size()));
   const bool traded_objective = &point == &points_[static_cast<std::size_t>(setup_.points - 1)];
-  result.objective_terms = traded_objective ? Eigen::VectorXd(Pick(values, traded_rows_) / traded_scale_)
-                                            : Eigen::VectorXd(terms);
-  result.constraint_values = Pick(values, point.rows);
+  const double sum = setup_.traded_sum ? TradedValue(record.constraint_values) : kNaN;
+  if (!traded_objective) {
+    result.objective_terms = terms;
+  } else if (setup_.traded_sum) {
+    result.objective_terms = Eigen::VectorXd::Constant(1, sum / traded_scale_);
+  } else {
+    result.objective_terms.resize(static_cast<Eigen::Index>(traded_rows_.size()));
+    for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
+      result.objective_terms[static_cast<Eigen::Index>(j)] =
+          setup_.traded_factors[j] * values[traded_rows_[j]] / traded_scale_;
+    }
+  }
+  result.constraint_values.resize(static_cast<Eigen::Index>(point.rows.size()));
+  for (std::size_t j = 0; j < point.rows.size(); ++j) {
+    const int h = point.rows[j];
+    result.constraint_values[static_cast<Eigen::Index>(j)] = h == kSumRow ? sum : values[h];
+  }
   if (!record.objective_gradients.empty()) {
     const std::size_t n = static_cast<std::size_t>(setup_.problem.num_variables());
-    const std::vector<double> objective_gradients =
-        traded_objective ? PickRows(record.constraint_gradients, n, traded_rows_, 1.0 / traded_scale_)
-                         : record.objective_gradients;
-    const std::vector<double> constraint_gradients = PickRows(record.constraint_gradients, n, point.rows, 1.0);
+    std::vector<double> objective_gradients;
+    if (!traded_objective) {
+      objective_gradients = record.objective_gradients;
+    } else if (setup_.traded_sum) {
+      objective_gradients = SumGradient(record.constraint_gradients, n);
+      for (double& d : objective_gradients) d /= traded_scale_;
+    } else {
+      for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
+        const std::vector<double> row = PickRows(record.constraint_gradients, n, {traded_rows_[j]},
+                                                 setup_.traded_factors[j] * (1.0 / traded_scale_));
+        objective_gradients.insert(objective_gradients.end(), row.begin(), row.end());
+      }
+    }
+    std::vector<double> constraint_gradients;
+    constraint_gradients.reserve(point.rows.size() * n);
+    for (int h : point.rows) {
+      const std::vector<double> row =
+          h == kSumRow ? SumGradient(record.constraint_gradients, n) : PickRows(record.constraint_gradients, n, {h}, 1.0);
+      constraint_gradients.insert(constraint_gradients.end(), row.begin(), row.end());
+    }
     AttachGradients(point.problem, objective_gradients, constraint_gradients, &result);
   }
   return result;

@@ -3,10 +3,12 @@
 // optimization job and keeps its contract, as DesignSetRun does, so the job
 // manager, the store, the scheduler and resume need nothing new:
 //  - every point's run is a slp::SlpOptimizer of its own (own LP solver),
-//    whose problem is the study's with the traded constraint's rows left
-//    out (point 0), made the objective (the last point, a min-max over the
-//    rows, each divided by the rows' scale), or bounded at the point's level
-//    (the points between);
+//    whose problem is the study's with the second objective's rows (the
+//    traded rows: a constraint's, or an objective's) left out (point 0),
+//    made the objective (the last point: a min-max over the rows, each
+//    times its factor and divided by the rows' scale, or their weighted
+//    sum), or bounded at the point's level (the points between: each row
+//    at level / factor, or one row, the weighted sum, at the level);
 //  - request ids: point k's request r is k * kRequestStride + r, so the
 //    runs' requests never collide and a result finds its run by its id;
 //  - a run starts when what it needs is known: the anchors at once, the
@@ -59,7 +61,14 @@ struct ParetoSetup {
   // how many the study has.
   std::vector<int> row_constraints;
   int num_constraints = 0;
-  int traded_constraint = -1;  // the constraint whose largest value is traded
+  // The rows of the second objective: those whose row_constraints entry is
+  // traded_constraint (a study constraint, or spec::kSecondObjectiveRow).
+  int traded_constraint = -1;
+  // One per traded row, in row order; empty: all 1. The second objective
+  // is F2 = max_h factor_h * g_h (each factor > 0), or with traded_sum
+  // F2 = sum_h factor_h * g_h (spec::StudyLayout::second_objective_factors).
+  std::vector<double> traded_factors;
+  bool traded_sum = false;
   int points = 0;              // >= 3
   int refine = 0;              // added points, 0 to points - 1
 };
@@ -91,14 +100,16 @@ class ParetoRun {
   struct Analysed {
     Eigen::VectorXd x;
     double objective = 0;                 // the study's F
-    double traded_value_si = 0;           // the traded constraint's largest value
+    double traded_value_si = 0;           // the second objective (TradedValue)
     std::vector<double> violations;       // per study constraint, against the study's limits
   };
   struct Point {
     int parent = -1;                      // for an added point: set when it starts
     double level_si = 0;                  // NaN for the anchors
     slp::ProblemSpec problem;             // set when the run starts
-    std::vector<int> rows;                // the run's row h -> the study's row
+    // The run's row h -> the study's row, or kSumRow: the traded rows'
+    // weighted sum (a second objective that is a sum).
+    std::vector<int> rows;
     std::unique_ptr<slp::SlpOptimizer> run;  // null until it starts
     std::vector<Analysed> analysed;       // its successful analyses, in arrival order
     bool ended = false;
@@ -116,6 +127,12 @@ class ParetoRun {
   slp::AnalysisResult ResultFor(const Point& point, const AnalysisRecord& record) const;
   Analysed Analyse(const AnalysisRecord& record) const;
   bool IsTraded(int row) const;
+  // The second objective at the study's row values, and its gradient
+  // from the rows' (row-major, `columns` each; none when empty).
+  double TradedValue(const std::vector<double>& row_values) const;
+  std::vector<double> SumGradient(const std::vector<double>& row_gradients, std::size_t columns) const;
+
+  static constexpr int kSumRow = -1;
 
   ParetoSetup setup_;
   LpSolverFactory make_lp_solver_;

@@ -28,6 +28,34 @@ std::string WhyNotTradable(const Constraint& c) {
   return "";
 }
 
+// Why objective `o` cannot be a front's second objective, or "" when it
+// can. The epsilon-constraint method bounds the second objective by SLP
+// constraint rows: a largest of values (every form but these) by one row
+// per value, a sum of one-value terms by one row; neither holds a distance
+// to targets (a square root of a sum) or a sum of peaks (each peak needs
+// a bound variable of its own, which a row cannot carry).
+std::string WhyNotSecondObjective(const Objective& o) {
+  switch (o.form) {
+    case Objective::Form::kFeasible:
+      return "empty: expected `minimize`, `maximize`, `minimize_max_of`, `minimize_max_over` or `minimize_sum`";
+    case Objective::Form::kTargetDistance:
+      return "target_distance cannot be a second objective (a distance to targets is not bounded by constraint "
+             "rows); write the distance as a response and `minimize` it";
+    case Objective::Form::kWeightedSum:
+      for (size_t k = 0; k < o.sum_terms.size(); ++k) {
+        if (IsPeakReduction(o.sum_terms[k].reduction)) {
+          return absl::StrCat("minimize_sum.terms[", k,
+                              "] is a peak (REDUCTION_MAX, REDUCTION_MAX_ABS or REDUCTION_MIN); a sum that is a "
+                              "second objective takes one-value terms only (FINAL, RMS, INTEGRAL, RANGE, MEAN); "
+                              "for the largest of peaks use minimize_max_over");
+        }
+      }
+      return "";
+    default:
+      return "";
+  }
+}
+
 }  // namespace
 
 Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where, Errors* errors) {
@@ -39,7 +67,8 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
     errors->Add(where, "pareto", "a study has a Pareto front or a sweep or sample, not both");
   }
   if (study.objective.form == Objective::Form::kFeasible) {
-    errors->Add(where, "pareto", "a Pareto front trades the study's objective against a constraint: add an objective");
+    errors->Add(where, "pareto",
+                "a Pareto front trades the study's objective against a second objective: add an objective");
   }
   pareto.points = p.points() == 0 ? kDefaultParetoPoints : p.points();
   if (pareto.points < kMinParetoPoints || pareto.points > kMaxParetoPoints) {
@@ -54,11 +83,26 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
                                 "most), got %d",
                                 std::max(pareto.points - 1, 0), pareto.points, p.refine()));
   }
+  if (p.has_objective()) {
+    if (!p.against().empty()) {
+      errors->Add(w, "against",
+                  absl::StrCat("a front has one second objective: a constraint's largest value (`against: \"",
+                               p.against(), "\"`) or an `objective`, not both"));
+      return pareto;
+    }
+    if (const std::string why = WhyNotSecondObjective(study.second_objective); !why.empty()) {
+      errors->Add(w, "objective", why);
+      return pareto;
+    }
+    pareto.trades_objective = true;
+    return pareto;
+  }
   if (p.against().empty()) {
     errors->Add(w, "against",
-                absl::StrCat("name the constraint whose largest value is the second objective; the study's "
+                absl::StrCat("name the constraint whose largest value is the second objective (the study's "
                              "constraints: ",
-                             ConstraintNames(study)));
+                             ConstraintNames(study),
+                             "), or write the second objective as the study's is (`objective { minimize: ... }`)"));
     return pareto;
   }
   int found = -1;
@@ -80,9 +124,15 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
 }
 
 std::string DescribePareto(const Study& study) {
-  const Constraint& c = study.constraints[static_cast<size_t>(study.pareto.constraint)];
-  return absl::StrCat("a Pareto front of the objective against the largest value of ", c.name,
-                      c.unit.empty() ? "" : absl::StrCat(" (", c.unit, ")"), ", ", study.pareto.points,
+  std::string second;
+  if (study.pareto.trades_objective) {
+    const std::string& unit = study.second_objective.unit;
+    second = absl::StrCat("a second objective", unit.empty() ? "" : absl::StrCat(" (", unit, ")"));
+  } else {
+    const Constraint& c = study.constraints[static_cast<size_t>(study.pareto.constraint)];
+    second = absl::StrCat("the largest value of ", c.name, c.unit.empty() ? "" : absl::StrCat(" (", c.unit, ")"));
+  }
+  return absl::StrCat("a Pareto front of the objective against ", second, ", ", study.pareto.points,
                       " points",
                       study.pareto.refine == 0 ? ""
                                                : absl::StrCat(" and ", study.pareto.refine, " more where it bends"),

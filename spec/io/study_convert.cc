@@ -346,6 +346,152 @@ TimeWindow ConvertWindow(const Where& w, const v1::TimeWindow& m, const Study& s
   return window;
 }
 
+// Objective `o` (the study's, or a Pareto front's second) at `ow`. A form
+// not set is kFeasible, without an error: each caller says what it means.
+Objective ConvertObjective(const v1::Objective& o, const Study& study, const Where& ow, Errors* errors) {
+  Objective obj;
+  obj.unit = o.unit();
+  switch (o.form_case()) {
+    case v1::Objective::kMinimizeMaxOf: {
+      obj.form = Objective::Form::kMinimizeMaxOf;
+      obj.output = FindOutput(study, ow, "minimize_max_of", o.minimize_max_of(), errors);
+      if (o.reduction() == v1::REDUCTION_MAX) {
+        obj.reduction = Reduction::kMax;
+      } else if (o.reduction() == v1::REDUCTION_MAX_ABS) {
+        obj.reduction = Reduction::kMaxAbs;
+      } else {
+        errors->Add(ow, "reduction", "minimize_max_of needs REDUCTION_MAX or REDUCTION_MAX_ABS");
+      }
+      break;
+    }
+    case v1::Objective::kMinimize:
+    case v1::Objective::kMaximize: {
+      obj.form = Objective::Form::kMinimize;
+      obj.maximize = o.form_case() == v1::Objective::kMaximize;
+      obj.output = obj.maximize ? FindOutput(study, ow, "maximize", o.maximize(), errors)
+                                : FindOutput(study, ow, "minimize", o.minimize(), errors);
+      const std::optional<Reduction> r =
+          o.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(o.reduction());
+      if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
+        errors->Add(ow, "reduction",
+                    absl::StrCat(obj.maximize ? "maximize" : "minimize",
+                                 " takes one value per run: REDUCTION_FINAL (the default), REDUCTION_RMS, "
+                                 "REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN (for a maximum over time "
+                                 "use minimize_max_of)"));
+      }
+      obj.reduction = r.value_or(Reduction::kFinal);
+      break;
+    }
+    case v1::Objective::kTargetDistance: {
+      obj.form = Objective::Form::kTargetDistance;
+      const Where tw = ow.Child("target_distance");
+      if (o.target_distance().terms_size() == 0) {
+        errors->Add(tw, "terms", "target_distance needs at least one term");
+      }
+      for (int k = 0; k < o.target_distance().terms_size(); ++k) {
+        const v1::TargetTerm& t = o.target_distance().terms(k);
+        const Where kw = tw.Child("terms", k);
+        TargetTerm term;
+        term.output = FindOutput(study, kw, "output", t.output(), errors);
+        term.target = t.target();
+        term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
+        if (!(term.weight > 0.0) || !std::isfinite(term.weight)) {
+          errors->Add(kw, "weight", absl::StrFormat("must be positive, got %g", t.weight()));
+        }
+        if (!std::isfinite(t.target())) errors->Add(kw, "target", "must be a finite number");
+        term.unit = t.unit();
+        term.si_per_unit = UnitFactor(
+            kw, "unit", t.unit(),
+            SignalDimension(study, term.output),
+            errors);
+        obj.terms.push_back(std::move(term));
+      }
+      break;
+    }
+    case v1::Objective::kMinimizeSum:
+    case v1::Objective::kMinimizeMaxOver: {
+      const bool sum = o.form_case() == v1::Objective::kMinimizeSum;
+      obj.form = sum ? Objective::Form::kWeightedSum : Objective::Form::kMaxOver;
+      const char* form = sum ? "minimize_sum" : "minimize_max_over";
+      const Where sw = ow.Child(form);
+      const auto& terms = sum ? o.minimize_sum().terms() : o.minimize_max_over().terms();
+      if (terms.empty()) errors->Add(sw, "terms", absl::StrCat(form, " needs at least one term"));
+      if (!o.unit().empty()) {
+        errors->Add(ow, "unit", absl::StrCat(sum ? "a weighted sum" : "the largest of several terms",
+                                             " has no unit of its own: each term's `unit` says how it is taken"));
+      }
+      for (int k = 0; k < terms.size(); ++k) {
+        const v1::WeightedTerm& t = terms[k];
+        const Where kw = sw.Child("terms", k);
+        WeightedTerm term;
+        term.output = FindOutput(study, kw, "output", t.output(), errors);
+        const std::optional<Reduction> r =
+            t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
+        if (sum && !r.has_value()) {
+          errors->Add(kw, "reduction",
+                      "a term is one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
+                      "REDUCTION_RANGE or REDUCTION_MEAN, or a peak: REDUCTION_MAX, REDUCTION_MAX_ABS, or "
+                      "REDUCTION_MIN with a negative weight");
+        }
+        if (!sum && (!r.has_value() || *r == Reduction::kMin)) {
+          errors->Add(kw, "reduction",
+                      "a term of minimize_max_over is REDUCTION_MAX or REDUCTION_MAX_ABS (a term per instant), or "
+                      "one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, REDUCTION_RANGE "
+                      "or REDUCTION_MEAN");
+        }
+        term.reduction = r.value_or(Reduction::kFinal);
+        if (t.has_window()) term.window = ConvertWindow(kw.Child("window"), t.window(), study, errors);
+        term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
+        if (!std::isfinite(term.weight)) errors->Add(kw, "weight", "must be a finite number");
+        if (!sum && !(term.weight > 0.0)) {
+          errors->Add(kw, "weight", absl::StrFormat("a term of the largest must weigh more than 0, got %g",
+                                                    term.weight));
+        }
+        // A peak enters a sum through a bound variable, which can only push a
+        // largest value down: a peak with a negative weight (or a minimum
+        // with a positive one) would be maximized, which no bound states.
+        if (sum && r.has_value() && (*r == Reduction::kMax || *r == Reduction::kMaxAbs) && !(term.weight > 0.0)) {
+          errors->Add(kw, "weight",
+                      absl::StrFormat("a peak (%s) in a sum must weigh more than 0, got %g: a sum can push a peak "
+                                      "down, not up (to raise the smallest value use REDUCTION_MIN with a negative "
+                                      "weight)",
+                                      *r == Reduction::kMax ? "REDUCTION_MAX" : "REDUCTION_MAX_ABS", term.weight));
+        }
+        if (sum && r.has_value() && *r == Reduction::kMin && !(term.weight < 0.0)) {
+          errors->Add(kw, "weight",
+                      absl::StrFormat("REDUCTION_MIN in a sum needs a negative weight (raising the smallest value), "
+                                      "got %g: a sum cannot push a smallest value down",
+                                      term.weight));
+        }
+        term.unit = t.unit();
+        term.si_per_unit = UnitFactor(kw, "unit", t.unit(), SignalDimension(study, term.output),
+                                      errors);
+        obj.sum_terms.push_back(std::move(term));
+      }
+      break;
+    }
+    case v1::Objective::FORM_NOT_SET:
+      obj.form = Objective::Form::kFeasible;  // the caller says what that means
+      break;
+  }
+  const bool termwise = obj.form == Objective::Form::kWeightedSum || obj.form == Objective::Form::kMaxOver;
+  if (o.has_window()) {
+    if (obj.form == Objective::Form::kTargetDistance) {
+      errors->Add(ow, "window", "target_distance takes final values; it has no window");
+    }
+    if (termwise) errors->Add(ow, "window", "each term has a window of its own (terms[k].window)");
+    obj.window = ConvertWindow(ow.Child("window"), o.window(), study, errors);
+  }
+  if (obj.form != Objective::Form::kTargetDistance && obj.form != Objective::Form::kFeasible && !termwise) {
+    obj.si_per_unit =
+        UnitFactor(ow, "unit", o.unit(),
+                   SignalDimension(study, obj.output),
+                   errors);
+  }
+
+  return obj;
+}
+
 }  // namespace
 
 Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Errors* errors) {
@@ -473,160 +619,22 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
   study.responses = ConvertResponses(m, study, where, errors);
 
   // Objective.
-  const Where ow = where.Child("objective");
-  const v1::Objective& o = m.objective();
-  Objective& obj = study.objective;
-  obj.unit = o.unit();
-  switch (o.form_case()) {
-    case v1::Objective::kMinimizeMaxOf: {
-      obj.form = Objective::Form::kMinimizeMaxOf;
-      obj.output = FindOutput(study, ow, "minimize_max_of", o.minimize_max_of(), errors);
-      if (o.reduction() == v1::REDUCTION_MAX) {
-        obj.reduction = Reduction::kMax;
-      } else if (o.reduction() == v1::REDUCTION_MAX_ABS) {
-        obj.reduction = Reduction::kMaxAbs;
-      } else {
-        errors->Add(ow, "reduction", "minimize_max_of needs REDUCTION_MAX or REDUCTION_MAX_ABS");
+  study.objective = ConvertObjective(m.objective(), study, where.Child("objective"), errors);
+  if (m.objective().form_case() == v1::Objective::FORM_NOT_SET) {
+    if (!m.has_objective()) {
+      // No objective at all: find a design that meets the constraints.
+      if (m.constraints_size() == 0) {
+        errors->Add(where, "objective",
+                    "missing, and the study has no constraints either: a study without an objective finds a "
+                    "design that meets its constraints; add constraints, or an objective (`minimize_max_of`, "
+                    "`minimize`, `maximize`, `minimize_sum`, `minimize_max_over` or `target_distance`)");
       }
-      break;
-    }
-    case v1::Objective::kMinimize:
-    case v1::Objective::kMaximize: {
-      obj.form = Objective::Form::kMinimize;
-      obj.maximize = o.form_case() == v1::Objective::kMaximize;
-      obj.output = obj.maximize ? FindOutput(study, ow, "maximize", o.maximize(), errors)
-                                : FindOutput(study, ow, "minimize", o.minimize(), errors);
-      const std::optional<Reduction> r =
-          o.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(o.reduction());
-      if (!r.has_value() || !IsWholeSeriesReduction(*r)) {
-        errors->Add(ow, "reduction",
-                    absl::StrCat(obj.maximize ? "maximize" : "minimize",
-                                 " takes one value per run: REDUCTION_FINAL (the default), REDUCTION_RMS, "
-                                 "REDUCTION_INTEGRAL, REDUCTION_RANGE or REDUCTION_MEAN (for a maximum over time "
-                                 "use minimize_max_of)"));
-      }
-      obj.reduction = r.value_or(Reduction::kFinal);
-      break;
-    }
-    case v1::Objective::kTargetDistance: {
-      obj.form = Objective::Form::kTargetDistance;
-      const Where tw = ow.Child("target_distance");
-      if (o.target_distance().terms_size() == 0) {
-        errors->Add(tw, "terms", "target_distance needs at least one term");
-      }
-      for (int k = 0; k < o.target_distance().terms_size(); ++k) {
-        const v1::TargetTerm& t = o.target_distance().terms(k);
-        const Where kw = tw.Child("terms", k);
-        TargetTerm term;
-        term.output = FindOutput(study, kw, "output", t.output(), errors);
-        term.target = t.target();
-        term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
-        if (!(term.weight > 0.0) || !std::isfinite(term.weight)) {
-          errors->Add(kw, "weight", absl::StrFormat("must be positive, got %g", t.weight()));
-        }
-        if (!std::isfinite(t.target())) errors->Add(kw, "target", "must be a finite number");
-        term.unit = t.unit();
-        term.si_per_unit = UnitFactor(
-            kw, "unit", t.unit(),
-            SignalDimension(study, term.output),
-            errors);
-        obj.terms.push_back(std::move(term));
-      }
-      break;
-    }
-    case v1::Objective::kMinimizeSum:
-    case v1::Objective::kMinimizeMaxOver: {
-      const bool sum = o.form_case() == v1::Objective::kMinimizeSum;
-      obj.form = sum ? Objective::Form::kWeightedSum : Objective::Form::kMaxOver;
-      const char* form = sum ? "minimize_sum" : "minimize_max_over";
-      const Where sw = ow.Child(form);
-      const auto& terms = sum ? o.minimize_sum().terms() : o.minimize_max_over().terms();
-      if (terms.empty()) errors->Add(sw, "terms", absl::StrCat(form, " needs at least one term"));
-      if (!o.unit().empty()) {
-        errors->Add(ow, "unit", absl::StrCat(sum ? "a weighted sum" : "the largest of several terms",
-                                             " has no unit of its own: each term's `unit` says how it is taken"));
-      }
-      for (int k = 0; k < terms.size(); ++k) {
-        const v1::WeightedTerm& t = terms[k];
-        const Where kw = sw.Child("terms", k);
-        WeightedTerm term;
-        term.output = FindOutput(study, kw, "output", t.output(), errors);
-        const std::optional<Reduction> r =
-            t.reduction() == v1::REDUCTION_UNSPECIFIED ? Reduction::kFinal : ToReduction(t.reduction());
-        if (sum && !r.has_value()) {
-          errors->Add(kw, "reduction",
-                      "a term is one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, "
-                      "REDUCTION_RANGE or REDUCTION_MEAN, or a peak: REDUCTION_MAX, REDUCTION_MAX_ABS, or "
-                      "REDUCTION_MIN with a negative weight");
-        }
-        if (!sum && (!r.has_value() || *r == Reduction::kMin)) {
-          errors->Add(kw, "reduction",
-                      "a term of minimize_max_over is REDUCTION_MAX or REDUCTION_MAX_ABS (a term per instant), or "
-                      "one value: REDUCTION_FINAL (the default), REDUCTION_RMS, REDUCTION_INTEGRAL, REDUCTION_RANGE "
-                      "or REDUCTION_MEAN");
-        }
-        term.reduction = r.value_or(Reduction::kFinal);
-        if (t.has_window()) term.window = ConvertWindow(kw.Child("window"), t.window(), study, errors);
-        term.weight = t.weight() == 0.0 ? 1.0 : t.weight();
-        if (!std::isfinite(term.weight)) errors->Add(kw, "weight", "must be a finite number");
-        if (!sum && !(term.weight > 0.0)) {
-          errors->Add(kw, "weight", absl::StrFormat("a term of the largest must weigh more than 0, got %g",
-                                                    term.weight));
-        }
-        // A peak enters a sum through a bound variable, which can only push a
-        // largest value down: a peak with a negative weight (or a minimum
-        // with a positive one) would be maximized, which no bound states.
-        if (sum && r.has_value() && (*r == Reduction::kMax || *r == Reduction::kMaxAbs) && !(term.weight > 0.0)) {
-          errors->Add(kw, "weight",
-                      absl::StrFormat("a peak (%s) in a sum must weigh more than 0, got %g: a sum can push a peak "
-                                      "down, not up (to raise the smallest value use REDUCTION_MIN with a negative "
-                                      "weight)",
-                                      *r == Reduction::kMax ? "REDUCTION_MAX" : "REDUCTION_MAX_ABS", term.weight));
-        }
-        if (sum && r.has_value() && *r == Reduction::kMin && !(term.weight < 0.0)) {
-          errors->Add(kw, "weight",
-                      absl::StrFormat("REDUCTION_MIN in a sum needs a negative weight (raising the smallest value), "
-                                      "got %g: a sum cannot push a smallest value down",
-                                      term.weight));
-        }
-        term.unit = t.unit();
-        term.si_per_unit = UnitFactor(kw, "unit", t.unit(), SignalDimension(study, term.output),
-                                      errors);
-        obj.sum_terms.push_back(std::move(term));
-      }
-      break;
-    }
-    case v1::Objective::FORM_NOT_SET:
-      if (!m.has_objective()) {
-        // No objective at all: find a design that meets the constraints.
-        obj.form = Objective::Form::kFeasible;
-        if (m.constraints_size() == 0) {
-          errors->Add(where, "objective",
-                      "missing, and the study has no constraints either: a study without an objective finds a "
-                      "design that meets its constraints; add constraints, or an objective (`minimize_max_of`, "
-                      "`minimize`, `maximize`, `minimize_sum`, `minimize_max_over` or `target_distance`)");
-        }
-        break;
-      }
+    } else {
       errors->Add(where, "objective",
                   "empty: expected `minimize_max_of`, `minimize`, `maximize`, `minimize_sum`, "
                   "`minimize_max_over` or `target_distance` (or no `objective` at all, to find a design that "
                   "meets the constraints)");
-      break;
-  }
-  const bool termwise = obj.form == Objective::Form::kWeightedSum || obj.form == Objective::Form::kMaxOver;
-  if (o.has_window()) {
-    if (obj.form == Objective::Form::kTargetDistance) {
-      errors->Add(ow, "window", "target_distance takes final values; it has no window");
     }
-    if (termwise) errors->Add(ow, "window", "each term has a window of its own (terms[k].window)");
-    obj.window = ConvertWindow(ow.Child("window"), o.window(), study, errors);
-  }
-  if (obj.form != Objective::Form::kTargetDistance && obj.form != Objective::Form::kFeasible && !termwise) {
-    obj.si_per_unit =
-        UnitFactor(ow, "unit", o.unit(),
-                   SignalDimension(study, obj.output),
-                   errors);
   }
 
   // Constraints.
@@ -787,7 +795,7 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
     }
     if (p.screening_threshold() != 0.0) s.screening_threshold = p.screening_threshold();
     if (p.has_objective_target()) {
-      if (obj.form == Objective::Form::kFeasible) {
+      if (study.objective.form == Objective::Form::kFeasible) {
         errors->Add(w, "objective_target",
                     "the study has no objective: it stops at the first design that meets its constraints; leave "
                     "objective_target out");
@@ -812,6 +820,10 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
   }
 
   study.design_set = ConvertDesignSet(m, study, where, errors);
+  if (m.pareto().has_objective()) {
+    study.second_objective =
+        ConvertObjective(m.pareto().objective(), study, where.Child("pareto").Child("objective"), errors);
+  }
   study.pareto = ConvertPareto(m, study, where, errors);
 
   if (errors->empty()) {

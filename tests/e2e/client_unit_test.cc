@@ -373,6 +373,50 @@ TEST(ParetoFormat, OnePointInFullOrWhichPointsThereAre) {
   EXPECT_EQ(missing.status().message(), "--point 5: job job-5 has points 1 to 4 (of 4)");
 }
 
+// The same four points with the front's second objective a maximized
+// output in mm (`pareto { objective { maximize: "x" unit: "mm" } }`): the
+// records hold it as the runs minimize it, its negative, in its unit.
+v1::GetJobResponse FourPointFrontOfAMaximizedValue() {
+  v1::GetJobResponse job = FourPointFront();
+  v1::Pareto* pareto = job.mutable_study()->mutable_pareto();
+  pareto->clear_against();
+  pareto->mutable_objective()->set_maximize("x");
+  pareto->mutable_objective()->set_unit("mm");
+  const double minimized[] = {-1.0, -2.5, -3.0, -4.0};
+  const double level[] = {std::numeric_limits<double>::quiet_NaN(), -2.0, -3.5,
+                          std::numeric_limits<double>::quiet_NaN()};
+  for (int k = 0; k < 4; ++k) {
+    job.mutable_cycles(k)->set_pareto_value_si(minimized[k]);
+    job.mutable_cycles(k)->set_pareto_level_si(level[k]);
+  }
+  return job;
+}
+
+TEST(ParetoFormat, ASecondObjectiveIsNamedByWhatItIsAndAMaximizedOneShownAsItself) {
+  const v1::GetJobResponse job = FourPointFrontOfAMaximizedValue();
+  // Point 2 (F 1.6, x 2.5 mm) is beaten by point 3 (F 1.5, x 3 mm): the
+  // larger x is the better one.
+  EXPECT_EQ(client::ResultsCsv(job),
+            "point,level,objective,second_objective,max_violation,run_state,cycles,analyses,x1,status,reason\n"
+            "1,,1,1,-0.01,converged,3,0,10,front,\n"
+            "2,2,1.6000000000000001,2.5,-0.01,converged,3,0,20,dominated,\n"
+            "3,3.5,1.5,3,-0.01,converged,3,0,30,front,\n"
+            "4,,2,4,-0.01,converged,3,0,40,front,\n");
+  const std::string table = client::ResultsTable(job);
+  EXPECT_NE(table.find("F2: x (maximized) [mm]"), std::string::npos) << table;
+  absl::StatusOr<std::string> point = client::ParetoPointText(job, 3);
+  ASSERT_TRUE(point.ok()) << point.status();
+  EXPECT_NE(point->find("level:       F2: x (maximized) >= 3.5 mm"), std::string::npos) << *point;
+  v1::Objective largest;
+  largest.set_minimize_max_of("acc");
+  largest.set_reduction(v1::REDUCTION_MAX_ABS);
+  EXPECT_EQ(client::SecondObjectiveLabel(largest), "F2: max |acc|");
+  v1::Objective sum;
+  sum.mutable_minimize_sum()->add_terms()->set_output("x");
+  sum.mutable_minimize_sum()->add_terms()->set_output("acc");
+  EXPECT_EQ(client::SecondObjectiveLabel(sum), "F2: sum of 2 terms");
+}
+
 TEST(Backoff, GrowsGeometricallyUpToTheCapWithBoundedJitter) {
   worker::BackoffOptions options;
   options.initial = std::chrono::milliseconds(100);

@@ -3,6 +3,7 @@
 // of its points made again by a separate single run: the ride-comfort study
 // with the point's level written as the ordinary limit of s1.
 #include <cmath>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -76,6 +77,50 @@ TEST(VehicleParetoFront, TradesComfortAgainstSeatTravelAndAPointIsASingleRunsOpt
   EXPECT_NEAR(run->outcome.objective, middle.objective_x0, kSameOptimumRelative * middle.objective_x0);
   std::cout << "single run at the level " << s1.limit << " in: F " << run->outcome.objective << " (the front's "
             << middle.objective_x0 << "), " << run->outcome.analyses << " analyses\n";
+}
+
+// The front with its second objective written as an objective, the largest
+// |s1| in inches (`pareto { objective { minimize_max_of: "s1" reduction:
+// REDUCTION_MAX_ABS unit: "in" } }`, the constraint s1 taken out of the
+// study), is the front against the constraint s1: the same problems but
+// for point N's objective (|s1| / its limit against |s1| in inches), whose
+// scale may change the runs' path, and so their results within the
+// method's tolerance (measured: the same to 10 digits, the min-max's
+// iterates not depending on its scale here). Three points each, to keep
+// the test short.
+TEST(VehicleParetoFront, ASecondObjectiveOfTheSeatTravelGivesTheFrontAgainstItsConstraint) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_pareto.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  constexpr int kThree = 3;
+  spec::Study against = *study;
+  against.pareto.points = kThree;
+  spec::Study second = against;
+  const auto s1 = static_cast<std::size_t>(study->pareto.constraint);
+  const spec::Constraint travel = study->constraints[s1];
+  second.constraints.erase(second.constraints.begin() + static_cast<std::ptrdiff_t>(s1));
+  second.pareto.constraint = -1;
+  second.pareto.trades_objective = true;
+  second.second_objective = spec::Objective{};
+  second.second_objective.form = spec::Objective::Form::kMinimizeMaxOf;
+  second.second_objective.output = travel.output;
+  second.second_objective.reduction = spec::Reduction::kMaxAbs;
+  second.second_objective.unit = "in";
+  second.second_objective.si_per_unit = travel.si_per_unit;
+  const std::vector<slp::CycleRecord> by_constraint = RunFront(against);
+  const std::vector<slp::CycleRecord> by_objective = RunFront(second);
+  ASSERT_EQ(by_constraint.size(), static_cast<size_t>(kThree));
+  ASSERT_EQ(by_objective.size(), static_cast<size_t>(kThree));
+  for (int k = 0; k < kThree; ++k) {
+    const slp::CycleRecord& c = by_constraint[static_cast<size_t>(k)];
+    const slp::CycleRecord& o = by_objective[static_cast<size_t>(k)];
+    // The objective's values are in its unit (inches), the constraint's SI.
+    const double travel_in = c.pareto_value_si / travel.si_per_unit;
+    std::cout << std::setprecision(10) << "point " << k + 1 << ": F " << c.objective_x0 << " and " << o.objective_x0 << " m/s^2, |s1| "
+              << travel_in << " and " << o.pareto_value_si << " in\n";
+    EXPECT_TRUE(o.accepted) << "point " << k + 1 << ": " << o.rejection_reason;
+    EXPECT_NEAR(o.objective_x0, c.objective_x0, kSameOptimumRelative * c.objective_x0) << "point " << k + 1;
+    EXPECT_NEAR(o.pareto_value_si, travel_in, kSameOptimumRelative * travel_in) << "point " << k + 1;
+  }
 }
 
 }  // namespace

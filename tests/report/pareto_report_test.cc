@@ -72,6 +72,20 @@ TEST(ParetoReport, IsWellFormedWithTheFrontLabelledAndTheDominatedPointApart) {
   EXPECT_EQ(html.find("Chosen design"), std::string::npos);
 }
 
+TEST(ParetoReport, NamesASecondObjectiveAsSuchNotAsAConstraintsLargestValue) {
+  ParetoReportData data = Front();
+  data.against = "F2: max |s1|";
+  data.against_objective = true;
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  const std::vector<std::string> svgs = testing::SvgFragments(html);
+  ASSERT_EQ(svgs.size(), 1u);
+  EXPECT_NE(svgs[0].find("Pareto front: objective F against the second objective F2: max |s1|"), std::string::npos);
+  EXPECT_NE(svgs[0].find("F2: max |s1| [in]"), std::string::npos);
+  EXPECT_NE(html.find("<th>traded against</th><td>the second objective F2: max |s1|</td>"), std::string::npos);
+  EXPECT_EQ(html.find("the largest value of F2"), std::string::npos);
+}
+
 // A point added by refinement (number 6) lies between points 2 and 4 on the
 // front: the front's line goes through it there, not after point 5.
 TEST(ParetoReport, JoinsTheFrontInTheOrderOfTheTradedValueNotOfThePoints) {
