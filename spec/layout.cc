@@ -284,6 +284,7 @@ Dimension OutputDimension(const Output& output) {
                             case Q::kSpringForce: return Dimension::kForce;
                             case Q::kKineticEnergy:
                             case Q::kPotentialEnergy: return Dimension::kEnergy;
+                            case Q::kDriverEffort: return s.linear ? Dimension::kForce : Dimension::kTorque;
                           }
                           return Dimension::kAny;
                         },

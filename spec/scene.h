@@ -159,6 +159,9 @@ struct MultibodyDriver {
   Number start, rate;                 // kConstantRate; start is the mean for kHarmonic
   std::vector<Number> coefficients;   // kPolynomial
   Number amplitude, angular_frequency_rad_per_s, phase_rad;  // kHarmonic
+  // Spatial scenes: the driver prescribes the joint's slide (m), not its
+  // angle (a prismatic joint's, or a cylindrical joint's with `slide`).
+  bool slide = false;
 };
 struct MultibodySpring {
   std::string name;
@@ -265,7 +268,7 @@ struct SpatialModel {
   std::vector<SpatialMarker> ground_markers;
   std::vector<SpatialBody> bodies;
   std::vector<SpatialJoint> joints;
-  std::vector<MultibodyDriver> drivers;  // joint: a revolute or cylindrical joint's angle
+  std::vector<MultibodyDriver> drivers;  // joint: an angle (revolute, cylindrical) or a slide (`slide`)
   std::vector<SpatialSpring> springs;
   std::optional<Vec3> gravity_m_per_s2;
 };
@@ -354,9 +357,11 @@ struct SpatialOutput {
     kMarkerPosition, kMarkerVelocity, kMarkerAcceleration, kBodyOrientation,
     kJointCoordinate, kJointRate, kJointSlide, kJointSlideRate,
     kSpringLength, kSpringForce, kKineticEnergy, kPotentialEnergy,
+    kDriverEffort,  // of `driver`: torque (N m) or, `linear`, force (N) on the joint's body b
   } quantity = Quantity::kMarkerPosition;
   MarkerRef marker;
   int body = -1, joint = -1, spring = -1;
+  int driver = -1;  // kDriverEffort
   Axis axis = Axis::kX;
   int sequence[3] = {2, 1, 0};  // kBodyOrientation: as Orientation::sequence
   int angle = 0;                // kBodyOrientation: 0, 1 or 2

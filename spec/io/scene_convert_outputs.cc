@@ -116,10 +116,15 @@ void SceneConverter::ConvertOutputs() {
         needs = "linkage";
         out.kind = MassOutput{};
         break;
-      case v1::Output::kJointReaction:
       case v1::Output::kDriverEffort:
-        // Reactions and efforts need inverse dynamics, which spatial scenes
-        // do not have yet: "needs a multibody model".
+        if (spatial) {
+          needs = "spatial";
+          out.kind = SpatialOutputOf(o, ow);
+          break;
+        }
+        [[fallthrough]];
+      case v1::Output::kJointReaction:
+        // Spatial scenes have no joint reactions yet: "needs a multibody model".
         needs = "multibody";
         out.kind = multibody ? MultibodyOutputOf(o, ow) : MultibodyOutput{};
         break;

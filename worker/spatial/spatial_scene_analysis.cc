@@ -11,6 +11,7 @@
 #include "worker/spatial/euler_angles.h"
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/spatial_assembly.h"
+#include "worker/spatial/spatial_kinematics.h"
 #include "worker/spatial/spatial_system.h"
 
 namespace mbopt::spatial {
@@ -105,7 +106,8 @@ Joint::Kind JointKindOf(spec::SpatialJointKind kind) {
 
 // The value of output `o` in the state `s`.
 double OutputValue(const SpatialSystem& system, const Model& model, const spec::SpatialModel& sm,
-                   const spec::SpatialOutput& o, const std::vector<double>& p, const multibody::MotionSample& s) {
+                   const spec::SpatialOutput& o, const std::vector<double>& p, const multibody::MotionSample& s,
+                   const Eigen::VectorXd& lambda) {
   const int axis = static_cast<int>(o.axis);
   switch (o.quantity) {
     case Quantity::kMarkerPosition: return system.PointPosition(PointOf(sm, o.marker, p), s.q)[axis];
@@ -136,6 +138,10 @@ double OutputValue(const SpatialSystem& system, const Model& model, const spec::
     }
     case Quantity::kKineticEnergy: return system.KineticEnergy(s.q, s.v);
     case Quantity::kPotentialEnergy: return system.PotentialEnergy(s.q);
+    case Quantity::kDriverEffort:
+      // Driver rows are written so that their derivative along the driven
+      // coordinate is 1 at the solution: -lambda is the generalized force.
+      return lambda.size() == 0 ? NAN : -lambda[system.row_of_driver(o.driver)];
   }
   return NAN;
 }
@@ -168,7 +174,7 @@ absl::StatusOr<Model> CompileSpatialModel(const spec::Scene& scene, const std::v
   for (const spec::SpatialJoint& j : sm.joints) {
     m.joints.push_back(Joint{j.name, JointKindOf(j.kind), FrameOf(sm, j.a, p), FrameOf(sm, j.b, p)});
   }
-  for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p)});
+  for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p), d.slide});
   for (const spec::SpatialSpring& s : sm.springs) {
     SpringDamper spring;
     spring.name = s.name;
@@ -222,6 +228,50 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
     report.Fail(assembled.failure.kind, assembled.failure.reason);
     return report;
   }
+  // Inverse dynamics per instant only when an output asks for it.
+  bool needs_multipliers = false;
+  for (const spec::Output& o : scene.outputs) {
+    needs_multipliers |= std::get<spec::SpatialOutput>(o.kind).quantity == Quantity::kDriverEffort;
+  }
+  size_t next_instant = 0;
+  const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
+    if (budget != nullptr) {
+      if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
+    }
+    if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
+      return spec::AnalysisFailure::Ok();
+    }
+    ++next_instant;
+    const Eigen::VectorXd lambda = needs_multipliers ? Multipliers(system, s.t_s, s.q, s.v, s.a) : Eigen::VectorXd();
+    for (size_t k = 0; k < scene.outputs.size(); ++k) {
+      const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
+      const double value = OutputValue(system, *model, sm, o, p, s, lambda);
+      if (!std::isfinite(value)) {
+        return spec::AnalysisFailure::Of(
+            spec::FailureKind::kNonFiniteValue,
+            absl::StrFormat("output '%s' is not finite at t = %.6g s", scene.outputs[k].name, s.t_s));
+      }
+      report.outputs[k].series[0].push_back(value);
+    }
+    return spec::AnalysisFailure::Ok();
+  };
+  // The motion starts at t = 0; the grid may start later.
+  std::vector<double> times;
+  if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
+  times.insert(times.end(), report.times_s.begin(), report.times_s.end());
+  if (assembled.degrees_of_freedom == 0) {
+    // Every degree of freedom driven: the motion follows from the
+    // constraints alone, as in planar scenes (redundant rows included).
+    report.formulation = spec::Formulation::kKinematic;
+    SpatialKinematicOptions options;
+    options.budget = budget;
+    SpatialKinematicCounters counters;
+    const spec::AnalysisFailure outcome = RunSpatialKinematics(system, assembled.q, times, options, record, &counters);
+    report.counters.time_steps = counters.position_solves;
+    report.counters.newton_iterations += counters.newton_iterations;
+    if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
+    return report;
+  }
   if (assembled.redundant_rows > 0) {
     // The GGL integrator's augmented matrix is singular with redundant
     // rows: refused until they are handled.
@@ -233,31 +283,6 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
                                 assembled.redundant_rows));
     return report;
   }
-  // The motion starts at t = 0; the grid may start later.
-  std::vector<double> times;
-  if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
-  times.insert(times.end(), report.times_s.begin(), report.times_s.end());
-  size_t next_instant = 0;
-  const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
-    if (budget != nullptr) {
-      if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
-    }
-    if (next_instant >= report.times_s.size() || s.t_s != report.times_s[next_instant]) {
-      return spec::AnalysisFailure::Ok();
-    }
-    ++next_instant;
-    for (size_t k = 0; k < scene.outputs.size(); ++k) {
-      const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
-      const double value = OutputValue(system, *model, sm, o, p, s);
-      if (!std::isfinite(value)) {
-        return spec::AnalysisFailure::Of(
-            spec::FailureKind::kNonFiniteValue,
-            absl::StrFormat("output '%s' is not finite at t = %.6g s", scene.outputs[k].name, s.t_s));
-      }
-      report.outputs[k].series[0].push_back(value);
-    }
-    return spec::AnalysisFailure::Ok();
-  };
   const multibody::ForwardDynamicsOptions options = multibody::ForwardDynamicsOptions::Of(scene.integrator, budget);
   multibody::ForwardDynamicsCounters counters;
   const spec::AnalysisFailure outcome =
