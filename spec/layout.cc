@@ -288,8 +288,8 @@ Dimension OutputDimension(const Output& output) {
                             case Q::kBodyAngularVelocity: return Dimension::kAngularVelocity;
                             case Q::kJointReaction:
                             case Q::kBushingForce: return Dimension::kForce;
+                            case Q::kDriverEffort: return s.linear ? Dimension::kForce : Dimension::kTorque;
                             case Q::kJointReactionMoment:
-                            case Q::kDriverEffort:
                             case Q::kBushingMoment:
                             case Q::kRotationalSpringTorque: return Dimension::kTorque;
                           }

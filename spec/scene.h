@@ -159,6 +159,9 @@ struct MultibodyDriver {
   Number start, rate;                 // kConstantRate; start is the mean for kHarmonic
   std::vector<Number> coefficients;   // kPolynomial
   Number amplitude, angular_frequency_rad_per_s, phase_rad;  // kHarmonic
+  // Spatial scenes: the driver prescribes the joint's slide (m), not its
+  // angle (a prismatic joint's, or a cylindrical joint's with `slide`).
+  bool slide = false;
 };
 struct MultibodySpring {
   std::string name;
@@ -297,7 +300,7 @@ struct SpatialModel {
   std::vector<SpatialMarker> ground_markers;
   std::vector<SpatialBody> bodies;
   std::vector<SpatialJoint> joints;
-  std::vector<MultibodyDriver> drivers;  // joint: a revolute or cylindrical joint's angle
+  std::vector<MultibodyDriver> drivers;  // joint: an angle (revolute, cylindrical) or a slide (`slide`)
   std::vector<SpatialSpring> springs;
   std::optional<Vec3> gravity_m_per_s2;
   std::vector<SpatialPointForce> point_forces;
@@ -398,6 +401,7 @@ struct SpatialOutput {
   int body = -1, joint = -1, spring = -1;
   int bushing = -1;          // kBushingForce, kBushingMoment
   bool body_axes = false;    // kBodyAngularVelocity: in the body's axes, else world
+  int driver = -1;           // kDriverEffort: torque (N m) or, `linear`, force (N) on the joint's body b
   Axis axis = Axis::kX;
   int sequence[3] = {2, 1, 0};  // kBodyOrientation: as Orientation::sequence
   int angle = 0;                // kBodyOrientation: 0, 1 or 2

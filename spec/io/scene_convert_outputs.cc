@@ -116,8 +116,8 @@ void SceneConverter::ConvertOutputs() {
         needs = "linkage";
         out.kind = MassOutput{};
         break;
-      case v1::Output::kJointReaction:
       case v1::Output::kDriverEffort:
+      case v1::Output::kJointReaction:
       case v1::Output::kMarkerPosition:
       case v1::Output::kMarkerVelocity:
       case v1::Output::kMarkerAcceleration:

@@ -286,29 +286,41 @@ SpatialModel SceneConverter::ConvertSpatial(const v1::SpatialModel& m, const Whe
     }
     spatial_.joints.push_back(std::move(joint));
   }
-  std::set<int> driven;
+  std::set<std::pair<int, bool>> driven;  // (joint, slide)
   for (int i = 0; i < m.drivers_size(); ++i) {
     const v1::SpatialDriver& d = m.drivers(i);
     const Where dw = w.Child("drivers", i);
     MultibodyDriver driver;
     driver.joint = SpatialJointIndex(dw, "joint", d.joint());
+    driver.slide = d.slide();
     if (driver.joint >= 0) {
       const SpatialJointKind kind = spatial_.joints[static_cast<size_t>(driver.joint)].kind;
-      if (kind != SpatialJointKind::kRevolute && kind != SpatialJointKind::kCylindrical) {
+      if (kind == SpatialJointKind::kPrismatic) driver.slide = true;
+      if (kind == SpatialJointKind::kRevolute && d.slide()) {
+        errors_.Add(dw, "slide", absl::StrCat("joint \"", d.joint(),
+                                              "\" is revolute: it has no slide (drive a prismatic or cylindrical one)"));
+      } else if (kind != SpatialJointKind::kRevolute && kind != SpatialJointKind::kCylindrical &&
+                 kind != SpatialJointKind::kPrismatic) {
         errors_.Add(dw, "joint",
                     absl::StrCat("joint \"", d.joint(),
-                                 "\" is not revolute or cylindrical: a spatial driver prescribes such a joint's angle"));
+                                 "\" is not revolute, prismatic or cylindrical: a spatial driver prescribes the angle "
+                                 "of a revolute or cylindrical joint or the slide (`slide: true`) of a prismatic or "
+                                 "cylindrical one"));
       }
-      if (!driven.insert(driver.joint).second) errors_.Add(dw, "joint", "this joint already has a driver");
+      if (!driven.insert({driver.joint, driver.slide}).second) {
+        errors_.Add(dw, "joint", driver.slide ? "this joint's slide already has a driver"
+                                              : "this joint's angle already has a driver");
+      }
     }
+    // The profile's values are the coordinate's: m for a slide, rad for an angle.
+    const Dimension coordinate = driver.slide ? Dimension::kLength : Dimension::kAngle;
+    const Dimension rate = driver.slide ? Dimension::kVelocity : Dimension::kAngularVelocity;
     switch (d.profile_case()) {
       case v1::SpatialDriver::kConstantRate: {
         const Where pw = dw.Child("constant_rate");
         driver.profile = MultibodyDriver::Profile::kConstantRate;
-        driver.start =
-            Num(pw, "start", d.constant_rate().has_start(), d.constant_rate().start(), Dimension::kAngle, 0.0);
-        driver.rate =
-            Num(pw, "rate", d.constant_rate().has_rate(), d.constant_rate().rate(), Dimension::kAngularVelocity);
+        driver.start = Num(pw, "start", d.constant_rate().has_start(), d.constant_rate().start(), coordinate, 0.0);
+        driver.rate = Num(pw, "rate", d.constant_rate().has_rate(), d.constant_rate().rate(), rate);
         break;
       }
       case v1::SpatialDriver::kPolynomial: {
@@ -422,6 +434,24 @@ SpatialOutput SceneConverter::SpatialOutputOf(const v1::Output& o, const Where& 
     case v1::Output::kJointSlideRate: joint("joint_slide_rate", o.joint_slide_rate(), Q::kJointSlideRate); break;
     case v1::Output::kSpringLength: spring("spring_length", o.spring_length(), Q::kSpringLength); break;
     case v1::Output::kSpringForce: spring("spring_force", o.spring_force(), Q::kSpringForce); break;
+    case v1::Output::kDriverEffort: {
+      // The angle's driver when the joint has one, else the slide's.
+      const Where kw = ow.Child("driver_effort");
+      out.quantity = Q::kDriverEffort;
+      out.joint = SpatialJointIndex(kw, "joint", o.driver_effort().joint());
+      for (size_t d = 0; d < spatial_.drivers.size() && out.joint >= 0; ++d) {
+        const MultibodyDriver& driver = spatial_.drivers[d];
+        if (driver.joint == out.joint && (out.driver < 0 || !driver.slide)) {
+          out.driver = static_cast<int>(d);
+          out.linear = driver.slide;
+        }
+      }
+      if (out.joint >= 0 && out.driver < 0) {
+        errors_.Add(kw, "joint", absl::StrCat("joint \"", o.driver_effort().joint(),
+                                              "\" has no driver: a driver effort needs one"));
+      }
+      break;
+    }
     case v1::Output::kKineticEnergy: out.quantity = Q::kKineticEnergy; break;
     case v1::Output::kPotentialEnergy: out.quantity = Q::kPotentialEnergy; break;
     case v1::Output::kBodyOrientation: {

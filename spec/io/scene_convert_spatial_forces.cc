@@ -162,19 +162,11 @@ bool SceneConverter::SpatialForceOutputOf(const v1::Output& o, const Where& ow, 
       default: errors_.Add(kw, "axis", "expected AXIS_X, AXIS_Y or AXIS_Z"); return Axis::kX;
     }
   };
-  // Reactions of any joint; efforts of a driven one.
+  // Reactions of any joint (a driver's effort: scene_convert_spatial.cc).
   auto joint = [&](const char* field, const v1::JointOutput& j, Q quantity) {
     const Where kw = ow.Child(field);
     out->quantity = quantity;
     out->joint = SpatialJointIndex(kw, "joint", j.joint());
-    if (quantity == Q::kDriverEffort) {
-      bool driven = false;
-      for (const MultibodyDriver& d : spatial_.drivers) driven = driven || (out->joint >= 0 && d.joint == out->joint);
-      if (out->joint >= 0 && !driven) {
-        errors_.Add(kw, "joint", absl::StrCat("joint \"", j.joint(), "\" has no driver: a driver effort needs one"));
-      }
-      return;
-    }
     out->axis = axis_of(kw, j.axis());
   };
   switch (o.kind_case()) {
@@ -197,7 +189,6 @@ bool SceneConverter::SpatialForceOutputOf(const v1::Output& o, const Where& ow, 
     case v1::Output::kJointReactionMoment:
       joint("joint_reaction_moment", o.joint_reaction_moment(), Q::kJointReactionMoment);
       return true;
-    case v1::Output::kDriverEffort: joint("driver_effort", o.driver_effort(), Q::kDriverEffort); return true;
     case v1::Output::kBushingForce: {
       const Where kw = ow.Child("bushing_force");
       const v1::BushingOutput& b = o.bushing_force();

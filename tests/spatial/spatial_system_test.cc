@@ -156,6 +156,61 @@ TEST(SpatialSystem, DriverRowsMatchTheirTimeDerivatives) {
   EXPECT_NEAR(difference[row], -gamma[row], kDifferenceTolerance);
 }
 
+// A cylindrical joint driven in its angle and its slide: the slide
+// driver's row (z_a.d - s(t)) has its Jacobian, Phi_t and gamma checked
+// against difference quotients, and is zero where the slide is s(t).
+TEST(SpatialSystem, SlideDriverRowMatchesItsDerivatives) {
+  Model model = TwoBodies(Joint::Kind::kCylindrical);
+  Driver angle;
+  angle.joint = 1;
+  angle.profile.kind = multibody::Profile::Kind::kConstantRate;
+  angle.profile.rate = 2.0;
+  Driver slide;
+  slide.joint = 1;
+  slide.slide = true;
+  slide.profile.kind = multibody::Profile::Kind::kHarmonic;
+  slide.profile.start = 0.05;
+  slide.profile.amplitude = 0.1;
+  slide.profile.angular_frequency_rad_per_s = 4.0;
+  slide.profile.phase_rad = 0.3;
+  model.drivers = {angle, slide};
+  ASSERT_TRUE(model.Validate().ok()) << model.Validate();
+  const SpatialSystem s(model);
+  VectorXd q, v;
+  GeneralState(s, &q, &v);
+  const double t = 0.4;
+  const int row = s.row_of_driver(1);
+  ASSERT_EQ(row, s.num_constraints() - 1);
+  VectorXd phi, phi_t, gamma, phi_plus, phi_minus;
+  ASSERT_EQ(s.Constraints(t, q, &phi), 0);
+  EXPECT_NEAR(phi[row], s.JointTranslation(1, q) - slide.profile.At(t).q, 1e-15);
+  MatrixXd phi_q;
+  ASSERT_EQ(s.ConstraintJacobian(t, q, &phi_q), 0);
+  for (int k = 0; k < q.size(); ++k) {
+    VectorXd plus = q, minus = q;
+    plus[k] += kStep;
+    minus[k] -= kStep;
+    ASSERT_EQ(s.Constraints(t, plus, &phi_plus), 0);
+    ASSERT_EQ(s.Constraints(t, minus, &phi_minus), 0);
+    EXPECT_NEAR(phi_q(row, k), (phi_plus[row] - phi_minus[row]) / (2 * kStep), kDifferenceTolerance) << k;
+  }
+  ASSERT_EQ(s.ConstraintTimeDerivative(t, q, &phi_t), 0);
+  ASSERT_EQ(s.Constraints(t + kStep, q, &phi_plus), 0);
+  ASSERT_EQ(s.Constraints(t - kStep, q, &phi_minus), 0);
+  EXPECT_NEAR(phi_t[row], (phi_plus[row] - phi_minus[row]) / (2 * kStep), kDifferenceTolerance);
+  ASSERT_EQ(s.AccelerationRightSide(t, q, v, &gamma), 0);
+  auto rate = [&](double h) {
+    MatrixXd phi_q_h;
+    VectorXd phi_t_h;
+    EXPECT_EQ(s.ConstraintJacobian(t + h, q + h * v, &phi_q_h), 0);
+    EXPECT_EQ(s.ConstraintTimeDerivative(t + h, q + h * v, &phi_t_h), 0);
+    return VectorXd(phi_q_h * v + phi_t_h);
+  };
+  const VectorXd difference = (rate(kStep) - rate(-kStep)) / (2 * kStep);
+  EXPECT_NEAR(difference[row], -gamma[row], kDifferenceTolerance);
+  EXPECT_EQ(s.RowOwner(row), "the driver of joint 'between'");
+}
+
 // The mass matrix is the Hessian of the kinetic energy in v on |p| = 1,
 // up to the term along p (which lies in the normalization row's reaction):
 // v^T M v / 2 equals the kinetic energy for rates tangent to the sphere.
@@ -248,6 +303,20 @@ TEST(SpatialModel, RefusesADriverOnASphericalJoint) {
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("spherical joint 'between'"), std::string::npos) << status.message();
   EXPECT_NE(status.message().find("expected a revolute or cylindrical joint"), std::string::npos);
+}
+
+TEST(SpatialModel, RefusesASlideDriverOnARevoluteJoint) {
+  Model model = TwoBodies(Joint::Kind::kRevolute);
+  Driver d;
+  d.joint = 1;
+  d.slide = true;
+  model.drivers.push_back(d);
+  const absl::Status status = model.Validate();
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("drives the slide of revolute joint 'between', expected a prismatic or "
+                                  "cylindrical joint"),
+            std::string::npos)
+      << status.message();
 }
 
 TEST(SpatialModel, RefusesAJointWithinOneBody) {

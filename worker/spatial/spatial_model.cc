@@ -131,15 +131,18 @@ absl::Status Model::Validate() const {
                                                         d.joint, joints.size()));
     }
     const Joint& joint = joints[static_cast<size_t>(d.joint)];
-    if (joint.kind != Joint::Kind::kRevolute && joint.kind != Joint::Kind::kCylindrical) {
-      return absl::InvalidArgumentError(where + ": drives " + JointKindName(joint.kind) + " joint '" + joint.name +
-                                        "', expected a revolute or cylindrical joint (its rotation)");
+    const bool rotates = joint.kind == Joint::Kind::kRevolute || joint.kind == Joint::Kind::kCylindrical;
+    const bool slides = joint.kind == Joint::Kind::kPrismatic || joint.kind == Joint::Kind::kCylindrical;
+    if (d.slide ? !slides : !rotates) {
+      return absl::InvalidArgumentError(where + ": drives the " + (d.slide ? "slide" : "rotation") + " of " +
+                                        JointKindName(joint.kind) + " joint '" + joint.name + "', expected " +
+                                        (d.slide ? "a prismatic or cylindrical joint" : "a revolute or cylindrical joint"));
     }
     if (d.profile.kind == multibody::Profile::Kind::kTabulated && d.profile.table.empty()) {
       return absl::InvalidArgumentError(where + ": tabulated profile without a table");
     }
     for (size_t k = 0; k < i; ++k) {
-      if (drivers[k].joint == d.joint) {
+      if (drivers[k].joint == d.joint && drivers[k].slide == d.slide) {
         return absl::InvalidArgumentError(where + ": joint '" + joint.name + "' is already driven by driver " +
                                           std::to_string(k));
       }

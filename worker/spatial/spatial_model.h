@@ -79,11 +79,13 @@ struct Joint {
   Frame a, b;
 };
 
-// The rotation coordinate of a revolute or cylindrical joint as a function
-// of time (the planar drivers' profiles).
+// A joint coordinate as a function of time (the planar drivers' profiles):
+// the rotation of a revolute or cylindrical joint (rad), or with `slide` the
+// translation of a prismatic or cylindrical joint (m).
 struct Driver {
   int joint = -1;
   multibody::Profile profile;
+  bool slide = false;
 };
 
 // Tension T = k (L - L0) + c dL/dt + actuator between two points, pulling

@@ -32,12 +32,4 @@ JointReaction JointReactionOf(const SpatialSystem& system, int joint, double t, 
   return r;
 }
 
-double DriverEffort(const SpatialSystem& system, int joint, const Eigen::VectorXd& lambda) {
-  const Model& model = system.model();
-  for (size_t d = 0; d < model.drivers.size(); ++d) {
-    if (model.drivers[d].joint == joint) return -lambda[system.row_of_driver(static_cast<int>(d))];
-  }
-  return NAN;
-}
-
 }  // namespace mbopt::spatial

@@ -22,10 +22,4 @@ struct JointReaction {
 JointReaction JointReactionOf(const SpatialSystem& system, int joint, double t, const Eigen::VectorXd& q,
                               const Eigen::VectorXd& lambda);
 
-// The torque (N m) the driver of joint `joint` applies to body b about the
-// joint axis: its row is sin(theta - theta(t)) = 0, whose derivative in
-// theta is 1 on the solution, so the effort is -lambda of that row. NaN when
-// the joint has no driver.
-double DriverEffort(const SpatialSystem& system, int joint, const Eigen::VectorXd& lambda);
-
 }  // namespace mbopt::spatial

@@ -13,6 +13,7 @@
 #include "worker/spatial/redundant_constraints.h"
 #include "worker/spatial/spatial_assembly.h"
 #include "worker/spatial/spatial_force_elements.h"
+#include "worker/spatial/spatial_kinematics.h"
 #include "worker/spatial/spatial_reactions.h"
 #include "worker/spatial/spatial_system.h"
 
@@ -108,7 +109,8 @@ Joint::Kind JointKindOf(spec::SpatialJointKind kind) {
 
 // The value of output `o` in the state `s`.
 double OutputValue(const SpatialSystem& system, const Model& model, const spec::SpatialModel& sm,
-                   const spec::SpatialOutput& o, const std::vector<double>& p, const multibody::MotionSample& s) {
+                   const spec::SpatialOutput& o, const std::vector<double>& p, const multibody::MotionSample& s,
+                   const Eigen::VectorXd& lambda) {
   const int axis = static_cast<int>(o.axis);
   switch (o.quantity) {
     case Quantity::kMarkerPosition: return system.PointPosition(PointOf(sm, o.marker, p), s.q)[axis];
@@ -140,10 +142,12 @@ double OutputValue(const SpatialSystem& system, const Model& model, const spec::
     case Quantity::kPotentialEnergy: return system.PotentialEnergy(s.q);
     case Quantity::kBodyAngularVelocity:
       return (o.body_axes ? system.BodyAngularVelocity(o.body, s.q, s.v) : system.AngularVelocity(o.body, s.q, s.v))[axis];
-    case Quantity::kJointReaction: return JointReactionOf(system, o.joint, s.t_s, s.q, s.lambda).force_n[axis];
-    case Quantity::kJointReactionMoment:
-      return JointReactionOf(system, o.joint, s.t_s, s.q, s.lambda).moment_n_m[axis];
-    case Quantity::kDriverEffort: return DriverEffort(system, o.joint, s.lambda);
+    case Quantity::kJointReaction: return JointReactionOf(system, o.joint, s.t_s, s.q, lambda).force_n[axis];
+    case Quantity::kJointReactionMoment: return JointReactionOf(system, o.joint, s.t_s, s.q, lambda).moment_n_m[axis];
+    case Quantity::kDriverEffort:
+      // Driver rows are written so that their derivative along the driven
+      // coordinate is 1 at the solution: -lambda is the generalized force.
+      return -lambda[system.row_of_driver(o.driver)];
     case Quantity::kBushingForce: return BushingLoadOf(model, o.bushing, s.q, s.v).force_n[axis];
     case Quantity::kBushingMoment: return BushingLoadOf(model, o.bushing, s.q, s.v).moment_n_m[axis];
     case Quantity::kRotationalSpringTorque: return RotationalSpringTorque(model, o.spring, s.q, s.v);
@@ -179,7 +183,7 @@ absl::StatusOr<Model> CompileSpatialModel(const spec::Scene& scene, const std::v
   for (const spec::SpatialJoint& j : sm.joints) {
     m.joints.push_back(Joint{j.name, JointKindOf(j.kind), FrameOf(sm, j.a, p), FrameOf(sm, j.b, p)});
   }
-  for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p)});
+  for (const spec::MultibodyDriver& d : sm.drivers) m.drivers.push_back(Driver{d.joint, ProfileOf(d, p), d.slide});
   for (const spec::SpatialSpring& s : sm.springs) {
     SpringDamper spring;
     spring.name = s.name;
@@ -256,27 +260,26 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
     report.Fail(assembled.failure.kind, assembled.failure.reason);
     return report;
   }
+  // Reactions and efforts come from the multipliers, solved per instant
+  // from the motion (inverse dynamics) only when an output asks for them.
   // With redundant joints the multipliers belong to combinations of rows
   // (redundant_constraints.h): a joint's reaction is not unique.
-  if (assembled.redundant_rows > 0) {
-    for (const spec::Output& output : scene.outputs) {
-      const auto quantity = std::get<spec::SpatialOutput>(output.kind).quantity;
-      if (quantity == Quantity::kJointReaction || quantity == Quantity::kJointReactionMoment ||
-          quantity == Quantity::kDriverEffort) {
-        report.Fail(spec::FailureKind::kInvalidModel,
-                    absl::StrFormat("output '%s': the mechanism has %d redundant constraint equation(s), so its "
-                                    "joints' reactions and drivers' efforts are not unique; ask for them in a "
-                                    "mechanism without redundant joints (e.g. a spherical joint made a "
-                                    "point-on-line one)",
-                                    output.name, assembled.redundant_rows));
-        return report;
-      }
+  bool needs_multipliers = false;
+  for (const spec::Output& output : scene.outputs) {
+    const auto quantity = std::get<spec::SpatialOutput>(output.kind).quantity;
+    const bool multiplier_output = quantity == Quantity::kJointReaction ||
+                                   quantity == Quantity::kJointReactionMoment || quantity == Quantity::kDriverEffort;
+    if (multiplier_output && assembled.redundant_rows > 0) {
+      report.Fail(spec::FailureKind::kInvalidModel,
+                  absl::StrFormat("output '%s': the mechanism has %d redundant constraint equation(s), so its "
+                                  "joints' reactions and drivers' efforts are not unique; ask for them in a "
+                                  "mechanism without redundant joints (e.g. a spherical joint made a "
+                                  "point-on-line one)",
+                                  output.name, assembled.redundant_rows));
+      return report;
     }
+    needs_multipliers |= multiplier_output;
   }
-  // The motion starts at t = 0; the grid may start later.
-  std::vector<double> times;
-  if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
-  times.insert(times.end(), report.times_s.begin(), report.times_s.end());
   size_t next_instant = 0;
   const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
     if (budget != nullptr) {
@@ -286,9 +289,10 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
       return spec::AnalysisFailure::Ok();
     }
     ++next_instant;
+    const Eigen::VectorXd lambda = needs_multipliers ? Multipliers(system, s.t_s, s.q, s.v, s.a) : Eigen::VectorXd();
     for (size_t k = 0; k < scene.outputs.size(); ++k) {
       const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
-      const double value = OutputValue(system, *model, sm, o, p, s);
+      const double value = OutputValue(system, *model, sm, o, p, s, lambda);
       if (!std::isfinite(value)) {
         return spec::AnalysisFailure::Of(
             spec::FailureKind::kNonFiniteValue,
@@ -298,6 +302,23 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
     }
     return spec::AnalysisFailure::Ok();
   };
+  // The motion starts at t = 0; the grid may start later.
+  std::vector<double> times;
+  if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
+  times.insert(times.end(), report.times_s.begin(), report.times_s.end());
+  if (assembled.degrees_of_freedom == 0) {
+    // Every degree of freedom driven: the motion follows from the
+    // constraints alone, as in planar scenes (redundant rows included).
+    report.formulation = spec::Formulation::kKinematic;
+    SpatialKinematicOptions options;
+    options.budget = budget;
+    SpatialKinematicCounters counters;
+    const spec::AnalysisFailure outcome = RunSpatialKinematics(system, assembled.q, times, options, record, &counters);
+    report.counters.time_steps = counters.position_solves;
+    report.counters.newton_iterations += counters.newton_iterations;
+    if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
+    return report;
+  }
   const multibody::ForwardDynamicsOptions options = multibody::ForwardDynamicsOptions::Of(scene.integrator, budget);
   multibody::ForwardDynamicsCounters counters;
   // Redundant joints: integrated as independent combinations of their rows

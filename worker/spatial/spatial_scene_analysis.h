@@ -1,9 +1,11 @@
 // Analysis of a spatial scene (spec::SpatialModel) at one design point:
 // compiles the scene with the design's parameter values into a Model,
-// assembles it at t = 0 (AssembleSpatial) and integrates its forward
-// dynamics with IDAS (multibody::IntegrateForward, the planar kernel's GGL
-// integrator) to every grid instant, driven or not. Computes only the
-// requested outputs, at the scene's grid instants.
+// assembles it at t = 0 (AssembleSpatial) and, when every degree of
+// freedom is driven, runs its kinematic analysis (RunSpatialKinematics);
+// otherwise it integrates its forward dynamics with IDAS
+// (multibody::IntegrateForward, the planar kernel's GGL integrator) to
+// every grid instant. Computes only the requested outputs, at the scene's
+// grid instants (driver efforts by inverse dynamics from each state).
 //
 // Failures are data with their kind: unusable parameter values or
 // redundant joints (kInvalidModel, naming the body or joint), a mechanism

@@ -267,6 +267,10 @@ void SpatialSystem::EvaluateRows(double t, const VectorXd& q, const VectorXd* v,
     for (size_t k = 0; k < rows.size(); ++k) put(joint_row_[j] + static_cast<int>(k), rows[k], joint.a.body, joint.b.body);
   }
   for (size_t d = 0; d < model_.drivers.size(); ++d) {
+    if (model_.drivers[d].slide) {
+      PutSlideDriverRow(t, d, q, v, phi, phi_q, phi_t, gamma);
+      continue;
+    }
     // sin(angle - angle(t)) = sin(angle) cos(angle(t)) - cos(angle) sin(angle(t)),
     // with sin(angle) = x_b.y_a and cos(angle) = x_b.x_a: smooth in q, and
     // zero at the prescribed angle.
@@ -289,6 +293,21 @@ void SpatialSystem::EvaluateRows(double t, const VectorXd& q, const VectorXd* v,
                       angle.q_ddot * along + angle.q_dot * angle.q_dot * f.f;
     }
   }
+}
+
+void SpatialSystem::PutSlideDriverRow(double t, size_t d, const VectorXd& q, const VectorXd* v, VectorXd* phi,
+                                      Eigen::MatrixXd* phi_q, VectorXd* phi_t, VectorXd* gamma) const {
+  // z_a . (o_b - o_a) - s(t): the slide is linear in the prescribed value,
+  // so Phi_t = -s', Phi_tt = -s'' and Phi_qt = 0.
+  const Joint& joint = model_.joints[static_cast<size_t>(model_.drivers[d].joint)];
+  const FrameVectors a = FrameOf(joint.a, 0, q, v), b = FrameOf(joint.b, 1, q, v);
+  const PairScalar slide = Dot(a.z, Minus(b.origin, a.origin));
+  const multibody::Profile::Value s = model_.drivers[d].profile.At(t);
+  const int row = driver_row_[d];
+  if (phi != nullptr) (*phi)[row] = slide.f - s.q;
+  if (phi_q != nullptr) Scatter(slide.jacobian, joint.a.body, joint.b.body, phi_q->middleRows(row, 1));
+  if (phi_t != nullptr) (*phi_t)[row] = -s.q_dot;
+  if (gamma != nullptr) (*gamma)[row] = -slide.f_ddot0 + s.q_ddot;
 }
 
 int SpatialSystem::Constraints(double t, const VectorXd& q, VectorXd* phi) const {

@@ -8,7 +8,7 @@
 // Row layout: one normalization row per body (s (p.p - 1) = 0 with
 // s = kNormRowScale, in body order),
 // then each joint's rows in joint order (JointEquationCount), then one row
-// per driver. The equations of every joint are written from two kinds of
+// per driver (an angle's or a slide's). The equations of every joint are written from two kinds of
 // building block: the difference of two points and the dot product of two
 // vectors fixed in bodies (docs/physics.md, "Spatial scenes").
 //
@@ -113,6 +113,10 @@ class SpatialSystem : public multibody::ConstrainedSystem {
  private:
   void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
                     Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
+  // The row of a driver of a joint's slide (Driver::slide).
+  void PutSlideDriverRow(double t, size_t driver, const Eigen::VectorXd& q, const Eigen::VectorXd* v,
+                         Eigen::VectorXd* phi, Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t,
+                         Eigen::VectorXd* gamma) const;
 
   const Model& model_;
   mutable bool continue_past_bounds_ = false;  // ContinuePastBounds
