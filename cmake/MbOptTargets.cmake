@@ -12,27 +12,6 @@ function(mbopt_warnings target)
   endif()
 endfunction()
 
-# mbopt_precompile_proto_headers(TARGET): TARGET's units start from the
-# precompiled Protobuf, gRPC and generated headers (proto/precompiled_headers.h).
-# They dominate the front end's work in every unit of the boundary
-# libraries; one precompiled header is built, by the first target asking,
-# and reused by the others (they share their compile flags, as GCC requires;
-# with -Winvalid-pch and -Werror a mismatch fails the build instead of
-# silently parsing again). mbopt_library calls it for every library that
-# links mbopt_proto.
-function(mbopt_precompile_proto_headers target)
-  if(NOT MBOPT_PRECOMPILED_HEADERS)
-    return()
-  endif()
-  get_property(host GLOBAL PROPERTY MBOPT_PROTO_PCH_HOST)
-  if(host)
-    target_precompile_headers(${target} REUSE_FROM ${host})
-  else()
-    target_precompile_headers(${target} PRIVATE ${PROJECT_SOURCE_DIR}/proto/precompiled_headers.h)
-    set_property(GLOBAL PROPERTY MBOPT_PROTO_PCH_HOST ${target})
-  endif()
-endfunction()
-
 # mbopt_library(NAME SOURCES ... DEPS ...): a module library with warnings on.
 function(mbopt_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
@@ -40,9 +19,6 @@ function(mbopt_library name)
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   mbopt_warnings(${name})
-  if("mbopt_proto" IN_LIST ARG_DEPS OR "mbopt_proto" IN_LIST ARG_PRIVATE_DEPS)
-    mbopt_precompile_proto_headers(${name})
-  endif()
   # An edited include is checked before anything compiles (ModuleEdges.cmake).
   if(TARGET mbopt_module_edges)
     add_dependencies(${name} mbopt_module_edges)
