@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
+#include "tests/spatial/scene_text_testing.h"
 #include "worker/engine/analysis.h"
 
 namespace mbopt::spatial {
@@ -22,26 +23,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-spec::Scene Load(const std::string& text) {
-  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(text, "forces.scene.textproto");
-  EXPECT_TRUE(scene.ok()) << scene.status();
-  return scene.ok() ? *scene : spec::Scene{};
-}
+using scene_text::Series;
 
-std::string LoadError(const std::string& text) {
-  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(text, "forces.scene.textproto");
-  EXPECT_FALSE(scene.ok());
-  return scene.ok() ? "" : std::string(scene.status().message());
-}
-
-const std::vector<double>& Series(const spec::AnalysisReport& r, const std::string& name) {
-  for (const spec::OutputValues& o : r.outputs) {
-    if (o.name == name) return o.series.at(0);
-  }
-  static const std::vector<double> none;
-  ADD_FAILURE() << "no output " << name;
-  return none;
-}
+constexpr char kFileLabel[] = "forces.scene.textproto";
+spec::Scene Load(const std::string& text) { return scene_text::Load(text, kFileLabel); }
+std::string LoadError(const std::string& text) { return scene_text::LoadError(text, kFileLabel); }
 
 spec::AnalysisReport AnalyzeScene(const spec::Scene& scene, std::vector<double> p = {}) {
   if (p.empty()) p = scene.DefaultParameterValues();

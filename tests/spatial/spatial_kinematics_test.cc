@@ -17,6 +17,7 @@
 
 #include "absl/strings/str_format.h"
 #include "spec/io/study_io.h"
+#include "tests/spatial/scene_text_testing.h"
 #include "spec/layout.h"
 #include "spec/responses.h"
 #include "worker/engine/analysis.h"
@@ -28,26 +29,11 @@ using Eigen::Vector3d;
 
 constexpr double kPi = std::numbers::pi;
 
-spec::Scene Load(const std::string& text) {
-  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(text, "kinematic.scene.textproto");
-  EXPECT_TRUE(scene.ok()) << scene.status();
-  return scene.ok() ? *scene : spec::Scene{};
-}
+using scene_text::Series;
 
-std::string LoadError(const std::string& text) {
-  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(text, "kinematic.scene.textproto");
-  EXPECT_FALSE(scene.ok());
-  return scene.ok() ? "" : std::string(scene.status().message());
-}
-
-const std::vector<double>& Series(const spec::AnalysisReport& r, const std::string& name) {
-  for (const spec::OutputValues& o : r.outputs) {
-    if (o.name == name) return o.series.at(0);
-  }
-  static const std::vector<double> none;
-  ADD_FAILURE() << "no output " << name;
-  return none;
-}
+constexpr char kFileLabel[] = "kinematic.scene.textproto";
+spec::Scene Load(const std::string& text) { return scene_text::Load(text, kFileLabel); }
+std::string LoadError(const std::string& text) { return scene_text::LoadError(text, kFileLabel); }
 
 std::string Vec(const Vector3d& v) {
   return absl::StrFormat("{ x { value: %.17g } y { value: %.17g } z { value: %.17g } }", v.x(), v.y(), v.z());

@@ -15,6 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "spec/io/study_io.h"
+#include "tests/spatial/scene_text_testing.h"
 #include "worker/engine/analysis.h"
 #include "worker/engine/model_kinds.h"
 #include "worker/spatial/euler_angles.h"
@@ -28,26 +29,11 @@ using Eigen::Vector3d;
 
 constexpr double kPi = std::numbers::pi;
 
-spec::Scene Load(const std::string& text) {
-  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(text, "spatial.scene.textproto");
-  EXPECT_TRUE(scene.ok()) << scene.status();
-  return scene.ok() ? *scene : spec::Scene{};
-}
+using scene_text::Series;
 
-std::string LoadError(const std::string& text) {
-  absl::StatusOr<spec::Scene> scene = spec::io::ParseSceneText(text, "spatial.scene.textproto");
-  EXPECT_FALSE(scene.ok());
-  return scene.ok() ? "" : std::string(scene.status().message());
-}
-
-const std::vector<double>& Series(const spec::AnalysisReport& r, const std::string& name) {
-  for (const spec::OutputValues& o : r.outputs) {
-    if (o.name == name) return o.series.at(0);
-  }
-  static const std::vector<double> none;
-  ADD_FAILURE() << "no output " << name;
-  return none;
-}
+constexpr char kFileLabel[] = "spatial.scene.textproto";
+spec::Scene Load(const std::string& text) { return scene_text::Load(text, kFileLabel); }
+std::string LoadError(const std::string& text) { return scene_text::LoadError(text, kFileLabel); }
 
 // A crank turning at a constant rate about a hinge whose axis is tilted by
 // ZYX angles (30, 40, 0) deg, its tip `radius` from the axis: the tip runs
