@@ -16,6 +16,7 @@ namespace mbopt::fmu {
 
 absl::StatusOr<PrivateBinaryCopy> PrivateBinaryCopy::Make(const std::filesystem::path& binary) {
   const std::string suffix = binary.extension().string();
+  // mkstemps replaces the six X with a unique name part and creates the file.
   std::string name_template =
       (binary.parent_path() / absl::StrCat(binary.stem().string(), ".instance-XXXXXX", suffix)).string();
   const int descriptor = mkstemps(name_template.data(), static_cast<int>(suffix.size()));
