@@ -247,6 +247,26 @@ class ElasticLinkage {
     return bv.allFinite() ? 0 : 1;
   }
 
+  // The elastic displacement of every node of every moving link at the
+  // prepared instant (after Rhs or Moments at its t), world axes: a joint
+  // node's unknowns are world translations already, an inner node's are
+  // along and across its link.
+  void NodeDisplacements(const Eigen::VectorXd& y, std::vector<std::vector<Eigen::Vector2d>>* out) const {
+    out->assign(sys_.links.size(), {});
+    for (const LinkMesh& mesh : meshes_) {
+      const double angle = state_.LinkAngle(sys_.links[static_cast<size_t>(mesh.link)]);
+      const double c = std::cos(angle), s = std::sin(angle);
+      std::vector<Eigen::Vector2d>& nodes = (*out)[static_cast<size_t>(mesh.link)];
+      for (int nd = 0; nd <= mesh.elements; ++nd) {
+        const NodeDofs& d = mesh.nodes[static_cast<size_t>(nd)];
+        const double first = d.dof[0] < 0 ? 0.0 : y(d.dof[0]), second = d.dof[1] < 0 ? 0.0 : y(d.dof[1]);
+        const bool end = nd == 0 || nd == mesh.elements;
+        nodes.push_back(end ? Eigen::Vector2d(first, second)
+                            : Eigen::Vector2d(c * first - s * second, s * first + c * second));
+      }
+    }
+  }
+
   // Node moments of every link and the drive torque at t from y.
   bool Moments(double t, const Eigen::VectorXd& y, std::vector<std::vector<double>>* moments,
                double* drive_torque) {
@@ -464,7 +484,7 @@ class ElasticLinkage {
 spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::IntegratorSettings& integrator,
                                        const std::vector<double>& times_s, const RigidMotionAt& rigid_motion,
                                        const budget::AnalysisBudget* budget,
-                                       FloatingFrameResult* result) {
+                                       FloatingFrameResult* result, bool keep_node_displacements) {
   const double t_end = times_s.empty() ? 0.0 : times_s.back();
   ElasticLinkage elastic(system, rigid_motion);
   if (std::string why = elastic.Build(); !why.empty()) {
@@ -501,6 +521,7 @@ spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::
   result->rigid_states.clear();
   result->node_moment_n_m.clear();
   result->drive_torque_n_m.clear();
+  result->node_displacement_m.clear();
   for (double t : times_s) {
     if (t > cvodes.current_time()) {
       if (absl::Status s = cvodes.IntegrateTo(t, &y); !s.ok()) {
@@ -523,6 +544,7 @@ spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::
     result->rigid_states.push_back(elastic.rigid_state());
     result->node_moment_n_m.push_back(std::move(moments));
     result->drive_torque_n_m.push_back(torque);
+    if (keep_node_displacements) elastic.NodeDisplacements(y, &result->node_displacement_m.emplace_back());
   }
   result->counters = cvodes.counters();
   return {};

@@ -33,6 +33,8 @@
 #include <functional>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "spec/analysis_outcome.h"
 #include "spec/scene.h"
 #include "worker/budget/analysis_budget.h"
@@ -52,12 +54,19 @@ struct FloatingFrameResult {
   std::vector<double> drive_torque_n_m;  // [instant]
   sundials::CvodesCounters counters;
   double lowest_link_frequency_rad_per_s = 0.0;
+  // [instant][link][node] elastic displacement of every node of a moving
+  // link, world axes, m: its nodes from joint a to joint b (elements + 1;
+  // none for a link with both ends on the ground). Kept only when
+  // RunFloatingFrame is asked to (a drawing of the deflected links); an
+  // analysis leaves it empty.
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> node_displacement_m;
 };
 
 // Fails (with a reason naming the time, or the rigid link) if a moving link
 // is rigid, the rigid motion fails, or the integrator gives up.
 spec::AnalysisFailure RunFloatingFrame(const LinkageSystem& system, const spec::IntegratorSettings& integrator,
                                        const std::vector<double>& times_s, const RigidMotionAt& rigid_motion,
-                                       const budget::AnalysisBudget* budget, FloatingFrameResult* result);
+                                       const budget::AnalysisBudget* budget, FloatingFrameResult* result,
+                                       bool keep_node_displacements = false);
 
 }  // namespace mbopt::multibody

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include "absl/strings/str_format.h"
@@ -272,8 +273,17 @@ void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, bud
 
 }  // namespace
 
+bool UsesFloatingFrame(const spec::Scene& scene, const LinkageSystem& sys) {
+  const auto* linkage = std::get_if<spec::LinkageModel>(&scene.model);
+  if (linkage == nullptr || !sys.AnyFlexible() ||
+      linkage->flexible_formulation == spec::FlexibleFormulation::kCorotational) {
+    return false;
+  }
+  return std::any_of(scene.outputs.begin(), scene.outputs.end(), NeedsLoads);
+}
+
 AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
-                                   budget::AnalysisBudget* budget) {
+                                   budget::AnalysisBudget* budget, LinkageDeflection* deflection) {
   AnalysisReport report;
   report.times_s = GridTimes(scene.time_grid);
   const auto* linkage = std::get_if<spec::LinkageModel>(&scene.model);
@@ -430,7 +440,12 @@ AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<d
     return spec::AnalysisFailure::Ok();
   };
   FloatingFrameResult result;
-  const spec::AnalysisFailure o = RunFloatingFrame(sys, scene.integrator, report.times_s, rigid_motion, budget, &result);
+  const spec::AnalysisFailure o =
+      RunFloatingFrame(sys, scene.integrator, report.times_s, rigid_motion, budget, &result, deflection != nullptr);
+  if (deflection != nullptr) {
+    deflection->rigid_states = result.rigid_states;
+    deflection->node_displacement_m = std::move(result.node_displacement_m);
+  }
   report.counters.position_solves += counters.position_solves;
   report.counters.newton_iterations += counters.newton_iterations;
   report.counters.time_steps = result.counters.steps;

@@ -16,16 +16,37 @@
 
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "spec/analysis_report.h"
 #include "spec/scene.h"
 #include "worker/budget/analysis_budget.h"
+#include "worker/multibody/linkage_system.h"
 
 namespace mbopt::multibody {
 
+// A floating-frame analysis' own motion, for a drawing of the deflected
+// links (linkage_geometry.h): the rigid reference motion and every moving
+// link's elastic node displacements (FloatingFrameResult), at each grid
+// instant solved (those before a failure).
+struct LinkageDeflection {
+  std::vector<LinkageState> rigid_states;                                      // [instant]
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> node_displacement_m;  // [instant][link][node], world, m
+};
+
 // `scene.model` must hold a LinkageModel; `parameter_values_si` has one SI
 // value per scene parameter. `budget` (none: no limit) bounds the kinematic
-// sweep, the integration and every position solve.
+// sweep, the integration and every position solve. `deflection`, when
+// given, receives the motion of a floating-frame analysis (left empty by
+// the other formulations); without it nothing is kept for a drawing.
 spec::AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
-                                         budget::AnalysisBudget* budget = nullptr);
+                                         budget::AnalysisBudget* budget = nullptr,
+                                         LinkageDeflection* deflection = nullptr);
+
+// Whether AnalyzeLinkageScene follows `sys`'s links elastically in the
+// floating-frame formulation: a link is flexible, an output needs loads
+// (bending stress, drive torque), and the scene asks for no co-rotational
+// formulation.
+bool UsesFloatingFrame(const spec::Scene& scene, const LinkageSystem& sys);
 
 }  // namespace mbopt::multibody

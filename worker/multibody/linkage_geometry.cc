@@ -9,6 +9,7 @@
 #include "absl/strings/str_format.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/kinematic_analysis.h"
+#include "worker/multibody/linkage_analysis.h"
 #include "worker/multibody/linkage_front_end.h"
 #include "worker/multibody/linkage_system.h"
 #include "worker/multibody/mechanism.h"
@@ -22,6 +23,74 @@ constexpr double kDrawStepRad = std::numbers::pi / 18.0;
 // A grid that needs more solved instants than this is drawn only up to
 // there: a drawing has no use for millions of frames.
 constexpr int kMaxSolvedInstants = 200000;
+
+// A link point is carried in the link's frame: origin at joint a, x
+// towards joint b.
+void AppendLinkPoints(const LinkageSystem& sys, const std::vector<Eigen::Vector2d>& pins,
+                      std::vector<spec::DrawingPosition>* at) {
+  for (const LinkageLink& l : sys.links) {
+    const Eigen::Vector2d a = pins[static_cast<size_t>(l.joint_a)];
+    const Eigen::Vector2d e = (pins[static_cast<size_t>(l.joint_b)] - a).normalized();
+    const Eigen::Vector2d n(-e.y(), e.x());
+    for (const LinkagePoint& point : l.points) {
+      const Eigen::Vector2d r = a + point.local_m.x() * e + point.local_m.y() * n;
+      at->push_back(spec::DrawingPosition{r.x(), r.y()});
+    }
+  }
+}
+
+// One instant of a deflected linkage: each node where the rigid pins
+// `rigid_m` put it on its link's chord, moved by its elastic displacement
+// (`displacement_m[link][node]`, none when empty); a pin moves with the
+// joint nodes there (shared by the links it joins), and the links' own
+// points ride on the chord between the moved pins.
+void AppendDeflectedInstant(const LinkageSystem& sys, const std::vector<Eigen::Vector2d>& rigid_m,
+                            const std::vector<std::vector<Eigen::Vector2d>>& displacement_m,
+                            std::vector<spec::DrawingPosition>* at) {
+  const auto moved = [&](size_t link, int node) -> Eigen::Vector2d {
+    if (displacement_m.empty() || displacement_m[link].empty()) return Eigen::Vector2d::Zero();
+    return displacement_m[link][static_cast<size_t>(node)];
+  };
+  std::vector<Eigen::Vector2d> pins = rigid_m;
+  for (size_t k = 0; k < sys.links.size(); ++k) {
+    const LinkageLink& l = sys.links[k];
+    if (l.both_ground) continue;
+    pins[static_cast<size_t>(l.joint_a)] = rigid_m[static_cast<size_t>(l.joint_a)] + moved(k, 0);
+    pins[static_cast<size_t>(l.joint_b)] = rigid_m[static_cast<size_t>(l.joint_b)] + moved(k, l.flexible_elements);
+  }
+  for (const Eigen::Vector2d& pin : pins) at->push_back(spec::DrawingPosition{pin.x(), pin.y()});
+  AppendLinkPoints(sys, pins, at);
+  for (size_t k = 0; k < sys.links.size(); ++k) {
+    const LinkageLink& l = sys.links[k];
+    if (l.both_ground) continue;
+    const Eigen::Vector2d a = rigid_m[static_cast<size_t>(l.joint_a)], b = rigid_m[static_cast<size_t>(l.joint_b)];
+    for (int node = 1; node < l.flexible_elements; ++node) {
+      const Eigen::Vector2d r = a + (b - a) * (static_cast<double>(node) / l.flexible_elements) + moved(k, node);
+      at->push_back(spec::DrawingPosition{r.x(), r.y()});
+    }
+  }
+}
+
+// The floating-frame analysis' own motion, every instant it solved.
+void DrawDeflectedMotion(const spec::Scene& scene, const LinkageSystem& sys, const std::vector<double>& p,
+                         budget::AnalysisBudget* budget, spec::SceneDrawing* d) {
+  LinkageDeflection deflection;
+  const spec::AnalysisReport report = AnalyzeLinkageScene(scene, p, budget, &deflection);
+  for (size_t i = 0; i < deflection.rigid_states.size(); ++i) {
+    d->times_s.push_back(report.times_s[i]);
+    AppendDeflectedInstant(sys, deflection.rigid_states[i].position_m, deflection.node_displacement_m[i],
+                           &d->points_m.emplace_back());
+  }
+  if (d->points_m.empty()) {
+    // Nothing solved (it does not assemble, a moving link is rigid): the
+    // pins as given, and why.
+    std::vector<Eigen::Vector2d> pins;
+    for (const LinkageJoint& j : sys.joints) pins.push_back(j.position_m);
+    d->times_s.push_back(report.times_s.empty() ? 0.0 : report.times_s.front());
+    AppendDeflectedInstant(sys, pins, {}, &d->points_m.emplace_back());
+  }
+  if (!report.ok()) d->failure = report.failure.reason;
+}
 
 }  // namespace
 
@@ -44,7 +113,12 @@ spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<
     d.failure = why;
     return d;
   }
-  // Points: the pins, then every link's own points.
+  // A linkage the analysis follows elastically is drawn with its links'
+  // deflection: the analysis' own motion, each moving link as its centre
+  // line through its nodes (as a multibody scene's flexible links).
+  const bool deflected = UsesFloatingFrame(scene, sys);
+  // Points: the pins, then every link's own points, then the inner nodes of
+  // the links drawn deflected.
   for (const LinkageJoint& j : sys.joints) {
     const int point = d.AddPoint(j.name);
     d.joints.push_back(spec::SceneDrawing::Joint{j.name, spec::SceneDrawing::JointKind::kPin, point, {}});
@@ -53,9 +127,24 @@ spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<
   for (const LinkageLink& l : sys.links) {
     spec::SceneDrawing::Body body;
     body.name = l.name;
-    body.points = {l.joint_a, l.joint_b};
+    if (!deflected || l.both_ground) body.points = {l.joint_a, l.joint_b};
     for (const LinkagePoint& point : l.points) body.points.push_back(d.AddPoint(l.name + "." + point.name));
-    d.bodies.push_back(std::move(body));
+    if (!body.points.empty()) d.bodies.push_back(std::move(body));
+  }
+  if (deflected) {
+    for (const LinkageLink& l : sys.links) {
+      if (l.both_ground) continue;
+      spec::SceneDrawing::Line line;
+      line.name = l.name;
+      line.points.push_back(l.joint_a);
+      for (int k = 1; k < l.flexible_elements; ++k) {
+        line.points.push_back(d.AddPoint(absl::StrFormat("%s.node %d", l.name, k)));
+      }
+      line.points.push_back(l.joint_b);
+      d.lines.push_back(std::move(line));
+    }
+    DrawDeflectedMotion(scene, sys, p, budget, &d);
+    return d;
   }
 
   const CompiledLinkage compiled = CompileLinkage(sys);
@@ -71,17 +160,7 @@ spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<
       pins.push_back(mechanism.PointPosition(compiled.joint_point[j], q, t_s));
       at.push_back(spec::DrawingPosition{pins.back().x(), pins.back().y()});
     }
-    // A link point is carried in the link's frame: origin at joint a, x
-    // towards joint b.
-    for (const LinkageLink& l : sys.links) {
-      const Eigen::Vector2d a = pins[static_cast<size_t>(l.joint_a)];
-      const Eigen::Vector2d e = (pins[static_cast<size_t>(l.joint_b)] - a).normalized();
-      const Eigen::Vector2d n(-e.y(), e.x());
-      for (const LinkagePoint& point : l.points) {
-        const Eigen::Vector2d r = a + point.local_m.x() * e + point.local_m.y() * n;
-        at.push_back(spec::DrawingPosition{r.x(), r.y()});
-      }
-    }
+    AppendLinkPoints(sys, pins, &at);
   };
   if (!assembled.failure.ok()) {
     append(0.0, mechanism.InitialGuess());

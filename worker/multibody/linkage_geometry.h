@@ -3,8 +3,13 @@
 // pins hatched. The motion is the rigid linkage's kinematics on the
 // multibody engine, as the linkage analysis solves it (the driver turning
 // at most 10 degrees between two solved instants, so the assembly branch is
-// followed); the elastic deflection of flexible links is not drawn.
-// Computed only when asked: AnalyzeLinkageScene does no work for it. Pure.
+// followed). A linkage its analysis follows elastically in the floating-
+// frame formulation (UsesFloatingFrame, linkage_analysis.h) is drawn with
+// the deflection that analysis computes: each moving link as its centre
+// line through its nodes, each pin moved by its elastic displacement, the
+// links' own points on the chord between the moved pins. Computed only when
+// asked: an analysis keeps no node displacements unless a drawing asks for
+// them. Pure.
 #pragma once
 
 #include <vector>
