@@ -4,8 +4,10 @@
 #include <ostream>
 #include <utility>
 
+#include "absl/status/statusor.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "common/monotonic_clock.h"
 #include "spec/io/drawing_convert.h"
 #include "spec/io/study_io.h"
@@ -17,7 +19,7 @@ namespace mbopt::worker {
 namespace {
 
 const char kUsage[] =
-    "usage: mbopt-worker draw FILE --out DRAWING [--set NAME=VALUE ...]\n"
+    "usage: mbopt-worker draw FILE --out DRAWING [--case NAME] [--set NAME=VALUE ...]\n"
     "  Computes the drawing of a scene: FILE is a .scene.textproto (drawn at its\n"
     "  parameters' values) or a .study.textproto (its scene at the initial design).\n"
     "  Multibody and linkage scenes are drawn at every instant of their time grid,\n"
@@ -26,6 +28,9 @@ const char kUsage[] =
     "  --out FILE        the drawing file (required)\n"
     "  --set NAME=VALUE  a design variable (scaled) or a scene parameter (its unit);\n"
     "                    repeatable\n"
+    "  --case NAME       a study's load case: the scene with the parameters the case\n"
+    "                    sets (without it, a study with load cases is drawn with\n"
+    "                    its scene's own values)\n"
     "  exit status: 0 drawn, 1 drawn up to where the motion stopped (the file says\n"
     "  why), 2 bad input\n";
 
@@ -34,12 +39,31 @@ bool IsSceneFile(const std::string& path) {
          absl::EndsWith(path, ".scene.txtpb");
 }
 
+// The index of `name` among the study's load cases; -1 for no name. A name
+// the study does not have (or a scene file, which has no cases) is refused
+// with the names there are.
+absl::StatusOr<int> FindLoadCase(const spec::Study& study, const std::string& path, const std::string& name) {
+  if (name.empty()) return -1;
+  std::vector<std::string> names;
+  for (size_t c = 0; c < study.cases.size(); ++c) {
+    if (study.cases[c].name == name) return static_cast<int>(c);
+    names.push_back("\"" + study.cases[c].name + "\"");
+  }
+  if (names.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": --case \"", name, "\": this file has no load cases (only a study's `cases` have names)"));
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(path, ": --case \"", name, "\" is not a load case of the study; its cases: ",
+                   absl::StrJoin(names, ", ")));
+}
+
 }  // namespace
 
 const char* DrawUsage() { return kUsage; }
 
 int RunDraw(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  std::string path, out_path;
+  std::string path, out_path, case_name;
   std::vector<std::string> sets;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -47,12 +71,14 @@ int RunDraw(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       out << kUsage;
       return kExitOk;
     }
-    if (a == "--out" || a == "--set") {
+    if (a == "--out" || a == "--set" || a == "--case") {
       if (i + 1 >= args.size()) {
         err << "mbopt-worker draw: " << a << " needs a value\n" << kUsage;
         return kExitBadInput;
       }
-      (a == "--out" ? out_path : sets.emplace_back()) = args[++i];
+      (a == "--out" ? out_path : a == "--case" ? case_name : sets.emplace_back()) = args[++i];
+    } else if (a.rfind("--case=", 0) == 0) {
+      case_name = a.substr(7);
     } else if (a.rfind("--set=", 0) == 0) {
       sets.push_back(a.substr(6));
     } else if (a.rfind("--out=", 0) == 0) {
@@ -88,6 +114,11 @@ int RunDraw(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     study = *std::move(loaded);
   }
+  absl::StatusOr<int> load_case = FindLoadCase(study, path, case_name);
+  if (!load_case.ok()) {
+    err << "mbopt-worker draw: " << load_case.status().message() << "\n";
+    return kExitBadInput;
+  }
   std::vector<double> x;
   for (const spec::DesignVariable& v : study.variables) x.push_back(v.initial);
   std::vector<std::pair<int, double>> overrides;
@@ -98,6 +129,9 @@ int RunDraw(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
   }
   std::vector<double> parameters = study.ParameterValuesAt(x);
+  // The case's values as its analyses have them; a parameter set on the
+  // command line is the user's explicit choice and wins.
+  if (*load_case >= 0) parameters = study.CaseParameterValues(*load_case, std::move(parameters));
   for (const auto& [p, value] : overrides) parameters[static_cast<size_t>(p)] = value;
   // On this process' clock: the scene's time limit applies as to an analysis.
   budget::AnalysisBudget budget =
@@ -114,11 +148,13 @@ int RunDraw(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return kExitBadInput;
   }
   if (!drawing->failure.empty()) {
-    err << "mbopt-worker draw: " << study.scene.name << ": " << drawing->failure << "\n";
+    err << "mbopt-worker draw: " << study.scene.name << (case_name.empty() ? "" : " (load case " + case_name + ")")
+        << ": " << drawing->failure << "\n";
     return kExitAnalysisFailed;
   }
-  out << "drew " << study.scene.name << " at " << drawing->times_s.size() << " instant"
-      << (drawing->times_s.size() == 1 ? "" : "s") << " to " << out_path << "\n";
+  out << "drew " << study.scene.name << (case_name.empty() ? "" : " (load case " + case_name + ")") << " at "
+      << drawing->times_s.size() << " instant" << (drawing->times_s.size() == 1 ? "" : "s") << " to " << out_path
+      << "\n";
   return kExitOk;
 }
 
