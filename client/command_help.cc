@@ -106,16 +106,18 @@ constexpr Help kHelp[] = {
      "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"
      "  --point K             a Pareto front's page: mark point K as the chosen design and show it\n"},
     {"draw",
-     "usage: mbopt draw FILE [-o OUT.html] [--set NAME=VALUE ...]\n"
+     "usage: mbopt draw FILE [-o OUT.html] [--case NAME] [--set NAME=VALUE ...]\n"
      "\n"
      "Writes a self-contained HTML page with the drawing of a scene (FILE a .scene.textproto) or\n"
-     "of a study's scene at its initial design: multibody and linkage scenes over their time grid,\n"
+     "of a study's scene at its initial design (once per load case, with the parameters each\n"
+     "case sets, headed by its name): multibody and linkage scenes over their time grid,\n"
      "animated (slider and play button), lumped scenes as a schematic. No server is needed; the\n"
      "drawing is computed by mbopt-worker (found as for `mbopt report`).\n"
      "Exit 0 drawn, 4 drawn up to where the motion stopped (the page says why), 2 bad input.\n"
      "\n"
      "options:\n"
      "  -o, --output FILE     the page (default: FILE's name with .html, in this folder)\n"
+     "  --case NAME           only the study's load case NAME\n"
      "  --set NAME=VALUE      a design variable (scaled) or a scene parameter (its unit); repeatable\n"},
 };
 

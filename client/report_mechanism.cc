@@ -16,6 +16,8 @@
 namespace mbopt::client {
 namespace {
 
+constexpr char kNoFinalDesign[] = "The job has no final design yet: only the initial design is drawn.";
+
 // `--set` for every design variable at scaled design x: 17 digits, the
 // design the job reached bit for bit.
 std::vector<std::string> DesignSets(const spec::Study& study, const std::vector<double>& x) {
@@ -58,27 +60,48 @@ void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* dat
   google::protobuf::TextFormat::PrintToString(job.study(), &text);
   const std::string study_path = dir.path() + "/study.study.textproto";
   std::ofstream(study_path) << text;
-  std::fprintf(stderr, "drawing the mechanism at the initial and the final design ...\n");
-  std::vector<std::string> notes;
-  absl::StatusOr<spec::SceneDrawing> initial =
-      RunWorkerDraw(*worker, study_path, DesignSets(study, x0), dir.path() + "/initial.pb");
-  if (initial.ok()) {
-    mechanism.initial = *std::move(initial);
-  } else {
-    notes.push_back(absl::StrCat("The initial design could not be drawn: ", initial.status().message()));
-  }
-  if (!has_final) {
-    notes.push_back("The job has no final design yet: only the initial design is drawn.");
-  } else {
-    absl::StatusOr<spec::SceneDrawing> final =
-        RunWorkerDraw(*worker, study_path, DesignSets(study, x_final), dir.path() + "/final.pb");
-    if (final.ok()) {
-      mechanism.final = *std::move(final);
+  // One pair of drawings per load case (the worker sets the case's
+  // parameters), or of the scene as it is for a study without cases.
+  std::vector<std::string> cases;
+  for (const spec::LoadCase& c : study.cases) cases.push_back(c.name);
+  if (cases.empty()) cases.emplace_back();
+  std::fprintf(stderr, "drawing the mechanism at the initial and the final design%s ...\n",
+               study.cases.empty() ? "" : absl::StrFormat(" (%d load cases)", study.cases.size()).c_str());
+  for (size_t k = 0; k < cases.size(); ++k) {
+    const std::string& name = cases[k];
+    report::LoadCaseDrawings drawn;
+    drawn.name = name;
+    std::vector<std::string> notes;
+    const std::string prefix = dir.path() + "/case-" + std::to_string(k);
+    absl::StatusOr<spec::SceneDrawing> initial =
+        RunWorkerDraw(*worker, study_path, DesignSets(study, x0), prefix + "-initial.pb", name);
+    if (initial.ok()) {
+      drawn.initial = *std::move(initial);
     } else {
-      notes.push_back(absl::StrCat("The final design could not be drawn: ", final.status().message()));
+      notes.push_back(absl::StrCat("The initial design could not be drawn: ", initial.status().message()));
+    }
+    if (!has_final) {
+      // Said once for the whole section when there are cases.
+      if (study.cases.empty()) notes.push_back(kNoFinalDesign);
+    } else {
+      absl::StatusOr<spec::SceneDrawing> final =
+          RunWorkerDraw(*worker, study_path, DesignSets(study, x_final), prefix + "-final.pb", name);
+      if (final.ok()) {
+        drawn.final = *std::move(final);
+      } else {
+        notes.push_back(absl::StrCat("The final design could not be drawn: ", final.status().message()));
+      }
+    }
+    for (std::string& note : notes) drawn.note += (drawn.note.empty() ? "" : " ") + note;
+    if (study.cases.empty()) {
+      mechanism.initial = std::move(drawn.initial);
+      mechanism.final = std::move(drawn.final);
+      mechanism.note = std::move(drawn.note);
+    } else {
+      mechanism.cases.push_back(std::move(drawn));
     }
   }
-  for (std::string& note : notes) mechanism.note += (mechanism.note.empty() ? "" : " ") + note;
+  if (!study.cases.empty() && !has_final) mechanism.note = kNoFinalDesign;
 }
 
 }  // namespace mbopt::client

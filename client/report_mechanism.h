@@ -8,9 +8,10 @@
 
 namespace mbopt::client {
 
-// Fills data->mechanism: both drawings, or a note saying why not (no
-// design yet, a scene kind without a drawing, the worker program not
-// found, a motion that stops early). Prints a line on stderr while it runs.
+// Fills data->mechanism: both drawings (for a study with load cases, both
+// per case in `cases`, each with the parameters the case sets), or a note
+// saying why not (no design yet, a scene kind without a drawing, the
+// worker program not found, a motion that stops early). Prints a line on stderr while it runs.
 void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data);
 
 }  // namespace mbopt::client

@@ -23,8 +23,13 @@ absl::StatusOr<std::string> FindWorkerProgram() {
 }
 
 absl::StatusOr<spec::SceneDrawing> RunWorkerDraw(const std::string& worker, const std::string& file,
-                                                 const std::vector<std::string>& sets, const std::string& work_path) {
+                                                 const std::vector<std::string>& sets, const std::string& work_path,
+                                                 const std::string& load_case) {
   std::vector<std::string> argv = {worker, "draw", file, "--out", work_path};
+  if (!load_case.empty()) {
+    argv.push_back("--case");
+    argv.push_back(load_case);
+  }
   for (const std::string& s : sets) {
     argv.push_back("--set");
     argv.push_back(s);

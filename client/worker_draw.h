@@ -16,10 +16,13 @@ namespace mbopt::client {
 absl::StatusOr<std::string> FindWorkerProgram();
 
 // The drawing of `file` (a scene or a study) with the `--set NAME=VALUE`
-// assignments; the file goes through `work_path`. A motion that stops
+// assignments, of the study's load case `load_case` when not empty (the
+// scene with the parameters the case sets); the file goes through
+// `work_path`. A motion that stops
 // early is no error (SceneDrawing::failure says where and why); a scene
 // without a drawing or a bad file is, with the worker's message.
 absl::StatusOr<spec::SceneDrawing> RunWorkerDraw(const std::string& worker, const std::string& file,
-                                                 const std::vector<std::string>& sets, const std::string& work_path);
+                                                 const std::vector<std::string>& sets, const std::string& work_path,
+                                                 const std::string& load_case = "");
 
 }  // namespace mbopt::client

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "client/report/html_escape.h"
+#include "client/report/load_case_drawings.h"
 #include "client/report/number_format.h"
 
 namespace mbopt::report {
@@ -455,6 +456,7 @@ std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, cons
 }
 
 std::string MechanismSectionHtml(const MechanismDrawings& mechanism) {
+  if (!mechanism.cases.empty()) return LoadCaseSectionHtml(mechanism);
   if (!mechanism.initial && !mechanism.final && mechanism.note.empty()) return "";
   std::string out = "<h2>Mechanism</h2>\n";
   std::vector<DrawingLayer> layers;

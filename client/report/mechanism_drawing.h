@@ -38,6 +38,14 @@ inline constexpr int kMaxDrawingFrames = 240;
 // makes its elements' ids unique on a page (letters, digits, '-').
 std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers, const std::string& id);
 
+// One load case of a study (spec::LoadCase): the scene with the parameters
+// the case sets, at both designs; `note` says why one is missing.
+struct LoadCaseDrawings {
+  std::string name;
+  std::optional<spec::SceneDrawing> initial, final;
+  std::string note;
+};
+
 // The report's "Mechanism" section: the job's scene drawn at the initial
 // and at the final design, overlaid and animated together. Either may be
 // missing; `note` then says why (the scene kind has no drawing, the worker
@@ -45,6 +53,10 @@ std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers, const s
 struct MechanismDrawings {
   std::optional<spec::SceneDrawing> initial, final;
   std::string note;
+  // A study with load cases: one figure per case, in the study's order,
+  // headed by its name (`initial` and `final` are then not drawn;
+  // client/report/load_case_drawings.h draws them).
+  std::vector<LoadCaseDrawings> cases;
 };
 // Empty when there is neither a drawing nor a note.
 std::string MechanismSectionHtml(const MechanismDrawings& mechanism);
