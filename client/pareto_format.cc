@@ -42,17 +42,58 @@ absl::Status NoSuchPoint(const v1::GetJobResponse& job, int point) {
 bool IsParetoJob(const v1::GetJobResponse& job) {
   if (job.summary().pareto()) return true;
   if (job.has_study() && job.study().has_pareto()) return true;
-  return job.cycles_size() > 0 && job.cycles(0).pareto();
+  return job.cycles_size() > 0 && (job.cycles(0).pareto() || job.cycles(0).pareto_point() > 0);
 }
 
-std::string ParetoWatchHeader() {
-  return absl::StrFormat("%5s %14s %14s %14s %-10s %6s", "point", "F", "value (SI)", "level (SI)", "run", "cycles");
+int FarEndPoint(const v1::Study& study) {
+  return study.pareto().points() > 0 ? study.pareto().points() : spec::kDefaultParetoPoints;
 }
 
-std::string ParetoWatchRow(const v1::CycleRecord& r) {
-  return absl::StrFormat("%5d %14s %14s %14s %-10s %6d", r.cycle(), CellValue(r.objective_trial(), "-"),
-                         CellValue(r.pareto_value_si(), "-"), CellValue(r.pareto_level_si(), "-"), r.pareto_state(),
-                         r.pareto_cycles());
+std::vector<const v1::CycleRecord*> PointRunCycles(const v1::GetJobResponse& job, int point) {
+  std::vector<const v1::CycleRecord*> cycles;
+  for (const v1::CycleRecord& r : job.cycles()) {
+    if (r.pareto_point() == point) cycles.push_back(&r);
+  }
+  return cycles;
+}
+
+namespace {
+
+// The watch's headings of the second objective and its level; a label
+// wider than the column widens both columns (the values are aligned to
+// their right edge).
+struct WatchColumns {
+  std::string second = "value (raw)";
+  std::string level = "level (raw)";
+  double factor = 1.0;
+  int width = 14;
+};
+
+WatchColumns WatchColumnsOf(const v1::Study* study) {
+  WatchColumns c;
+  if (study != nullptr) {
+    const SecondObjectiveShown shown = ShowSecondObjective(*study);
+    c.second = Heading(shown.label, shown.unit);
+    c.level = Heading("level", shown.unit);
+    c.factor = shown.factor;
+  }
+  c.width = std::max<int>({c.width, static_cast<int>(c.second.size()), static_cast<int>(c.level.size())});
+  return c;
+}
+
+}  // namespace
+
+std::string ParetoWatchHeader(const v1::Study* study) {
+  const WatchColumns c = WatchColumnsOf(study);
+  return absl::StrFormat("%5s %14s %*s %*s %-10s %6s", "point", "F", c.width, c.second, c.width, c.level, "run",
+                         "cycles");
+}
+
+std::string ParetoWatchRow(const v1::CycleRecord& r, const v1::Study* study) {
+  const WatchColumns c = WatchColumnsOf(study);
+  return absl::StrFormat("%5d %14s %*s %*s %-10s %6d", r.cycle(), CellValue(r.objective_trial(), "-"), c.width,
+                         CellValue(c.factor * r.pareto_value_si(), "-"), c.width,
+                         CellValue(c.factor * r.pareto_level_si(), "-"), r.pareto_state(), r.pareto_cycles());
 }
 
 std::string SecondObjectiveLabel(const v1::Objective& o) {
@@ -69,35 +110,44 @@ std::string SecondObjectiveLabel(const v1::Objective& o) {
   }
 }
 
+SecondObjectiveShown ShowSecondObjective(const v1::Study& study) {
+  SecondObjectiveShown shown;
+  const v1::Pareto& pareto = study.pareto();
+  if (pareto.has_objective()) {
+    shown.objective = true;
+    shown.label = SecondObjectiveLabel(pareto.objective());
+    // An objective's values are in its unit already.
+    shown.unit = pareto.objective().unit();
+    // The runs minimize a maximized value's negative; it is shown as itself.
+    if (pareto.objective().form_case() == v1::Objective::kMaximize) {
+      shown.maximized = true;
+      shown.factor = -1.0;
+    }
+    return shown;
+  }
+  shown.label = pareto.against();
+  for (const auto& c : study.constraints()) {
+    if (c.name() == shown.label) shown.unit = c.unit();
+  }
+  if (!shown.unit.empty()) {
+    if (absl::StatusOr<spec::Unit> unit = spec::FindUnit(shown.unit); unit.ok()) {
+      shown.factor = 1.0 / unit->si_per_unit;
+    } else {
+      shown.unit.clear();  // shown in SI rather than mislabelled
+    }
+  }
+  return shown;
+}
+
 ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
   ParetoFront front;
-  const v1::Pareto& pareto = job.study().pareto();
-  // The second objective as the runs minimized it (a maximized value's
-  // negative) is what the records hold; it is shown as the study writes it.
-  double second_sign = 1.0;
-  if (pareto.has_objective()) {
-    front.against_objective = true;
-    front.against = SecondObjectiveLabel(pareto.objective());
-    front.unit = pareto.objective().unit();
-    if (pareto.objective().form_case() == v1::Objective::kMaximize) {
-      second_sign = -1.0;
-      front.against_maximized = true;
-    }
-  } else {
-    front.against = pareto.against();
-    for (const auto& c : job.study().constraints()) {
-      if (c.name() == front.against) front.unit = c.unit();
-    }
-  }
-  double si_per_unit = 1.0;
-  // An objective's values are in its unit already.
-  if (!front.unit.empty() && !front.against_objective) {
-    if (absl::StatusOr<spec::Unit> unit = spec::FindUnit(front.unit); unit.ok()) {
-      si_per_unit = unit->si_per_unit;
-    } else {
-      front.unit.clear();  // shown in SI rather than mislabelled
-    }
-  }
+  const SecondObjectiveShown shown = ShowSecondObjective(job.study());
+  front.against = shown.label;
+  front.unit = shown.unit;
+  front.against_objective = shown.objective;
+  front.against_maximized = shown.maximized;
+  // Dominance is decided on the second objective as the runs minimized it.
+  const double second_sign = shown.maximized ? -1.0 : 1.0;
   // The first objective as the optimizer minimized it.
   const double sign = job.study().objective().maximize().empty() ? 1.0 : -1.0;
   std::vector<spec::FrontPoint> usable;
@@ -107,8 +157,8 @@ ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
     row.point = r.cycle();
     row.record = &r;
     row.objective = r.objective_trial();
-    row.value = second_sign * r.pareto_value_si() / si_per_unit;
-    row.level = second_sign * r.pareto_level_si() / si_per_unit;
+    row.value = shown.factor * r.pareto_value_si();
+    row.level = shown.factor * r.pareto_level_si();
     if (r.pareto_state() == "not_run") {
       row.status = "not run";
     } else if (!r.accepted()) {
@@ -206,6 +256,25 @@ void PointObject(const v1::GetJobResponse& job, const ParetoPointRow& p, JsonWri
   w.EndObject();
   w.Field("status", p.status);
   w.Field("reason", r.rejection_reason());
+  // Every LP solve of the point's run, rejected trials included.
+  w.Key("history");
+  w.BeginArray();
+  for (const v1::CycleRecord* c : PointRunCycles(job, p.point)) {
+    w.BeginObject();
+    w.Field("cycle", c->cycle());
+    w.Field("attempt", c->attempt());
+    w.Field("accepted", c->accepted());
+    w.Field("restoration", c->restoration());
+    w.Field("objective", c->objective_trial());
+    w.Field("max_violation", c->max_violation_trial());
+    w.Field("max_approximation_error", c->max_approximation_error());
+    w.Field("optimality_residual", c->optimality_residual());
+    w.Field("lp_feasible", c->lp_feasible());
+    w.Field("analyses", static_cast<long long>(c->analyses_total()));
+    w.NumberArray("design", std::vector<double>(c->x_trial_physical().begin(), c->x_trial_physical().end()));
+    w.EndObject();
+  }
+  w.EndArray();
   w.EndObject();
 }
 
@@ -267,6 +336,21 @@ absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int p
   out += "constraints (largest (g - limit) / scale against the study's limits, > 0 violated):\n";
   for (int c = 0; c < job.study().constraints_size(); ++c) {
     out += absl::StrFormat("  %-12s %s\n", job.study().constraints(c).name(), CellValue(ConstraintViolation(r, c), "-"));
+  }
+  const std::vector<const v1::CycleRecord*> cycles = PointRunCycles(job, point);
+  if (!cycles.empty()) {
+    // The far end's run minimizes the second objective, not the study's.
+    const bool far_end = point == FarEndPoint(job.study());
+    out += absl::StrCat("cycles of its run (F: ",
+                        far_end ? "the second objective as the run minimizes it, divided by its rows' scale"
+                                : "the study's objective",
+                        "; maxg: against the run's own limits, its level included):\n");
+    out += CycleTableHeader();
+    out += '\n';
+    for (const v1::CycleRecord* c : cycles) {
+      out += CycleTableRow(*c);
+      out += '\n';
+    }
   }
   return out;
 }

@@ -28,11 +28,27 @@ struct ParetoPointRow {
   std::string status;
 };
 
+// What a front trades its objective against, as the tables show it: the
+// traded constraint (its name, its unit) or a second objective
+// (SecondObjectiveLabel, in the objective's `unit`), and the factor from a
+// record's pareto_value_si and pareto_level_si to the shown value: 1 / the
+// unit's SI size for a constraint, -1 for a maximized objective (the runs
+// minimize its negative, and a level is then a least value), else 1.
+struct SecondObjectiveShown {
+  std::string label;
+  std::string unit;  // "" when none (or SI, for a constraint of an unknown unit)
+  bool objective = false;
+  bool maximized = false;
+  double factor = 1.0;
+};
+SecondObjectiveShown ShowSecondObjective(const v1::Study& study);
+
 // The watch's lines as each point's record arrives: "point" (1-based), F,
-// the traded constraint's largest value and the level (SI: the watch has
-// no study), the run's end and its cycles.
-std::string ParetoWatchHeader();
-std::string ParetoWatchRow(const v1::CycleRecord& record);
+// the second objective and the level as the tables show them, the run's
+// end and its cycles. Without the study (null), the raw values: SI for a
+// constraint, as minimized for an objective.
+std::string ParetoWatchHeader(const v1::Study* study);
+std::string ParetoWatchRow(const v1::CycleRecord& record, const v1::Study* study);
 
 // The traded constraint's name and unit ("" for SI), and the points in
 // their order with dominance decided among the usable ones.
@@ -55,8 +71,19 @@ std::string ParetoTable(const v1::GetJobResponse& job);
 std::string ParetoCsv(const v1::GetJobResponse& job);
 std::string ParetoJson(const v1::GetJobResponse& job, const std::string& database = "");
 
+// The point at the front's far end (1-based), whose run minimizes the
+// second objective: its cycles' F is that, not the study's objective.
+int FarEndPoint(const v1::Study& study);
+
+// The cycle records of point `point`'s run (1-based), in their order:
+// none for a point not run, and for a job logged before the runs' cycles
+// were.
+std::vector<const v1::CycleRecord*> PointRunCycles(const v1::GetJobResponse& job, int point);
+
 // Point `point` (1-based) in full: its design, its values, each
-// constraint's largest normalized value, its run; as text or JSON.
+// constraint's largest normalized value, its run and the run's cycle
+// table (JSON: every point has its "history", one object per LP solve);
+// as text or JSON.
 // InvalidArgument naming the points there are when it has no such point.
 absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int point);
 absl::StatusOr<std::string> ParetoPointJson(const v1::GetJobResponse& job, int point);

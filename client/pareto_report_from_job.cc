@@ -1,10 +1,13 @@
 #include "client/pareto_report_from_job.h"
 
+#include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "client/job_format.h"
 #include "client/pareto_format.h"
+#include "client/report/report_from_proto.h"
 #include "client/report_responses.h"
 
 namespace mbopt::client {
@@ -22,6 +25,7 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
   data.against = front.against;
   data.against_unit = front.unit;
   data.against_objective = front.against_objective;
+  data.against_maximized = front.against_maximized;
   data.points_total = s.max_cycles();
   data.variable_names.assign(s.design_names().begin(), s.design_names().end());
   data.variable_units.assign(s.design_units().begin(), s.design_units().end());
@@ -44,7 +48,48 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
     p.constraints.assign(r.constraint_violations().begin(), r.constraint_violations().end());
     data.points.push_back(std::move(p));
   }
+  if (chosen > 0) AddChosenPointHistory(job, &data);
   return data;
+}
+
+void AddChosenPointHistory(const v1::GetJobResponse& job, report::ParetoReportData* data) {
+  const std::vector<const v1::CycleRecord*> cycles = PointRunCycles(job, data->chosen);
+  const v1::CycleRecord* record = nullptr;
+  for (const v1::CycleRecord& r : job.cycles()) {
+    if (r.pareto() && r.cycle() == data->chosen) record = &r;
+  }
+  if (cycles.empty()) {
+    data->chosen_history_note =
+        record != nullptr && record->pareto_state() == "not_run"
+            ? "Its run has no cycles: the point was not run."
+            : "Its run's cycles are not in the job's log (a front logged before they were, or a point not "
+              "ended yet).";
+    return;
+  }
+  // The run as a single job: its records, and its result as the final design.
+  v1::GetJobResponse run;
+  *run.mutable_study() = job.study();
+  v1::JobSummary& s = *run.mutable_summary();
+  s = job.summary();
+  s.set_pareto(false);
+  s.set_design_set(false);
+  if (record != nullptr) {
+    s.set_cycles(record->pareto_cycles());
+    s.set_analyses(record->pareto_analyses());
+    s.set_objective(record->objective_trial());
+    s.set_max_violation(record->max_violation_trial());
+    s.mutable_design()->Assign(record->x_trial_physical().begin(), record->x_trial_physical().end());
+  }
+  for (const v1::CycleRecord* c : cycles) *run.add_cycles() = *c;
+  data->chosen_history = report::ReportDataFromJob(run);
+  if (data->chosen == FarEndPoint(job.study())) {
+    // Its run minimizes the second objective, in no unit of the study's.
+    data->chosen_history.objective_unit.clear();
+    data->chosen_history.objective = std::numeric_limits<double>::quiet_NaN();
+    data->chosen_history_note =
+        "This is the front's far end: its run's F is the second objective as the run minimizes it, divided by "
+        "its rows' scale, not the study's objective.";
+  }
 }
 
 void AddChosenPointResponses(const v1::GetJobResponse& job, report::ParetoReportData* data) {

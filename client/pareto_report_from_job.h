@@ -10,6 +10,11 @@ namespace mbopt::client {
 
 report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int chosen);
 
+// The chosen point's (data->chosen) run's cycle history, as a single job's
+// records (ParetoReportFromJob calls it when a point is chosen); or
+// data->chosen_history_note saying why there is none.
+void AddChosenPointHistory(const v1::GetJobResponse& job, report::ParetoReportData* data);
+
 // The chosen point's (data->chosen) responses: its design analysed as a
 // single job's final design is (client/report_responses.h, two runs of
 // `mbopt-worker eval`), each plot naming the point; or

@@ -172,6 +172,7 @@ int RunCommandMain(const Args& args) {
   WatchOptions watch_options;
   watch_options.table_out = (quiet || json) ? nullptr : stdout;
   watch_options.progress_line = watch_options.table_out != nullptr && isatty(STDOUT_FILENO);
+  watch_options.study = &*study;
   WatchOutcome outcome = WatchJob(*job_service, address, job_id, watch_options);
 
   v1::GetJobResponse job;

@@ -1,5 +1,7 @@
 #include "client/watch.h"
 
+#include <memory>
+
 #include "client/design_set_format.h"
 #include "client/pareto_format.h"
 #include "client/interrupts.h"
@@ -30,6 +32,18 @@ void DrawProgress(const WatchOptions& options, const v1::JobSummary& s) {
   std::fflush(options.table_out);
 }
 
+// The study of a job, for the lines of its front's points; null when the
+// server does not give it (the lines then show the raw values).
+std::unique_ptr<v1::Study> StudyOfJob(v1::JobService::Stub& job_service, const std::string& job_id) {
+  v1::JobRef ref;
+  ref.set_job_id(job_id);
+  v1::GetJobResponse job;
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  if (!job_service.Get(&context, ref, &job).ok() || !job.has_study()) return nullptr;
+  return std::unique_ptr<v1::Study>(job.release_study());
+}
+
 }  // namespace
 
 WatchOutcome WatchJob(v1::JobService::Stub& job_service, const std::string& address,
@@ -41,20 +55,30 @@ WatchOutcome WatchJob(v1::JobService::Stub& job_service, const std::string& addr
   ref.set_job_id(job_id);
   auto reader = job_service.Watch(&context, ref);
   bool header_printed = false;
+  const v1::Study* study = options.study;
+  std::unique_ptr<v1::Study> fetched_study;
+  bool study_asked = false;
   v1::JobEvent event;
   while (reader->Read(&event)) {
     if (event.has_cycle()) {
       if (options.table_out == nullptr) continue;
+      // A front's points' runs' cycles: the watch shows the points.
+      if (event.cycle().pareto_point() > 0) continue;
       ClearProgress(options);
       const bool design = event.cycle().design_set();
       const bool point = event.cycle().pareto();
+      if (point && study == nullptr && !study_asked) {
+        study_asked = true;
+        fetched_study = StudyOfJob(job_service, job_id);
+        study = fetched_study.get();
+      }
       if (!header_printed) {
         std::fprintf(options.table_out, "%s\n",
-                     (point ? ParetoWatchHeader() : design ? DesignWatchHeader() : CycleTableHeader()).c_str());
+                     (point ? ParetoWatchHeader(study) : design ? DesignWatchHeader() : CycleTableHeader()).c_str());
         header_printed = true;
       }
       std::fprintf(options.table_out, "%s\n",
-                   (point    ? ParetoWatchRow(event.cycle())
+                   (point    ? ParetoWatchRow(event.cycle(), study)
                     : design ? DesignWatchRow(event.cycle())
                              : CycleTableRow(event.cycle()))
                        .c_str());

@@ -14,6 +14,10 @@ namespace mbopt::client {
 struct WatchOptions {
   std::FILE* table_out = stdout;  // nullptr: no table
   bool progress_line = false;     // redraw a status line (terminals only)
+  // The job's study, for a Pareto front's lines (its second objective's
+  // name, unit and sign); null: asked of the server when the first point
+  // arrives.
+  const v1::Study* study = nullptr;
 };
 
 struct WatchOutcome {

@@ -5,9 +5,11 @@
 #include <string>
 #include <vector>
 
+#include "client/report/history_plots.h"
 #include "client/report/html_escape.h"
 #include "client/report/number_format.h"
 #include "client/report/page_head.h"
+#include "client/report/report_tables.h"
 #include "client/report/response_plots.h"
 #include "client/report/scalar_bars.h"
 #include "client/report/svg_line_plot.h"
@@ -15,10 +17,15 @@
 namespace mbopt::report {
 namespace {
 
-// Beside the shared page style: dominated points and the chosen one.
+// Beside the shared page style: dominated points and the chosen one, and
+// the chosen point's run's cycle table.
 constexpr const char* kFrontRowsCss = R"css(
 tr.dominated td { color: #777; }
 tr.chosen td { background: #fff6d5; }
+tr.rejected td { background: #fdecea; }
+div.wide { overflow-x: auto; }
+table.cycles { font-size: 12px; width: 100%; }
+table.cycles th, table.cycles td { padding: 2px 4px; }
 )css";
 
 using Point = ParetoReportData::Point;
@@ -137,6 +144,30 @@ std::string ChosenPoint(const ParetoReportData& data) {
   return "";
 }
 
+std::string ChosenHistory(const ParetoReportData& data) {
+  if (data.chosen == 0) return "";
+  const ReportData& history = data.chosen_history;
+  std::string out = "<h2>Cycle history of point " + std::to_string(data.chosen) + "'s run</h2>\n";
+  if (history.records.empty()) {
+    return out + "<p class=\"note\">" +
+           EscapeHtml(data.chosen_history_note.empty() ? std::string("Its run has no cycle records.")
+                                                       : data.chosen_history_note) +
+           "</p>\n";
+  }
+  out += "<p class=\"note\">As a single job's history: each point k is the design the run accepted in cycle k "
+         "(0: the design it started from); hollow red markers are rejected trial points. maxg is against the "
+         "run's own limits, the point's level included.";
+  if (!data.chosen_history_note.empty()) out += " " + EscapeHtml(data.chosen_history_note);
+  out += "</p>\n";
+  for (const PlotSpec& spec : {ObjectivePlot(history), ViolationPlot(history), ApproximationErrorPlot(history),
+                               MoveLimitPlot(history), DesignVariablePlot(history)}) {
+    out += "<div class=\"figure\">\n" + RenderLinePlotSvg(spec) + "</div>\n";
+  }
+  out += "<p class=\"note\">One row per LP solve of the run.</p>\n";
+  out += "<div class=\"wide\">\n" + CycleTableHtml(history) + "</div>\n";
+  return out;
+}
+
 std::string ChosenResponses(const ParetoReportData& data) {
   if (data.chosen == 0) return "";
   std::string out = "<h2>Responses of point " + std::to_string(data.chosen) + "</h2>\n";
@@ -178,9 +209,13 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
   if (data.points.empty()) {
     out += "<p class=\"note\">No point has been computed yet.</p>\n";
   } else {
+    // A maximized second objective is held above its level, and its
+    // best value is the greatest.
+    const bool maximized = data.against_maximized;
     out += "<p class=\"note\">Each point is one optimization: the least F with " + EscapeHtml(data.against) +
-           " held below the point's level (point 1: " + EscapeHtml(data.against) +
-           " free; at the other end: its least value; points added where the front bends are numbered "
+           (maximized ? " held above" : " held below") + " the point's level (point 1: " + EscapeHtml(data.against) +
+           " free; at the other end: its " + (maximized ? "greatest" : "least") +
+           " value; points added where the front bends are numbered "
            "after the others). Points are numbered as in the table; a point another beats in both is "
            "dominated.</p>\n";
     out += FrontPlot(data);
@@ -188,6 +223,7 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
   out += "<h2>Points</h2>\n";
   out += PointsTable(data);
   out += ChosenPoint(data);
+  out += ChosenHistory(data);
   out += ChosenResponses(data);
   out += "</body>\n</html>\n";
   return out;

@@ -3,9 +3,10 @@
 // constraint's largest value, every point labelled with its number, the
 // dominated and the failed points set apart, the chosen point (if one was
 // picked) marked; then the table of the points and, for the chosen one, its
-// design and its constraints, and its objective's and constraints'
-// responses over time against the initial design's (the single job's
-// page's plots, client/report/response_plots.h). Plain data in, one
+// design and its constraints, its run's cycle history (the single job's
+// page's history plots and cycle table) and its objective's and
+// constraints' responses over time against the initial design's (the
+// single job's page's plots, client/report/response_plots.h). Plain data in, one
 // self-contained HTML page out.
 //
 // Units: the objective in `objective_unit`, the traded constraint's value
@@ -29,6 +30,7 @@ struct ParetoReportData {
   std::string objective_unit;
   std::string against;       // the traded constraint's name, or the second objective's label
   bool against_objective = false;  // the second objective is an objective, not a constraint's value
+  bool against_maximized = false;  // ... a maximized one: values as themselves, a level a least value
   std::string against_unit;
   int points_total = 0;
   std::vector<std::string> variable_names;
@@ -55,6 +57,12 @@ struct ParetoReportData {
   // `chosen_responses_note` says why.
   std::vector<ResponsePlot> chosen_responses;
   std::string chosen_responses_note;
+  // The chosen point's run's cycle history, as a single job's page shows
+  // its own (records, variables, objective unit; its F the run's: at the far
+  // end, the second objective as minimized); when it has no records,
+  // `chosen_history_note` says why.
+  ReportData chosen_history;
+  std::string chosen_history_note;
 };
 
 std::string RenderParetoReportHtml(const ParetoReportData& data);

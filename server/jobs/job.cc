@@ -67,6 +67,21 @@ slp::AnalysisResult ResultOf(const AnalysisRecord& record, const slp::ProblemSpe
   return result;
 }
 
+// Whether a front's log was written before its points' runs logged their
+// cycles: it holds a point whose run has cycles, and none of them. (A log
+// of points whose runs have no cycles, failed at their first analysis, is
+// the same either way, and goes on with them.)
+bool LogLacksRunCycles(const std::vector<std::string>& logged_records) {
+  bool point_with_cycles = false;
+  for (const std::string& bytes : logged_records) {
+    absl::StatusOr<slp::CycleRecord> record = DecodeCycleRecord(bytes);
+    if (!record.ok()) continue;  // the replay's comparison names it
+    if (record->pareto_point > 0) return false;
+    point_with_cycles |= record->pareto && record->pareto_cycles > 0;
+  }
+  return point_with_cycles;
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Job>> Job::Create(spec::Study study, std::unique_ptr<lp::LpSolver> lp_solver,
@@ -275,6 +290,7 @@ absl::StatusOr<std::vector<slp::CycleRecord>> Job::Apply(const AnalysisRecord& r
 
 absl::StatusOr<std::vector<slp::CycleRecord>> Job::Replay(const std::vector<AnalysisRecord>& logged,
                                                           const std::vector<std::string>& logged_records) {
+  if (pareto_ != nullptr) pareto_->LogRunCycles(!LogLacksRunCycles(logged_records));
   std::map<std::int64_t, const AnalysisRecord*> by_id;
   for (const AnalysisRecord& a : logged) by_id[a.request_id] = &a;
   size_t next_record = 0;

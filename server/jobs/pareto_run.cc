@@ -300,6 +300,21 @@ void ParetoRun::End(int k) {
   }
 }
 
+slp::CycleRecord ParetoRun::RunCycle(const Point& point, int k, slp::CycleRecord record) const {
+  record.pareto_point = k + 1;
+  // The run's row h is the study's row point.rows[h]; the bound on a
+  // second objective that is a sum has no row of the study's and is named
+  // by its first term's.
+  auto study_row = [&](int h) {
+    if (h < 0 || static_cast<std::size_t>(h) >= point.rows.size()) return h;
+    const int row = point.rows[static_cast<std::size_t>(h)];
+    return row == kSumRow ? traded_rows_.front() : row;
+  };
+  record.worst_constraint_trial = study_row(record.worst_constraint_trial);
+  record.worst_approximation_row = study_row(record.worst_approximation_row);
+  return record;
+}
+
 ParetoRun::Analysed ParetoRun::Analyse(const AnalysisRecord& record) const {
   const slp::ProblemSpec& p = setup_.problem;
   Analysed a;
@@ -408,7 +423,9 @@ absl::Status ParetoRun::Submit(const AnalysisRecord& record) {
   if (record.ok()) point.analysed.push_back(Analyse(record));
   const absl::Status submitted = point.run->SubmitResult(ResultFor(point, record));
   if (!submitted.ok()) return submitted;
-  point.run->TakeNewRecords();  // the run's own cycles are not logged (see the header)
+  for (slp::CycleRecord& cycle : point.run->TakeNewRecords()) {
+    if (log_run_cycles_) point.cycles.push_back(RunCycle(point, k, std::move(cycle)));
+  }
   if (point.run->state() != slp::RunState::kRunning) {
     End(k);
     StartRuns();
@@ -418,6 +435,9 @@ absl::Status ParetoRun::Submit(const AnalysisRecord& record) {
     slp::CycleRecord& r = points_[emitted_].record;
     analyses_total += r.pareto_analyses;
     r.analyses_total = analyses_total;
+    std::vector<slp::CycleRecord>& cycles = points_[emitted_].cycles;
+    for (slp::CycleRecord& cycle : cycles) new_records_.push_back(std::move(cycle));
+    cycles = {};
     new_records_.push_back(r);
     ++emitted_;
   }

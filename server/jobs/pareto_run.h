@@ -26,9 +26,12 @@
 //  - one record per point (a design set's record with the Pareto fields,
 //    slp::CycleRecord), emitted in the points' order: point k's once points
 //    0..k have ended, so the record log does not depend on the order of
-//    results either, and a replay of the logged analyses emits it again.
-// The runs' own cycle records are not logged: the analyses are, and they
-// make every run again.
+//    results either, and a replay of the logged analyses emits it again;
+//  - each point's run's own cycle records (its history, pareto_point set),
+//    held until the point's record goes out and emitted just before it:
+//    runs side by side emit their cycles interleaved in the order of their
+//    results, which the log must not depend on. A job logged before the
+//    histories were (LogRunCycles(false)) resumes without them.
 //
 // Pure: no I/O, no clock, no threads.
 #pragma once
@@ -90,6 +93,10 @@ class ParetoRun {
   absl::Status Submit(const AnalysisRecord& record);
   std::vector<slp::CycleRecord> TakeNewRecords();
 
+  // Whether the runs' cycle records are emitted (the default); off for a
+  // job whose log has none, so that its replay emits what it logged.
+  void LogRunCycles(bool log) { log_run_cycles_ = log; }
+
   bool done() const { return emitted_ == points_.size(); }
   int size() const { return static_cast<int>(points_.size()); }
   int points_done() const { return static_cast<int>(emitted_); }
@@ -116,6 +123,7 @@ class ParetoRun {
     bool usable = false;                  // ended with a feasible result
     std::string not_run_reason;           // "" unless the point was never run
     slp::CycleRecord record;              // set when it ends
+    std::vector<slp::CycleRecord> cycles;  // its run's records, until they are emitted
   };
 
   explicit ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
@@ -124,6 +132,8 @@ class ParetoRun {
   void Start(int k, const Eigen::VectorXd& initial);
   void EndWithoutRun(int k, const std::string& reason);
   void End(int k);
+  // A run's record as the log keeps it: its point's number, the study's rows.
+  slp::CycleRecord RunCycle(const Point& point, int k, slp::CycleRecord record) const;
   slp::AnalysisResult ResultFor(const Point& point, const AnalysisRecord& record) const;
   Analysed Analyse(const AnalysisRecord& record) const;
   bool IsTraded(int row) const;
@@ -141,6 +151,7 @@ class ParetoRun {
   std::vector<Point> points_;
   std::int64_t analyses_ = 0;
   std::size_t emitted_ = 0;
+  bool log_run_cycles_ = true;
   std::vector<slp::CycleRecord> new_records_;
 };
 

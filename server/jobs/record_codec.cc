@@ -18,7 +18,11 @@ namespace {
 // 5: the records of a Pareto front's points: a design set's record and the
 // point's level, value, run state, cycles and analyses. Only those are
 // written as 5, so a design set logged before resumes byte for byte.
-constexpr unsigned char kVersion = 5;
+// 6: a cycle record of a Pareto point's run: an optimization's record (the
+// fields of 3) and the point's number. Only those are written as 6.
+constexpr unsigned char kVersion = 6;
+constexpr unsigned char kParetoRunVersion = 6;
+constexpr unsigned char kParetoPointVersion = 5;
 constexpr unsigned char kDesignSetVersion = 4;
 constexpr unsigned char kOptimizationVersion = 3;
 constexpr unsigned char kOldestReadVersion = 2;
@@ -118,9 +122,10 @@ class Reader {
 
 std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   Writer w;
-  w.out().push_back(static_cast<char>(r.pareto       ? kVersion
-                                      : r.design_set ? kDesignSetVersion
-                                                     : kOptimizationVersion));
+  w.out().push_back(static_cast<char>(r.pareto_point > 0 ? kParetoRunVersion
+                                      : r.pareto         ? kParetoPointVersion
+                                      : r.design_set     ? kDesignSetVersion
+                                                         : kOptimizationVersion));
   w.Int(r.cycle);
   w.Int(r.attempt);
   w.Bool(r.accepted);
@@ -161,6 +166,7 @@ std::string EncodeCycleRecord(const slp::CycleRecord& r) {
     w.Int(r.pareto_cycles);
     w.Int64(r.pareto_analyses);
   }
+  if (r.pareto_point > 0) w.Int(r.pareto_point);
   return std::move(w.out());
 }
 
@@ -202,13 +208,15 @@ absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
   c.analyses_total = r.Int64();
   c.converged = r.Bool();
   if (version >= 3) c.restoration = r.Bool();
-  if (version >= 4) {
+  if (version == kParetoRunVersion) {
+    c.pareto_point = r.Int();
+  } else if (version >= kDesignSetVersion) {
     c.design_set = true;
     const Eigen::VectorXd violations = r.Vector();
     c.constraint_violations.assign(violations.data(), violations.data() + violations.size());
     c.failure_kind = r.String();
   }
-  if (version >= 5) {
+  if (version == kParetoPointVersion) {
     c.pareto = true;
     c.pareto_level_si = r.Double();
     c.pareto_value_si = r.Double();

@@ -87,7 +87,7 @@ grpc::Status JobServiceImpl::Get(grpc::ServerContext* context, const v1::JobRef*
   if (!view.ok()) return ToGrpcStatus(view.status());
   *response->mutable_summary() = ToProto(view->summary);
   for (const slp::CycleRecord& r : view->records) {
-    *response->add_cycles() = ToProto(r, view->layout.get(), view->variable_scales, view->objective_sign);
+    *response->add_cycles() = ToProto(r, *view);
   }
   SetSerializedMessageField(v1::GetJobResponse::kStudyFieldNumber, view->study_bytes, response);
   absl::StatusOr<std::vector<store::AnalysesByHolder>> computed_by = manager_->ComputedBy(request->job_id());
@@ -177,7 +177,7 @@ grpc::Status JobServiceImpl::Watch(grpc::ServerContext* context, const v1::JobRe
     version = view->version;
     for (const slp::CycleRecord& r : view->records) {
       v1::JobEvent event;
-      *event.mutable_cycle() = ToProto(r, view->layout.get(), view->variable_scales, view->objective_sign);
+      *event.mutable_cycle() = ToProto(r, *view);
       if (!writer->Write(event)) return grpc::Status::CANCELLED;
     }
     next_record = view->first_record + view->records.size();

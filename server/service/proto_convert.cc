@@ -112,6 +112,7 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
   for (double v : r.constraint_violations) out.add_constraint_violations(v);
   out.set_failure_kind(r.failure_kind);
   out.set_design_set(r.design_set);
+  out.set_pareto_point(r.pareto_point);
   if (r.pareto) {
     out.set_pareto(true);
     out.set_pareto_level_si(r.pareto_level_si);
@@ -119,6 +120,15 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
     out.set_pareto_state(r.pareto_state);
     out.set_pareto_cycles(r.pareto_cycles);
     out.set_pareto_analyses(r.pareto_analyses);
+  }
+  return out;
+}
+
+v1::CycleRecord ToProto(const slp::CycleRecord& r, const jobs::manager::JobView& view) {
+  v1::CycleRecord out = ToProto(r, view.layout.get(), view.variable_scales, view.ReportedSign(r));
+  if (r.pareto) {
+    out.set_pareto_value(view.pareto_shown_factor * r.pareto_value_si);
+    out.set_pareto_level(view.pareto_shown_factor * r.pareto_level_si);
   }
   return out;
 }

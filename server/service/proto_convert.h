@@ -20,6 +20,9 @@ v1::JobSummary ToProto(const jobs::manager::JobSummaryData& summary);
 // maximized value as itself).
 v1::CycleRecord ToProto(const slp::CycleRecord& record, const spec::StudyLayout* layout,
                         const std::vector<double>& variable_scales, double objective_sign);
+// The same with what the job's view knows: its rows' names, the variables'
+// scales, the sign of each record's F and a front's shown values.
+v1::CycleRecord ToProto(const slp::CycleRecord& record, const jobs::manager::JobView& view);
 
 // A worker's result as the job manager takes it (the job's intake then
 // validates the record). `holder`: the name of the token that sent it.

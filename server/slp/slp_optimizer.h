@@ -156,6 +156,12 @@ struct CycleRecord {
   std::string pareto_state;
   int pareto_cycles = 0;
   std::int64_t pareto_analyses = 0;
+  // Set only in the cycle records of a Pareto front's point's run (its own
+  // history, logged just before the point's record): the point's 1-based
+  // number. The record is that run's as this core emitted it (its F, its
+  // maxg against its own rows and level, its analyses_total counting its
+  // own analyses), but for the row indices, which are the study's.
+  int pareto_point = 0;
 };
 
 class SlpOptimizer {

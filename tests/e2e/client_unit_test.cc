@@ -417,6 +417,70 @@ TEST(ParetoFormat, ASecondObjectiveIsNamedByWhatItIsAndAMaximizedOneShownAsItsel
   EXPECT_EQ(client::SecondObjectiveLabel(sum), "F2: sum of 2 terms");
 }
 
+// A point's run's cycle records (pareto_point set, just before the point's
+// record) are its history: `--point K` lists them as a cycle table and the
+// JSON has them per point; they are no points of the front.
+TEST(ParetoFormat, APointListsItsRunsCyclesAndTheyAreNoPoints) {
+  v1::GetJobResponse job = FourPointFront();
+  v1::GetJobResponse with_history;
+  *with_history.mutable_study() = job.study();
+  with_history.mutable_study()->mutable_pareto()->set_points(4);
+  *with_history.mutable_summary() = job.summary();
+  for (const v1::CycleRecord& point : job.cycles()) {
+    for (int cycle = 1; cycle <= 2; ++cycle) {
+      v1::CycleRecord* r = with_history.add_cycles();
+      r->set_pareto_point(point.cycle());
+      r->set_cycle(cycle);
+      r->set_accepted(true);
+      r->set_objective_trial(10.0 * point.cycle() + cycle);
+      r->set_analyses_total(7 * cycle);
+    }
+    *with_history.add_cycles() = point;
+  }
+  EXPECT_EQ(client::ResultsCsv(with_history), client::ResultsCsv(job));
+  EXPECT_EQ(client::PointRunCycles(with_history, 3).size(), 2u);
+  absl::StatusOr<std::string> text = client::ParetoPointText(with_history, 3);
+  ASSERT_TRUE(text.ok()) << text.status();
+  const size_t table = text->find("cycles of its run (F: the study's objective;");
+  ASSERT_NE(table, std::string::npos) << *text;
+  EXPECT_NE(text->find("           31", table), std::string::npos) << *text;
+  EXPECT_NE(text->find("           32", table), std::string::npos) << *text;
+  EXPECT_EQ(text->find("           21", table), std::string::npos) << *text;
+  absl::StatusOr<std::string> far_end = client::ParetoPointText(with_history, 4);
+  ASSERT_TRUE(far_end.ok());
+  EXPECT_NE(far_end->find("cycles of its run (F: the second objective as the run minimizes it"), std::string::npos)
+      << *far_end;
+  const std::string json = client::ResultsJson(with_history);
+  EXPECT_NE(json.find("\"history\": ["), std::string::npos) << json;
+  EXPECT_NE(json.find("\"objective\": 32"), std::string::npos) << json;
+  // Without the runs' cycles (a front logged before them) a point has no table.
+  absl::StatusOr<std::string> bare = client::ParetoPointText(job, 3);
+  ASSERT_TRUE(bare.ok());
+  EXPECT_EQ(bare->find("cycles of its run"), std::string::npos) << *bare;
+}
+
+// `mbopt watch` prints each point as it arrives: with the study, the
+// second objective as the tables show it (a maximized one as itself, in
+// its unit); without it, the records' raw values.
+TEST(ParetoFormat, TheWatchShowsAMaximizedSecondObjectiveAsItself) {
+  const v1::GetJobResponse job = FourPointFrontOfAMaximizedValue();
+  const std::string header = client::ParetoWatchHeader(&job.study());
+  EXPECT_NE(header.find("F2: x (maximized) [mm]"), std::string::npos) << header;
+  EXPECT_NE(header.find("level [mm]"), std::string::npos) << header;
+  const std::string row = client::ParetoWatchRow(job.cycles(1), &job.study());
+  EXPECT_NE(row.find(" 2.5 "), std::string::npos) << row;
+  EXPECT_NE(row.find(" 2 "), std::string::npos) << row;
+  EXPECT_EQ(row.find("-2"), std::string::npos) << row;
+  const std::string raw = client::ParetoWatchRow(job.cycles(1), nullptr);
+  EXPECT_NE(raw.find("-2.5"), std::string::npos) << raw;
+  EXPECT_NE(client::ParetoWatchHeader(nullptr).find("value (raw)"), std::string::npos);
+  // A traded constraint's values in its unit (the records hold SI).
+  const v1::GetJobResponse against = FourPointFront();
+  const std::string in_mm = client::ParetoWatchRow(against.cycles(2), &against.study());
+  EXPECT_NE(in_mm.find(" 2.5 "), std::string::npos) << in_mm;
+  EXPECT_NE(client::ParetoWatchHeader(&against.study()).find("travel [mm]"), std::string::npos);
+}
+
 TEST(Backoff, GrowsGeometricallyUpToTheCapWithBoundedJitter) {
   worker::BackoffOptions options;
   options.initial = std::chrono::milliseconds(100);

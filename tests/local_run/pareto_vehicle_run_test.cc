@@ -6,11 +6,13 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "server/jobs/job.h"
+#include "server/jobs/record_codec.h"
 #include "server/lp/make_clp_lp_solver.h"
 #include "spec/io/study_io.h"
 #include "spec/pareto.h"
@@ -35,7 +37,10 @@ std::vector<slp::CycleRecord> RunFront(const spec::Study& study) {
   InProcessEvaluator evaluator((*job)->study(), (*job)->layout());
   std::vector<slp::CycleRecord> records;
   jobs::JobRunOptions options;
-  options.on_record = [&records](const slp::CycleRecord& r) { records.push_back(r); };
+  // The points' records (their runs' cycles come before each).
+  options.on_record = [&records](const slp::CycleRecord& r) {
+    if (r.pareto) records.push_back(r);
+  };
   const absl::Status ran = (*job)->Run(evaluator, options);
   EXPECT_TRUE(ran.ok()) << ran;
   EXPECT_EQ((*job)->state(), jobs::JobState::kCompleted);
@@ -121,6 +126,47 @@ TEST(VehicleParetoFront, ASecondObjectiveOfTheSeatTravelGivesTheFrontAgainstItsC
     EXPECT_NEAR(o.objective_x0, c.objective_x0, kSameOptimumRelative * c.objective_x0) << "point " << k + 1;
     EXPECT_NEAR(o.pareto_value_si, travel_in, kSameOptimumRelative * travel_in) << "point " << k + 1;
   }
+}
+
+// A front's job logged before its points' runs logged their cycles holds
+// the points' records alone: its replay emits those again (the runs' cycles
+// left out), so it resumes; a log with the cycles replays them.
+TEST(VehicleParetoFront, AFrontLoggedWithoutItsRunsCyclesReplaysWithoutThem) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_pareto.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  study->pareto.points = 3;
+  const auto shared = std::make_shared<const spec::Study>(*study);
+  auto make = [&shared] {
+    absl::StatusOr<std::unique_ptr<jobs::Job>> job =
+        jobs::Job::Create(shared, [] { return lp::MakeClpLpSolver(); });
+    EXPECT_TRUE(job.ok()) << job.status();
+    return *std::move(job);
+  };
+  std::unique_ptr<jobs::Job> first = make();
+  InProcessEvaluator evaluator(first->study(), first->layout());
+  std::vector<jobs::AnalysisRecord> analyses;
+  std::vector<std::string> all, points_only;
+  jobs::JobRunOptions options;
+  options.on_analysis = [&analyses](const jobs::AnalysisRecord& a) { analyses.push_back(a); };
+  options.on_record = [&](const slp::CycleRecord& r) {
+    all.push_back(jobs::EncodeCycleRecord(r));
+    if (r.pareto) points_only.push_back(all.back());
+  };
+  ASSERT_TRUE(first->Run(evaluator, options).ok());
+  ASSERT_EQ(points_only.size(), 3u);
+  ASSERT_GT(all.size(), 2 * points_only.size()) << "every run logs its cycles";
+
+  std::unique_ptr<jobs::Job> with_cycles = make();
+  absl::StatusOr<std::vector<slp::CycleRecord>> replayed = with_cycles->Replay(analyses, all);
+  ASSERT_TRUE(replayed.ok()) << replayed.status();
+  EXPECT_TRUE(replayed->empty());
+  EXPECT_EQ(with_cycles->state(), jobs::JobState::kCompleted);
+
+  std::unique_ptr<jobs::Job> legacy = make();
+  replayed = legacy->Replay(analyses, points_only);
+  ASSERT_TRUE(replayed.ok()) << replayed.status();
+  EXPECT_TRUE(replayed->empty()) << "nothing beyond the logged points";
+  EXPECT_EQ(legacy->state(), jobs::JobState::kCompleted);
 }
 
 }  // namespace

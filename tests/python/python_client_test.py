@@ -23,6 +23,8 @@ MBOPT = os.environ["MBOPT_TEST_MBOPT"]
 SOURCE_DIR = os.environ["MBOPT_TEST_SOURCE_DIR"]
 VEHICLE_STUDY = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle.study.textproto")
 VEHICLE_SCENE = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle.scene.textproto")
+VEHICLE_PARETO = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle_pareto.study.textproto")
+VEHICLE_SWEEP = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle_sweep.study.textproto")
 
 # The tests' servers are their own: settings for another in the caller's
 # environment must not reach the clients here.
@@ -121,6 +123,52 @@ class PythonClientTest(unittest.TestCase):
         status = self.client.status(job)
         self.assertEqual((status.status, status.objective), ("converged", results.objective))
         self.assertIn(job, [s.job_id for s in self.client.list()])
+
+    def assert_reads_as_the_cli(self, job, results):
+        cli = mbopt_cli("results", job, "--json", "--server", self.server.address)
+        self.assertEqual(cli.returncode, 0, cli.stderr)
+        # The same doubles, bit for bit (the CLI prints 17 digits, which
+        # json.loads reads back exactly).
+        self.assertEqual(results.as_dict(), json.loads(cli.stdout))
+
+    def test_front_lists_its_points_not_cycle_records(self):
+        shutil.copy(VEHICLE_SCENE, self.folder)
+        with open(VEHICLE_PARETO) as f:
+            text = f.read()
+        self.assertIn("points: 5", text)
+        study = self.write("vehicle_pareto3.study.textproto", text.replace("points: 5", "points: 3", 1))
+        job = self.client.submit(study)
+        self.assertEqual(self.client.wait(job).status, "completed")
+        front = self.client.results(job)
+        self.assertIsInstance(front, mbopt.FrontResults)
+        self.assertEqual((front.against, front.against_unit, front.points_done), ("s1", "in", 3))
+        self.assertEqual([p["point"] for p in front.points], [1, 2, 3])
+        records = {r.cycle: r for r in self.client.get(job).cycles if r.pareto}
+        for p in front.points:
+            self.assertEqual(p["status"], "front", p["reason"])
+            # The traded constraint in its unit (inches), not SI.
+            self.assertAlmostEqual(p["value"] * 0.0254, records[p["point"]].pareto_value_si, delta=1e-12)
+            # Its run's cycles: the last one the run's last, or the cycle
+            # its run stopped in.
+            self.assertTrue(p["history"], f"point {p['point']} has no history")
+            self.assertIn(p["history"][-1]["cycle"], (p["cycles"], p["cycles"] + 1))
+        self.assertIsNone(front.point(1)["level"])
+        self.assertLess(front.point(2)["level"], front.point(1)["value"])
+        with self.assertRaises(KeyError) as raised:
+            front.point(4)
+        self.assertIn(f"job {job} has points 1 to 3 (of 3)", str(raised.exception))
+        self.assert_reads_as_the_cli(job, front)
+
+    def test_sweep_lists_its_designs_not_cycle_records(self):
+        job = self.client.submit(VEHICLE_SWEEP)
+        self.assertEqual(self.client.wait(job).status, "completed")
+        sweep = self.client.results(job)
+        self.assertIsInstance(sweep, mbopt.DesignSetResults)
+        self.assertEqual(sweep.form, "sweep")
+        self.assertEqual(len(sweep.designs), sweep.designs_total)
+        self.assertEqual([d["design"] for d in sweep.designs], list(range(1, sweep.designs_total + 1)))
+        self.assertTrue(all(d["status"] == "ok" for d in sweep.designs))
+        self.assert_reads_as_the_cli(job, sweep)
 
     def test_cancelled_job_resumes_to_the_same_optimum(self):
         # A server without workers: the job waits for its first analyses

@@ -86,6 +86,63 @@ TEST(ParetoReport, NamesASecondObjectiveAsSuchNotAsAConstraintsLargestValue) {
   EXPECT_EQ(html.find("the largest value of F2"), std::string::npos);
 }
 
+// A maximized second objective is held above each point's level, and the
+// front's far end is its greatest value, not its least.
+TEST(ParetoReport, SaysAMaximizedSecondObjectiveIsHeldAboveItsLevel) {
+  ParetoReportData data = Front();
+  data.against = "F2: grip (maximized)";
+  data.against_objective = true;
+  data.against_maximized = true;
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  EXPECT_NE(html.find("the least F with F2: grip (maximized) held above the point's level"), std::string::npos)
+      << html;
+  EXPECT_NE(html.find("at the other end: its greatest value"), std::string::npos) << html;
+  EXPECT_EQ(html.find("held below"), std::string::npos) << html;
+  const std::string minimized = RenderParetoReportHtml(Front());
+  EXPECT_NE(minimized.find("held below the point's level"), std::string::npos);
+  EXPECT_NE(minimized.find("at the other end: its least value"), std::string::npos);
+}
+
+// The chosen point's run's history is drawn as a single job's: the history
+// plots and the table of LP solves; without records, the note says why.
+TEST(ParetoReport, DrawsTheChosenPointsRunHistoryOrSaysWhyNot) {
+  ParetoReportData data = Front();
+  data.chosen = 2;
+  for (int cycle = 1; cycle <= 3; ++cycle) {
+    ReportCycle c;
+    c.cycle = cycle;
+    c.accepted = true;
+    c.x0_scaled = c.x_trial_scaled = {1.0 + 0.1 * cycle, 2.0};
+    c.objective_x0 = 2.0 - 0.1 * (cycle - 1);
+    c.objective_trial = 2.0 - 0.1 * cycle;
+    c.max_violation_x0 = c.max_violation_trial = -0.01;
+    c.max_approximation_error = 0.05;
+    c.move_limits = c.move_limits_next = {0.2, 0.2};
+    c.analyses_total = 3 * cycle;
+    data.chosen_history.records.push_back(c);
+  }
+  data.chosen_history.variables.resize(2);
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  const size_t history = html.find("<h2>Cycle history of point 2's run</h2>");
+  ASSERT_NE(history, std::string::npos) << html;
+  EXPECT_LT(history, html.find("<h2>Responses of point 2</h2>"));
+  // The front, then the run's objective, violation, error, move limits and
+  // design variables.
+  EXPECT_EQ(testing::SvgFragments(html).size(), 6u);
+  EXPECT_NE(html.find("<table class=\"cycles\"", history), std::string::npos);
+
+  data.chosen_history = ReportData{};
+  data.chosen_history_note = "The cycles are not in the log.";
+  const std::string without = RenderParetoReportHtml(data);
+  EXPECT_NE(without.find("<h2>Cycle history of point 2's run</h2>\n<p class=\"note\">The cycles are not in the "
+                         "log.</p>"),
+            std::string::npos)
+      << without;
+  EXPECT_EQ(testing::SvgFragments(without).size(), 1u);
+}
+
 // A point added by refinement (number 6) lies between points 2 and 4 on the
 // front: the front's line goes through it there, not after point 5.
 TEST(ParetoReport, JoinsTheFrontInTheOrderOfTheTradedValueNotOfThePoints) {

@@ -20,6 +20,7 @@
 
 #include "server/jobs/pareto_run.h"
 #include "server/jobs/record_codec.h"
+#include "server/slp/best_design.h"
 #include "server/lp/make_clp_lp_solver.h"
 #include "spec/pareto.h"
 
@@ -86,6 +87,18 @@ AnalysisRecord Answer(const slp::AnalysisRequest& request) {
   return record;
 }
 
+// The points' records among encoded records (the others are their runs'
+// cycles).
+size_t PointsIn(const std::vector<std::string>& encoded) {
+  size_t points = 0;
+  for (const std::string& bytes : encoded) {
+    absl::StatusOr<slp::CycleRecord> record = DecodeCycleRecord(bytes);
+    EXPECT_TRUE(record.ok()) << record.status();
+    if (record.ok() && record->pareto) ++points;
+  }
+  return points;
+}
+
 // Drives the front to its end as `workers` workers would: each round answers
 // at most `workers` of the pending requests, picked and ordered by `seed`.
 // Returns the encoded records in the order they came out.
@@ -106,7 +119,7 @@ std::vector<std::string> RunFront(ParetoSetup setup, int workers, unsigned seed,
       EXPECT_TRUE((*run)->Submit(Answer(request)).ok());
       for (slp::CycleRecord& record : (*run)->TakeNewRecords()) {
         encoded.push_back(EncodeCycleRecord(record));
-        if (out != nullptr) out->push_back(std::move(record));
+        if (out != nullptr && record.pareto) out->push_back(std::move(record));
       }
     }
   }
@@ -164,7 +177,7 @@ TEST(ParetoRun, ReproducesTheClosedFormFrontOfTheTwoSpheres) {
 
 TEST(ParetoRun, SameRecordsWhateverTheWorkersAndTheOrderOfResults) {
   const std::vector<std::string> one = RunFront(/*gradients=*/false, 1, 7, nullptr);
-  ASSERT_EQ(one.size(), static_cast<size_t>(kPoints));
+  ASSERT_EQ(PointsIn(one), static_cast<size_t>(kPoints));
   EXPECT_EQ(RunFront(false, 3, 11, nullptr), one);
   EXPECT_EQ(RunFront(false, 64, 12345, nullptr), one);
 }
@@ -201,7 +214,9 @@ TEST(ParetoRun, ObjectivesThatDoNotConflictLeaveThePointsBetweenUnrun) {
     for (const slp::AnalysisRequest& request : (*run)->PendingRequests()) {
       ASSERT_TRUE((*run)->Submit(answer_same(request)).ok());
     }
-    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) {
+      if (r.pareto) records.push_back(std::move(r));
+    }
   }
   ASSERT_EQ(records.size(), static_cast<size_t>(kPoints));
   for (int k = 1; k + 1 < kPoints; ++k) {
@@ -229,7 +244,9 @@ TEST(ParetoRun, AFailedEndLeavesThePointsBetweenUnrunAndSaysWhy) {
       }
       ASSERT_TRUE((*run)->Submit(record).ok());
     }
-    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) {
+      if (r.pareto) records.push_back(std::move(r));
+    }
   }
   ASSERT_EQ(records.size(), static_cast<size_t>(kPoints));
   EXPECT_TRUE(records.front().accepted);
@@ -285,7 +302,7 @@ TEST(ParetoRun, RefinedPointsHalveTheSegmentsWhereTheFrontBends) {
 
 TEST(ParetoRun, RefinedFrontIsTheSameWhateverTheWorkersAndTheOrderOfResults) {
   const std::vector<std::string> one = RunFront(RefinedTwoSpheres(4), 1, 7, nullptr);
-  ASSERT_EQ(one.size(), static_cast<size_t>(kPoints + 4));
+  ASSERT_EQ(PointsIn(one), static_cast<size_t>(kPoints + 4));
   EXPECT_EQ(RunFront(RefinedTwoSpheres(4), 3, 11, nullptr), one);
   EXPECT_EQ(RunFront(RefinedTwoSpheres(4), 64, 12345, nullptr), one);
 }
@@ -294,7 +311,7 @@ TEST(ParetoRun, RefinedFrontIsTheSameWhateverTheWorkersAndTheOrderOfResults) {
 // order they were logged; it must then go on as the first one would have.
 TEST(ParetoRun, ARefinedFrontResumedFromItsLoggedResultsEndsTheSame) {
   const std::vector<std::string> reference = RunFront(RefinedTwoSpheres(2), 2, 21, nullptr);
-  ASSERT_EQ(reference.size(), static_cast<size_t>(kPoints + 2));
+  ASSERT_EQ(PointsIn(reference), static_cast<size_t>(kPoints + 2));
   auto make = [] {
     absl::StatusOr<std::unique_ptr<ParetoRun>> run =
         ParetoRun::Create(RefinedTwoSpheres(2), [] { return lp::MakeClpLpSolver(); });
@@ -355,7 +372,9 @@ TEST(ParetoRun, AddedPointsWithoutASegmentEndUnrunAndSayWhy) {
       }
       ASSERT_TRUE((*run)->Submit(record).ok());
     }
-    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+    for (slp::CycleRecord& r : (*run)->TakeNewRecords()) {
+      if (r.pareto) records.push_back(std::move(r));
+    }
   }
   ASSERT_EQ(records.size(), static_cast<size_t>(kPoints + 2));
   for (int k = kPoints; k < kPoints + 2; ++k) {
@@ -370,6 +389,100 @@ TEST(ParetoRun, RefusesMoreAddedPointsThanSegments) {
       ParetoRun::Create(RefinedTwoSpheres(kPoints), [] { return lp::MakeClpLpSolver(); });
   ASSERT_FALSE(run.ok());
   EXPECT_EQ(run.status().message(), "a front of 9 points can be refined by 0 to 8 points, got 9");
+}
+
+// Each point's run logs its own cycle records, all of them just before the
+// point's record: the run's history, whose best design is the point's
+// result. Points not run have none.
+TEST(ParetoRun, EachPointsRunLogsItsCyclesJustBeforeThePoint) {
+  ParetoSetup setup = TwoSpheres(/*gradients=*/true);
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(std::move(setup), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  std::mt19937 random(5);
+  std::vector<slp::CycleRecord> records;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    std::vector<slp::AnalysisRequest> pending = (*run)->PendingRequests();
+    std::shuffle(pending.begin(), pending.end(), random);
+    for (const slp::AnalysisRequest& request : pending) {
+      ASSERT_TRUE((*run)->Submit(Answer(request)).ok());
+      for (slp::CycleRecord& r : (*run)->TakeNewRecords()) records.push_back(std::move(r));
+    }
+  }
+  ASSERT_TRUE((*run)->done());
+  std::vector<slp::CycleRecord> history;
+  int points = 0;
+  for (const slp::CycleRecord& r : records) {
+    if (r.pareto_point > 0) {
+      EXPECT_FALSE(r.pareto);
+      EXPECT_FALSE(r.design_set);
+      EXPECT_EQ(r.pareto_point, points + 1) << "a run's cycle after its point's record";
+      history.push_back(r);
+      continue;
+    }
+    ASSERT_TRUE(r.pareto);
+    ++points;
+    SCOPED_TRACE(::testing::Message() << "point " << r.cycle);
+    EXPECT_EQ(r.cycle, points);
+    ASSERT_FALSE(history.empty());
+    // The run's cycles, in order, as the core emitted them.
+    EXPECT_EQ(history.front().cycle, 1);
+    EXPECT_EQ(history.back().cycle, r.pareto_cycles);
+    for (std::size_t j = 1; j < history.size(); ++j) {
+      EXPECT_GE(history[j].cycle, history[j - 1].cycle);
+      EXPECT_GE(history[j].analyses_total, history[j - 1].analyses_total);
+    }
+    EXPECT_LE(history.back().analyses_total, r.pareto_analyses);
+    slp::BestDesign best;
+    for (const slp::CycleRecord& c : history) best.OfferRecord(c);
+    ASSERT_TRUE(best.best().has_value());
+    EXPECT_EQ(best.best()->x, r.x0) << "the point's result is its run's best design";
+    history.clear();
+  }
+  EXPECT_EQ(points, kPoints);
+  EXPECT_TRUE(history.empty());
+}
+
+// A run's cycle record keeps its point's number and every field through the
+// log's encoding; a point's record stays as it was (version 5).
+TEST(ParetoRunRecords, RunCyclesKeepTheirPointThroughAnEncodeAndDecode) {
+  const std::vector<std::string> encoded = RunFront(true, 2, 3, nullptr);
+  int run_cycles = 0;
+  for (const std::string& bytes : encoded) {
+    absl::StatusOr<slp::CycleRecord> decoded = DecodeCycleRecord(bytes);
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    EXPECT_EQ(EncodeCycleRecord(*decoded), bytes);
+    EXPECT_EQ(bytes[0], decoded->pareto_point > 0 ? 6 : 5);
+    if (decoded->pareto_point > 0) {
+      ++run_cycles;
+      EXPECT_LE(decoded->pareto_point, kPoints);
+      EXPECT_FALSE(decoded->design_set);
+      EXPECT_FALSE(decoded->pareto);
+      EXPECT_EQ(decoded->x0.size(), 2);
+    }
+  }
+  EXPECT_GE(run_cycles, kPoints);
+}
+
+// A job logged before the runs' cycles were resumes with its log: a front
+// that does not log them emits its points' records alone, the same bytes.
+TEST(ParetoRun, WithoutItsRunsCyclesEmitsThePointsAlone) {
+  std::vector<std::string> points;
+  for (const std::string& bytes : RunFront(true, 3, 9, nullptr)) {
+    if (DecodeCycleRecord(bytes)->pareto) points.push_back(bytes);
+  }
+  absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+      ParetoRun::Create(TwoSpheres(true), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_TRUE(run.ok()) << run.status();
+  (*run)->LogRunCycles(false);
+  std::vector<std::string> emitted;
+  for (int round = 0; round < kMaxRounds && !(*run)->done(); ++round) {
+    for (const slp::AnalysisRequest& request : (*run)->PendingRequests()) {
+      ASSERT_TRUE((*run)->Submit(Answer(request)).ok());
+      for (slp::CycleRecord& r : (*run)->TakeNewRecords()) emitted.push_back(EncodeCycleRecord(r));
+    }
+  }
+  EXPECT_EQ(emitted, points);
 }
 
 TEST(ParetoRunRecords, ArePointRecordsAfterAnEncodeAndDecode) {

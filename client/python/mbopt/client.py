@@ -13,7 +13,7 @@ Every failure is an mbopt.errors exception carrying the server's message.
 import grpc
 
 from mbopt.connection import UNARY_DEADLINE_S, Security, create_channel, resolve_address, rpc_error
-from mbopt.jobs import JobResults, JobStatus
+from mbopt.jobs import JobStatus, results_of
 from mbopt.errors import BadInput
 from mbopt.study_file import StudyFile
 from mbopt.v1 import service_pb2, service_pb2_grpc
@@ -67,8 +67,10 @@ class Client:
         return [JobStatus.from_proto(s) for s in self._call(self._jobs.List, service_pb2.ListJobsRequest()).jobs]
 
     def results(self, job_id):
-        """The job's JobResults (`mbopt results --json`)."""
-        return JobResults.from_proto(self._call(self._jobs.Get, service_pb2.JobRef(job_id=job_id)))
+        """The job's results as `mbopt results --json` gives them: JobResults
+        for an optimization, FrontResults (its points) for a Pareto front,
+        DesignSetResults (its designs) for a sweep or sample."""
+        return results_of(self._call(self._jobs.Get, service_pb2.JobRef(job_id=job_id)))
 
     def get(self, job_id):
         """The server's whole answer (mbopt.v1.GetJobResponse): summary, every

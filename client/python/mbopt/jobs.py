@@ -1,7 +1,9 @@
 """Jobs as plain Python values: a job's status (from the server's
 JobSummary) and its results (from GetJobResponse), with the fields and names
-of `mbopt results --json` (client/job_format.cc), so that a script and the
-CLI read the same thing. Values are in the study's units as the server
+of `mbopt results --json` (client/job_format.cc; a Pareto front's points
+and a sweep's or sample's designs as client/pareto_format.cc and
+client/design_set_format.cc list them), so that a script and the CLI read
+the same thing. Values are in the study's units as the server
 reports them; a value that is not finite (no objective yet) is None, as the
 CLI's JSON writes null.
 """
@@ -9,7 +11,7 @@ CLI's JSON writes null.
 import math
 from dataclasses import dataclass, field
 
-from mbopt.v1 import service_pb2
+from mbopt.v1 import service_pb2, study_pb2
 
 _STATE_NAMES = {
     service_pb2.JOB_STATE_QUEUED: "queued",
@@ -156,3 +158,240 @@ class JobResults:
         out["failed_analyses"] = dict(self.failed_analyses)
         out["history"] = [dict(h) for h in self.history]
         return out
+
+
+def _second_objective_label(o):
+    """A front's second objective as the CLI names it (client/pareto_format.cc,
+    SecondObjectiveLabel): "F2: s1", "F2: x (maximized)", "F2: max |s1|", ..."""
+    form = o.WhichOneof("form")
+    if form == "minimize":
+        return f"F2: {o.minimize}"
+    if form == "maximize":
+        return f"F2: {o.maximize} (maximized)"
+    if form == "minimize_max_of":
+        bar = "|" if o.reduction == study_pb2.REDUCTION_MAX_ABS else ""
+        return f"F2: max {bar}{o.minimize_max_of}{bar}"
+    if form == "minimize_max_over":
+        return f"F2: largest of {len(o.minimize_max_over.terms)} terms"
+    if form == "minimize_sum":
+        return f"F2: sum of {len(o.minimize_sum.terms)} terms"
+    return "F2"
+
+
+def _at(values, i):
+    return _number(values[i]) if i < len(values) else None
+
+
+def _point_history_entry(r):
+    return {
+        "cycle": r.cycle,
+        "attempt": r.attempt,
+        "accepted": r.accepted,
+        "restoration": r.restoration,
+        "objective": _number(r.objective_trial),
+        "max_violation": _number(r.max_violation_trial),
+        "max_approximation_error": _number(r.max_approximation_error),
+        "optimality_residual": _number(r.optimality_residual),
+        "lp_feasible": r.lp_feasible,
+        "analyses": r.analyses_total,
+        "design": [_number(v) for v in r.x_trial_physical],
+    }
+
+
+def _dominated(points):
+    """Which of (first, second, usable) points another usable point beats:
+    no worse in both objectives (as minimized) and better in one
+    (spec/pareto.h, DominatedPoints)."""
+    dominated = [False] * len(points)
+    for i, (first, second, usable) in enumerate(points):
+        if not usable:
+            continue
+        for j, (other_first, other_second, other_usable) in enumerate(points):
+            if j == i or not other_usable:
+                continue
+            no_worse = other_first <= first and other_second <= second
+            better = other_first < first or other_second < second
+            if no_worse and better:
+                dominated[i] = True
+                break
+    return dominated
+
+
+@dataclass
+class FrontResults:
+    """What `mbopt results --json` prints for a Pareto front, field for field:
+    `points` has one dict per point of the front (its level, both
+    objectives, its run's end, its design, each constraint's largest
+    normalized value, its status: "front", "dominated", "infeasible",
+    "failed" or "not run", and its run's `history`, one dict per LP solve),
+    in the points' order. The second objective and its levels are as the
+    CLI shows them: a traded constraint's in its unit, a maximized
+    objective as itself."""
+
+    job_id: str
+    study: str
+    status: str
+    against: str
+    against_unit: str
+    objective_unit: str
+    points_total: int
+    points_done: int
+    analyses: int
+    message: str
+    points: list
+
+    def point(self, number):
+        """Point `number` (1-based) of the front; KeyError naming the points
+        there are when it has no such point."""
+        for p in self.points:
+            if p["point"] == number:
+                return p
+        raise KeyError(f"point {number}: job {self.job_id} has "
+                       + (f"points 1 to {len(self.points)}" if self.points else "no point yet")
+                       + f" (of {self.points_total})")
+
+    @classmethod
+    def from_proto(cls, job):
+        s = job.summary
+        study = job.study
+        pareto = study.pareto
+        maximized = False
+        if pareto.HasField("objective"):
+            against = _second_objective_label(pareto.objective)
+            against_unit = pareto.objective.unit
+            maximized = pareto.objective.WhichOneof("form") == "maximize"
+        else:
+            against = pareto.against
+            against_unit = next((c.unit for c in study.constraints if c.name == against), "")
+        # Dominance on both objectives as the runs minimize them.
+        first_sign = -1.0 if study.objective.WhichOneof("form") == "maximize" else 1.0
+        second_sign = -1.0 if maximized else 1.0
+        names = list(s.design_names)
+        constraints = [c.name for c in study.constraints]
+        histories = {}
+        for r in job.cycles:
+            if r.pareto_point > 0:
+                histories.setdefault(r.pareto_point, []).append(_point_history_entry(r))
+        points, ranked = [], []
+        for r in job.cycles:
+            if not r.pareto:
+                continue
+            if r.pareto_state == "not_run":
+                status = "not run"
+            elif not r.accepted:
+                failed = r.pareto_state == "failed" or not math.isfinite(r.objective_trial)
+                status = "failed" if failed else "infeasible"
+            else:
+                status = ""
+            points.append({
+                "point": r.cycle,
+                "level": _number(r.pareto_level),
+                "objective": _number(r.objective_trial),
+                "value": _number(r.pareto_value),
+                "max_violation": _number(r.max_violation_trial),
+                "run_state": r.pareto_state,
+                "cycles": r.pareto_cycles,
+                "analyses": r.pareto_analyses,
+                "design": {n: _at(r.x_trial_physical, i) for i, n in enumerate(names)},
+                "x_scaled": [_number(v) for v in r.x_trial_scaled],
+                "constraints": {n: _at(r.constraint_violations, c) for c, n in enumerate(constraints)},
+                "status": status,
+                "reason": r.rejection_reason,
+                "history": histories.get(r.cycle, []),
+            })
+            ranked.append((first_sign * r.objective_trial, second_sign * r.pareto_value, status == ""))
+        for p, dominated in zip(points, _dominated(ranked)):
+            if p["status"] == "":
+                p["status"] = "dominated" if dominated else "front"
+        return cls(job_id=s.job_id, study=s.study_name, status=state_name(s.state), against=against,
+                   against_unit=against_unit, objective_unit=s.objective_unit, points_total=s.max_cycles,
+                   points_done=s.cycles, analyses=s.analyses, message=s.message, points=points)
+
+    def as_dict(self):
+        """The same object as `mbopt results --json` parsed with json.loads."""
+        return {
+            "job_id": self.job_id, "study": self.study, "status": self.status, "form": "pareto",
+            "against": self.against, "against_unit": self.against_unit, "objective_unit": self.objective_unit,
+            "points_total": self.points_total, "points_done": self.points_done, "analyses": self.analyses,
+            "message": self.message, "points": [dict(p) for p in self.points],
+        }
+
+
+@dataclass
+class DesignSetResults:
+    """What `mbopt results --json` prints for a sweep or a sample, field for
+    field: `designs` has one dict per design analysed, in the designs'
+    order (its values, its objective and largest normalized constraint
+    value, each constraint's, its status: "ok" or the failure's kind)."""
+
+    job_id: str
+    study: str
+    status: str
+    form: str  # "sweep" or "sample"
+    designs_total: int
+    designs_done: int
+    analyses: int
+    objective_unit: str
+    best_objective: float
+    best_max_violation: float
+    variables: list
+    constraints: list
+    message: str
+    failed_analyses: dict
+    designs: list
+
+    @classmethod
+    def from_proto(cls, job):
+        s = job.summary
+        study = job.study
+        names = list(s.design_names)
+        units = list(s.design_units)
+        variables = []
+        for i, n in enumerate(names):
+            variable = {"name": n}
+            for v in study.variables:
+                if v.name == n:
+                    variable["parameter"] = v.parameter
+                    variable["scale"] = v.scale or 1.0
+            variable["unit"] = units[i] if i < len(units) else ""
+            variables.append(variable)
+        constraints = [c.name for c in study.constraints]
+        designs = [{
+            "design": r.cycle,
+            "values": {n: _at(r.x_trial_physical, i) for i, n in enumerate(names)},
+            "x_scaled": [_number(v) for v in r.x_trial_scaled],
+            "objective": _number(r.objective_trial),
+            "max_violation": _number(r.max_violation_trial),
+            "constraints": {n: _at(r.constraint_violations, c) for c, n in enumerate(constraints)},
+            "status": r.failure_kind or "ok",
+            "failure_reason": r.rejection_reason,
+        } for r in job.cycles]
+        return cls(job_id=s.job_id, study=s.study_name, status=state_name(s.state),
+                   form="sample" if study.HasField("sample") else "sweep", designs_total=s.max_cycles,
+                   designs_done=s.cycles, analyses=s.analyses, objective_unit=s.objective_unit,
+                   best_objective=_number(s.objective), best_max_violation=_number(s.max_violation),
+                   variables=variables, constraints=constraints, message=s.message,
+                   failed_analyses=dict(sorted(s.failed_analyses_by_kind.items())), designs=designs)
+
+    def as_dict(self):
+        """The same object as `mbopt results --json` parsed with json.loads."""
+        return {
+            "job_id": self.job_id, "study": self.study, "status": self.status, "form": self.form,
+            "designs_total": self.designs_total, "designs_done": self.designs_done, "analyses": self.analyses,
+            "objective_unit": self.objective_unit, "best_objective": self.best_objective,
+            "best_max_violation": self.best_max_violation, "variables": [dict(v) for v in self.variables],
+            "constraints": list(self.constraints), "message": self.message,
+            "failed_analyses": dict(self.failed_analyses), "designs": [dict(d) for d in self.designs],
+        }
+
+
+def results_of(job):
+    """A GetJobResponse as what `mbopt results --json` prints of it: a
+    Pareto front's FrontResults, a sweep's or sample's DesignSetResults, an
+    optimization's JobResults."""
+    if job.summary.pareto or (job.HasField("study") and job.study.HasField("pareto")):
+        return FrontResults.from_proto(job)
+    if job.summary.design_set or (job.HasField("study") and
+                                  (job.study.HasField("sweep") or job.study.HasField("sample"))):
+        return DesignSetResults.from_proto(job)
+    return JobResults.from_proto(job)

@@ -60,7 +60,20 @@ struct JobView {
   std::shared_ptr<const spec::StudyLayout> layout;
   std::vector<double> variable_scales;    // physical = scale * x
   double objective_sign = 1.0;            // reported F = sign * the records' F (-1: maximized)
+  // A Pareto front's far end, the point whose run minimizes the second
+  // objective (0: not a front): its run's F is no reported objective.
+  int pareto_far_end = 0;
+  // A front's point record's second objective and level as shown
+  // (CycleRecord.pareto_value): factor * the record's. 1 / the unit's SI
+  // size for a traded constraint; -1 for a maximized second objective (the
+  // runs minimize its negative), else 1.
+  double pareto_shown_factor = 1.0;
   std::string study_bytes;
+
+  // The sign of record r's F as reported.
+  double ReportedSign(const slp::CycleRecord& r) const {
+    return pareto_far_end > 0 && r.pareto_point == pareto_far_end ? 1.0 : objective_sign;
+  }
 };
 
 // Who a view is for: a reader (Get) gets the study's bytes as well; a

@@ -130,6 +130,15 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record, Job
     view.layout = entry.layout;
     for (const spec::DesignVariable& v : entry.study->variables) view.variable_scales.push_back(v.scale);
     view.objective_sign = entry.study->objective.ReportedSign();
+    const spec::Study& study = *entry.study;
+    if (study.pareto.enabled()) {
+      view.pareto_far_end = study.pareto.points;
+      if (study.pareto.trades_objective) {
+        view.pareto_shown_factor = study.second_objective.ReportedSign();
+      } else if (study.pareto.constraint >= 0 && static_cast<size_t>(study.pareto.constraint) < study.constraints.size()) {
+        view.pareto_shown_factor = 1.0 / study.constraints[static_cast<size_t>(study.pareto.constraint)].si_per_unit;
+      }
+    }
   }
   if (view_for == JobViewFor::kReader) view.study_bytes = entry.row.study;
   return view;
