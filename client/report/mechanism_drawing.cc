@@ -327,10 +327,18 @@ std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mappi
   std::vector<const SceneDrawing::Body*> bodies;
   for (const SceneDrawing::Body& body : d.bodies) bodies.push_back(&body);
   if (d.spatial) {
+    // Non-finite points (a motion that blew up) are left out, so the order
+    // stays a strict weak one.
     auto depth = [&](const SceneDrawing::Body* body) {
       double sum = 0.0;
-      for (const int p : body->points) sum += at[static_cast<size_t>(p)].z_m;
-      return body->points.empty() ? 0.0 : sum / static_cast<double>(body->points.size());
+      int finite = 0;
+      for (const int p : body->points) {
+        const double z = at[static_cast<size_t>(p)].z_m;
+        if (!std::isfinite(z)) continue;
+        sum += z;
+        ++finite;
+      }
+      return finite == 0 ? 0.0 : sum / finite;
     };
     std::stable_sort(bodies.begin(), bodies.end(),
                      [&](const SceneDrawing::Body* a, const SceneDrawing::Body* b) { return depth(a) < depth(b); });
