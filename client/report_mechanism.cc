@@ -31,8 +31,9 @@ std::vector<std::string> DesignSets(const spec::Study& study, const std::vector<
 void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data) {
   report::MechanismDrawings& mechanism = data->mechanism;
   const v1::Scene::ModelCase kind = job.study().scene().model_case();
-  if (kind != v1::Scene::kMultibody && kind != v1::Scene::kLinkage && kind != v1::Scene::kLumped) {
-    mechanism.note = "Only multibody, linkage and lumped scenes are drawn; this job's scene is of another kind.";
+  if (kind != v1::Scene::kMultibody && kind != v1::Scene::kLinkage && kind != v1::Scene::kLumped &&
+      kind != v1::Scene::kSpatial) {
+    mechanism.note = "Only multibody, linkage, spatial and lumped scenes are drawn; this job's scene is of another kind.";
     return;
   }
   absl::StatusOr<spec::Study> loaded = spec::io::StudyFromProto(job.study(), "the job's study");

@@ -125,7 +125,7 @@ function(mbopt_declare_modules)
     SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")
   mbopt_module(spatial DIRS worker/spatial USES multibody budget spec common PURE
     LIBS mbopt_spatial
-    SUMMARY "spatial multibody systems: the model, equations in absolute coordinates with Euler parameters as a multibody ConstrainedSystem (integrated by its IDAS forward dynamics), assembly, Euler angles, the `spatial` scene's analysis")
+    SUMMARY "spatial multibody systems: the model, equations in absolute coordinates with Euler parameters as a multibody ConstrainedSystem (integrated by its IDAS forward dynamics), assembly, Euler angles, the `spatial` scene's analysis and its drawing")
   mbopt_module(engine DIRS worker/engine USES budget fmu multibody spatial lumped spec common PURE
     LIBS mbopt_engine mbopt_study_values mbopt_study_sensitivities mbopt_evaluate_study mbopt_scene_drawing
     SUMMARY "one analysis of a scene (the table of model kinds), the one evaluation of a study at a design point, and the drawing of a scene")

@@ -8,9 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "client/report/drawing_views.h"
 #include "client/report/html_escape.h"
 #include "client/report/load_case_drawings.h"
 #include "client/report/number_format.h"
+#include "client/report/spatial_symbols.h"
 
 namespace mbopt::report {
 namespace {
@@ -133,6 +135,7 @@ Px Along(const Px& a, const Px& b, double f) { return Px{a.x + f * (b.x - a.x), 
 // A spring (zigzag), a damper (a pot and its piston) or both side by side
 // between a and b; neither: a dashed line (an actuator).
 std::string ElementSvg(Px a, Px b, const SceneDrawing::Element& e, const DrawingLayer& layer) {
+  if (e.bushing) return BushingSvg(ScreenPoint{a.x, a.y}, ScreenPoint{b.x, b.y}, e.name, layer.color);
   const double length = std::hypot(b.x - a.x, b.y - a.y);
   if (!(length > 1e-9)) return "";
   const Px u{(b.x - a.x) / length, (b.y - a.y) / length};
@@ -208,6 +211,12 @@ std::string JointSvg(const Px& at, const SceneDrawing::Joint& joint, double axis
       out += "<circle class=\"pin\" cx=\"" + Num(at.x) + "\" cy=\"" + Num(at.y) + "\" r=\"" + Num(kPinRadiusPx) +
              "\" fill=\"#ffffff\" " + stroke + "/>";
       break;
+    case SceneDrawing::JointKind::kSpherical:
+    case SceneDrawing::JointKind::kUniversal:
+    case SceneDrawing::JointKind::kCylindrical:
+    case SceneDrawing::JointKind::kPlanar:
+    case SceneDrawing::JointKind::kPointOnPlane:
+      break;  // spatial kinds only: SpatialJointSvg draws them
   }
   return out + "</g>";
 }
@@ -314,7 +323,29 @@ std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mappi
   std::string out = "<g class=\"layer\"";
   if (layer.opacity < 1.0) out += " opacity=\"" + FormatValue(layer.opacity, 3) + "\"";
   out += ">";
-  for (const SceneDrawing::Body& body : d.bodies) {
+  // A view of a spatial drawing paints the bodies farthest from the viewer
+  // first (by their points' mean depth), so nearer ones cover them.
+  std::vector<const SceneDrawing::Body*> bodies;
+  for (const SceneDrawing::Body& body : d.bodies) bodies.push_back(&body);
+  if (d.spatial) {
+    // Non-finite points (a motion that blew up) are left out, so the order
+    // stays a strict weak one.
+    auto depth = [&](const SceneDrawing::Body* body) {
+      double sum = 0.0;
+      int finite = 0;
+      for (const int p : body->points) {
+        const double z = at[static_cast<size_t>(p)].z_m;
+        if (!std::isfinite(z)) continue;
+        sum += z;
+        ++finite;
+      }
+      return finite == 0 ? 0.0 : sum / finite;
+    };
+    std::stable_sort(bodies.begin(), bodies.end(),
+                     [&](const SceneDrawing::Body* a, const SceneDrawing::Body* b) { return depth(a) < depth(b); });
+  }
+  for (const SceneDrawing::Body* body_ptr : bodies) {
+    const SceneDrawing::Body& body = *body_ptr;
     std::vector<Px> points;
     for (const int p : body.points) {
       if (Finite(at[static_cast<size_t>(p)])) points.push_back(px(p));
@@ -332,7 +363,18 @@ std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mappi
   for (const SceneDrawing::Joint& joint : d.joints) {
     if (joint.rotational_spring || joint.rotational_damper) out += RotationalElementSvg(px(joint.point), joint, layer);
   }
-  for (const SceneDrawing::Load& load : d.loads) out += LoadSvg(px(load.point), load);
+  for (const SceneDrawing::Load& load : d.loads) {
+    if (!d.spatial) {
+      out += LoadSvg(px(load.point), load);
+      continue;
+    }
+    const Px c = px(load.point);
+    const spec::DrawingDirection direction = instant < load.directions.size()
+                                                 ? load.directions[instant]
+                                                 : spec::DrawingDirection{load.direction_x, load.direction_y,
+                                                                          load.direction_z};
+    out += SpatialLoadSvg(ScreenPoint{c.x, c.y}, load, direction);
+  }
   // The points themselves, small, under the joints.
   for (size_t p = 0; p < at.size(); ++p) {
     const Px c = px(static_cast<int>(p));
@@ -340,6 +382,15 @@ std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mappi
            "\"><title>" + EscapeHtml(d.point_names[p]) + "</title></circle>";
   }
   for (const SceneDrawing::Joint& joint : d.joints) {
+    if (d.spatial) {
+      const Px c = px(joint.point);
+      const spec::DrawingDirection* axis =
+          instant < joint.axis_directions.size() ? &joint.axis_directions[instant] : nullptr;
+      const spec::DrawingDirection* second =
+          instant < joint.second_axis_directions.size() ? &joint.second_axis_directions[instant] : nullptr;
+      out += SpatialJointSvg(ScreenPoint{c.x, c.y}, joint, axis, second, layer.color, layer.fill);
+      continue;
+    }
     const double axis = instant < joint.axis_angle_rad.size() ? joint.axis_angle_rad[instant] : 0.0;
     out += JointSvg(px(joint.point), joint, axis, layer);
   }
@@ -360,27 +411,25 @@ std::vector<size_t> FrameInstants(size_t instants) {
   return picked;
 }
 
-}  // namespace
-
-std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, const std::string& id) {
-  std::vector<DrawingLayer> layers;
-  for (const DrawingLayer& layer : layers_in) {
-    if (layer.drawing != nullptr && !layer.drawing->points_m.empty()) layers.push_back(layer);
-  }
-  std::string out = "<div class=\"mechanism\" id=\"" + EscapeHtml(id) + "\">\n";
-  if (layers.empty()) return out + "<p class=\"note\">Nothing to draw.</p>\n</div>\n";
-  const Mapping map = MapOf(layers);
-  size_t instants = 0;
-  const std::vector<double>* times = nullptr;
+// The legend: one line per labelled layer.
+std::string LegendSvg(const std::vector<DrawingLayer>& layers) {
+  std::string out;
+  double y = 16;
   for (const DrawingLayer& layer : layers) {
-    if (layer.drawing->points_m.size() > instants) {
-      instants = layer.drawing->points_m.size();
-      times = &layer.drawing->times_s;
-    }
+    if (layer.label.empty()) continue;
+    out += "<rect x=\"10\" y=\"" + Num(y - 9) + "\" width=\"14\" height=\"9\" fill=\"" + layer.fill + "\" stroke=\"" +
+           layer.color + "\"/><text x=\"30\" y=\"" + Num(y) + "\" font-size=\"12\">" + EscapeHtml(layer.label) +
+           "</text>\n";
+    y += 16;
   }
-  const std::vector<size_t> frames = FrameInstants(instants);
-  out += "<svg class=\"drawing\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) + "\" viewBox=\"0 0 " +
-         Num(map.width) + " " + Num(map.height) + "\" role=\"img\">\n";
+  return out;
+}
+
+// The <svg> of planar drawings: one picture, x to the right and y up.
+std::string PlanarSheetSvg(const std::vector<DrawingLayer>& layers, const std::vector<size_t>& frames) {
+  const Mapping map = MapOf(layers);
+  std::string out = "<svg class=\"drawing\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) +
+                    "\" viewBox=\"0 0 " + Num(map.width) + " " + Num(map.height) + "\" role=\"img\">\n";
   out += "<rect x=\"0\" y=\"0\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) +
          "\" fill=\"#fcfcfc\" stroke=\"#dddddd\"/>\n";
   // Ground does not move: drawn once per layer, under the frames.
@@ -397,16 +446,128 @@ std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, cons
     }
     out += "</g>\n";
   }
-  // The legend: one line per layer.
-  double y = 16;
-  for (const DrawingLayer& layer : layers) {
-    if (layer.label.empty()) continue;
-    out += "<rect x=\"10\" y=\"" + Num(y - 9) + "\" width=\"14\" height=\"9\" fill=\"" + layer.fill + "\" stroke=\"" +
-           layer.color + "\"/><text x=\"30\" y=\"" + Num(y) + "\" font-size=\"12\">" + EscapeHtml(layer.label) +
-           "</text>\n";
-    y += 16;
+  return out + LegendSvg(layers) + "</svg>\n";
+}
+
+// The sheet of a spatial drawing: four views (drawing_views.h) on a 2 x 2
+// grid of cells half the figure wide, each frame showing the same instant
+// in all four.
+constexpr double kMaxCellHeightPx = 300.0;
+constexpr double kMinCellHeightPx = 150.0;
+
+std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::vector<size_t>& frames) {
+  const std::vector<DrawingView>& views = SpatialDrawingViews();
+  std::vector<std::vector<SceneDrawing>> viewed(views.size());
+  struct Span {
+    double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min, y_min = x_min, y_max = -x_min;
+  };
+  std::vector<Span> spans(views.size());
+  double size = 1e-6;
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (const DrawingLayer& layer : layers) {
+      viewed[v].push_back(InView(*layer.drawing, views[v]));
+      for (const std::vector<spec::DrawingPosition>& instant : viewed[v].back().points_m) {
+        for (const spec::DrawingPosition& p : instant) {
+          if (!Finite(p)) continue;
+          spans[v].x_min = std::min(spans[v].x_min, p.x_m);
+          spans[v].x_max = std::max(spans[v].x_max, p.x_m);
+          spans[v].y_min = std::min(spans[v].y_min, p.y_m);
+          spans[v].y_max = std::max(spans[v].y_max, p.y_m);
+        }
+      }
+    }
+    if (std::isfinite(spans[v].x_min)) {
+      size = std::max({size, spans[v].x_max - spans[v].x_min, spans[v].y_max - spans[v].y_min});
+    } else {
+      spans[v] = Span{0.0, 0.0, 0.0, 0.0};
+    }
   }
-  out += "</svg>\n";
+  // A view of points on a line still gets an area, as a planar drawing.
+  auto width_of = [&](size_t v) { return std::max(spans[v].x_max - spans[v].x_min, 0.05 * size); };
+  auto height_of = [&](size_t v) { return std::max(spans[v].y_max - spans[v].y_min, 0.05 * size); };
+  const double cell_width = kWidthPx / 2, inner_width = cell_width - 2 * kMarginPx;
+  double scale = std::numeric_limits<double>::infinity();
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (views[v].isometric) continue;
+    scale = std::min({scale, inner_width / width_of(v), (kMaxCellHeightPx - 2 * kMarginPx) / height_of(v)});
+  }
+  double row_height[2] = {kMinCellHeightPx, kMinCellHeightPx};
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (views[v].isometric) continue;
+    double& h = row_height[views[v].row];
+    h = std::max(h, height_of(v) * scale + 2 * kMarginPx);
+  }
+  std::vector<Mapping> maps(views.size());
+  for (size_t v = 0; v < views.size(); ++v) {
+    const double h = row_height[views[v].row], top = views[v].row == 0 ? 0.0 : row_height[0];
+    Mapping& m = maps[v];
+    m.scale = views[v].isometric ? std::min(inner_width / width_of(v), (h - 2 * kMarginPx) / height_of(v)) : scale;
+    m.x0 = 0.5 * (spans[v].x_min + spans[v].x_max) - width_of(v) / 2;
+    m.y0 = 0.5 * (spans[v].y_min + spans[v].y_max) + height_of(v) / 2;
+    m.offset_x = views[v].column * cell_width + kMarginPx + 0.5 * (inner_width - width_of(v) * m.scale);
+    m.offset_y = top + 0.5 * (h - height_of(v) * m.scale);
+  }
+  const double width = kWidthPx, height = row_height[0] + row_height[1];
+  std::string out = "<svg class=\"drawing spatial\" width=\"" + Num(width) + "\" height=\"" + Num(height) +
+                    "\" viewBox=\"0 0 " + Num(width) + " " + Num(height) + "\" role=\"img\">\n";
+  out += "<rect x=\"0\" y=\"0\" width=\"" + Num(width) + "\" height=\"" + Num(height) +
+         "\" fill=\"#fcfcfc\" stroke=\"#dddddd\"/>\n";
+  for (size_t v = 0; v < views.size(); ++v) {
+    const double x = views[v].column * cell_width, top = views[v].row == 0 ? 0.0 : row_height[0];
+    const double h = row_height[views[v].row];
+    out += "<g class=\"view\"><rect x=\"" + Num(x) + "\" y=\"" + Num(top) + "\" width=\"" + Num(cell_width) +
+           "\" height=\"" + Num(h) + "\" fill=\"none\" stroke=\"#e4e4e4\"/><text x=\"" + Num(x + 8) + "\" y=\"" +
+           Num(top + h - 8) + "\" font-size=\"11\" fill=\"#666666\">" + EscapeHtml(views[v].label) + "</text>";
+    // Ground does not move: drawn once per layer, under the frames.
+    for (size_t l = 0; l < layers.size(); ++l) {
+      DrawingLayer layer = layers[l];
+      layer.drawing = &viewed[v][l];
+      for (const int p : layer.drawing->ground_points) {
+        out += GroundSvg(maps[v](layer.drawing->points_m[0][static_cast<size_t>(p)]), layer);
+      }
+    }
+    out += "</g>\n";
+  }
+  for (size_t f = 0; f < frames.size(); ++f) {
+    out += "<g class=\"frame\"" + std::string(f == 0 ? "" : " display=\"none\"") + ">";
+    for (size_t v = 0; v < views.size(); ++v) {
+      for (size_t l = 0; l < layers.size(); ++l) {
+        DrawingLayer layer = layers[l];
+        layer.drawing = &viewed[v][l];
+        out += LayerFrameSvg(layer, std::min(frames[f], layer.drawing->points_m.size() - 1), maps[v]);
+      }
+    }
+    out += "</g>\n";
+  }
+  return out + LegendSvg(layers) + "</svg>\n";
+}
+
+}  // namespace
+
+std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, const std::string& id) {
+  std::vector<DrawingLayer> layers;
+  for (const DrawingLayer& layer : layers_in) {
+    if (layer.drawing != nullptr && !layer.drawing->points_m.empty()) layers.push_back(layer);
+  }
+  std::string out = "<div class=\"mechanism\" id=\"" + EscapeHtml(id) + "\">\n";
+  if (layers.empty()) return out + "<p class=\"note\">Nothing to draw.</p>\n</div>\n";
+  size_t instants = 0;
+  const std::vector<double>* times = nullptr;
+  bool spatial = false;
+  for (const DrawingLayer& layer : layers) {
+    spatial = spatial || layer.drawing->spatial;
+    if (layer.drawing->points_m.size() > instants) {
+      instants = layer.drawing->points_m.size();
+      times = &layer.drawing->times_s;
+    }
+  }
+  const std::vector<size_t> frames = FrameInstants(instants);
+  out += spatial ? SpatialSheetSvg(layers, frames) : PlanarSheetSvg(layers, frames);
+  if (spatial) {
+    out += "<p class=\"note\">Views of world axes in third-angle arrangement: top (x-y) above front (x-z), the "
+           "right side (y-z, seen from +x) beside the front, one scale for the three; the isometric view is scaled "
+           "to fit.</p>\n";
+  }
   std::string time_list;
   for (const size_t f : frames) {
     time_list += (time_list.empty() ? "" : ",") + std::string("\"") +

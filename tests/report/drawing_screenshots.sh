@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Screenshots of scene drawings for docs/report.md, in headless Chromium,
 # each page opened at one frame of its animation ("#frame=N"):
-#  - `mbopt draw` on the press, the isolator, the four-bar and the vehicle:
+#  - `mbopt draw` on the press, the isolator, the four-bar, the vehicle and
+#    the suspension (a spatial scene):
 #    docs/images/drawing_<scene>.png;
 #  - the report of the press, isolator and vehicle studies optimized with
 #    `mbopt run`, its top (header and "Mechanism"):
@@ -40,6 +41,7 @@ scenes=(
   "isolator/isolator.scene.textproto 40 700"
   "fourbar/fourbar_rigid.scene.textproto 20 680"
   "vehicle/vehicle.scene.textproto 0 700"
+  "suspension/suspension.scene.textproto 28 800"
 )
 for scene in "${scenes[@]}"; do
   read -r file frame height <<<"$scene"

@@ -7,6 +7,7 @@
 #include "worker/lumped/lumped_schematic.h"
 #include "worker/multibody/linkage_geometry.h"
 #include "worker/multibody/scene_geometry.h"
+#include "worker/spatial/spatial_drawing.h"
 
 namespace mbopt::engine {
 
@@ -18,10 +19,11 @@ absl::StatusOr<spec::SceneDrawing> DrawScene(const spec::Scene& scene, const std
   }
   if (std::holds_alternative<spec::MultibodyModel>(scene.model)) return multibody::DrawMultibodyScene(scene, p, budget);
   if (std::holds_alternative<spec::LinkageModel>(scene.model)) return multibody::DrawLinkageScene(scene, p, budget);
+  if (std::holds_alternative<spec::SpatialModel>(scene.model)) return spatial::DrawSpatialScene(scene, p, budget);
   if (std::holds_alternative<spec::LumpedModel>(scene.model)) return lumped::LumpedSchematic(scene, p);
   return absl::InvalidArgumentError(absl::StrFormat(
-      "scene '%s' (%s): only multibody, linkage and lumped scenes can be drawn; an external or FMU scene's "
-      "geometry is not known to mbopt, and spatial scenes are not drawn yet",
+      "scene '%s' (%s): only multibody, linkage and lumped scenes can be drawn, and spatial ones; an "
+      "external or FMU scene's geometry is not known to mbopt",
       scene.name, scene.source_file));
 }
 

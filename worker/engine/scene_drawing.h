@@ -1,7 +1,7 @@
-// The drawing of a scene at one design point, by model kind: multibody and
-// linkage scenes over their time grid, lumped scenes as a schematic. What
-// `mbopt-worker draw` writes; never part of an analysis (a scene computes
-// only the outputs asked for, and a drawing is not one).
+// The drawing of a scene at one design point, by model kind: multibody,
+// linkage and spatial scenes over their time grid, lumped scenes as a
+// schematic. What `mbopt-worker draw` writes; never part of an analysis (a
+// scene computes only the outputs asked for, and a drawing is not one).
 #pragma once
 
 #include <vector>
