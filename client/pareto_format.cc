@@ -110,14 +110,32 @@ std::string SecondObjectiveLabel(const v1::Objective& o) {
   }
 }
 
+namespace {
+
+std::string SharedTermUnit(const v1::Objective& o) {
+  const auto& terms = o.minimize_max_over().terms();
+  if (terms.empty()) return "";
+  for (const v1::WeightedTerm& t : terms) {
+    const bool unweighted = t.weight() == 0.0 || t.weight() == 1.0;  // 0: not given
+    if (t.unit().empty() || t.unit() != terms[0].unit() || !unweighted) return "";
+  }
+  return terms[0].unit();
+}
+
+}  // namespace
+
 SecondObjectiveShown ShowSecondObjective(const v1::Study& study) {
   SecondObjectiveShown shown;
   const v1::Pareto& pareto = study.pareto();
   if (pareto.has_objective()) {
     shown.objective = true;
     shown.label = SecondObjectiveLabel(pareto.objective());
-    // An objective's values are in its unit already.
+    // An objective's values are in its unit already. A largest of terms
+    // has no unit of its own (the loader refuses one); its terms' values are
+    // each in their term's unit, so one unit shared by every term, none of
+    // them weighted, is the largest's unit too.
     shown.unit = pareto.objective().unit();
+    if (pareto.objective().form_case() == v1::Objective::kMinimizeMaxOver) shown.unit = SharedTermUnit(pareto.objective());
     // The runs minimize a maximized value's negative; it is shown as itself.
     if (pareto.objective().form_case() == v1::Objective::kMaximize) {
       shown.maximized = true;

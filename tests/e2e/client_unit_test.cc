@@ -417,6 +417,27 @@ TEST(ParetoFormat, ASecondObjectiveIsNamedByWhatItIsAndAMaximizedOneShownAsItsel
   EXPECT_EQ(client::SecondObjectiveLabel(sum), "F2: sum of 2 terms");
 }
 
+// A largest of terms may not state a unit of its own; when every term is
+// taken in one unit and none is weighted, the front's columns carry it.
+TEST(ParetoFormat, ALargestOfTermsInOneUnitIsShownInIt) {
+  v1::Study study;
+  v1::MaxOver* over = study.mutable_pareto()->mutable_objective()->mutable_minimize_max_over();
+  for (const char* output : {"s2", "s3"}) {
+    v1::WeightedTerm* t = over->add_terms();
+    t->set_output(output);
+    t->set_reduction(v1::REDUCTION_MAX_ABS);
+    t->set_unit("in");
+  }
+  EXPECT_EQ(client::ShowSecondObjective(study).unit, "in");
+  EXPECT_NE(client::ParetoWatchHeader(&study).find("F2: largest of 2 terms [in]"), std::string::npos)
+      << client::ParetoWatchHeader(&study);
+  over->mutable_terms(1)->set_weight(2.0);  // a weighted term: the largest is in no one unit
+  EXPECT_EQ(client::ShowSecondObjective(study).unit, "");
+  over->mutable_terms(1)->set_weight(0.0);
+  over->mutable_terms(1)->set_unit("mm");
+  EXPECT_EQ(client::ShowSecondObjective(study).unit, "");
+}
+
 // A point's run's cycle records (pareto_point set, just before the point's
 // record) are its history: `--point K` lists them as a cycle table and the
 // JSON has them per point; they are no points of the front.

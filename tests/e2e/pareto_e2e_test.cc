@@ -133,7 +133,7 @@ TEST(ParetoEndToEnd, TheTravelExampleRunsItsSecondObjectiveThroughTheCli) {
   ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);
   const std::string& text = run.stdout_text;
   EXPECT_NE(text.find("points:        5 of 5 on the Pareto front computed"), std::string::npos) << text;
-  EXPECT_NE(text.find("F2: largest of 2 terms"), std::string::npos) << text;
+  EXPECT_NE(text.find("F2: largest of 2 terms [in]"), std::string::npos) << text;
   auto csv = Mbopt({"results", "job-1", "--csv", "--db", db}, env);
   ASSERT_EQ(csv.exit_code, kExitOk) << Describe(csv);
   const std::vector<std::string> lines = SplitOn(csv.stdout_text, '\n');
