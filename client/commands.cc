@@ -125,11 +125,7 @@ int FailRpc(const grpc::Status& status, const std::string& address,
 
 // One job with its cycle history and study, as the server keeps it.
 grpc::Status GetJob(Connection& c, const std::string& job_id, v1::GetJobResponse* response) {
-  v1::JobRef ref;
-  ref.set_job_id(job_id);
-  grpc::ClientContext context;
-  SetUnaryDeadline(&context);
-  return c.job_service->Get(&context, ref, response);
+  return client::GetJob(*c.job_service, job_id, response);
 }
 
 // Follows a job to its end, printing the table; returns the exit code of its

@@ -59,4 +59,12 @@ void SetUnaryDeadline(grpc::ClientContext* context) {
                         std::chrono::seconds(kUnaryDeadlineSeconds));
 }
 
+grpc::Status GetJob(v1::JobService::Stub& job_service, const std::string& job_id, v1::GetJobResponse* response) {
+  v1::JobRef ref;
+  ref.set_job_id(job_id);
+  grpc::ClientContext context;
+  SetUnaryDeadline(&context);
+  return job_service.Get(&context, ref, response);
+}
+
 }  // namespace mbopt::client

@@ -41,4 +41,8 @@ RpcFailure DescribeRpcFailure(const grpc::Status& status, const std::string& add
 inline constexpr int kUnaryDeadlineSeconds = 30;
 void SetUnaryDeadline(grpc::ClientContext* context);
 
+// One job with its cycle history and study, as the server keeps it (a
+// unary Get with the deadline above).
+grpc::Status GetJob(v1::JobService::Stub& job_service, const std::string& job_id, v1::GetJobResponse* response);
+
 }  // namespace mbopt::client

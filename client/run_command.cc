@@ -176,14 +176,7 @@ int RunCommandMain(const Args& args) {
   WatchOutcome outcome = WatchJob(*job_service, address, job_id, watch_options);
 
   v1::GetJobResponse job;
-  grpc::Status get_status;
-  {
-    v1::JobRef ref;
-    ref.set_job_id(job_id);
-    grpc::ClientContext context;
-    SetUnaryDeadline(&context);
-    get_status = job_service->Get(&context, ref, &job);
-  }
+  const grpc::Status get_status = GetJob(*job_service, job_id, &job);
   // Close our connection first: a server that is stopping waits out its
   // grace period (server/service/server.cc) for clients still connected.
   job_service.reset();

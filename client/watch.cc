@@ -35,12 +35,8 @@ void DrawProgress(const WatchOptions& options, const v1::JobSummary& s) {
 // The study of a job, for the lines of its front's points; null when the
 // server does not give it (the lines then show the raw values).
 std::unique_ptr<v1::Study> StudyOfJob(v1::JobService::Stub& job_service, const std::string& job_id) {
-  v1::JobRef ref;
-  ref.set_job_id(job_id);
   v1::GetJobResponse job;
-  grpc::ClientContext context;
-  SetUnaryDeadline(&context);
-  if (!job_service.Get(&context, ref, &job).ok() || !job.has_study()) return nullptr;
+  if (!GetJob(job_service, job_id, &job).ok() || !job.has_study()) return nullptr;
   return std::unique_ptr<v1::Study>(job.release_study());
 }
 
