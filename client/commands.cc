@@ -142,14 +142,7 @@ int Follow(Connection& c, const std::string& job_id) {
   }
   if (!outcome.ok) return Fail(outcome.failure.message, outcome.failure.exit_code);
   const auto& s = outcome.summary;
-  std::printf("%s: %s after %d %s, %lld analyses", job_id.c_str(), StateName(s.state()).c_str(),
-              s.cycles(), s.design_set() ? "designs" : "cycles", static_cast<long long>(s.analyses()));
-  if (std::isfinite(s.objective())) {
-    std::printf(", F = %.10g %s, max violation %.4g\n", s.objective(), s.objective_unit().c_str(),
-                s.max_violation());
-  } else {
-    std::printf(", no design analysed\n");
-  }
+  std::fputs(WatchEndLine(job_id, s).c_str(), stdout);
   if (!s.message().empty()) std::printf("%s\n", s.message().c_str());
   return ExitCodeForState(s.state());
 }

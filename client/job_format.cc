@@ -173,6 +173,23 @@ std::string ListHeader() {
   return buf;
 }
 
+std::string WatchEndLine(const std::string& job_id, const v1::JobSummary& s) {
+  if (s.pareto()) {
+    // A front has no one F: each point has its own, listed by `results`.
+    return absl::StrFormat("%s: %s after %d of %d points, %d analyses; `mbopt results %s` lists the front\n", job_id,
+                           StateName(s.state()), s.cycles(), s.max_cycles(), s.analyses(), job_id);
+  }
+  std::string out = absl::StrFormat("%s: %s after %d %s, %d analyses", job_id, StateName(s.state()), s.cycles(),
+                                    s.design_set() ? "designs" : "cycles", s.analyses());
+  if (std::isfinite(s.objective())) {
+    out += absl::StrFormat(", F = %.10g %s, max violation %.4g\n", s.objective(), s.objective_unit(),
+                           s.max_violation());
+  } else {
+    out += ", no design analysed\n";
+  }
+  return out;
+}
+
 std::string ListRow(const v1::JobSummary& s) {
   char buf[512];
   const std::string objective = std::isfinite(s.objective()) ? Format("%.7g", s.objective()) : "-";

@@ -26,6 +26,9 @@ std::string CycleTableRow(const v1::CycleRecord& record);
 // variable and the parameter it sets: "x1 = 5  (k1 = 50 lbf/in)"; without
 // it, only the parameter value, which is all the summary carries.
 std::string SummaryText(const v1::JobSummary& summary, const v1::Study* study = nullptr);
+// The line `watch` ends with: the state, cycles (designs, or points of a
+// front) and analyses, and the objective where the job has one.
+std::string WatchEndLine(const std::string& job_id, const v1::JobSummary& summary);
 // One line for `list`.
 std::string ListHeader();
 std::string ListRow(const v1::JobSummary& summary);

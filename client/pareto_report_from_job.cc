@@ -22,6 +22,7 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
   data.state = StateName(s.state());
   data.message = s.message();
   data.objective_unit = s.objective_unit();
+  data.objective_maximized = !job.study().objective().maximize().empty();
   data.against = front.against;
   data.against_unit = front.unit;
   data.against_objective = front.against_objective;

@@ -58,10 +58,21 @@ std::string Pair(const Px& p) { return Num(p.x) + "," + Num(p.y); }
 
 bool Finite(const spec::DrawingPosition& p) { return std::isfinite(p.x_m) && std::isfinite(p.y_m); }
 
-Mapping MapOf(const std::vector<DrawingLayer>& layers) {
+// The drawings a figure's axes hold: its layers' and the `extent` it shares.
+std::vector<const SceneDrawing*> AxesDrawings(const std::vector<DrawingLayer>& layers,
+                                              const std::vector<const SceneDrawing*>& extent) {
+  std::vector<const SceneDrawing*> drawings;
+  for (const DrawingLayer& layer : layers) drawings.push_back(layer.drawing);
+  for (const SceneDrawing* d : extent) {
+    if (d != nullptr) drawings.push_back(d);
+  }
+  return drawings;
+}
+
+Mapping MapOf(const std::vector<const SceneDrawing*>& drawings) {
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min, y_min = x_min, y_max = -x_min;
-  for (const DrawingLayer& layer : layers) {
-    for (const std::vector<spec::DrawingPosition>& instant : layer.drawing->points_m) {
+  for (const SceneDrawing* drawing : drawings) {
+    for (const std::vector<spec::DrawingPosition>& instant : drawing->points_m) {
       for (const spec::DrawingPosition& p : instant) {
         if (!Finite(p)) continue;
         x_min = std::min(x_min, p.x_m);
@@ -397,20 +408,6 @@ std::string LayerFrameSvg(const DrawingLayer& layer, size_t instant, const Mappi
   return out + "</g>";
 }
 
-// The instants shown: all, or kMaxDrawingFrames picked evenly.
-std::vector<size_t> FrameInstants(size_t instants) {
-  std::vector<size_t> picked;
-  if (instants <= static_cast<size_t>(kMaxDrawingFrames)) {
-    for (size_t i = 0; i < instants; ++i) picked.push_back(i);
-    return picked;
-  }
-  for (int k = 0; k < kMaxDrawingFrames; ++k) {
-    picked.push_back(static_cast<size_t>(std::llround(static_cast<double>(k) * static_cast<double>(instants - 1) /
-                                                      (kMaxDrawingFrames - 1))));
-  }
-  return picked;
-}
-
 // The legend: one line per labelled layer.
 std::string LegendSvg(const std::vector<DrawingLayer>& layers) {
   std::string out;
@@ -426,8 +423,9 @@ std::string LegendSvg(const std::vector<DrawingLayer>& layers) {
 }
 
 // The <svg> of planar drawings: one picture, x to the right and y up.
-std::string PlanarSheetSvg(const std::vector<DrawingLayer>& layers, const std::vector<size_t>& frames) {
-  const Mapping map = MapOf(layers);
+std::string PlanarSheetSvg(const std::vector<DrawingLayer>& layers, const std::vector<size_t>& frames,
+                           const std::vector<const SceneDrawing*>& extent) {
+  const Mapping map = MapOf(AxesDrawings(layers, extent));
   std::string out = "<svg class=\"drawing\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) +
                     "\" viewBox=\"0 0 " + Num(map.width) + " " + Num(map.height) + "\" role=\"img\">\n";
   out += "<rect x=\"0\" y=\"0\" width=\"" + Num(map.width) + "\" height=\"" + Num(map.height) +
@@ -455,7 +453,8 @@ std::string PlanarSheetSvg(const std::vector<DrawingLayer>& layers, const std::v
 constexpr double kMaxCellHeightPx = 300.0;
 constexpr double kMinCellHeightPx = 150.0;
 
-std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::vector<size_t>& frames) {
+std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::vector<size_t>& frames,
+                            const std::vector<const SceneDrawing*>& extent) {
   const std::vector<DrawingView>& views = SpatialDrawingViews();
   std::vector<std::vector<SceneDrawing>> viewed(views.size());
   struct Span {
@@ -464,9 +463,13 @@ std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::
   std::vector<Span> spans(views.size());
   double size = 1e-6;
   for (size_t v = 0; v < views.size(); ++v) {
-    for (const DrawingLayer& layer : layers) {
-      viewed[v].push_back(InView(*layer.drawing, views[v]));
-      for (const std::vector<spec::DrawingPosition>& instant : viewed[v].back().points_m) {
+    for (const DrawingLayer& layer : layers) viewed[v].push_back(InView(*layer.drawing, views[v]));
+    std::vector<SceneDrawing> in_view = viewed[v];
+    for (const SceneDrawing* shared : extent) {
+      if (shared != nullptr) in_view.push_back(InView(*shared, views[v]));
+    }
+    for (const SceneDrawing& drawing : in_view) {
+      for (const std::vector<spec::DrawingPosition>& instant : drawing.points_m) {
         for (const spec::DrawingPosition& p : instant) {
           if (!Finite(p)) continue;
           spans[v].x_min = std::min(spans[v].x_min, p.x_m);
@@ -544,7 +547,21 @@ std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::
 
 }  // namespace
 
-std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, const std::string& id) {
+std::vector<size_t> FrameInstants(size_t instants) {
+  std::vector<size_t> picked;
+  if (instants <= static_cast<size_t>(kMaxDrawingFrames)) {
+    for (size_t i = 0; i < instants; ++i) picked.push_back(i);
+    return picked;
+  }
+  for (int k = 0; k < kMaxDrawingFrames; ++k) {
+    picked.push_back(static_cast<size_t>(std::llround(static_cast<double>(k) * static_cast<double>(instants - 1) /
+                                                      (kMaxDrawingFrames - 1))));
+  }
+  return picked;
+}
+
+std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, const std::string& id,
+                                const std::vector<const SceneDrawing*>& extent_in) {
   std::vector<DrawingLayer> layers;
   for (const DrawingLayer& layer : layers_in) {
     if (layer.drawing != nullptr && !layer.drawing->points_m.empty()) layers.push_back(layer);
@@ -562,7 +579,12 @@ std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, cons
     }
   }
   const std::vector<size_t> frames = FrameInstants(instants);
-  out += spatial ? SpatialSheetSvg(layers, frames) : PlanarSheetSvg(layers, frames);
+  std::vector<const SceneDrawing*> extent;
+  for (const SceneDrawing* d : extent_in) {
+    // Only drawings of the figure's kind: a plane's axes are not a view's.
+    if (d != nullptr && !d->points_m.empty() && d->spatial == spatial) extent.push_back(d);
+  }
+  out += spatial ? SpatialSheetSvg(layers, frames, extent) : PlanarSheetSvg(layers, frames, extent);
   if (spatial) {
     out += "<p class=\"note\">Views of world axes in third-angle arrangement: top (x-y) above front (x-z), the "
            "right side (y-z, seen from +x) beside the front, one scale for the three; the isometric view is scaled "
@@ -611,7 +633,9 @@ std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, cons
          "button.textContent=\"Play\";return;}button.textContent=\"Pause\";timer=setInterval(function(){"
          "show((shown+1)%frames.length);}," +
          std::to_string(kFrameIntervalMs) +
-         ");});var asked=/frame=([0-9]+)/.exec(location.hash);"
+         ");});root.showTime=function(t){var best=0;for(var i=1;i<times.length;i++){"
+         "if(Math.abs(Number(times[i])-t)<Math.abs(Number(times[best])-t))best=i;}show(best);};"
+         "var asked=/frame=([0-9]+)/.exec(location.hash);"
          "if(asked)show(Math.min(Number(asked[1]),frames.length-1));})();</script>\n";
   return out + "</div>\n";
 }

@@ -34,9 +34,19 @@ struct DrawingLayer {
 // kept): a page stays a few hundred kilobytes whatever the grid.
 inline constexpr int kMaxDrawingFrames = 240;
 
+// The instants of a grid of `instants` drawn as frames: all, or
+// kMaxDrawingFrames picked evenly.
+std::vector<size_t> FrameInstants(size_t instants);
+
 // The figure (<div> with the <svg>, the controls and its script); `id`
-// makes its elements' ids unique on a page (letters, digits, '-').
-std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers, const std::string& id);
+// makes its elements' ids unique on a page (letters, digits, '-'). An
+// animated figure's element has a function showTime(t), which shows the
+// frame nearest t (s): a page's other controls move it. The axes hold
+// every instant of the layers and of `extent`, drawings not drawn here
+// (the other load cases' on a page), so figures given each other's
+// drawings share one scale and window.
+std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers, const std::string& id,
+                                const std::vector<const spec::SceneDrawing*>& extent = {});
 
 // One load case of a study (spec::LoadCase): the scene with the parameters
 // the case sets, at both designs; `note` says why one is missing.

@@ -212,7 +212,8 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
     // A maximized second objective is held above its level, and its
     // best value is the greatest.
     const bool maximized = data.against_maximized;
-    out += "<p class=\"note\">Each point is one optimization: the least F with " + EscapeHtml(data.against) +
+    out += std::string("<p class=\"note\">Each point is one optimization: the ") +
+           (data.objective_maximized ? "greatest" : "least") + " F with " + EscapeHtml(data.against) +
            (maximized ? " held above" : " held below") + " the point's level (point 1: " + EscapeHtml(data.against) +
            " free; at the other end: its " + (maximized ? "greatest" : "least") +
            " value; points added where the front bends are numbered "

@@ -28,6 +28,7 @@ struct ParetoReportData {
   std::string state;
   std::string message;
   std::string objective_unit;
+  bool objective_maximized = false;  // F is a value the study maximizes: each point its greatest
   std::string against;       // the traded constraint's name, or the second objective's label
   bool against_objective = false;  // the second objective is an objective, not a constraint's value
   bool against_maximized = false;  // ... a maximized one: values as themselves, a level a least value

@@ -222,6 +222,28 @@ TEST(JobState, ExitCodesFollowTheOutcome) {
   EXPECT_TRUE(client::IsTerminal(v1::JOB_STATE_COMPLETED));
 }
 
+// `watch` ends with the job's outcome; a front's has its points and no F,
+// which would be one point's among many.
+TEST(WatchEndLine, AnOptimizationHasItsFAndAFrontItsPoints) {
+  v1::JobSummary s;
+  s.set_state(v1::JOB_STATE_CONVERGED);
+  s.set_cycles(10);
+  s.set_analyses(71);
+  s.set_objective(6.389035698);
+  s.set_objective_unit("m/s^2");
+  s.set_max_violation(-0.06324);
+  EXPECT_EQ(client::WatchEndLine("job-1", s),
+            "job-1: converged after 10 cycles, 71 analyses, F = 6.389035698 m/s^2, max violation -0.06324\n");
+  s.set_state(v1::JOB_STATE_COMPLETED);
+  s.set_pareto(true);
+  s.set_design_set(true);
+  s.set_cycles(5);
+  s.set_max_cycles(5);
+  s.set_analyses(234);
+  EXPECT_EQ(client::WatchEndLine("job-2", s),
+            "job-2: completed after 5 of 5 points, 234 analyses; `mbopt results job-2` lists the front\n");
+}
+
 // A sweep of k over two designs, the second failed: every format lists both,
 // the failed one without values and with its kind and reason.
 v1::GetJobResponse TwoDesignSweep() {

@@ -2,6 +2,7 @@
 // (examples/vehicle/vehicle_pareto.study.textproto) run in process, and one
 // of its points made again by a separate single run: the ride-comfort study
 // with the point's level written as the ordinary limit of s1.
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -125,6 +126,53 @@ TEST(VehicleParetoFront, ASecondObjectiveOfTheSeatTravelGivesTheFrontAgainstItsC
     EXPECT_TRUE(o.accepted) << "point " << k + 1 << ": " << o.rejection_reason;
     EXPECT_NEAR(o.objective_x0, c.objective_x0, kSameOptimumRelative * c.objective_x0) << "point " << k + 1;
     EXPECT_NEAR(o.pareto_value_si, travel_in, kSameOptimumRelative * travel_in) << "point " << k + 1;
+  }
+}
+
+// The comfort-against-axle-travel front (vehicle_pareto_travel.study.
+// textproto: the second objective the largest of |s2| and |s3| in inches)
+// point by point: each interior point's F is that of a separate single run
+// of the ride-comfort study whose s2 and s3 limits are lowered to the
+// point's level (the largest of the two at or below a level is both at or
+// below it).
+TEST(VehicleParetoFront, EachInteriorPointOfTheTravelFrontIsASingleRunsOptimum) {
+  absl::StatusOr<spec::Study> study =
+      spec::io::LoadStudyFile("examples/vehicle/vehicle_pareto_travel.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_TRUE(study->pareto.trades_objective);
+  const std::vector<slp::CycleRecord> front = RunFront(*study);
+  ASSERT_EQ(front.size(), static_cast<size_t>(kPoints));
+  int s2 = -1, s3 = -1;
+  for (size_t c = 0; c < study->constraints.size(); ++c) {
+    if (study->constraints[c].name == "s2") s2 = static_cast<int>(c);
+    if (study->constraints[c].name == "s3") s3 = static_cast<int>(c);
+  }
+  ASSERT_GE(s2, 0);
+  ASSERT_GE(s3, 0);
+  for (int k = 1; k + 1 < kPoints; ++k) {
+    const slp::CycleRecord& point = front[static_cast<size_t>(k)];
+    ASSERT_TRUE(point.accepted) << "point " << k + 1 << ": " << point.rejection_reason;
+    // A second objective's level and value are in its unit, inches here.
+    const double level_in = point.pareto_level_si;
+    spec::Study single = *study;
+    single.pareto = spec::Pareto{};
+    single.second_objective = spec::Objective{};
+    for (int c : {s2, s3}) {
+      spec::Constraint& limit = single.constraints[static_cast<size_t>(c)];
+      ASSERT_EQ(limit.unit, "in");
+      ASSERT_EQ(limit.reduction, spec::Reduction::kMaxAbs);
+      limit.limit = std::min(limit.limit, level_in);
+    }
+    absl::StatusOr<LocalRunResult> run = RunStudyLocally(single, LocalRunOptions{});
+    ASSERT_TRUE(run.ok()) << run.status();
+    std::cout << std::setprecision(10) << "point " << k + 1 << " (level " << level_in << " in): F "
+              << point.objective_x0 << " m/s^2, peak travel " << point.pareto_value_si
+              << " in; the single run: F " << run->outcome.objective << ", " << run->outcome.analyses
+              << " analyses\n";
+    EXPECT_EQ(run->outcome.state, slp::RunState::kConverged) << run->end_reason;
+    EXPECT_LE(run->outcome.max_violation, 0.0);
+    EXPECT_NEAR(run->outcome.objective, point.objective_x0, kSameOptimumRelative * point.objective_x0)
+        << "point " << k + 1;
   }
 }
 

@@ -138,9 +138,25 @@ class PythonClientTest(unittest.TestCase):
         self.assertIn("points: 5", text)
         study = self.write("vehicle_pareto3.study.textproto", text.replace("points: 5", "points: 3", 1))
         job = self.client.submit(study)
-        self.assertEqual(self.client.wait(job).status, "completed")
+        # Followed point by point: each point once, as its run ends, with
+        # its run's history; the runs' cycle records are not yielded.
+        watched, statuses = [], []
+        for event in self.client.watch_front(job):
+            (statuses if isinstance(event, mbopt.JobStatus) else watched).append(event)
+        self.assertEqual(statuses[-1].status, "completed")
+        done = [s.cycles for s in statuses]
+        self.assertEqual(done, sorted(done))
+        self.assertEqual(len(set((s.status, s.cycles) for s in statuses)), len(statuses))
         front = self.client.results(job)
         self.assertIsInstance(front, mbopt.FrontResults)
+        self.assertEqual([p["point"] for p in watched], [1, 2, 3])
+        for p, q in zip(watched, front.points):
+            self.assertEqual(p.pop("run_status"), "feasible")
+            self.assertEqual(p, {k: v for k, v in q.items() if k != "status"})
+        sweep = self.client.submit(VEHICLE_SWEEP)
+        with self.assertRaises(ValueError):
+            next(self.client.watch_front(sweep))
+        self.client.cancel(sweep)  # the other tests share the worker
         self.assertEqual((front.against, front.against_unit, front.points_done), ("s1", "in", 3))
         self.assertEqual([p["point"] for p in front.points], [1, 2, 3])
         records = {r.cycle: r for r in self.client.get(job).cycles if r.pareto}

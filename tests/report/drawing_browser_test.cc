@@ -12,8 +12,10 @@
 
 #include <gtest/gtest.h>
 
+#include "client/report/load_case_drawings.h"
 #include "client/report/mechanism_drawing.h"
 #include "tests/report/headless_chromium.h"
+#include "tests/report/markup_checker.h"
 #include "tests/report/png_decoder.h"
 
 namespace mbopt::report {
@@ -27,8 +29,9 @@ constexpr int kHeightPx = 700;
 // with the background, the inside of a 14 px wide bar keeps the colour.
 constexpr int kColorTolerance = 12;
 
-// A crank 1 m long turning once over 20 instants about a hatched ground pin.
-spec::SceneDrawing Crank() {
+// A crank 1 m long turning once over `instants` instants, 1/20 s apart,
+// about a hatched ground pin.
+spec::SceneDrawing Crank(int instants = 20) {
   spec::SceneDrawing d;
   d.scene_name = "crank";
   const int o = d.AddPoint("O"), a = d.AddPoint("A");
@@ -36,7 +39,7 @@ spec::SceneDrawing Crank() {
   d.joints.push_back({"O", spec::SceneDrawing::JointKind::kPin, o, {}});
   d.joints.push_back({"A", spec::SceneDrawing::JointKind::kPin, a, {}});
   d.ground_points.push_back(o);
-  for (int i = 0; i < 20; ++i) {
+  for (int i = 0; i < instants; ++i) {
     d.times_s.push_back(0.05 * i);
     const double th = 2 * M_PI * 0.05 * i;
     d.points_m.push_back({{0, 0}, {std::cos(th), std::sin(th)}});
@@ -94,6 +97,38 @@ TEST_F(DrawingInBrowser, ScriptShowsTheFrameTheAddressAsksForWithoutErrors) {
     EXPECT_EQ(frames[f].find("display=\"none\"") == std::string::npos, f == 7) << "frame " << f << ": " << frames[f];
   }
   EXPECT_NE(dom.find("t = 0.35 s"), std::string::npos);
+}
+
+// The <g class="frame"> tags of a page's figures, in the page's order.
+std::vector<std::string> FrameTags(const std::string& dom) {
+  std::vector<std::string> frames;
+  for (std::size_t p = dom.find("<g class=\"frame\""); p != std::string::npos;
+       p = dom.find("<g class=\"frame\"", p + 1)) {
+    frames.push_back(dom.substr(p, dom.find('>', p) - p));
+  }
+  return frames;
+}
+
+// Load cases' figures share one slider: "#time=0.62" in the address shows
+// each figure's instant nearest 0.62 s: 0.6 s on the grid to 0.95 s, the
+// last, 0.35 s, on the grid that ends there.
+TEST_F(DrawingInBrowser, TheCasesSharedSliderMovesEveryFigure) {
+  const fs::path cases = dir_ / "cases.html";
+  std::ofstream(cases) << LoadCaseDrawingsPageHtml({CaseDrawing{"long", Crank(20)}, CaseDrawing{"short", Crank(8)}},
+                                                   "crank study", "crank.study.textproto");
+  ASSERT_EQ(Run("--dump-dom", "cases", cases.string() + "#time=0.62"), 0) << testing::ReadWholeFile(dir_ / "cases.err");
+  const std::string dom = testing::ReadWholeFile(dir_ / "cases.out");
+  const std::string log = testing::ReadWholeFile(dir_ / "cases.err");
+  EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
+  const std::vector<std::string> frames = FrameTags(dom);
+  ASSERT_EQ(frames.size(), 28u);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const bool shown = f == 12 || f == 20 + 7;
+    EXPECT_EQ(frames[f].find("display=\"none\"") == std::string::npos, shown) << "frame " << f << ": " << frames[f];
+  }
+  EXPECT_EQ(testing::CountOccurrences(dom, "t = 0.6 s"), 2) << "the first figure's label and the shared one";
+  EXPECT_EQ(testing::CountOccurrences(dom, "t = 0.35 s"), 1) << "the second figure's label";
 }
 
 }  // namespace

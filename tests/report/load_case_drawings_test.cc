@@ -55,7 +55,10 @@ TEST(LoadCaseDrawings, TheReportDrawsEachCaseHeadedByItsName) {
   EXPECT_THAT(html, HasSubstr("id=\"mechanism-case-0\""));
   EXPECT_THAT(html, HasSubstr("id=\"mechanism-case-1\""));
   EXPECT_EQ(testing::CountOccurrences(html, "<g class=\"frame\""), 8 + 6);
-  EXPECT_EQ(testing::CountOccurrences(html, "<input type=\"range\""), 2);
+  // A slider each, and one above them that moves both.
+  EXPECT_EQ(testing::CountOccurrences(html, "<input type=\"range\""), 3);
+  EXPECT_LT(html.find("id=\"cases-time\">Every case:"), html.find("<h3>Load case smooth</h3>"));
+  EXPECT_THAT(html, HasSubstr("var ids=[\"mechanism-case-0\",\"mechanism-case-1\"]"));
   EXPECT_EQ(testing::CheckMarkup(html, false), "");
   for (const std::string& svg : testing::SvgFragments(html)) EXPECT_EQ(testing::CheckMarkup(svg, true), "");
 }
@@ -73,6 +76,8 @@ TEST(LoadCaseDrawings, ACaseThatCouldNotBeDrawnSaysWhyUnderItsName) {
   EXPECT_THAT(html, HasSubstr("The job has no final design yet"));
   EXPECT_THAT(html, Not(HasSubstr("id=\"mechanism-case-1\"")));
   EXPECT_EQ(testing::CountOccurrences(html, "<g class=\"frame\""), 4);
+  // One figure has nothing to share a slider with.
+  EXPECT_THAT(html, Not(HasSubstr("cases-time")));
 }
 
 TEST(LoadCaseDrawings, TheDrawPageHasAFigurePerCase) {
@@ -89,6 +94,54 @@ TEST(LoadCaseDrawings, TheDrawPageHasAFigurePerCase) {
   EXPECT_THAT(html, HasSubstr("id=\"drawing-case-1\""));
   EXPECT_EQ(testing::SvgFragments(html).size(), 2u);
   EXPECT_THAT(html, Not(HasSubstr("http")));
+  // The shared slider steps through the longer grid's instants.
+  EXPECT_THAT(html, HasSubstr("Every case: <button type=\"button\">Play</button> <input type=\"range\" min=\"0\" max=\"4\""));
+}
+
+// A bar 1 m long sliding 4 m along x over `instants` instants.
+spec::SceneDrawing SlidingBar(int instants) {
+  spec::SceneDrawing d;
+  d.scene_name = "bar";
+  const int a = d.AddPoint("A"), b = d.AddPoint("B");
+  d.bodies.push_back({"bar", {a, b}});
+  for (int i = 0; i < instants; ++i) {
+    const double x = 4.0 * i / (instants - 1);
+    d.times_s.push_back(static_cast<double>(i) / instants);
+    d.points_m.push_back({{x, 0}, {x + 1, 0}});
+  }
+  return d;
+}
+
+// The opening tags of a page's drawings' <svg> elements.
+std::vector<std::string> SvgTags(const std::string& html) {
+  std::vector<std::string> tags;
+  for (size_t p = html.find("<svg class=\"drawing\""); p != std::string::npos;
+       p = html.find("<svg class=\"drawing\"", p + 1)) {
+    tags.push_back(html.substr(p, html.find('>', p) - p));
+  }
+  return tags;
+}
+
+// Cases on one scale and window: a crank turning in a 2 m square and a bar
+// sliding along a 5 m line get figures of the same size, each holding both
+// motions (alone, the bar's figure would be a thin strip).
+TEST(LoadCaseDrawings, TheCasesShareTheirAxes) {
+  const std::string page = LoadCaseDrawingsPageHtml(
+      {CaseDrawing{"turning", Crank(1.0, 8)}, CaseDrawing{"sliding", SlidingBar(8)}}, "study", "s.study.textproto");
+  const std::vector<std::string> tags = SvgTags(page);
+  ASSERT_EQ(tags.size(), 2u);
+  EXPECT_EQ(tags[0], tags[1]);
+  const std::vector<std::string> alone = SvgTags(LoadCaseDrawingsPageHtml(
+      {CaseDrawing{"sliding", SlidingBar(8)}}, "study", "s.study.textproto"));
+  ASSERT_EQ(alone.size(), 1u);
+  EXPECT_NE(alone[0], tags[1]) << "the bar alone is drawn on axes of its own";
+
+  ReportData data = testing::SyntheticVehicleReport();
+  data.mechanism.cases.push_back(LoadCaseDrawings{"turning", Crank(1.0, 8), Crank(1.0, 8), ""});
+  data.mechanism.cases.push_back(LoadCaseDrawings{"sliding", SlidingBar(8), SlidingBar(8), ""});
+  const std::vector<std::string> report = SvgTags(RenderJobReportHtml(data));
+  ASSERT_EQ(report.size(), 2u);
+  EXPECT_EQ(report[0], report[1]);
 }
 
 }  // namespace

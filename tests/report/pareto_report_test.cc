@@ -104,6 +104,17 @@ TEST(ParetoReport, SaysAMaximizedSecondObjectiveIsHeldAboveItsLevel) {
   EXPECT_NE(minimized.find("at the other end: its least value"), std::string::npos);
 }
 
+// A maximized F is each point's greatest, not its least.
+TEST(ParetoReport, SaysEachPointHasTheGreatestOfAMaximizedObjective) {
+  ParetoReportData data = Front();
+  data.objective_maximized = true;
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_NE(html.find("Each point is one optimization: the greatest F with"), std::string::npos) << html;
+  EXPECT_EQ(html.find("the least F"), std::string::npos) << html;
+  EXPECT_NE(RenderParetoReportHtml(Front()).find("Each point is one optimization: the least F with"),
+            std::string::npos);
+}
+
 // The chosen point's run's history is drawn as a single job's: the history
 // plots and the table of LP solves; without records, the note says why.
 TEST(ParetoReport, DrawsTheChosenPointsRunHistoryOrSaysWhyNot) {

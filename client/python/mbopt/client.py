@@ -13,7 +13,7 @@ Every failure is an mbopt.errors exception carrying the server's message.
 import grpc
 
 from mbopt.connection import UNARY_DEADLINE_S, Security, create_channel, resolve_address, rpc_error
-from mbopt.jobs import JobStatus, results_of
+from mbopt.jobs import FrontPointFollower, JobStatus, results_of
 from mbopt.errors import BadInput
 from mbopt.study_file import StudyFile
 from mbopt.v1 import service_pb2, service_pb2_grpc
@@ -106,6 +106,31 @@ class Client:
             raise rpc_error(e, self.address) from None
         finally:
             call.cancel()
+
+    def watch_front(self, job_id):
+        """For a Pareto front: yields each point as its run ends (a dict with
+        the keys of FrontResults.points, its run's `history` included, and
+        `run_status` "feasible", "infeasible", "failed" or "not run" in
+        place of `status`: whether a feasible point is on the front or
+        dominated needs the points still to come, results() tells it once
+        the job has ended), and a JobStatus whenever the job's state or its
+        count of points done changes. The runs' own cycle records are
+        gathered into their points' histories, not yielded. ValueError when
+        the job is not a front."""
+        job = self.get(job_id)
+        if not (job.summary.pareto or job.study.HasField("pareto")):
+            raise ValueError(f"job {job_id} is not a Pareto front; watch() follows it")
+        follower = FrontPointFollower(job)
+        last = None
+        for event in self.watch(job_id):
+            if isinstance(event, JobStatus):
+                if last is None or (event.status, event.cycles) != (last.status, last.cycles):
+                    yield event
+                last = event
+                continue
+            point = follower.feed(event)
+            if point is not None:
+                yield point
 
     def wait(self, job_id, on_event=None):
         """Follows the job to its end and returns its last JobStatus;

@@ -76,10 +76,11 @@ class JobStatus:
             failed_analyses=dict(sorted(s.failed_analyses_by_kind.items())))
 
 
-def _history_entry(r):
+def _record_entry(r):
+    """What a job's history and a front point's run history both say of one
+    LP solve."""
     return {
         "cycle": r.cycle,
-        "attempts": r.attempt + 1,
         "restoration": r.restoration,
         "objective": _number(r.objective_trial),
         "max_violation": _number(r.max_violation_trial),
@@ -87,11 +88,17 @@ def _history_entry(r):
         "optimality_residual": _number(r.optimality_residual),
         "lp_feasible": r.lp_feasible,
         "analyses": r.analyses_total,
-        "move_limits": [_number(v) for v in r.move_limits],
-        "move_limits_next": [_number(v) for v in r.move_limits_next],
         "design": [_number(v) for v in r.x_trial_physical],
-        "x_scaled": [_number(v) for v in r.x_trial_scaled],
     }
+
+
+def _history_entry(r):
+    entry = _record_entry(r)
+    entry["attempts"] = r.attempt + 1
+    entry["move_limits"] = [_number(v) for v in r.move_limits]
+    entry["move_limits_next"] = [_number(v) for v in r.move_limits_next]
+    entry["x_scaled"] = [_number(v) for v in r.x_trial_scaled]
+    return entry
 
 
 @dataclass
@@ -183,19 +190,62 @@ def _at(values, i):
 
 
 def _point_history_entry(r):
+    entry = _record_entry(r)
+    entry["attempt"] = r.attempt
+    entry["accepted"] = r.accepted
+    return entry
+
+
+def _run_status(r):
+    """A front point's status as far as its own run tells it: "" for a
+    feasible end (front or dominated is decided against the other points),
+    "not run", "failed" or "infeasible"."""
+    if r.pareto_state == "not_run":
+        return "not run"
+    if not r.accepted:
+        return "failed" if r.pareto_state == "failed" or not math.isfinite(r.objective_trial) else "infeasible"
+    return ""
+
+
+def _front_point(r, names, constraints, history):
+    """One point of a front from its record, as FrontResults.points lists it
+    but without "status" (which needs the other points)."""
     return {
-        "cycle": r.cycle,
-        "attempt": r.attempt,
-        "accepted": r.accepted,
-        "restoration": r.restoration,
+        "point": r.cycle,
+        "level": _number(r.pareto_level),
         "objective": _number(r.objective_trial),
+        "value": _number(r.pareto_value),
         "max_violation": _number(r.max_violation_trial),
-        "max_approximation_error": _number(r.max_approximation_error),
-        "optimality_residual": _number(r.optimality_residual),
-        "lp_feasible": r.lp_feasible,
-        "analyses": r.analyses_total,
-        "design": [_number(v) for v in r.x_trial_physical],
+        "run_state": r.pareto_state,
+        "cycles": r.pareto_cycles,
+        "analyses": r.pareto_analyses,
+        "design": {n: _at(r.x_trial_physical, i) for i, n in enumerate(names)},
+        "x_scaled": [_number(v) for v in r.x_trial_scaled],
+        "constraints": {n: _at(r.constraint_violations, c) for c, n in enumerate(constraints)},
+        "reason": r.rejection_reason,
+        "history": history,
     }
+
+
+class FrontPointFollower:
+    """Turns a front's records, in the order the server sends them (a
+    point's run history, then the point's own record), into its points:
+    feed() returns the point a record completes, or None."""
+
+    def __init__(self, job):
+        self._names = list(job.summary.design_names)
+        self._constraints = [c.name for c in job.study.constraints]
+        self._histories = {}
+
+    def feed(self, r):
+        if r.pareto_point > 0:
+            self._histories.setdefault(r.pareto_point, []).append(_point_history_entry(r))
+            return None
+        if not r.pareto:
+            return None
+        point = _front_point(r, self._names, self._constraints, self._histories.pop(r.cycle, []))
+        point["run_status"] = _run_status(r) or "feasible"
+        return point
 
 
 def _dominated(points):
@@ -276,30 +326,10 @@ class FrontResults:
         for r in job.cycles:
             if not r.pareto:
                 continue
-            if r.pareto_state == "not_run":
-                status = "not run"
-            elif not r.accepted:
-                failed = r.pareto_state == "failed" or not math.isfinite(r.objective_trial)
-                status = "failed" if failed else "infeasible"
-            else:
-                status = ""
-            points.append({
-                "point": r.cycle,
-                "level": _number(r.pareto_level),
-                "objective": _number(r.objective_trial),
-                "value": _number(r.pareto_value),
-                "max_violation": _number(r.max_violation_trial),
-                "run_state": r.pareto_state,
-                "cycles": r.pareto_cycles,
-                "analyses": r.pareto_analyses,
-                "design": {n: _at(r.x_trial_physical, i) for i, n in enumerate(names)},
-                "x_scaled": [_number(v) for v in r.x_trial_scaled],
-                "constraints": {n: _at(r.constraint_violations, c) for c, n in enumerate(constraints)},
-                "status": status,
-                "reason": r.rejection_reason,
-                "history": histories.get(r.cycle, []),
-            })
-            ranked.append((first_sign * r.objective_trial, second_sign * r.pareto_value, status == ""))
+            point = _front_point(r, names, constraints, histories.get(r.cycle, []))
+            point["status"] = _run_status(r)
+            points.append(point)
+            ranked.append((first_sign * r.objective_trial, second_sign * r.pareto_value, point["status"] == ""))
         for p, dominated in zip(points, _dominated(ranked)):
             if p["status"] == "":
                 p["status"] = "dominated" if dominated else "front"
