@@ -236,7 +236,7 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
   Map<VectorXd> fs(N_VGetArrayPointer(f_scale.get()), size);
   fs.head(n) = options.tolerance * row_tolerance.cwiseInverse();
   for (int j = 0; j < m; ++j) {
-    // Exactly 1 for rows above their floor, as before the floors.
+    // Exactly 1 where the floor is below the tolerance (planar rows), as before.
     fs[n + j] = constraint_tolerance[j] > options.tolerance ? options.tolerance / constraint_tolerance[j] : 1.0;
   }
   void* mem = kinsol.get();
