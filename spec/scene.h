@@ -307,6 +307,8 @@ struct SpatialModel {
   std::vector<SpatialTorque> torques;
   std::vector<SpatialRotationalSpring> rotational_springs;
   std::vector<SpatialBushing> bushings;
+  // Static: the equilibrium at each instant (worker/spatial/spatial_static_equilibrium.h).
+  MultibodyModel::Analysis analysis = MultibodyModel::Analysis::kFromDegreesOfFreedom;
 };
 
 // ---- external (an analysis by a simulation code the worker declares as a

@@ -193,6 +193,16 @@ int SceneConverter::SpatialJointIndex(const Where& w, const std::string& field, 
 
 SpatialModel SceneConverter::ConvertSpatial(const v1::SpatialModel& m, const Where& w) {
   spatial_ = SpatialModel{};
+  switch (m.analysis()) {
+    case v1::MULTIBODY_ANALYSIS_FROM_DEGREES_OF_FREEDOM: break;
+    case v1::MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM:
+      spatial_.analysis = MultibodyModel::Analysis::kStaticEquilibrium;
+      break;
+    default:
+      errors_.Add(w, "analysis",
+                  "expected MULTIBODY_ANALYSIS_FROM_DEGREES_OF_FREEDOM or MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM");
+      break;
+  }
   spatial_.ground_markers = SpatialMarkers(w, "ground_markers", m.ground_markers());
   for (int i = 0; i < m.bodies_size(); ++i) {
     const v1::SpatialBody& b = m.bodies(i);
@@ -377,6 +387,22 @@ SpatialModel SceneConverter::ConvertSpatial(const v1::SpatialModel& m, const Whe
 }
 
 SpatialOutput SceneConverter::SpatialOutputOf(const v1::Output& o, const Where& ow) {
+  using Q = SpatialOutput::Quantity;
+  const SpatialOutput out = SpatialQuantityOf(o, ow);
+  const bool motion = out.quantity == Q::kMarkerVelocity || out.quantity == Q::kMarkerAcceleration ||
+                      out.quantity == Q::kJointRate || out.quantity == Q::kJointSlideRate ||
+                      out.quantity == Q::kBodyAngularVelocity || out.quantity == Q::kKineticEnergy;
+  if (motion && spatial_.analysis == MultibodyModel::Analysis::kStaticEquilibrium) {
+    errors_.Add(ow, "",
+                absl::StrCat("output \"", o.name(),
+                             "\" is a rate, an acceleration or kinetic energy: a static-equilibrium analysis has "
+                             "no motion (ask for positions, orientations, joint coordinates, reactions, driver "
+                             "efforts, spring, rotational spring and bushing forces, potential energy)"));
+  }
+  return out;
+}
+
+SpatialOutput SceneConverter::SpatialQuantityOf(const v1::Output& o, const Where& ow) {
   using Q = SpatialOutput::Quantity;
   SpatialOutput out;
   if (SpatialForceOutputOf(o, ow, &out)) return out;

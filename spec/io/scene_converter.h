@@ -111,7 +111,9 @@ class SceneConverter {
   MarkerRef SpatialMarkerOf(const Where& w, const std::string& field, const std::string& ref);
   int SpatialJointIndex(const Where& w, const std::string& field, const std::string& name);
   SpatialModel ConvertSpatial(const v1::SpatialModel& m, const Where& w);
+  // Refuses rates, accelerations and kinetic energy in a static analysis.
   SpatialOutput SpatialOutputOf(const v1::Output& o, const Where& ow);
+  SpatialOutput SpatialQuantityOf(const v1::Output& o, const Where& ow);
 
   // --------------------------------- scene_convert_spatial_forces.cc --
   // Point forces, torques, rotational springs and bushings into spatial_

@@ -4,8 +4,8 @@
 //
 //   mbopt_simbody_spatial_oracle MECHANISM ACCURACY END_S INTERVALS
 //
-// MECHANISM is double_pendulum (released at rest) or
-// spinning_double_pendulum (spatial_oracle.h), or one of the closed loops
+// MECHANISM is double_pendulum (released at rest),
+// spinning_double_pendulum or hung_chain (spatial_oracle.h), or one of the closed loops
 // of spatial_mechanisms.h: bricard, rssr, cardan. A closed loop becomes a
 // tree of mobilizers (each joint whose second body is not yet placed) and
 // constraints closing it: Constraint::Ball for a spherical joint, a ball
@@ -183,6 +183,56 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
   return 0;
 }
 
+// Released at rest straight down and brought to rest by the hinges'
+// dampers: at END_S the state is the static equilibrium.
+int HungChain(double accuracy, const std::vector<double>& times) {
+  const mbopt::oracle::SpatialHungChain p;
+  MultibodySystem system;
+  SimbodyMatterSubsystem matter(system);
+  GeneralForceSubsystem forces(system);
+  Force::UniformGravity gravity(forces, matter, Vec3(0, 0, -p.g));
+  auto link = [&](int i) {
+    const double* j = p.inertia_kg_m2[i];
+    return Body::Rigid(MassProperties(p.mass_kg[i], Vec3(0), Inertia(Vec3(j[0], j[1], j[2]))));
+  };
+  // A pin turns about its frames' z axes: world x for the upper hinge, world y for the lower.
+  const Rotation about_x(Pi / 2, YAxis), about_y(-Pi / 2, XAxis);
+  MobilizedBody::Pin upper(matter.Ground(), Transform(about_x, Vec3(0)), link(0),
+                           Transform(about_x, Vec3(0, 0, p.half_length_m[0])));
+  MobilizedBody::Pin lower(upper, Transform(about_y, Vec3(0, 0, -p.half_length_m[0])), link(1),
+                           Transform(about_y, Vec3(0, 0, p.half_length_m[1])));
+  const MobilizedBody* bodies[2] = {&upper, &lower};
+  for (int i = 0; i < 2; ++i) {
+    Force::TwoPointLinearSpring(forces, matter.Ground(), Vec3(p.anchor_m[i][0], p.anchor_m[i][1], p.anchor_m[i][2]),
+                                *bodies[i], Vec3(p.attachment_m[i][0], p.attachment_m[i][1], p.attachment_m[i][2]),
+                                p.stiffness_n_per_m[i], p.free_length_m[i]);
+    Force::MobilityLinearDamper(forces, *bodies[i], MobilizerUIndex(0), p.hinge_damping_n_m_s_per_rad[i]);
+  }
+  State state = system.realizeTopology();
+  RungeKuttaMersonIntegrator integrator(system);
+  integrator.setAccuracy(accuracy);
+  TimeStepper stepper(system, integrator);
+  stepper.initialize(state);
+  for (double t : times) {
+    if (t > 0.0) stepper.stepTo(t);
+    const State& s = integrator.getState();
+    system.realize(s, Stage::Position);
+    std::printf("%.17g", t);
+    for (const MobilizedBody* b : bodies) {
+      const Vec3 c = b->getBodyOriginLocation(s);
+      std::printf(" %.17g %.17g %.17g", c[0], c[1], c[2]);
+    }
+    for (const MobilizedBody* b : bodies) {
+      const Rotation& r = b->getBodyRotation(s);
+      for (int i = 0; i < 3; ++i) {
+        for (int k = 0; k < 3; ++k) std::printf(" %.17g", r[i][k]);
+      }
+    }
+    std::printf("\n");
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -198,6 +248,7 @@ int main(int argc, char** argv) {
   try {
     if (mechanism == "double_pendulum") return DoublePendulum(false, accuracy, times);
     if (mechanism == "spinning_double_pendulum") return DoublePendulum(true, accuracy, times);
+    if (mechanism == "hung_chain") return HungChain(accuracy, times);
     if (mechanism == "bricard") return ClosedLoop(mbopt::oracle::Bricard(), accuracy, times);
     if (mechanism == "rssr") return ClosedLoop(mbopt::oracle::Rssr(), accuracy, times);
     if (mechanism == "cardan") return ClosedLoop(mbopt::oracle::CardanShaft(), accuracy, times);

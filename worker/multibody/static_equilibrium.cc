@@ -96,9 +96,18 @@ double RelativeLeastStiffness(Problem* p, const VectorXd& x, bool* ok) {
   MatrixXd null_space = MatrixXd::Identity(n, n);
   if (p->m > 0) {
     Evaluate(p, x, &p->forces);  // refreshes p->phi_q at x
-    Eigen::ColPivHouseholderQR<MatrixXd> qr(p->phi_q.transpose());
+    // Rows of unit length for the rank decision: the QR's threshold is
+    // relative to its largest pivot, and a spatial body's norm row (2e6 p^T)
+    // would otherwise hide a joint row of unit size. The null space is the
+    // same, so are the reduced eigenvalues (N is orthonormal either way).
+    MatrixXd rows = p->phi_q;
+    for (int i = 0; i < rows.rows(); ++i) {
+      const double norm = rows.row(i).norm();
+      if (norm > 0.0) rows.row(i) /= norm;
+    }
+    Eigen::ColPivHouseholderQR<MatrixXd> qr(rows.transpose());
     qr.setThreshold(1e-9);
-    qr.compute(p->phi_q.transpose());
+    qr.compute(rows.transpose());
     const int rank = static_cast<int>(qr.rank());
     if (rank >= n) return 1.0;
     const MatrixXd basis = qr.householderQ();
@@ -188,20 +197,27 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
   // 1e9 N/m) makes its rows' residual noisy at eps * K_ii * |q|, far above
   // 1e-10 N, where Newton can make no further progress.
   VectorXd row_tolerance = VectorXd::Constant(n, options.tolerance * force_scale);
+  VectorXd constraint_tolerance = VectorXd::Constant(m, options.tolerance);
+  const double floor = 100.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, MaxAbs(q0));
   {
     MatrixXd dfdq;
     if (Stiffness(&p, x, &dfdq)) {
-      const double q_scale = std::max(1.0, MaxAbs(q0));
-      // x and y rows of a body share one floor: as an element turns, its
-      // axial stiffness moves between them.
-      for (int i = 0; i + 2 < n; i += 3) {
-        const double translation = std::max(std::abs(dfdq(i, i)), std::abs(dfdq(i + 1, i + 1)));
-        const double rotation = std::abs(dfdq(i + 2, i + 2));
-        const double floor = 100.0 * std::numeric_limits<double>::epsilon() * q_scale;
-        row_tolerance[i] = std::max(row_tolerance[i], floor * translation);
-        row_tolerance[i + 1] = std::max(row_tolerance[i + 1], floor * translation);
-        row_tolerance[i + 2] = std::max(row_tolerance[i + 2], floor * rotation);
+      // A body's translation rows share one floor: as an element turns, its
+      // axial stiffness moves between them; so do its rotation rows.
+      const int per_body = options.coordinates_per_body, translations = options.translations_per_body;
+      for (int i = 0; i + per_body - 1 < n; i += per_body) {
+        double translation = 0.0, rotation = 0.0;
+        for (int k = 0; k < translations; ++k) translation = std::max(translation, std::abs(dfdq(i + k, i + k)));
+        for (int k = translations; k < per_body; ++k) rotation = std::max(rotation, std::abs(dfdq(i + k, i + k)));
+        for (int k = 0; k < per_body; ++k) {
+          row_tolerance[i + k] = std::max(row_tolerance[i + k], floor * (k < translations ? translation : rotation));
+        }
       }
+    }
+  }
+  if (m > 0) {
+    for (int j = 0; j < m; ++j) {
+      constraint_tolerance[j] = std::max(constraint_tolerance[j], floor * p.phi_q.row(j).cwiseAbs().maxCoeff());
     }
   }
 
@@ -219,7 +235,10 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
   N_VConst(1.0, u_scale.get());
   Map<VectorXd> fs(N_VGetArrayPointer(f_scale.get()), size);
   fs.head(n) = options.tolerance * row_tolerance.cwiseInverse();
-  fs.tail(m).setConstant(1.0);
+  for (int j = 0; j < m; ++j) {
+    // Exactly 1 where the floor is below the tolerance (planar rows), as before.
+    fs[n + j] = constraint_tolerance[j] > options.tolerance ? options.tolerance / constraint_tolerance[j] : 1.0;
+  }
   void* mem = kinsol.get();
   if (KINInit(mem, Residual, u.get()) != KIN_SUCCESS || KINSetUserData(mem, &p) != KIN_SUCCESS ||
       KINSetErrHandlerFn(mem, sundials::CaptureMessage, &message) != KIN_SUCCESS ||
@@ -252,7 +271,7 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     // the residual like a converged solve.
     return (flag >= 0 || flag == KIN_LINESEARCH_NONCONV) && Evaluate(&p, u_values, &f) == 0 &&
            (f.head(n).cwiseAbs().array() <= 10.0 * row_tolerance.array()).all() &&
-           (m == 0 || MaxAbs(f.tail(m)) <= options.tolerance * 10.0);
+           (f.tail(m).cwiseAbs().array() <= 10.0 * constraint_tolerance.array()).all();
   };
   auto charge = [&](double t) {
     return options.budget != nullptr ? options.budget->ChargeSteps(1, t) : spec::AnalysisFailure::Ok();

@@ -34,7 +34,9 @@
 namespace mbopt::multibody {
 
 struct StaticOptions {
-  // Converged when every constraint residual is below this (m or rad) and
+  // Converged when every constraint residual is below this (m or rad), or
+  // below its row's round-off floor (100 eps |Phi_q row| |q|: a spatial
+  // body's Euler-parameter norm row is scaled by 1e6) if that is higher, and
   // every force residual below it times the force scale (the largest applied
   // force at the start, at least 1 N), or below its row's round-off floor
   // (100 eps K_ii |q|, from the stiffness at the start) if that is higher.
@@ -43,6 +45,13 @@ struct StaticOptions {
   // Relative size of the most negative reduced stiffness eigenvalue (to the
   // largest in magnitude) that still counts as neutral, not unstable.
   double stability_tolerance = 1e-8;
+  // How the coordinates group into bodies, for the round-off floors: each
+  // body's first `translations_per_body` coordinates are translations (m),
+  // the rest of its `coordinates_per_body` describe its rotation. Planar:
+  // (x, y, theta), 3 and 2; spatial: (r, Euler parameters), 7 and 3. The
+  // translation rows of a body share one floor, its rotation rows another.
+  int coordinates_per_body = 3;
+  int translations_per_body = 2;
   // Charged one step per instant and per continuation step; also the
   // deadline and cancel flag. Null: no limit.
   budget::AnalysisBudget* budget = nullptr;

@@ -11,6 +11,7 @@
 #include "worker/spatial/spatial_assembly.h"
 #include "worker/spatial/spatial_kinematics.h"
 #include "worker/spatial/spatial_scene_analysis.h"
+#include "worker/spatial/spatial_static_equilibrium.h"
 
 namespace mbopt::spatial {
 namespace {
@@ -240,7 +241,10 @@ spec::SceneDrawing DrawSpatialScene(const spec::Scene& scene, const std::vector<
     return spec::AnalysisFailure::Ok();
   };
   spec::AnalysisFailure outcome;
-  if (assembled.degrees_of_freedom == 0) {
+  if (std::get<spec::SpatialModel>(scene.model).analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium) {
+    multibody::StaticCounters counters;
+    outcome = RunSpatialStaticEquilibrium(system, assembled, times, budget, record, &counters);
+  } else if (assembled.degrees_of_freedom == 0) {
     SpatialKinematicOptions options;
     options.budget = budget;
     SpatialKinematicCounters counters;

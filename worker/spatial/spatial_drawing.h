@@ -10,7 +10,8 @@
 // Computed only when asked, apart from the scene's analysis: the motion is
 // solved as AnalyzeSpatialScene solves it (the same model and assembly,
 // kinematics when every degree of freedom is driven, else IDAS forward
-// dynamics, redundant joints included), but no output is evaluated. Pure:
+// dynamics, redundant joints included; the equilibrium configurations of a
+// static scene), but no output is evaluated. Pure:
 // no I/O, no threads.
 #pragma once
 

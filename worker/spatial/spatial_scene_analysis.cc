@@ -15,6 +15,7 @@
 #include "worker/spatial/spatial_force_elements.h"
 #include "worker/spatial/spatial_kinematics.h"
 #include "worker/spatial/spatial_reactions.h"
+#include "worker/spatial/spatial_static_equilibrium.h"
 #include "worker/spatial/spatial_system.h"
 
 namespace mbopt::spatial {
@@ -280,6 +281,7 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
     }
     needs_multipliers |= multiplier_output;
   }
+  const bool is_static = sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium;
   size_t next_instant = 0;
   const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
     if (budget != nullptr) {
@@ -289,7 +291,11 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
       return spec::AnalysisFailure::Ok();
     }
     ++next_instant;
-    const Eigen::VectorXd lambda = needs_multipliers ? Multipliers(system, s.t_s, s.q, s.v, s.a) : Eigen::VectorXd();
+    // A static solve brings its multipliers; a motion's come from inverse
+    // dynamics.
+    const Eigen::VectorXd lambda = is_static           ? s.lambda
+                                   : needs_multipliers ? Multipliers(system, s.t_s, s.q, s.v, s.a)
+                                                       : Eigen::VectorXd();
     for (size_t k = 0; k < scene.outputs.size(); ++k) {
       const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
       const double value = OutputValue(system, *model, sm, o, p, s, lambda);
@@ -306,6 +312,17 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
   std::vector<double> times;
   if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
   times.insert(times.end(), report.times_s.begin(), report.times_s.end());
+  if (is_static) {
+    report.formulation = spec::Formulation::kStatic;
+    multibody::StaticCounters counters;
+    const spec::AnalysisFailure outcome =
+        RunSpatialStaticEquilibrium(system, assembled, times, budget, record, &counters);
+    report.counters.position_solves += counters.position_solves;
+    report.counters.newton_iterations += counters.newton_iterations;
+    report.counters.rhs_evaluations += counters.residual_evaluations;
+    if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
+    return report;
+  }
   if (assembled.degrees_of_freedom == 0) {
     // Every degree of freedom driven: the motion follows from the
     // constraints alone, as in planar scenes (redundant rows included).

@@ -4,8 +4,11 @@
 // freedom is driven, runs its kinematic analysis (RunSpatialKinematics);
 // otherwise it integrates its forward dynamics with IDAS
 // (multibody::IntegrateForward, the planar kernel's GGL integrator) to
-// every grid instant. Computes only the requested outputs, at the scene's
-// grid instants (driver efforts by inverse dynamics from each state).
+// every grid instant. A scene asking for static equilibrium
+// (spatial_static_equilibrium.h) gets it at every grid instant instead,
+// reactions and efforts from its multipliers. Computes only the requested
+// outputs, at the scene's grid instants (driver efforts by inverse dynamics
+// from each state of a motion).
 //
 // Failures are data with their kind: unusable parameter values or
 // redundant joints (kInvalidModel, naming the body or joint), a mechanism
