@@ -242,5 +242,45 @@ TEST(SpatialSensitivity, DrivenPendulumDerivativesAgreeWithCentralDifferences) {
   std::cout << "driven pendulum: worst " << a.worst_series << " over the instants\n";
 }
 
+// A door on two coaxial hinges (redundant rows, integrated as combinations
+// of its rows) has no sensitivity equations: the analysis says so and
+// returns its values without derivatives, and a study then differences
+// plain analyses for that design (engine::AnalyzeStudyWithGradients), as
+// for any planar scene whose sensitivities are unavailable.
+constexpr char kDoorOnTwoHinges[] = R"pb(
+  parameters { name: "mass" value: 12 unit: "kg" }
+  spatial {
+    ground_markers { name: "low" position_m { z { value: -0.8 } } }
+    ground_markers { name: "high" position_m { z { value: 0.8 } } }
+    bodies {
+      name: "door"
+      mass_kg { param: "mass" }
+      principal_inertia { moments_kg_m2 { x { value: 1.0 } y { value: 1.2 } z { value: 0.25 } } }
+      position_m { x { value: 0.4 } }
+      markers { name: "low" position_m { x { value: -0.4 } z { value: -0.8 } } }
+      markers { name: "high" position_m { x { value: -0.4 } z { value: 0.8 } } }
+    }
+    joints { name: "lower" kind: SPATIAL_JOINT_REVOLUTE a: "ground.low" b: "door.low" }
+    joints { name: "upper" kind: SPATIAL_JOINT_REVOLUTE a: "ground.high" b: "door.high" }
+    gravity { acceleration_m_per_s2 { y { value: -9.81 } } }
+  }
+  outputs { name: "angle" joint_coordinate { joint: "lower" } }
+  time_grid { start_s: 0 end_s: 0.5 points: 11 }
+)pb";
+
+TEST(SpatialSensitivity, RedundantJointsSayTheirSensitivitiesAreUnavailable) {
+  const spec::Scene scene = scene_text::Load(kDoorOnTwoHinges, "door.scene.textproto");
+  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, Values(scene), {0});
+  ASSERT_TRUE(result.report.ok()) << result.report.failure.reason;
+  EXPECT_NE(result.unavailable.find("redundant constraint equation"), std::string::npos) << result.unavailable;
+  EXPECT_TRUE(result.output_derivatives.empty());
+  const spec::AnalysisReport plain = AnalyzeSpatialScene(scene, Values(scene));
+  ASSERT_TRUE(plain.ok()) << plain.failure.reason;
+  // The same motion (its start polished by two more Newton steps).
+  const std::vector<double>&a = scene_text::Series(result.report, "angle"), &b = scene_text::Series(plain, "angle");
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-9) << "t = " << plain.times_s[i];
+}
+
 }  // namespace
 }  // namespace mbopt::spatial
