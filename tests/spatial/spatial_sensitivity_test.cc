@@ -24,14 +24,12 @@
 namespace mbopt::spatial {
 namespace {
 
-// The whole analyses are integrated at rtol 1e-8, the tightest at which
-// the spatial forward sensitivities integrate (at 1e-9 their corrector
-// fails part-way: docs/status.md); their central differences use a
-// relative step of 1e-3 (noise about rtol / step = 1e-5, truncation about
-// step^2 = 1e-6), so the comparison judges to about 1e-4, not 1e-6.
-constexpr double kRelativeStep = 1e-3;
-constexpr double kRelativeTolerance = 1e-8;
-constexpr double kAbsoluteTolerance = 1e-9;
+// The whole analyses are integrated at rtol 1e-10, so that their central
+// differences (relative step 1e-4: noise about rtol / step = 1e-6,
+// truncation about step^2 = 1e-8) can judge the sensitivities.
+constexpr double kRelativeStep = 1e-4;
+constexpr double kRelativeTolerance = 1e-10;
+constexpr double kAbsoluteTolerance = 1e-11;
 
 // Below this a derivative counts as zero (outputs are O(1) in SI here).
 constexpr double kNoDependence = 1e-8;
@@ -191,17 +189,19 @@ constexpr char kPendulum[] = R"pb(
   outputs { name: "yaw" body_orientation { body: "rod" sequence: EULER_ZYX angle: 1 } }
   outputs { name: "reaction_z" joint_reaction { joint: "hinge" axis: AXIS_Z } }
   time_grid { start_s: 0 end_s: 1.5 points: 31 }
-  integrator { relative_tolerance: 1e-8 absolute_tolerance: 1e-9 }
+  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-11 }
 )pb";
 
 // What the comparisons hold to, relative to each output's largest
-// derivative (measured with the settings above: the governor 3.6e-4 over
-// the instants and 8.0e-5 at the peaks; the pendulum 6.8e-4, its hinge
-// reaction 3.2e-3 (from multipliers of interpolated accelerations), and
-// 1.6e-5 at the peaks; the driven pendulum 7.1e-9).
-constexpr double kSeriesAgreement = 2e-3;
-constexpr double kReactionSeriesAgreement = 1e-2;
-constexpr double kPeakAgreement = 2e-4;
+// derivative (measured with the settings above: the governor 3.5e-5 over
+// the instants and 1.7e-5 at the peaks; the pendulum 1.3e-4 and 2.6e-6,
+// its hinge reaction, from multipliers of interpolated accelerations,
+// 4.4e-4 and 1.6e-5; the driven pendulum 6.7e-9). Not the 1e-6 the
+// differences could judge: the state terms of the sensitivity residuals
+// are themselves differences (GglStateDirectionalDerivative).
+constexpr double kSeriesAgreement = 3e-4;
+constexpr double kReactionSeriesAgreement = 2e-3;
+constexpr double kPeakAgreement = 5e-5;
 constexpr double kDrivenAgreement = 1e-7;
 
 TEST(SpatialSensitivity, GovernorDerivativesAgreeWithCentralDifferences) {

@@ -41,7 +41,7 @@ int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen
 // Phi_q at y's q); the rest, how M v', Q, Phi_q^T lambda, Phi_q^T mu and
 // Phi_q v + Phi_t change with (q, v), is a central difference of the
 // residual along the direction's (q, v) part, scaled so that no component
-// moves by more than 1e-6 (1 + |y_i|).
+// moves by more than 1e-4 (1 + |y_i|).
 int GglStateDirectionalDerivative(const ConstrainedSystem& s, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
                                   const Eigen::Ref<const Eigen::VectorXd>& y_dot,
                                   const Eigen::Ref<const Eigen::VectorXd>& direction, const Eigen::MatrixXd& phi_q,
