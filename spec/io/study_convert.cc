@@ -812,11 +812,6 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: linkage scenes have no "
                   "simulator sensitivities (write the mechanism as a multibody scene, or use finite differences)");
     }
-    if (s.simulator_sensitivities && std::holds_alternative<SpatialModel>(scene.model)) {
-      errors->Add(w, "sensitivity",
-                  "SENSITIVITY_METHOD_SIMULATOR is not available for spatial scenes yet (their forward dynamics "
-                  "has no sensitivity equations); use finite differences");
-    }
   }
 
   study.design_set = ConvertDesignSet(m, study, where, errors);

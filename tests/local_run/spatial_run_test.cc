@@ -36,5 +36,41 @@ TEST(RunStudyLocally, SpatialGovernorTakesTheShortestArmAndTheSpringOnTheLimit) 
             << run.cycles << ", analyses " << run.analyses << ", wall " << result->wall_seconds << " s\n";
 }
 
+// The same study with simulator sensitivities
+// (examples/spatial/governor_sensitivity.study.textproto): IDAS forward
+// sensitivities of the spatial system give the optimizer the gradients
+// finite differences give it, so it reaches the same optimum with one
+// analysis per cycle instead of 1 + 2.
+TEST(RunStudyLocally, SpatialGovernorWithSimulatorSensitivitiesReachesTheSameOptimumWithFewerAnalyses) {
+  absl::StatusOr<spec::Study> differences_study = spec::io::LoadStudyFile("examples/spatial/governor.study.textproto");
+  absl::StatusOr<spec::Study> simulator_study =
+      spec::io::LoadStudyFile("examples/spatial/governor_sensitivity.study.textproto");
+  ASSERT_TRUE(differences_study.ok()) << differences_study.status();
+  ASSERT_TRUE(simulator_study.ok()) << simulator_study.status();
+  ASSERT_TRUE(simulator_study->optimizer.simulator_sensitivities);
+  ASSERT_FALSE(differences_study->optimizer.simulator_sensitivities);
+  absl::StatusOr<LocalRunResult> differences = RunStudyLocally(*differences_study);
+  absl::StatusOr<LocalRunResult> simulator = RunStudyLocally(*simulator_study);
+  ASSERT_TRUE(differences.ok()) << differences.status();
+  ASSERT_TRUE(simulator.ok()) << simulator.status();
+  EXPECT_EQ(simulator->outcome.state, slp::RunState::kConverged)
+      << slp::RunStateName(simulator->outcome.state) << " " << simulator->end_reason;
+  EXPECT_EQ(simulator->analyses_failed, 0);
+  ASSERT_EQ(simulator->design_physical.size(), 2u);
+  ASSERT_EQ(differences->design_physical.size(), 2u);
+  // The same optimum: the arm on its bound, the stiffness within 0.1 % (the
+  // radius constraint is met to 1e-4 of its limit either way).
+  EXPECT_NEAR(simulator->design_physical[1], differences->design_physical[1], 1e-3);
+  EXPECT_NEAR(simulator->design_physical[0], differences->design_physical[0], 1e-3 * differences->design_physical[0]);
+  EXPECT_LE(std::abs(simulator->outcome.max_violation), 1e-4);
+  EXPECT_LT(simulator->analyses_run, differences->analyses_run);
+  std::cout << "governor: " << simulator->outcome.cycles << " cycles, " << simulator->analyses_run
+            << " analyses, " << simulator->wall_seconds << " s with simulator sensitivities (k "
+            << simulator->design_physical[0] << " N/m, arm " << simulator->design_physical[1] << " mm); "
+            << differences->outcome.cycles << " cycles, " << differences->analyses_run << " analyses, "
+            << differences->wall_seconds << " s with finite differences (k " << differences->design_physical[0]
+            << " N/m, arm " << differences->design_physical[1] << " mm)\n";
+}
+
 }  // namespace
 }  // namespace mbopt::local_run

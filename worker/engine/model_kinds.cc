@@ -72,6 +72,13 @@ spec::AnalysisReport AnalyzeSpatial(const spec::Scene& scene, const std::vector<
   return spatial::AnalyzeSpatialScene(scene, p, budget);
 }
 
+SensitivityAnalysis AnalyzeSpatialWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
+                                                    const std::vector<int>& parameters,
+                                                    budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
+  spatial::SpatialSensitivityResult result = spatial::AnalyzeSpatialSceneWithSensitivities(scene, p, parameters, budget);
+  return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
+}
+
 spec::AnalysisReport AnalyzeFmu(const spec::Scene& scene, const std::vector<double>& p,
                                 budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
   return fmu::AnalyzeFmuScene(scene, p, budget);
@@ -176,11 +183,10 @@ std::vector<ModelKind> MakeTable() {
       "newton_iterations of assembly and IDAS; time_steps, rhs_evaluations (residuals) and jacobian_evaluations "
       "of IDAS",
       &AnalyzeSpatial,
-      [](const spec::Scene&, const std::vector<int>&) {
-        return Never("a spatial analysis has no simulator sensitivities yet: its forward dynamics is not "
-                     "differentiated");
-      },
-      nullptr};
+      // Every output and parameter has them; a mechanism with redundant
+      // joints, found only at assembly, says so from its analysis.
+      [](const spec::Scene&, const std::vector<int>&) { return std::string(); },
+      &AnalyzeSpatialWithSensitivities};
   for (const ModelKind& kind : table) MBOPT_CHECK(kind.analyze != nullptr, "a scene model kind has no table entry");
   return table;
 }

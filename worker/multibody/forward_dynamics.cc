@@ -35,9 +35,9 @@ struct Problem {
   const std::vector<ParameterPerturbation>* parameters = nullptr;  // sensitivities, if any
   GglWorkspace work;
   Eigen::MatrixXd newton;
-  // dF/dy and M at (state_jacobian_t, state_jacobian_at), for the
-  // sensitivity residuals.
-  Eigen::MatrixXd state_jacobian, state_mass;
+  // dF/dy (or, for a system without analytic derivatives, Phi_q) and M at
+  // (state_jacobian_t, state_jacobian_at), for the sensitivity residuals.
+  Eigen::MatrixXd state_jacobian, state_mass, state_phi_q;
   double state_jacobian_t = 0.0;
   VectorXd state_jacobian_at;
   // The sparse Newton matrix's pattern in compressed columns (KLU only).
@@ -134,7 +134,9 @@ int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* 
 // every iteration of the sensitivities. F_p_k is exact where the parameter
 // has a derivative model, else the central difference of the residual
 // alone between the systems at p_k +- step_k, at the same state
-// (parameter_derivatives.h). The first version differenced the residual
+// (parameter_derivatives.h). A system without analytic derivatives (the
+// spatial one) gets F_y s_k from GglStateDirectionalDerivative instead: two
+// residuals per parameter and call. The first version differenced the residual
 // along (s, s') too (round-off then forced exact constraint rows by
 // polarization of gamma): eight residuals per parameter and call, and the
 // isolator's sensitivities cost 4.1 plain analyses at two parameters.
@@ -145,9 +147,19 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
     const int n = p->n, size = 2 * n + 2 * p->m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
+    const bool analytic = p->system->has_analytic_derivatives();
     if (!(p->state_jacobian_at.size() == size && p->state_jacobian_t == t && p->state_jacobian_at == y)) {
-      if (int flag = GglNewtonMatrix(*p->system, t, 0.0, y, &p->work, &p->state_jacobian); flag != 0) return flag;
-      p->state_mass = p->work.mass;
+      if (analytic) {
+        if (int flag = GglNewtonMatrix(*p->system, t, 0.0, y, &p->work, &p->state_jacobian); flag != 0) return flag;
+        p->state_mass = p->work.mass;
+      } else {
+        const VectorXd q = y.head(n);
+        const ContinuedPastBounds continued(*p->system);
+        if (int flag = p->system->MassMatrix(q, &p->state_mass); flag != 0) return flag;
+        if (p->m > 0) {
+          if (int flag = p->system->ConstraintJacobian(t, q, &p->state_phi_q); flag != 0) return flag;
+        }
+      }
       p->state_jacobian_t = t;
       p->state_jacobian_at = y;
     }
@@ -158,7 +170,12 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
       const Map<const VectorXd> s_dot(N_VGetArrayPointer(yp_s[k]), size);
       Map<VectorXd> result(N_VGetArrayPointer(rr_s[k]), size);
       if (int flag = GglParameterDerivative(dp, t, y, y_dot, &p->work, partial); flag != 0) return flag;
-      result.noalias() = p->state_jacobian * s;
+      if (analytic) {
+        result.noalias() = p->state_jacobian * s;
+      } else if (int flag = GglStateDirectionalDerivative(*p->system, t, y, y_dot, s, p->state_phi_q, &p->work, result);
+                 flag != 0) {
+        return flag;
+      }
       result.head(n) += s_dot.head(n);
       result.segment(n, n).noalias() += p->state_mass * s_dot.segment(n, n);
       result += partial;
@@ -512,13 +529,6 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   const int num_sens = sensitivities != nullptr ? static_cast<int>(sensitivities->parameters.size()) : 0;
   sundials::VectorArray y_s, yp_s, atol_s;
   if (num_sens > 0) {
-    // The sensitivity residuals are formed from the Newton matrix's
-    // derivatives.
-    if (!analytic) {
-      return Failed(spec::FailureKind::kInvalidModel,
-                    "forward sensitivities need a system with analytic derivatives (ConstrainedSystem::"
-                    "has_analytic_derivatives)");
-    }
     p.parameters = &sensitivities->parameters;
     y_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);
     yp_s = sundials::VectorArray(N_VCloneVectorArray(num_sens, h.yy.get()), num_sens);

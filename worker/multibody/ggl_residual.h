@@ -35,6 +35,18 @@ int GglResidual(const ConstrainedSystem& s, double t, const Eigen::Ref<const Eig
 int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen::Ref<const Eigen::VectorXd>& y,
                     GglWorkspace* work, Eigen::MatrixXd* newton);
 
+// dF/dy times `direction` at (t, y, y'), for a system without analytic
+// derivatives (forward sensitivities: forward_dynamics.h). The parts of F
+// linear in (v, lambda, mu) and the position rows are exact (with `phi_q`,
+// Phi_q at y's q); the rest, how M v', Q, Phi_q^T lambda, Phi_q^T mu and
+// Phi_q v + Phi_t change with (q, v), is a central difference of the
+// residual along the direction's (q, v) part, scaled so that no component
+// moves by more than 1e-4 (1 + |y_i|).
+int GglStateDirectionalDerivative(const ConstrainedSystem& s, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                                  const Eigen::Ref<const Eigen::VectorXd>& y_dot,
+                                  const Eigen::Ref<const Eigen::VectorXd>& direction, const Eigen::MatrixXd& phi_q,
+                                  GglWorkspace* work, Eigen::Ref<Eigen::VectorXd> out);
+
 // Which entries of the Newton matrix can be non-zero (size x size), from the
 // system's DerivativePattern.
 ConstrainedSystem::Pattern GglNewtonPattern(const ConstrainedSystem& s);

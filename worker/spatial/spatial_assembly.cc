@@ -80,6 +80,19 @@ SpatialAssembly AssembleSpatial(const SpatialSystem& system, double t, const Spa
       phi = trial_phi;
       residual = trial_residual;
     }
+    for (int i = 0; i < options.polish_iterations; ++i) {
+      if (system.ConstraintJacobian(t, out.q, &phi_q) != 0) {
+        out.failure = not_finite();
+        return out;
+      }
+      const VectorXd polished = out.q + Eigen::CompleteOrthogonalDecomposition<MatrixXd>(phi_q).solve(-phi);
+      if (system.Constraints(t, polished, &phi) != 0) {
+        out.failure = not_finite();
+        return out;
+      }
+      out.q = polished;
+      ++out.newton_iterations;
+    }
   }
   // Velocities: the smallest change of the bodies' initial velocities that
   // satisfies Phi_q v + Phi_t = 0.

@@ -29,6 +29,10 @@ struct SpatialAssemblyOptions {
   // Relative threshold of the QR's diagonal below which a row is counted
   // as redundant.
   double rank_tolerance = 1e-9;
+  // Full Newton steps taken after the tolerance is met: sensitivities
+  // difference the assemblies of models at p +- h, so each must close to
+  // round-off, not merely to the tolerance.
+  int polish_iterations = 0;
 };
 
 struct SpatialAssembly {

@@ -1,6 +1,7 @@
 #include "worker/spatial/spatial_scene_analysis.h"
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <utility>
 #include <variant>
@@ -8,6 +9,7 @@
 #include "absl/strings/str_format.h"
 #include "spec/layout.h"
 #include "worker/multibody/forward_dynamics.h"
+#include "worker/multibody/kinematic_sensitivity.h"
 #include "worker/spatial/euler_angles.h"
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/redundant_constraints.h"
@@ -223,22 +225,81 @@ absl::StatusOr<Model> CompileSpatialModel(const spec::Scene& scene, const std::v
   return m;
 }
 
-spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::vector<double>& p,
-                                         budget::AnalysisBudget* budget) {
-  spec::AnalysisReport report;
+namespace {
+
+// The model rebuilt at p_k + step and p_k - step, for sensitivities.
+struct Variant {
+  std::vector<double> p;
+  Model model;
+  std::unique_ptr<SpatialSystem> system;  // refers to `model`: a Variant never moves
+  SpatialAssembly assembled;
+};
+struct Perturbed {
+  std::unique_ptr<Variant> plus, minus;
+  double step = 0.0;
+  double magnitude = 1.0;  // |p_k|, or 1 for p_k = 0
+};
+
+// As the planar scenes' (worker/multibody/scene_analysis.cc): small enough
+// for the central differences' truncation (h^2), large enough for the
+// equations' round-off (eps / h).
+constexpr double kRelativeParameterStep = 1e-5;
+
+// Builds and assembles one variant; empty string on success, else why not.
+std::string MakeVariant(const spec::Scene& scene, std::vector<double> p, const SpatialAssemblyOptions& options,
+                        const SpatialSystem& nominal, std::unique_ptr<Variant>* out) {
+  auto v = std::make_unique<Variant>();
+  v->p = std::move(p);
+  absl::StatusOr<Model> model = CompileSpatialModel(scene, v->p);
+  if (!model.ok()) return std::string(model.status().message());
+  v->model = *std::move(model);
+  v->system = std::make_unique<SpatialSystem>(v->model);
+  if (v->system->num_constraints() != nominal.num_constraints()) return "the constraint rows change with the parameter";
+  v->assembled = AssembleSpatial(*v->system, 0.0, options);
+  if (!v->assembled.failure.ok()) return v->assembled.failure.reason;
+  *out = std::move(v);
+  return "";
+}
+
+// d output / dp along (state derivative, e_k): a central difference between
+// the variants, each at the state moved along the derivative. Orientation
+// outputs thus follow the Euler parameters' derivatives; multipliers (for
+// reactions and efforts) are the variants' inverse dynamics of the moved
+// states.
+double OutputDerivative(const spec::SpatialModel& sm, const spec::SpatialOutput& o, const Perturbed& dp,
+                        const multibody::MotionSample& s, const multibody::StateSensitivity& ds,
+                        bool needs_multipliers) {
+  const double h = dp.step;
+  auto value = [&](const Variant& variant, double sign) {
+    multibody::MotionSample x;
+    x.t_s = s.t_s;
+    x.q = s.q + sign * h * ds.q;
+    x.v = s.v + sign * h * ds.v;
+    x.a = s.a + sign * h * ds.a;
+    const Eigen::VectorXd lambda =
+        needs_multipliers ? Multipliers(*variant.system, x.t_s, x.q, x.v, x.a) : Eigen::VectorXd();
+    return OutputValue(*variant.system, variant.model, sm, o, variant.p, x, lambda);
+  };
+  return (value(*dp.plus, 1.0) - value(*dp.minus, -1.0)) / (2.0 * h);
+}
+
+// The one analysis; with `parameters`, also the output derivatives.
+void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::vector<int>* parameters,
+             budget::AnalysisBudget* budget, SpatialSensitivityResult* result) {
+  spec::AnalysisReport& report = result->report;
   report.times_s = scene.time_grid.Instants();
   report.formulation = spec::Formulation::kDynamic;
   if (!std::holds_alternative<spec::SpatialModel>(scene.model) || p.size() != scene.parameters.size()) {
     report.Fail(spec::FailureKind::kInvalidModel,
                 absl::StrFormat("expected a spatial scene and %d parameter values", scene.parameters.size()));
-    return report;
+    return;
   }
   const auto& sm = std::get<spec::SpatialModel>(scene.model);
   for (size_t k = 0; k < scene.outputs.size(); ++k) {
     const spec::Output& o = scene.outputs[k];
     if (!std::holds_alternative<spec::SpatialOutput>(o.kind)) {
       report.Fail(spec::FailureKind::kInvalidModel, absl::StrFormat("output '%s' is not a spatial output", o.name));
-      return report;
+      return;
     }
     const spec::OutputShape shape = spec::OutputShapeOf(scene, static_cast<int>(k));
     spec::OutputValues values;
@@ -248,18 +309,22 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
     values.series[0].reserve(report.times_s.size());
     report.outputs.push_back(std::move(values));
   }
-  if (report.outputs.empty()) return report;  // nothing requested: nothing computed
+  if (report.outputs.empty()) return;  // nothing requested: nothing computed
   absl::StatusOr<Model> model = CompileSpatialModel(scene, p);
   if (!model.ok()) {
     report.Fail(spec::FailureKind::kInvalidModel, std::string(model.status().message()));
-    return report;
+    return;
   }
+  const bool sensitivities = parameters != nullptr && !parameters->empty();
+  SpatialAssemblyOptions assembly_options;
+  // Variants are differenced: close every assembly to round-off.
+  if (sensitivities) assembly_options.polish_iterations = 2;
   const SpatialSystem system(*model);
-  const SpatialAssembly assembled = AssembleSpatial(system, 0.0);
+  const SpatialAssembly assembled = AssembleSpatial(system, 0.0, assembly_options);
   report.counters.newton_iterations += assembled.newton_iterations;
   if (!assembled.failure.ok()) {
     report.Fail(assembled.failure.kind, assembled.failure.reason);
-    return report;
+    return;
   }
   // Reactions and efforts come from the multipliers, solved per instant
   // from the motion (inverse dynamics) only when an output asks for them.
@@ -277,11 +342,58 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
                                   "mechanism without redundant joints (e.g. a spherical joint made a "
                                   "point-on-line one)",
                                   output.name, assembled.redundant_rows));
-      return report;
+      return;
     }
     needs_multipliers |= multiplier_output;
   }
   const bool is_static = sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium;
+  // The variants at p_k +- step_k: their equations are differenced (no
+  // exact derivative models for spatial systems), their assemblies give the
+  // start's derivatives.
+  std::vector<Perturbed> perturbed;
+  if (sensitivities && is_static) {
+    result->unavailable = "static equilibrium of spatial scenes has no sensitivity equations yet";
+  } else if (sensitivities && assembled.redundant_rows > 0) {
+    result->unavailable = absl::StrFormat(
+        "the mechanism has %d redundant constraint equation(s): its motion is integrated with combinations of its "
+        "rows, which have no sensitivity equations yet",
+        assembled.redundant_rows);
+  }
+  if (sensitivities && result->unavailable.empty()) {
+    for (const int index : *parameters) {
+      Perturbed dp;
+      const double value = p[static_cast<size_t>(index)];
+      dp.magnitude = value != 0.0 ? std::abs(value) : 1.0;
+      dp.step = kRelativeParameterStep * dp.magnitude;
+      std::vector<double> plus = p, minus = p;
+      plus[static_cast<size_t>(index)] += dp.step;
+      minus[static_cast<size_t>(index)] -= dp.step;
+      std::string why = MakeVariant(scene, std::move(plus), assembly_options, system, &dp.plus);
+      if (why.empty()) why = MakeVariant(scene, std::move(minus), assembly_options, system, &dp.minus);
+      if (why.empty() && (dp.plus->assembled.degrees_of_freedom != assembled.degrees_of_freedom ||
+                          dp.minus->assembled.degrees_of_freedom != assembled.degrees_of_freedom)) {
+        why = "the degrees of freedom change with the parameter";
+      }
+      if (!why.empty()) {
+        result->unavailable = absl::StrFormat("parameter '%s' +- %g: %s",
+                                              scene.parameters[static_cast<size_t>(index)].name, dp.step, why);
+        perturbed.clear();
+        break;
+      }
+      perturbed.push_back(std::move(dp));
+    }
+  }
+  const bool with_derivatives = !perturbed.empty();
+  if (with_derivatives) {
+    result->output_derivatives.assign(perturbed.size(),
+                                      std::vector<std::vector<double>>(scene.outputs.size(), std::vector<double>()));
+  }
+  std::vector<multibody::ParameterPerturbation> perturbations;
+  for (const Perturbed& dp : perturbed) {
+    perturbations.push_back(
+        multibody::ParameterPerturbation{dp.plus->system.get(), dp.minus->system.get(), dp.step, dp.magnitude, nullptr});
+  }
+  std::vector<multibody::StateSensitivity> kinematic;  // work space of the driven path
   size_t next_instant = 0;
   const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
     if (budget != nullptr) {
@@ -306,52 +418,92 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
       }
       report.outputs[k].series[0].push_back(value);
     }
+    if (!with_derivatives || !result->unavailable.empty()) return spec::AnalysisFailure::Ok();
+    // Forward dynamics brings the state's derivatives; a driven
+    // mechanism's come from its differentiated constraint equations.
+    const std::vector<multibody::StateSensitivity>* ds = &s.sensitivities;
+    if (ds->size() != perturbed.size()) {
+      if (!multibody::KinematicStateSensitivities(system, perturbations, s, &kinematic)) {
+        result->unavailable = absl::StrFormat("no state derivative at t = %.6g s", s.t_s);
+        return spec::AnalysisFailure::Ok();
+      }
+      ds = &kinematic;
+    }
+    for (size_t i = 0; i < perturbed.size(); ++i) {
+      for (size_t k = 0; k < scene.outputs.size(); ++k) {
+        const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
+        result->output_derivatives[i][k].push_back(
+            OutputDerivative(sm, o, perturbed[i], s, (*ds)[i], needs_multipliers));
+      }
+    }
     return spec::AnalysisFailure::Ok();
   };
   // The motion starts at t = 0; the grid may start later.
   std::vector<double> times;
   if (report.times_s.empty() || report.times_s.front() > 0.0) times.push_back(0.0);
   times.insert(times.end(), report.times_s.begin(), report.times_s.end());
+  spec::AnalysisFailure outcome;
   if (is_static) {
     report.formulation = spec::Formulation::kStatic;
     multibody::StaticCounters counters;
-    const spec::AnalysisFailure outcome =
-        RunSpatialStaticEquilibrium(system, assembled, times, budget, record, &counters);
+    outcome = RunSpatialStaticEquilibrium(system, assembled, times, budget, record, &counters);
     report.counters.position_solves += counters.position_solves;
     report.counters.newton_iterations += counters.newton_iterations;
     report.counters.rhs_evaluations += counters.residual_evaluations;
-    if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
-    return report;
-  }
-  if (assembled.degrees_of_freedom == 0) {
+  } else if (assembled.degrees_of_freedom == 0) {
     // Every degree of freedom driven: the motion follows from the
     // constraints alone, as in planar scenes (redundant rows included).
     report.formulation = spec::Formulation::kKinematic;
     SpatialKinematicOptions options;
     options.budget = budget;
     SpatialKinematicCounters counters;
-    const spec::AnalysisFailure outcome = RunSpatialKinematics(system, assembled.q, times, options, record, &counters);
+    outcome = RunSpatialKinematics(system, assembled.q, times, options, record, &counters);
     report.counters.time_steps = counters.position_solves;
     report.counters.newton_iterations += counters.newton_iterations;
-    if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
-    return report;
+  } else {
+    const multibody::ForwardDynamicsOptions options = multibody::ForwardDynamicsOptions::Of(scene.integrator, budget);
+    multibody::ForwardDynamicsCounters counters;
+    multibody::ForwardSensitivityInput input;
+    if (with_derivatives) {
+      input.parameters = perturbations;
+      for (const Perturbed& dp : perturbed) {
+        input.q0.push_back((dp.plus->assembled.q - dp.minus->assembled.q) / (2.0 * dp.step));
+        input.v0.push_back((dp.plus->assembled.v - dp.minus->assembled.v) / (2.0 * dp.step));
+      }
+    }
+    // Redundant joints: integrated as independent combinations of their
+    // rows (redundant_constraints.h), every row checked along the way.
+    RedundantIntegrationCounters redundant;
+    outcome = assembled.redundant_rows > 0
+                  ? IntegrateWithRedundantRows(system, assembled.independent_combination, 0.0, assembled.q,
+                                               assembled.v, times, options, record, &counters, &redundant)
+                  : multibody::IntegrateForward(system, 0.0, assembled.q, assembled.v, times, options, record,
+                                                &counters, with_derivatives ? &input : nullptr);
+    report.counters.time_steps = counters.steps;
+    report.counters.rhs_evaluations = counters.residual_evaluations;
+    report.counters.jacobian_evaluations = counters.jacobian_evaluations;
+    report.counters.newton_iterations += counters.nonlinear_iterations;
   }
-  const multibody::ForwardDynamicsOptions options = multibody::ForwardDynamicsOptions::Of(scene.integrator, budget);
-  multibody::ForwardDynamicsCounters counters;
-  // Redundant joints: integrated as independent combinations of their rows
-  // (redundant_constraints.h), every row checked along the way.
-  RedundantIntegrationCounters redundant;
-  const spec::AnalysisFailure outcome =
-      assembled.redundant_rows > 0
-          ? IntegrateWithRedundantRows(system, assembled.independent_combination, 0.0, assembled.q, assembled.v, times,
-                                       options, record, &counters, &redundant)
-          : multibody::IntegrateForward(system, 0.0, assembled.q, assembled.v, times, options, record, &counters);
-  report.counters.time_steps = counters.steps;
-  report.counters.rhs_evaluations = counters.residual_evaluations;
-  report.counters.jacobian_evaluations = counters.jacobian_evaluations;
-  report.counters.newton_iterations += counters.nonlinear_iterations;
   if (!outcome.ok()) report.Fail(outcome.kind, outcome.reason);
-  return report;
+  if (!report.ok() || !result->unavailable.empty()) result->output_derivatives.clear();
+  if (sensitivities && !report.ok() && result->unavailable.empty()) result->unavailable = "the analysis failed";
+}
+
+}  // namespace
+
+spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::vector<double>& p,
+                                         budget::AnalysisBudget* budget) {
+  SpatialSensitivityResult result;
+  Analyze(scene, p, nullptr, budget, &result);
+  return std::move(result.report);
+}
+
+SpatialSensitivityResult AnalyzeSpatialSceneWithSensitivities(const spec::Scene& scene, const std::vector<double>& p,
+                                                              const std::vector<int>& parameters,
+                                                              budget::AnalysisBudget* budget) {
+  SpatialSensitivityResult result;
+  Analyze(scene, p, &parameters, budget, &result);
+  return result;
 }
 
 }  // namespace mbopt::spatial

@@ -1,0 +1,286 @@
+// Simulator sensitivities of spatial analyses against central differences
+// of whole analyses: IDAS forward sensitivities of the flyball governor
+// (examples/spatial) and of a spatial pendulum on a tilted hinge, and the
+// differentiated constraint equations of the same pendulum when driven,
+// with respect to a mass, a spring's stiffness and a marker's coordinate
+// (which moves the assembled start). Outputs: a marker's position at every
+// instant, its peak, an energy, an Euler angle of a body (through the Euler
+// parameters' sensitivities), a joint angle and a joint reaction.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+#include "spec/io/study_io.h"
+#include "tests/spatial/scene_text_testing.h"
+#include "worker/spatial/spatial_scene_analysis.h"
+
+namespace mbopt::spatial {
+namespace {
+
+// The whole analyses are integrated at rtol 1e-10, so that their central
+// differences (relative step 1e-4: noise about rtol / step = 1e-6,
+// truncation about step^2 = 1e-8) can judge the sensitivities.
+constexpr double kRelativeStep = 1e-4;
+constexpr double kRelativeTolerance = 1e-10;
+constexpr double kAbsoluteTolerance = 1e-11;
+
+// Below this a derivative counts as zero (outputs are O(1) in SI here).
+constexpr double kNoDependence = 1e-8;
+
+// Per output, the largest |simulator - central difference| over the
+// instants relative to the largest |central difference|; and the same for
+// the peak (the largest value over the instants), whose derivative is the
+// output's derivative at the peak's instant.
+struct Agreement {
+  double worst_series = 0.0;
+  double worst_peak = 0.0;
+};
+
+std::vector<double> Values(const spec::Scene& scene) { return scene.DefaultParameterValues(); }
+
+int IndexOf(const spec::Scene& scene, const std::string& name) {
+  for (size_t i = 0; i < scene.parameters.size(); ++i) {
+    if (scene.parameters[i].name == name) return static_cast<int>(i);
+  }
+  ADD_FAILURE() << "no parameter " << name;
+  return 0;
+}
+
+size_t ArgMax(const std::vector<double>& v) {
+  return static_cast<size_t>(std::max_element(v.begin(), v.end()) - v.begin());
+}
+
+Agreement Compare(const spec::Scene& scene, const std::vector<std::string>& parameters,
+                  const std::vector<std::string>& outputs) {
+  const std::vector<double> p = Values(scene);
+  std::vector<int> indices;
+  for (const std::string& name : parameters) indices.push_back(IndexOf(scene, name));
+  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, p, indices);
+  EXPECT_TRUE(result.report.ok()) << result.report.failure.reason;
+  EXPECT_EQ(result.unavailable, "");
+  if (!result.report.ok() || result.output_derivatives.size() != indices.size()) return {INFINITY, INFINITY};
+  // The values are the plain analysis', to the integration tolerance (the
+  // sensitivities in the error test change the steps).
+  const spec::AnalysisReport plain = AnalyzeSpatialScene(scene, p);
+  EXPECT_TRUE(plain.ok()) << plain.failure.reason;
+  for (const std::string& name : outputs) {
+    const std::vector<double>& a = scene_text::Series(result.report, name);
+    const std::vector<double>& b = scene_text::Series(plain, name);
+    EXPECT_EQ(a.size(), b.size());
+    if (a.size() != b.size()) return {INFINITY, INFINITY};
+    for (size_t t = 0; t < a.size(); ++t) EXPECT_NEAR(a[t], b[t], 1e4 * scene.integrator.relative_tolerance * (1.0 + std::abs(b[t]))) << name;
+  }
+  Agreement agreement;
+  for (size_t i = 0; i < indices.size(); ++i) {
+    const size_t k = static_cast<size_t>(indices[i]);
+    const double h = kRelativeStep * std::abs(p[k]);
+    std::vector<double> plus = p, minus = p;
+    plus[k] += h;
+    minus[k] -= h;
+    const spec::AnalysisReport up = AnalyzeSpatialScene(scene, plus), down = AnalyzeSpatialScene(scene, minus);
+    EXPECT_TRUE(up.ok() && down.ok()) << up.failure.reason << down.failure.reason;
+    if (!up.ok() || !down.ok()) return {INFINITY, INFINITY};
+    for (const std::string& name : outputs) {
+      size_t o = 0;
+      while (o < scene.outputs.size() && scene.outputs[o].name != name) ++o;
+      EXPECT_LT(o, scene.outputs.size()) << name;
+      if (o == scene.outputs.size()) return {INFINITY, INFINITY};
+      const std::vector<double>& d = result.output_derivatives[i][o];
+      const std::vector<double>&u = scene_text::Series(up, name), &w = scene_text::Series(down, name);
+      EXPECT_EQ(d.size(), u.size());
+      double scale = 0.0, difference = 0.0;
+      for (size_t t = 0; t < d.size() && t < u.size(); ++t) {
+        const double fd = (u[t] - w[t]) / (2 * h);
+        scale = std::max(scale, std::abs(fd));
+        difference = std::max(difference, std::abs(d[t] - fd));
+      }
+      if (scale < kNoDependence) {
+        // The output does not depend on the parameter (a position of a
+        // driven mechanism on a mass): the simulator must say so too.
+        EXPECT_LT(difference, kNoDependence) << parameters[i] << " -> " << name;
+        std::cout << parameters[i] << " -> " << name << ": independent (difference " << difference << ")\n";
+        continue;
+      }
+      agreement.worst_series = std::max(agreement.worst_series, difference / scale);
+      const std::vector<double>& values = scene_text::Series(result.report, name);
+      const double peak_fd = (u[ArgMax(u)] - w[ArgMax(w)]) / (2 * h);
+      const double peak = d[ArgMax(values)];
+      const double peak_difference = std::abs(peak - peak_fd) / scale;
+      agreement.worst_peak = std::max(agreement.worst_peak, peak_difference);
+      std::cout << parameters[i] << " -> " << name << ": max |d| " << scale << ", difference " << difference
+                << " (" << difference / scale << " relative); peak " << peak << " vs " << peak_fd << " ("
+                << peak_difference << " relative)\n";
+    }
+  }
+  return agreement;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void Replace(const std::string& from, const std::string& to, std::string* text) {
+  const size_t at = text->find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text->replace(at, from.size(), to);
+}
+
+// The governor of examples/spatial with the flyweight's mass made a
+// parameter, over its first 1.5 s (the spin-up swing and its peak),
+// integrated tightly.
+spec::Scene Governor() {
+  std::string text = ReadFile("examples/spatial/governor.scene.textproto");
+  Replace("mass_kg { value: 0.5 }", "mass_kg { param: \"ball_mass\" }", &text);
+  Replace("spatial {", "parameters { name: \"ball_mass\" value: 0.5 unit: \"kg\" }\nspatial {", &text);
+  Replace("time_grid { start_s: 0 end_s: 3 points: 61 }", "time_grid { start_s: 0 end_s: 1.5 points: 31 }", &text);
+  Replace("integrator { relative_tolerance: 1e-7 absolute_tolerance: 1e-8 }",
+          absl::StrCat("integrator { relative_tolerance: ", kRelativeTolerance,
+                       " absolute_tolerance: ", kAbsoluteTolerance, " }"),
+          &text);
+  return scene_text::Load(text, "governor.scene.textproto");
+}
+
+// A rod on a hinge whose axis is tilted out of the horizontal (ZYX 20, 0,
+// 80 deg), the hinge's ground marker 20 mm off the rod's initial pivot (the
+// assembly moves the rod there, so the start depends on that coordinate),
+// pulled sideways by a spring from a ground anchor to its tip and swinging
+// under gravity.
+constexpr char kPendulum[] = R"pb(
+  parameters { name: "mass" value: 2 unit: "kg" }
+  parameters { name: "stiffness" value: 150 unit: "N/m" }
+  parameters { name: "hinge_x" value: 20 unit: "mm" }
+  spatial {
+    ground_markers {
+      name: "hinge" position_m { x { param: "hinge_x" } }
+      orientation { euler_angles { sequence: EULER_ZYX angles_deg: [20, 0, 80] } }
+    }
+    ground_markers { name: "anchor" position_m { x { value: 0.3 } y { value: 0.1 } z { value: -0.5 } } }
+    bodies {
+      name: "rod"
+      mass_kg { param: "mass" }
+      principal_inertia { moments_kg_m2 { x { value: 0.03 } y { value: 0.03 } z { value: 0.002 } } }
+      position_m { z { value: -0.4 } }
+      markers {
+        name: "hub" position_m { z { value: 0.4 } }
+        orientation { euler_angles { sequence: EULER_ZYX angles_deg: [20, 0, 80] } }
+      }
+      markers { name: "tip" position_m { z { value: -0.4 } } }
+    }
+    joints { name: "hinge" kind: SPATIAL_JOINT_REVOLUTE a: "ground.hinge" b: "rod.hub" }
+    springs {
+      name: "pull" a: "ground.anchor" b: "rod.tip"
+      free_length_m { value: 0.1 } stiffness_n_per_m { param: "stiffness" } damping_n_s_per_m { value: 0.5 }
+    }
+    gravity { acceleration_m_per_s2 { z { value: -9.81 } } }
+  }
+  outputs { name: "tip_x" marker_position { marker: "rod.tip" axis: AXIS_X } }
+  outputs { name: "tip_z" marker_position { marker: "rod.tip" axis: AXIS_Z } }
+  outputs { name: "angle" joint_coordinate { joint: "hinge" } }
+  outputs { name: "kinetic" kinetic_energy {} }
+  outputs { name: "yaw" body_orientation { body: "rod" sequence: EULER_ZYX angle: 1 } }
+  outputs { name: "reaction_z" joint_reaction { joint: "hinge" axis: AXIS_Z } }
+  time_grid { start_s: 0 end_s: 1.5 points: 31 }
+  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-11 }
+)pb";
+
+// What the comparisons hold to, relative to each output's largest
+// derivative (measured with the settings above: the governor 3.5e-5 over
+// the instants and 1.7e-5 at the peaks; the pendulum 1.3e-4 and 2.6e-6,
+// its hinge reaction, from multipliers of interpolated accelerations,
+// 4.4e-4 and 1.6e-5; the driven pendulum 6.7e-9). Not the 1e-6 the
+// differences could judge: the state terms of the sensitivity residuals
+// are themselves differences (GglStateDirectionalDerivative).
+constexpr double kSeriesAgreement = 3e-4;
+constexpr double kReactionSeriesAgreement = 2e-3;
+constexpr double kPeakAgreement = 5e-5;
+constexpr double kDrivenAgreement = 1e-7;
+
+TEST(SpatialSensitivity, GovernorDerivativesAgreeWithCentralDifferences) {
+  const spec::Scene scene = Governor();
+  const Agreement a = Compare(scene, {"ball_mass", "stiffness", "arm"},
+                              {"ball_x", "ball_z", "spring_force", "tilt", "kinetic_energy"});
+  EXPECT_LT(a.worst_series, kSeriesAgreement);
+  EXPECT_LT(a.worst_peak, kPeakAgreement);
+  std::cout << "governor: worst " << a.worst_series << " over the instants, " << a.worst_peak << " at the peaks\n";
+}
+
+TEST(SpatialSensitivity, PendulumDerivativesAgreeWithCentralDifferences) {
+  const spec::Scene scene = scene_text::Load(kPendulum, "pendulum.scene.textproto");
+  const Agreement a =
+      Compare(scene, {"mass", "stiffness", "hinge_x"}, {"tip_x", "tip_z", "angle", "kinetic", "yaw"});
+  EXPECT_LT(a.worst_series, kSeriesAgreement);
+  EXPECT_LT(a.worst_peak, kPeakAgreement);
+  const Agreement reaction = Compare(scene, {"mass", "stiffness", "hinge_x"}, {"reaction_z"});
+  EXPECT_LT(reaction.worst_series, kReactionSeriesAgreement);
+  EXPECT_LT(reaction.worst_peak, kPeakAgreement);
+  std::cout << "pendulum: worst " << a.worst_series << " over the instants, " << a.worst_peak << " at the peaks\n";
+}
+
+// The same pendulum with its hinge driven (no degree of freedom left): the
+// derivatives come from the differentiated constraint equations, the
+// reaction's from inverse dynamics of the varied models.
+TEST(SpatialSensitivity, DrivenPendulumDerivativesAgreeWithCentralDifferences) {
+  std::string text = kPendulum;
+  Replace("    gravity {", "    drivers { joint: \"hinge\" constant_rate { rate { value: 2 } } }\n    gravity {", &text);
+  const spec::Scene scene = scene_text::Load(text, "driven_pendulum.scene.textproto");
+  const spec::AnalysisReport plain = AnalyzeSpatialScene(scene, Values(scene));
+  ASSERT_TRUE(plain.ok()) << plain.failure.reason;
+  EXPECT_EQ(plain.formulation, spec::Formulation::kKinematic);
+  const Agreement a =
+      Compare(scene, {"mass", "stiffness", "hinge_x"}, {"tip_x", "tip_z", "kinetic", "yaw", "reaction_z"});
+  EXPECT_LT(a.worst_series, kDrivenAgreement);
+  EXPECT_LT(a.worst_peak, kDrivenAgreement);
+  std::cout << "driven pendulum: worst " << a.worst_series << " over the instants\n";
+}
+
+// A door on two coaxial hinges (redundant rows, integrated as combinations
+// of its rows) has no sensitivity equations: the analysis says so and
+// returns its values without derivatives, and a study then differences
+// plain analyses for that design (engine::AnalyzeStudyWithGradients), as
+// for any planar scene whose sensitivities are unavailable.
+constexpr char kDoorOnTwoHinges[] = R"pb(
+  parameters { name: "mass" value: 12 unit: "kg" }
+  spatial {
+    ground_markers { name: "low" position_m { z { value: -0.8 } } }
+    ground_markers { name: "high" position_m { z { value: 0.8 } } }
+    bodies {
+      name: "door"
+      mass_kg { param: "mass" }
+      principal_inertia { moments_kg_m2 { x { value: 1.0 } y { value: 1.2 } z { value: 0.25 } } }
+      position_m { x { value: 0.4 } }
+      markers { name: "low" position_m { x { value: -0.4 } z { value: -0.8 } } }
+      markers { name: "high" position_m { x { value: -0.4 } z { value: 0.8 } } }
+    }
+    joints { name: "lower" kind: SPATIAL_JOINT_REVOLUTE a: "ground.low" b: "door.low" }
+    joints { name: "upper" kind: SPATIAL_JOINT_REVOLUTE a: "ground.high" b: "door.high" }
+    gravity { acceleration_m_per_s2 { y { value: -9.81 } } }
+  }
+  outputs { name: "angle" joint_coordinate { joint: "lower" } }
+  time_grid { start_s: 0 end_s: 0.5 points: 11 }
+)pb";
+
+TEST(SpatialSensitivity, RedundantJointsSayTheirSensitivitiesAreUnavailable) {
+  const spec::Scene scene = scene_text::Load(kDoorOnTwoHinges, "door.scene.textproto");
+  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, Values(scene), {0});
+  ASSERT_TRUE(result.report.ok()) << result.report.failure.reason;
+  EXPECT_NE(result.unavailable.find("redundant constraint equation"), std::string::npos) << result.unavailable;
+  EXPECT_TRUE(result.output_derivatives.empty());
+  const spec::AnalysisReport plain = AnalyzeSpatialScene(scene, Values(scene));
+  ASSERT_TRUE(plain.ok()) << plain.failure.reason;
+  // The same motion (its start polished by two more Newton steps).
+  const std::vector<double>&a = scene_text::Series(result.report, "angle"), &b = scene_text::Series(plain, "angle");
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-9) << "t = " << plain.times_s[i];
+}
+
+}  // namespace
+}  // namespace mbopt::spatial
