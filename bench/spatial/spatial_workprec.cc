@@ -272,8 +272,8 @@ int main(int argc, char** argv) {
     rkm.push_back(RunSimbody("rkm", tol, repeats));
     if (tol >= kCpodesTightest) cpodes.push_back(RunSimbody("cpodes", tol, repeats));
   }
-  curves.push_back(rkm);
-  curves.push_back(cpodes);
+  curves.push_back(std::move(rkm));
+  curves.push_back(std::move(cpodes));
   std::printf("references at %.0e: mbopt %s, Simbody rkm %s; they differ by %.3g\n", kReferenceTolerance,
               mbopt_reference.ok ? "ok" : mbopt_reference.failure.c_str(),
               simbody_reference.ok ? "ok" : simbody_reference.failure.c_str(),
@@ -295,11 +295,13 @@ int main(int argc, char** argv) {
     }
   }
   // mbopt's time over Simbody's at each of mbopt's errors.
+  const std::vector<Run>& rkm_curve = curves[dq_curves.size()];
+  const std::vector<Run>& cpodes_curve = curves[dq_curves.size() + 1];
   for (size_t c = 0; c < dq_curves.size(); ++c) {
     for (const Run& r : curves[c]) {
       if (!r.ok) continue;
-      const std::optional<double> t_rkm = TimeAtError(rkm, r.error);
-      const std::optional<double> t_cpodes = TimeAtError(cpodes, r.error);
+      const std::optional<double> t_rkm = TimeAtError(rkm_curve, r.error);
+      const std::optional<double> t_cpodes = TimeAtError(cpodes_curve, r.error);
       std::optional<double> fastest = t_rkm;
       if (t_cpodes && (!fastest || *t_cpodes < *fastest)) fastest = t_cpodes;
       auto ratio = [&](const std::optional<double>& simbody_s) { return simbody_s ? r.cpu_s / *simbody_s : NAN; };
