@@ -2,11 +2,14 @@
 // its own for the reasons tests/oracle/simbody_oracle.h gives (Simbody 3.7's
 // headers are C++17 and its SimTKmath exports an old SUNDIALS' symbols).
 //
-//   mbopt_simbody_spatial_oracle MECHANISM ACCURACY END_S INTERVALS
+//   mbopt_simbody_spatial_oracle [--integrator=rkm|cpodes] [--cpu=REPEATS]
+//       MECHANISM ACCURACY END_S INTERVALS
 //
 // MECHANISM is double_pendulum (released at rest),
-// spinning_double_pendulum or hung_chain (spatial_oracle.h), or one of the closed loops
-// of spatial_mechanisms.h: bricard, rssr, cardan. A closed loop becomes a
+// spinning_double_pendulum or hung_chain (spatial_oracle.h), or one of the
+// closed loops of spatial_mechanisms.h: bricard, rssr, cardan, spherical_chain.
+// The options apply to the closed loops: the integrator (Runge-Kutta-Merson by
+// default, or CPodes' BDF) and CPU timing (see ClosedLoop). A closed loop becomes a
 // tree of mobilizers (each joint whose second body is not yet placed) and
 // constraints closing it: Constraint::Ball for a spherical joint, a ball
 // and two right angles (Constraint::ConstantAngle) for a revolute one,
@@ -16,9 +19,12 @@
 //
 // Prints one line per instant: the time and the values with 17 significant
 // digits; exit status 1 and the reason on stderr when Simbody fails.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <exception>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -30,6 +36,8 @@
 namespace {
 
 using namespace SimTK;
+
+std::string g_integrator = "rkm";
 
 Rotation Initial(const mbopt::oracle::SpatialDoublePendulum& p, int body) {
   return Rotation(p.angle_rad[body], UnitVec3(Vec3(p.axis[body][0], p.axis[body][1], p.axis[body][2])));
@@ -87,8 +95,11 @@ Rotation R(const mbopt::oracle::Mat& m) {
   return Rotation(Mat33(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8]));
 }
 
-// Simulates a mechanism of spatial_mechanisms.h and prints its values.
-int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::vector<double>& times) {
+// Simulates a mechanism of spatial_mechanisms.h and prints its values;
+// with cpu_repeats > 0 it integrates that many times and first prints the
+// median CPU time of the stepping and the steps taken ("# CPU_S STEPS").
+int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::vector<double>& times,
+               int cpu_repeats) {
   MultibodySystem system;
   SimbodyMatterSubsystem matter(system);
   GeneralForceSubsystem forces(system);
@@ -160,24 +171,49 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
   // the velocities the loops then need come from the projection below.
   system.realize(state, Stage::Position);
   system.project(state, 1e-14);
-  RungeKuttaMersonIntegrator integrator(system);
-  integrator.setAccuracy(accuracy);
-  integrator.setConstraintTolerance(1e-12);
-  TimeStepper stepper(system, integrator);
-  stepper.initialize(state);
-  for (double t : times) {
-    if (t > 0.0) stepper.stepTo(t);
-    const State& s = integrator.getState();
-    system.realize(s, Stage::Position);
-    std::printf("%.17g", t);
-    for (const MobilizedBody& b : bodies) {
-      const Vec3 c = b.getBodyOriginLocation(s);
-      std::printf(" %.17g %.17g %.17g", c[0], c[1], c[2]);
-      const Rotation& r = b.getBodyRotation(s);
-      for (int i = 0; i < 3; ++i) {
-        for (int k = 0; k < 3; ++k) std::printf(" %.17g", r[i][k]);
-      }
+  // The constraint tolerance follows the accuracy (as tests/oracle's, a
+  // hundredth of it) but not below 1e-12, where the comparisons run.
+  const double constraint_tolerance = std::max(accuracy * 1e-2, 1e-12);
+  std::vector<double> cpu_seconds;
+  std::vector<std::vector<double>> values;
+  long steps = 0;
+  for (int repeat = 0; repeat < std::max(cpu_repeats, 1); ++repeat) {
+    values.clear();
+    const std::clock_t start = std::clock();
+    std::unique_ptr<Integrator> integrator;
+    if (g_integrator == "cpodes") {
+      integrator = std::make_unique<CPodesIntegrator>(system, CPodes::BDF, CPodes::Newton);
+    } else {
+      integrator = std::make_unique<RungeKuttaMersonIntegrator>(system);
     }
+    integrator->setAccuracy(accuracy);
+    integrator->setConstraintTolerance(constraint_tolerance);
+    TimeStepper stepper(system, *integrator);
+    stepper.initialize(state);
+    for (double t : times) {
+      if (t > 0.0) stepper.stepTo(t);
+      const State& s = integrator->getState();
+      system.realize(s, Stage::Position);
+      std::vector<double> row{t};
+      for (const MobilizedBody& b : bodies) {
+        const Vec3 c = b.getBodyOriginLocation(s);
+        for (int k = 0; k < 3; ++k) row.push_back(c[k]);
+        const Rotation& r = b.getBodyRotation(s);
+        for (int i = 0; i < 3; ++i) {
+          for (int k = 0; k < 3; ++k) row.push_back(r[i][k]);
+        }
+      }
+      values.push_back(row);
+    }
+    cpu_seconds.push_back(static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC);
+    steps = integrator->getNumStepsTaken();
+  }
+  if (cpu_repeats > 0) {
+    std::sort(cpu_seconds.begin(), cpu_seconds.end());
+    std::printf("# %.9g %ld\n", cpu_seconds[cpu_seconds.size() / 2], steps);
+  }
+  for (const std::vector<double>& row : values) {
+    for (size_t k = 0; k < row.size(); ++k) std::printf(k == 0 ? "%.17g" : " %.17g", row[k]);
     std::printf("\n");
   }
   return 0;
@@ -236,22 +272,40 @@ int HungChain(double accuracy, const std::vector<double>& times) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr, "usage: %s MECHANISM ACCURACY END_S INTERVALS\n", argv[0]);
+  int cpu_repeats = 0;
+  int first = 1;
+  for (; first < argc && std::string(argv[first]).rfind("--", 0) == 0; ++first) {
+    const std::string option = argv[first];
+    if (option == "--integrator=rkm" || option == "--integrator=cpodes") {
+      g_integrator = option.substr(13);
+    } else if (option.rfind("--cpu=", 0) == 0 && std::atoi(option.c_str() + 6) > 0) {
+      cpu_repeats = std::atoi(option.c_str() + 6);
+    } else {
+      std::fprintf(stderr, "unknown option '%s' (expected --integrator=rkm|cpodes or --cpu=REPEATS > 0)\n",
+                   option.c_str());
+      return 2;
+    }
+  }
+  if (argc - first != 4) {
+    std::fprintf(stderr, "usage: %s [--integrator=rkm|cpodes] [--cpu=REPEATS] MECHANISM ACCURACY END_S INTERVALS\n",
+                 argv[0]);
     return 2;
   }
-  const std::string mechanism = argv[1];
-  const double accuracy = std::atof(argv[2]), end_s = std::atof(argv[3]);
-  const int intervals = std::atoi(argv[4]);
+  const std::string mechanism = argv[first];
+  const double accuracy = std::atof(argv[first + 1]), end_s = std::atof(argv[first + 2]);
+  const int intervals = std::atoi(argv[first + 3]);
   std::vector<double> times;
   for (int i = 0; i <= intervals; ++i) times.push_back(end_s * i / intervals);
   try {
     if (mechanism == "double_pendulum") return DoublePendulum(false, accuracy, times);
     if (mechanism == "spinning_double_pendulum") return DoublePendulum(true, accuracy, times);
     if (mechanism == "hung_chain") return HungChain(accuracy, times);
-    if (mechanism == "bricard") return ClosedLoop(mbopt::oracle::Bricard(), accuracy, times);
-    if (mechanism == "rssr") return ClosedLoop(mbopt::oracle::Rssr(), accuracy, times);
-    if (mechanism == "cardan") return ClosedLoop(mbopt::oracle::CardanShaft(), accuracy, times);
+    if (mechanism == "bricard") return ClosedLoop(mbopt::oracle::Bricard(), accuracy, times, cpu_repeats);
+    if (mechanism == "rssr") return ClosedLoop(mbopt::oracle::Rssr(), accuracy, times, cpu_repeats);
+    if (mechanism == "cardan") return ClosedLoop(mbopt::oracle::CardanShaft(), accuracy, times, cpu_repeats);
+    if (mechanism == "spherical_chain") {
+      return ClosedLoop(mbopt::oracle::SphericalChain(), accuracy, times, cpu_repeats);
+    }
     std::fprintf(stderr, "unknown mechanism '%s'\n", mechanism.c_str());
     return 2;
   } catch (const std::exception& e) {

@@ -164,4 +164,36 @@ inline Mechanism CardanShaft() {
   return m;
 }
 
+// A ten-bar chain on spherical joints closed back to ground (the spatial
+// speed benchmark's mechanism, bench/spatial): bars of 1 m and 1 kg
+// (square section 0.1 m) laid end to end in the horizontal plane z = 0,
+// bar i along the angle -60 + 12 (i + 1/2) degrees from world x, so the
+// chain bows as an arc from the ground point at the origin to a second
+// ground point 8.29 m away along x. Spherical joints at the origin,
+// between the bars and at the far end (the closing one), gravity 9.81 m/s^2
+// along -z, released at rest: the arc falls and swings through below its
+// ends. 60 - 33 = 27 degrees of freedom, ten of them the bars' spins about
+// their own axes (not excited).
+inline constexpr int kChainBars = 10;
+inline Mechanism SphericalChain() {
+  const double pi = 3.14159265358979323846;
+  Mechanism m;
+  Vec joint{0, 0, 0};
+  for (int i = 0; i < kChainBars; ++i) {
+    const double angle = -pi / 3 + (2 * pi / 3) * (i + 0.5) / kChainBars;
+    const Vec u{std::cos(angle), std::sin(angle), 0};
+    MechanismBody bar;
+    bar.mass_kg = 1.0;
+    bar.principal_moments_kg_m2 = BarMoments(1.0, 1.0, 0.1);
+    bar.position_m = {joint[0] + u[0] / 2, joint[1] + u[1] / 2, joint[2] + u[2] / 2};
+    bar.orientation = XAlong(u);
+    m.bodies.push_back(bar);
+    m.joints.push_back({MechanismJointKind::kSpherical, i - 1, i, joint, AxesWithZAlongZ()});
+    joint = {joint[0] + u[0], joint[1] + u[1], joint[2] + u[2]};
+  }
+  m.joints.push_back({MechanismJointKind::kSpherical, kChainBars - 1, -1, joint, AxesWithZAlongZ()});
+  m.gravity_m_per_s2 = {0, 0, -9.81};
+  return m;
+}
+
 }  // namespace mbopt::oracle

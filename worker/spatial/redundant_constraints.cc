@@ -81,6 +81,38 @@ int CombinedConstraintSystem::AccelerationRightSide(double t, const VectorXd& q,
   return status;
 }
 
+// T Phi's derivatives from Phi's: the curvature with the multipliers
+// T^T w, the velocity Jacobian and the pattern's rows through T.
+int CombinedConstraintSystem::ConstraintCurvature(double t, const VectorXd& q, const VectorXd& w,
+                                                  MatrixXd* curvature) const {
+  return full_.ConstraintCurvature(t, q, combination_.transpose() * w, curvature);
+}
+
+int CombinedConstraintSystem::VelocityConstraintJacobian(double t, const VectorXd& q, const VectorXd& v,
+                                                         MatrixXd* jacobian) const {
+  MatrixXd all;
+  const int status = full_.VelocityConstraintJacobian(t, q, v, &all);
+  if (status == 0) *jacobian = combination_ * all;
+  return status;
+}
+
+int CombinedConstraintSystem::ForceJacobians(double t, const VectorXd& q, const VectorXd& v, MatrixXd* q_q,
+                                             MatrixXd* q_v) const {
+  return full_.ForceJacobians(t, q, v, q_q, q_v);
+}
+
+void CombinedConstraintSystem::DerivativePattern(Pattern* coupling, Pattern* rows) const {
+  Pattern all;
+  full_.DerivativePattern(coupling, &all);
+  const Pattern used = combination_.array() != 0.0;
+  rows->setConstant(combination_.rows(), all.cols(), false);
+  for (int r = 0; r < combination_.rows(); ++r) {
+    for (int k = 0; k < combination_.cols(); ++k) {
+      if (used(r, k)) rows->row(r) = rows->row(r) || all.row(k);
+    }
+  }
+}
+
 namespace {
 
 // The cosine of the largest principal angle between the ranges spanned by

@@ -74,6 +74,16 @@ class CombinedConstraintSystem : public multibody::ConstrainedSystem {
   int ConstraintTimeDerivative(double t, const Eigen::VectorXd& q, Eigen::VectorXd* phi_t) const override;
   int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                             Eigen::VectorXd* gamma) const override;
+  // The full system's derivatives through the combination (its own when
+  // it has them).
+  bool has_analytic_derivatives() const override { return full_.has_analytic_derivatives(); }
+  int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
+                          Eigen::MatrixXd* curvature) const override;
+  int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                 Eigen::MatrixXd* jacobian) const override;
+  int ForceJacobians(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, Eigen::MatrixXd* q_q,
+                     Eigen::MatrixXd* q_v) const override;
+  void DerivativePattern(Pattern* coupling, Pattern* rows) const override;
   std::string FailureReason() const override { return full_.FailureReason(); }
   double DefinedUntil_s() const override { return full_.DefinedUntil_s(); }
 

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_format.h"
 #include "worker/spatial/euler_parameters.h"
+#include "worker/spatial/pair_vectors.h"
 #include "worker/spatial/spatial_force_elements.h"
 
 namespace mbopt::spatial {
@@ -15,157 +16,20 @@ using Eigen::Vector4d;
 using Eigen::VectorXd;
 
 constexpr int kBlock = SpatialSystem::kCoordinatesPerBody;
+static_assert(kBlock == pair::kBlock);
 constexpr double kNormRowScale = SpatialSystem::kNormRowScale;
-// The two bodies of a joint or spring: slot 0 for frame (point) a's body,
-// slot 1 for b's; each slot spans the body's 7 coordinates.
-constexpr int kPairColumns = 2 * kBlock;
 
-struct BodyCoordinates {
-  Vector3d r = Vector3d::Zero(), r_dot = Vector3d::Zero();
-  Vector4d p = Vector4d(1.0, 0.0, 0.0, 0.0), p_dot = Vector4d::Zero();
-  bool ground = true;
-};
-
-BodyCoordinates CoordinatesOf(int body, const VectorXd& q, const VectorXd* v) {
-  BodyCoordinates c;
-  if (body == kGround) return c;
-  c.ground = false;
-  const int at = kBlock * body;
-  c.r = q.segment<3>(at);
-  c.p = q.segment<4>(at + 3);
-  if (v != nullptr) {
-    c.r_dot = v->segment<3>(at);
-    c.p_dot = v->segment<4>(at + 3);
-  }
-  return c;
-}
-
-// A vector of a joint's equations: its value, its rate, its second time
-// derivative with zero accelerations (the part gamma needs) and its
-// Jacobian over the pair's coordinates.
-struct PairVector {
-  Vector3d x = Vector3d::Zero(), x_dot = Vector3d::Zero(), x_ddot0 = Vector3d::Zero();
-  Eigen::Matrix<double, 3, kPairColumns> jacobian = Eigen::Matrix<double, 3, kPairColumns>::Zero();
-};
-
-struct PairScalar {
-  double f = 0.0, f_dot = 0.0, f_ddot0 = 0.0;
-  Eigen::Matrix<double, 1, kPairColumns> jacobian = Eigen::Matrix<double, 1, kPairColumns>::Zero();
-};
-
-// r + A(p) s for a point (with_origin), A(p) s for a direction.
-PairVector FixedIn(const BodyCoordinates& c, int slot, const Vector3d& s, bool with_origin) {
-  PairVector out;
-  const Eigen::Matrix<double, 3, 4> d = RotatedVectorJacobian(c.p, s);
-  out.x = RotationOf(c.p) * s + (with_origin ? c.r : Vector3d::Zero());
-  if (c.ground) return out;
-  out.x_dot = d * c.p_dot + (with_origin ? c.r_dot : Vector3d::Zero());
-  out.x_ddot0 = 2.0 * RotationOf(c.p_dot) * s;
-  out.jacobian.block<3, 4>(0, kBlock * slot + 3) = d;
-  if (with_origin) out.jacobian.block<3, 3>(0, kBlock * slot).setIdentity();
-  return out;
-}
-
-PairVector Minus(const PairVector& a, const PairVector& b) {
-  PairVector out;
-  out.x = a.x - b.x;
-  out.x_dot = a.x_dot - b.x_dot;
-  out.x_ddot0 = a.x_ddot0 - b.x_ddot0;
-  out.jacobian = a.jacobian - b.jacobian;
-  return out;
-}
-
-PairScalar Dot(const PairVector& a, const PairVector& b) {
-  PairScalar out;
-  out.f = a.x.dot(b.x);
-  out.f_dot = a.x_dot.dot(b.x) + a.x.dot(b.x_dot);
-  out.f_ddot0 = a.x_ddot0.dot(b.x) + 2.0 * a.x_dot.dot(b.x_dot) + a.x.dot(b.x_ddot0);
-  out.jacobian = b.x.transpose() * a.jacobian + a.x.transpose() * b.jacobian;
-  return out;
-}
-
-PairScalar Component(const PairVector& a, int k) {
-  PairScalar out;
-  out.f = a.x[k];
-  out.f_dot = a.x_dot[k];
-  out.f_ddot0 = a.x_ddot0[k];
-  out.jacobian = a.jacobian.row(k);
-  return out;
-}
-
-// A frame's origin and axes in world axes.
-struct FrameVectors {
-  PairVector origin, x, y, z;
-};
-
-FrameVectors FrameOf(const Frame& f, int slot, const VectorXd& q, const VectorXd* v) {
-  const BodyCoordinates c = CoordinatesOf(f.body, q, v);
-  return {FixedIn(c, slot, f.position_m, true), FixedIn(c, slot, f.axes.col(0), false),
-          FixedIn(c, slot, f.axes.col(1), false), FixedIn(c, slot, f.axes.col(2), false)};
-}
-
-// The scalar equations of a joint, in the order docs/physics.md lists them.
-std::vector<PairScalar> JointEquations(const Joint& joint, const VectorXd& q, const VectorXd* v) {
-  const FrameVectors a = FrameOf(joint.a, 0, q, v), b = FrameOf(joint.b, 1, q, v);
-  const PairVector d = Minus(b.origin, a.origin);
-  std::vector<PairScalar> rows;
-  auto coincide = [&] {
-    for (int k = 0; k < 3; ++k) rows.push_back(Component(d, k));
-  };
-  auto on_axis = [&] {
-    rows.push_back(Dot(a.x, d));
-    rows.push_back(Dot(a.y, d));
-  };
-  auto axes_aligned = [&] {
-    rows.push_back(Dot(a.z, b.x));
-    rows.push_back(Dot(a.z, b.y));
-  };
-  switch (joint.kind) {
-    case Joint::Kind::kSpherical:
-      coincide();
-      break;
-    case Joint::Kind::kRevolute:
-      coincide();
-      axes_aligned();
-      break;
-    case Joint::Kind::kUniversal:
-      coincide();
-      rows.push_back(Dot(a.x, b.y));
-      break;
-    case Joint::Kind::kFixed:
-      coincide();
-      axes_aligned();
-      rows.push_back(Dot(a.x, b.y));
-      break;
-    case Joint::Kind::kPrismatic:
-      on_axis();
-      axes_aligned();
-      rows.push_back(Dot(a.x, b.y));
-      break;
-    case Joint::Kind::kCylindrical:
-      on_axis();
-      axes_aligned();
-      break;
-    case Joint::Kind::kPlanar:
-      rows.push_back(Dot(a.z, d));
-      axes_aligned();
-      break;
-    case Joint::Kind::kPointOnLine:
-      on_axis();
-      break;
-    case Joint::Kind::kPointOnPlane:
-      rows.push_back(Dot(a.z, d));
-      break;
-  }
-  return rows;
-}
-
-// Adds a pair's row (or rows) into a matrix of all coordinates.
-template <class PairMatrix>
-void Scatter(const PairMatrix& pair, int body_a, int body_b, Eigen::Ref<Eigen::MatrixXd> out) {
-  if (body_a != kGround) out.middleCols(kBlock * body_a, kBlock) += pair.leftCols(kBlock);
-  if (body_b != kGround) out.middleCols(kBlock * body_b, kBlock) += pair.rightCols(kBlock);
-}
+using pair::BodyCoordinates;
+using pair::CoordinatesOf;
+using pair::Dot;
+using pair::FixedIn;
+using pair::FrameOf;
+using pair::FrameVectors;
+using pair::JointEquations;
+using pair::Minus;
+using pair::PairScalar;
+using pair::PairVector;
+using pair::Scatter;
 
 bool AllFinite(const VectorXd& x) { return x.allFinite(); }
 
@@ -225,6 +89,14 @@ int SpatialSystem::AppliedForces(double t, const VectorXd& q, const VectorXd& v,
     const Eigen::Matrix<double, 3, 4> l_dot = BodyRateMatrix(p_dot);
     forces->segment<4>(at + 3) += 8.0 * l_dot.transpose() * b.inertia_kg_m2 * l_dot * p;
   }
+  VectorXd elements;
+  if (ElementForces(t, q, v, &elements) != 0) return 1;
+  *forces += elements;
+  return AllFinite(*forces) ? 0 : 1;
+}
+
+int SpatialSystem::ElementForces(double t, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
+  forces->setZero(num_coordinates());
   for (const SpringDamper& s : model_.springs) {
     const PairVector d = Minus(FixedIn(CoordinatesOf(s.b.body, q, &v), 1, s.b.position_m, true),
                                FixedIn(CoordinatesOf(s.a.body, q, &v), 0, s.a.position_m, true));
@@ -233,14 +105,12 @@ int SpatialSystem::AppliedForces(double t, const VectorXd& q, const VectorXd& v,
     if (!(length > 0.0)) return 1;
     const Vector3d unit = d.x / length;
     const double tension = SpringTension(s, length, unit.dot(d.x_dot), continue_past_bounds_);
-    Eigen::Map<Eigen::RowVectorXd> row(forces->data(), forces->size());
-    Eigen::Matrix<double, 1, kPairColumns> pair = -tension * unit.transpose() * d.jacobian;
+    const pair::PairRow pair_row = -tension * unit.transpose() * d.jacobian;
     Eigen::MatrixXd scattered = Eigen::MatrixXd::Zero(1, num_coordinates());
-    Scatter(pair, s.a.body, s.b.body, scattered);
-    row += scattered.row(0);
+    Scatter(pair_row, s.a.body, s.b.body, scattered);
+    *forces += scattered.row(0).transpose();
   }
-  if (AddForceElementForces(model_, t, q, v, forces) != 0) return 1;
-  return AllFinite(*forces) ? 0 : 1;
+  return AddForceElementForces(model_, t, q, v, forces);
 }
 
 void SpatialSystem::EvaluateRows(double t, const VectorXd& q, const VectorXd* v, VectorXd* phi,

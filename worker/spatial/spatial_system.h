@@ -17,8 +17,12 @@
 // since 2 p^T is the normalization row's Jacobian, the added force lies in
 // that row's reaction and only its multiplier changes, not the motion.
 //
-// No analytic Newton derivatives yet (has_analytic_derivatives() is false):
-// the integrator forms its Newton matrix by difference quotients.
+// Analytic Newton derivatives (spatial_derivatives.cc): the constraints'
+// exact second derivatives and the Euler parameters' velocity terms; the
+// springs' and force elements' Jacobians are central differences of their
+// forces alone. The Newton matrix leaves out d(M(q) a)/dq (M depends on
+// the Euler parameters), a term of the order of the step times the
+// accelerations: IDAS's Newton iteration converges with it left out.
 //
 // Immutable after construction; the model must be valid (Model::Validate)
 // and must outlive the system.
@@ -73,6 +77,16 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                             Eigen::VectorXd* gamma) const override;
 
+  // The Newton matrix's derivatives (spatial_derivatives.cc).
+  bool has_analytic_derivatives() const override { return true; }
+  int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
+                          Eigen::MatrixXd* curvature) const override;
+  int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                 Eigen::MatrixXd* jacobian) const override;
+  int ForceJacobians(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, Eigen::MatrixXd* q_q,
+                     Eigen::MatrixXd* q_v) const override;
+  void DerivativePattern(Pattern* coupling, Pattern* rows) const override;
+
   // The springs' force curves' tables (spatial_force_elements.h): past one,
   // the analysis ends naming the spring.
   int num_validity_bounds() const override;
@@ -111,6 +125,10 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
 
  private:
+  // The springs' and force elements' generalized forces (no gravity, no
+  // velocity terms); 0, or 1 when one is not finite.
+  int ElementForces(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, Eigen::VectorXd* forces) const;
+  bool has_force_elements() const;
   void EvaluateRows(double t, const Eigen::VectorXd& q, const Eigen::VectorXd* v, Eigen::VectorXd* phi,
                     Eigen::MatrixXd* phi_q, Eigen::VectorXd* phi_t, Eigen::VectorXd* gamma) const;
   // The row of a driver of a joint's slide (Driver::slide).
