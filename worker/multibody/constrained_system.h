@@ -56,6 +56,12 @@ class ConstrainedSystem {
   // integrator to form that matrix by difference quotients of its residual,
   // one residual per unknown; the others must implement all three below.
   virtual bool has_analytic_derivatives() const { return false; }
+  // Whether those derivatives make the residual's whole state Jacobian, so
+  // that sensitivity equations may use them (forward_dynamics.cc,
+  // static_equilibrium.cc). A system whose Newton matrix leaves a term out
+  // (it only slows Newton's convergence) says false here, and its
+  // sensitivities difference the residual instead.
+  virtual bool has_exact_state_jacobian() const { return has_analytic_derivatives(); }
   // d(Phi_q^T w)/dq for given multipliers w (m values): n x n, symmetric
   // (the constraints' second derivatives weighted by w).
   virtual int ConstraintCurvature(double /*t*/, const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*w*/,

@@ -134,7 +134,7 @@ int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* 
 // every iteration of the sensitivities. F_p_k is exact where the parameter
 // has a derivative model, else the central difference of the residual
 // alone between the systems at p_k +- step_k, at the same state
-// (parameter_derivatives.h). A system without analytic derivatives (the
+// (parameter_derivatives.h). A system without an exact state Jacobian (the
 // spatial one) gets F_y s_k from GglStateDirectionalDerivative instead: two
 // residuals per parameter and call. The first version differenced the residual
 // along (s, s') too (round-off then forced exact constraint rows by
@@ -147,7 +147,7 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
     const int n = p->n, size = 2 * n + 2 * p->m;
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
-    const bool analytic = p->system->has_analytic_derivatives();
+    const bool analytic = p->system->has_exact_state_jacobian();
     if (!(p->state_jacobian_at.size() == size && p->state_jacobian_t == t && p->state_jacobian_at == y)) {
       if (analytic) {
         if (int flag = GglNewtonMatrix(*p->system, t, 0.0, y, &p->work, &p->state_jacobian); flag != 0) return flag;

@@ -87,7 +87,8 @@ struct ForwardDynamicsCounters {
 // sensitivity module, staggered corrector, sensitivities in the error test
 // with absolute tolerances divided by each parameter's magnitude). The
 // sensitivity residuals F_y s + F_y' s' + F_p take F_y from the system's
-// analytic derivatives, or for a system without them F_y s from a central
+// analytic derivatives where they are its exact state Jacobian
+// (has_exact_state_jacobian()), or else F_y s from a central
 // difference of the residual along s (GglStateDirectionalDerivative), and
 // F_p from the parameter's derivative model, else from central differences
 // of the residual alone between the systems rebuilt at p_k +- step_k

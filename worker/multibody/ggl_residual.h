@@ -35,8 +35,8 @@ int GglResidual(const ConstrainedSystem& s, double t, const Eigen::Ref<const Eig
 int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen::Ref<const Eigen::VectorXd>& y,
                     GglWorkspace* work, Eigen::MatrixXd* newton);
 
-// dF/dy times `direction` at (t, y, y'), for a system without analytic
-// derivatives (forward sensitivities: forward_dynamics.h). The parts of F
+// dF/dy times `direction` at (t, y, y'), for a system without an exact
+// state Jacobian (has_exact_state_jacobian(); forward sensitivities: forward_dynamics.h). The parts of F
 // linear in (v, lambda, mu) and the position rows are exact (with `phi_q`,
 // Phi_q at y's q); the rest, how M v', Q, Phi_q^T lambda, Phi_q^T mu and
 // Phi_q v + Phi_t change with (q, v), is a central difference of the

@@ -132,7 +132,7 @@ double RelativeLeastStiffness(Problem* p, const VectorXd& x, bool* ok) {
 
 bool StaticStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
                               const MotionSample& sample, std::vector<StateSensitivity>* sensitivities) {
-  if (!system.has_analytic_derivatives()) return false;
+  if (!system.has_exact_state_jacobian()) return false;
   const int n = system.num_coordinates(), m = system.num_constraints();
   const double t = sample.t_s;
   const VectorXd& q = sample.q;

@@ -72,8 +72,9 @@ struct StaticCounters {
 //
 // the matrix from the system's analytic derivatives (velocities zero), one
 // LU for every parameter; dG/dp from parameter_derivatives.h. Velocities
-// and accelerations stay zero. False when the system has no analytic
-// derivatives or the matrix is singular (a dead centre).
+// and accelerations stay zero. False when the system has no exact state
+// Jacobian (has_exact_state_jacobian()) or the matrix is singular (a dead
+// centre).
 bool StaticStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
                               const MotionSample& sample, std::vector<StateSensitivity>* sensitivities);
 

@@ -77,6 +77,7 @@ class CombinedConstraintSystem : public multibody::ConstrainedSystem {
   // The full system's derivatives through the combination (its own when
   // it has them).
   bool has_analytic_derivatives() const override { return full_.has_analytic_derivatives(); }
+  bool has_exact_state_jacobian() const override { return full_.has_exact_state_jacobian(); }
   int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
                           Eigen::MatrixXd* curvature) const override;
   int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,

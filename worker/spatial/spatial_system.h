@@ -79,6 +79,10 @@ class SpatialSystem : public multibody::ConstrainedSystem {
 
   // The Newton matrix's derivatives (spatial_derivatives.cc).
   bool has_analytic_derivatives() const override { return true; }
+  // The Newton matrix leaves out d(M(q) v')/dq (the mass matrix depends on
+  // the Euler parameters), and the force elements' Jacobians are difference
+  // quotients: sensitivities difference the residual instead.
+  bool has_exact_state_jacobian() const override { return false; }
   int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
                           Eigen::MatrixXd* curvature) const override;
   int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
