@@ -463,12 +463,7 @@ std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::
   std::vector<Span> spans(views.size());
   double size = 1e-6;
   for (size_t v = 0; v < views.size(); ++v) {
-    for (const DrawingLayer& layer : layers) viewed[v].push_back(InView(*layer.drawing, views[v]));
-    std::vector<SceneDrawing> in_view = viewed[v];
-    for (const SceneDrawing* shared : extent) {
-      if (shared != nullptr) in_view.push_back(InView(*shared, views[v]));
-    }
-    for (const SceneDrawing& drawing : in_view) {
+    auto hold = [&spans, v](const SceneDrawing& drawing) {
       for (const std::vector<spec::DrawingPosition>& instant : drawing.points_m) {
         for (const spec::DrawingPosition& p : instant) {
           if (!Finite(p)) continue;
@@ -478,7 +473,13 @@ std::string SpatialSheetSvg(const std::vector<DrawingLayer>& layers, const std::
           spans[v].y_max = std::max(spans[v].y_max, p.y_m);
         }
       }
+    };
+    for (const DrawingLayer& layer : layers) {
+      viewed[v].push_back(InView(*layer.drawing, views[v]));
+      hold(viewed[v].back());
     }
+    // The shared drawings count for the axes only: viewed, held, dropped.
+    for (const SceneDrawing* shared : extent) hold(InView(*shared, views[v]));
     if (std::isfinite(spans[v].x_min)) {
       size = std::max({size, spans[v].x_max - spans[v].x_min, spans[v].y_max - spans[v].y_min});
     } else {

@@ -35,7 +35,7 @@ struct Problem {
   const std::vector<ParameterPerturbation>* parameters = nullptr;  // sensitivities, if any
   GglWorkspace work;
   Eigen::MatrixXd newton;
-  // dF/dy (or, for a system without analytic derivatives, Phi_q) and M at
+  // dF/dy (or, for a system without an exact state Jacobian, Phi_q) and M at
   // (state_jacobian_t, state_jacobian_at), for the sensitivity residuals.
   Eigen::MatrixXd state_jacobian, state_mass, state_phi_q;
   double state_jacobian_t = 0.0;
