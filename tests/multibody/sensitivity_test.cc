@@ -100,7 +100,7 @@ double WorstRelativeDifference(const spec::Scene& scene, const std::vector<doubl
     const spec::AnalysisReport up = AnalyzeMultibodyScene(scene, plus), down = AnalyzeMultibodyScene(scene, minus);
     EXPECT_TRUE(up.ok() && down.ok());
     for (size_t o = 0; o < up.outputs.size(); ++o) {
-      const std::vector<double>& d = result.output_derivatives[i][o];
+      const std::vector<double>& d = result.output_derivatives[i][o][0];
       EXPECT_EQ(d.size(), up.outputs[o].series[0].size());
       double scale = 0.0, diff = 0.0;
       for (size_t t = 0; t < d.size(); ++t) {

@@ -299,7 +299,7 @@ TEST(MultibodyStatics, SensitivitiesAgreeWithCentralDifferencesOfWholeAnalyses) 
     ASSERT_TRUE(up.ok() && down.ok());
     for (size_t o = 0; o < up.outputs.size(); ++o) {
       const double fd = (up.outputs[o].series[0][0] - down.outputs[o].series[0][0]) / (2 * h);
-      const double simulator = result.output_derivatives[i][o][0];
+      const double simulator = result.output_derivatives[i][o][0][0];
       EXPECT_NEAR(simulator, fd, 1e-6 * std::max(1.0, std::abs(fd)))
           << scene->parameters[i].name << " -> " << scene->outputs[o].name;
       std::cout << scene->parameters[i].name << " -> " << scene->outputs[o].name << ": " << simulator
@@ -307,7 +307,7 @@ TEST(MultibodyStatics, SensitivitiesAgreeWithCentralDifferencesOfWholeAnalyses) 
     }
   }
   // The angle moves with every parameter (not a trivially zero derivative).
-  for (size_t i = 0; i < p.size(); ++i) EXPECT_GT(std::abs(result.output_derivatives[i][0][0]), 1e-3);
+  for (size_t i = 0; i < p.size(); ++i) EXPECT_GT(std::abs(result.output_derivatives[i][0][0][0]), 1e-3);
 }
 
 // The knee scene of bench_multibody_sensitivity: 101 equilibria under a
@@ -336,7 +336,7 @@ TEST(MultibodyStatics, LoadedArmSensitivitiesAgreeAtEveryInstant) {
     const spec::AnalysisReport up = AnalyzeMultibodyScene(*scene, plus), down = AnalyzeMultibodyScene(*scene, minus);
     ASSERT_TRUE(up.ok() && down.ok());
     for (size_t o = 0; o < up.outputs.size(); ++o) {
-      const std::vector<double>& d = result.output_derivatives[i][o];
+      const std::vector<double>& d = result.output_derivatives[i][o][0];
       ASSERT_EQ(d.size(), up.outputs[o].series[0].size());
       double scale = 0.0, difference = 0.0;
       for (size_t t = 0; t < d.size(); ++t) {

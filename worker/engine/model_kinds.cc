@@ -46,7 +46,7 @@ SensitivityAnalysis AnalyzeLumpedWithSensitivities(const spec::Scene& scene, con
   lumped::LumpedSensitivityOptions options;
   options.budget = budget;
   lumped::LumpedSensitivityResult result = lumped::SimulateLumpedWithSensitivities(scene, p, parameters, options);
-  return {std::move(result.report), std::move(result.output_derivatives), ""};
+  return {std::move(result.report), OneSeriesPerOutput(std::move(result.output_derivatives)), ""};
 }
 
 spec::AnalysisReport AnalyzeLinkage(const spec::Scene& scene, const std::vector<double>& p,
@@ -76,7 +76,8 @@ SensitivityAnalysis AnalyzeSpatialWithSensitivities(const spec::Scene& scene, co
                                                     const std::vector<int>& parameters,
                                                     budget::AnalysisBudget* budget, const ExternalAnalyzer*) {
   spatial::SpatialSensitivityResult result = spatial::AnalyzeSpatialSceneWithSensitivities(scene, p, parameters, budget);
-  return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
+  return {std::move(result.report), OneSeriesPerOutput(std::move(result.output_derivatives)),
+          std::move(result.unavailable)};
 }
 
 spec::AnalysisReport AnalyzeFmu(const spec::Scene& scene, const std::vector<double>& p,
@@ -88,7 +89,8 @@ SensitivityAnalysis AnalyzeFmuWithSensitivities(const spec::Scene& scene, const 
                                                 const std::vector<int>& parameters, budget::AnalysisBudget* budget,
                                                 const ExternalAnalyzer*) {
   fmu::FmuSensitivityAnalysis result = fmu::AnalyzeFmuSceneWithSensitivities(scene, p, parameters, budget);
-  return {std::move(result.report), std::move(result.output_derivatives), std::move(result.unavailable)};
+  return {std::move(result.report), OneSeriesPerOutput(std::move(result.output_derivatives)),
+          std::move(result.unavailable)};
 }
 
 spec::AnalysisReport AnalyzeExternal(const spec::Scene& scene, const std::vector<double>& p,
@@ -119,7 +121,9 @@ SensitivityAnalysis AnalyzeExternalWithSensitivities(const spec::Scene& scene, c
     out.report = FailedAtStart(scene, std::move(spent));
     return out;
   }
-  out.report = external->AnalyzeExternalWithSensitivities(scene, p, parameters, &out.output_derivatives);
+  std::vector<std::vector<std::vector<double>>> derivatives;
+  out.report = external->AnalyzeExternalWithSensitivities(scene, p, parameters, &derivatives);
+  out.output_derivatives = OneSeriesPerOutput(std::move(derivatives));
   return out;
 }
 
@@ -192,6 +196,16 @@ std::vector<ModelKind> MakeTable() {
 }
 
 }  // namespace
+
+std::vector<std::vector<std::vector<std::vector<double>>>> OneSeriesPerOutput(
+    std::vector<std::vector<std::vector<double>>> derivatives) {
+  std::vector<std::vector<std::vector<std::vector<double>>>> out(derivatives.size());
+  for (size_t k = 0; k < derivatives.size(); ++k) {
+    out[k].reserve(derivatives[k].size());
+    for (std::vector<double>& series : derivatives[k]) out[k].push_back({std::move(series)});
+  }
+  return out;
+}
 
 const std::vector<ModelKind>& ModelKinds() {
   static const std::vector<ModelKind> table = MakeTable();

@@ -20,11 +20,18 @@ namespace mbopt::engine {
 // scene parameters.
 struct SensitivityAnalysis {
   spec::AnalysisReport report;
-  // [k][output][instant]: d output / d parameter_values_si[parameters[k]];
-  // empty when `unavailable` says why (the values in `report` still count).
-  std::vector<std::vector<std::vector<double>>> output_derivatives;
+  // [k][output][series][instant]: d output / d parameter_values_si[parameters[k]],
+  // one derivative series per series of the output's values (a flexible
+  // link's stress: one per node); empty when `unavailable` says why (the
+  // values in `report` still count).
+  std::vector<std::vector<std::vector<std::vector<double>>>> output_derivatives;
   std::string unavailable;
 };
+
+// Engines whose outputs all have one series give [k][output][instant]: the
+// same derivatives, each output's series wrapped as its only one.
+std::vector<std::vector<std::vector<std::vector<double>>>> OneSeriesPerOutput(
+    std::vector<std::vector<std::vector<double>>> derivatives);
 
 struct ModelKind {
   const char* name;  // the scene file's name of the kind

@@ -33,9 +33,9 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
     out.report = AnalyzeCases(study, parameters_si, external, budget);
     return out;
   }
-  // [parameter][signal]: every case's outputs in turn, as AnalyzeCases
-  // orders them.
-  std::vector<std::vector<std::vector<double>>> output_derivatives(parameters.size());
+  // [parameter][signal][series]: every case's outputs in turn, as
+  // AnalyzeCases orders them.
+  std::vector<std::vector<std::vector<std::vector<double>>>> output_derivatives(parameters.size());
   for (int c = 0; c < study.num_cases(); ++c) {
     const std::vector<double> case_si = study.CaseParameterValues(c, parameters_si);
     budget::AnalysisBudget case_budget =
@@ -45,7 +45,7 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
     spec::AnalysisReport report = std::move(result.report);
     report.counters.wall_seconds = budget.NowSeconds() - start_s;
     if (out.gradients_unavailable.empty()) out.gradients_unavailable = std::move(result.unavailable);
-    std::vector<std::vector<std::vector<double>>> derivatives = std::move(result.output_derivatives);
+    std::vector<std::vector<std::vector<std::vector<double>>>> derivatives = std::move(result.output_derivatives);
     const bool ok = report.ok();
     if (study.cases.empty()) {
       out.report = std::move(report);
@@ -63,13 +63,17 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
   }
   if (!out.gradients_unavailable.empty()) return out;
   for (const auto& per_parameter : output_derivatives) {
-    if (per_parameter.size() != out.report.outputs.size()) {
-      out.gradients_unavailable = "the engine's sensitivities do not cover every output";
+    bool covered = per_parameter.size() == out.report.outputs.size();
+    for (size_t o = 0; covered && o < per_parameter.size(); ++o) {
+      covered = per_parameter[o].size() == out.report.outputs[o].series.size();
+    }
+    if (!covered) {
+      out.gradients_unavailable = "the engine's sensitivities do not cover every output and series";
       return out;
     }
   }
-  // One series per output: wrap each derivative series, summed over the
-  // parameters of each variable.
+  // Each output's derivative series, summed over the parameters of each
+  // variable.
   const size_t n = study.variables.size();
   const size_t num_outputs = out.report.outputs.size();
   std::vector<std::vector<std::vector<std::vector<double>>>> wrapped(n);
@@ -80,12 +84,14 @@ StudyAnalysisWithGradients AnalyzeStudyWithGradients(const spec::Study& study,
   for (size_t k = 0; k < parameters.size(); ++k) {
     const size_t i = variable_of[k];
     for (size_t o = 0; o < num_outputs; ++o) {
-      const std::vector<double>& d = output_derivatives[k][o];
+      const std::vector<std::vector<double>>& d = output_derivatives[k][o];
       if (wrapped[i][o].empty()) {
-        wrapped[i][o] = {d};
-      } else {
-        std::vector<double>& sum = wrapped[i][o][0];
-        for (size_t t = 0; t < sum.size() && t < d.size(); ++t) sum[t] += d[t];
+        wrapped[i][o] = d;
+        continue;
+      }
+      for (size_t j = 0; j < d.size(); ++j) {
+        std::vector<double>& sum = wrapped[i][o][j];
+        for (size_t t = 0; t < sum.size() && t < d[j].size(); ++t) sum[t] += d[j][t];
       }
     }
   }

@@ -311,6 +311,23 @@ double OutputDerivative(const spec::MultibodyModel& sm, const spec::MultibodyOut
   return (plus - minus) / (2.0 * h);
 }
 
+// d stress / dp at every node of flexible link `link`, as OutputDerivative:
+// the variants carry the parameter's effect on the section (area, modulus,
+// hence stiffness and fibre distance) and on the reference geometry, the
+// shifted states that through the motion. False if nodes coincide.
+bool StressDerivatives(const spec::MultibodyModel& sm, int link, const Perturbed& dp, const MotionSample& s,
+                       const StateSensitivity& ds, std::vector<double>* derivatives) {
+  const double h = dp.step;
+  std::vector<double> plus, minus;
+  if (!NodeStresses(*dp.plus->mechanism, sm, link, dp.plus->p, s.q + h * ds.q, s.v + h * ds.v, &plus) ||
+      !NodeStresses(*dp.minus->mechanism, sm, link, dp.minus->p, s.q - h * ds.q, s.v - h * ds.v, &minus)) {
+    return false;
+  }
+  derivatives->resize(plus.size());
+  for (size_t j = 0; j < plus.size(); ++j) (*derivatives)[j] = (plus[j] - minus[j]) / (2.0 * h);
+  return true;
+}
+
 // The most turns a driver may make between two instants: an analysis that
 // follows the motion needs a step per turn at least, and more than the
 // step budget's worth can never end within it.
@@ -364,7 +381,6 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     report.Fail(spec::FailureKind::kInvalidModel, why);
     return;
   }
-  bool has_stress = false;
   for (size_t k = 0; k < scene.outputs.size(); ++k) {
     const spec::Output& o = scene.outputs[k];
     const auto* stress = std::get_if<spec::BendingStressOutput>(&o.kind);
@@ -373,7 +389,6 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       report.Fail(spec::FailureKind::kInvalidModel, absl::StrFormat("output '%s' is not a multibody output", o.name));
       return;
     }
-    has_stress = has_stress || stress != nullptr;
     const spec::OutputShape shape = spec::OutputShapeOf(scene, static_cast<int>(k));
     spec::OutputValues values;
     values.name = o.name;
@@ -421,8 +436,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   const bool is_static = sm.analysis == spec::MultibodyModel::Analysis::kStaticEquilibrium;
   std::vector<Perturbed> perturbed;
-  if (sensitivities && has_stress) result->unavailable = MultibodySensitivityUnavailable(scene);
-  if (sensitivities && result->unavailable.empty()) {
+  if (sensitivities) {
     for (const int index : *parameters) {
       Perturbed dp;
       const double value = p[static_cast<size_t>(index)];
@@ -445,8 +459,9 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   const bool with_derivatives = !perturbed.empty();
   if (with_derivatives) {
-    result->output_derivatives.assign(perturbed.size(),
-                                      std::vector<std::vector<double>>(scene.outputs.size(), std::vector<double>()));
+    std::vector<std::vector<std::vector<double>>> per_parameter(report.outputs.size());
+    for (size_t k = 0; k < report.outputs.size(); ++k) per_parameter[k].resize(report.outputs[k].series.size());
+    result->output_derivatives.assign(perturbed.size(), per_parameter);
   }
   // The motion starts at t = 0; the grid may start later.
   std::vector<double> times;
@@ -509,8 +524,19 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     }
     for (size_t i = 0; i < perturbed.size(); ++i) {
       for (size_t k = 0; k < scene.outputs.size(); ++k) {
+        std::vector<std::vector<double>>& series = result->output_derivatives[i][k];
+        if (const auto* stress = std::get_if<spec::BendingStressOutput>(&scene.outputs[k].kind)) {
+          if (!StressDerivatives(sm, stress->link, perturbed[i], s, (*ds)[i], &stresses)) {
+            result->unavailable = absl::StrFormat(
+                "flexible link nodes coincide in a perturbed state at t = %.6g s (parameter '%s')", s.t_s,
+                scene.parameters[static_cast<size_t>((*parameters)[i])].name);
+            return spec::AnalysisFailure::Ok();
+          }
+          for (size_t j = 0; j < stresses.size(); ++j) series[j].push_back(stresses[j]);
+          continue;
+        }
         const auto& o = std::get<spec::MultibodyOutput>(scene.outputs[k].kind);
-        result->output_derivatives[i][k].push_back(OutputDerivative(sm, o, perturbed[i], s, (*ds)[i], &phi_q));
+        series[0].push_back(OutputDerivative(sm, o, perturbed[i], s, (*ds)[i], &phi_q));
       }
     }
     return spec::AnalysisFailure::Ok();
@@ -579,11 +605,6 @@ MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Sc
 std::string MultibodySensitivityUnavailable(const spec::Scene& scene) {
   const auto* sm = std::get_if<spec::MultibodyModel>(&scene.model);
   if (sm == nullptr) return "not a multibody scene";
-  for (const spec::Output& o : scene.outputs) {
-    if (std::holds_alternative<spec::BendingStressOutput>(o.kind)) {
-      return "bending-stress outputs of flexible links have no simulator sensitivities yet";
-    }
-  }
   return "";
 }
 

@@ -42,12 +42,15 @@ spec::AnalysisReport AnalyzeMultibodyScene(const spec::Scene& scene, const std::
 // function theorem at each instant (static_equilibrium.h); driven
 // mechanisms: the differentiated constraint equations at each instant
 // (kinematic_sensitivity.h); outputs: central differences along (state
-// derivative, e_k).
+// derivative, e_k). A bending-stress output is differenced the same way at
+// every node: the perturbed models carry the parameter's effect on the
+// section (modulus, area, hence stiffness and fibre distance).
 struct MultibodySensitivityResult {
   spec::AnalysisReport report;
-  // [k][output][instant]: d output / d parameter_values_si[parameters[k]];
+  // [k][output][series][instant]: d output / d parameter_values_si[parameters[k]],
+  // as many series per output as its values (a stress output: one per node);
   // empty when `unavailable` says why (the values in `report` still count).
-  std::vector<std::vector<std::vector<double>>> output_derivatives;
+  std::vector<std::vector<std::vector<std::vector<double>>>> output_derivatives;
   std::string unavailable;
 };
 MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Scene& scene,
@@ -56,7 +59,7 @@ MultibodySensitivityResult AnalyzeMultibodySceneWithSensitivities(const spec::Sc
                                                                   budget::AnalysisBudget* budget = nullptr);
 
 // Empty if the scene's analysis has simulator sensitivities; else why not
-// (bending-stress outputs of flexible links).
+// (not a multibody scene).
 std::string MultibodySensitivityUnavailable(const spec::Scene& scene);
 
 // The model of a multibody scene at the given parameter values (SI), checked
