@@ -23,39 +23,11 @@
 namespace mbopt::multibody {
 namespace {
 
-// Steel rod, 1 m, area 1e-4 m^2 (EI = 159 N m^2, tip stiffness 3 EI / L^3 =
-// 477 N/m), clamped at the wall; its tip rests on a spring to the ground
-// that takes part of the 10 N load: how much depends on the rod's EI, so
-// the root stress depends on the modulus too.
-constexpr char kProppedCantilever[] = R"pb(
-name: "propped_cantilever"
-parameters { name: "A" value: 1e-4 unit: "m^2" }
-parameters { name: "E" value: 2e11 unit: "Pa" }
-parameters { name: "L" value: 1 unit: "m" }
-parameters { name: "k" value: 500 unit: "N/m" }
-parameters { name: "P" value: 10 unit: "N" }
-multibody {
-  analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
-  ground_markers { name: "wall" }
-  ground_markers { name: "floor" position_m { x { value: 1 } y { value: -1 } } }
-  flexible_links {
-    name: "rod"
-    length_m { param: "L" }
-    section { area_m2 { param: "A" } youngs_modulus_pa { param: "E" } density_kg_per_m3 { value: 7800 } }
-    elements: 6
-  }
-  joints { name: "clamp" kind: JOINT_FIXED a: "ground.wall" b: "rod.a" }
-  springs { name: "prop" a: "ground.floor" b: "rod.b" free_length_m { value: 1 } stiffness_n_per_m { param: "k" } }
-  point_forces { at: "rod.b" force_n { x { value: 0 } y { expr: "-P" } } }
-}
-outputs { name: "tip_y" marker_position { marker: "rod.b" axis: AXIS_Y } }
-outputs { name: "stress" bending_stress { link: "rod" } }
-time_grid { start_s: 0 end_s: 0 points: 1 }
-)pb";
+constexpr char kProppedCantilever[] = "tests/multibody/propped_cantilever.scene.textproto";
 
-// The same rod pinned at the wall, swinging down under gravity from
-// horizontal, with 5 % structural damping (its rate follows the lowest
-// bending frequency, hence the parameters).
+// The propped cantilever's rod, ten times softer, pinned at the wall and
+// swinging down under gravity from horizontal, with 5 % structural damping
+// (its rate follows the lowest bending frequency, hence the parameters).
 constexpr char kFlexiblePendulum[] = R"pb(
 name: "flexible_pendulum"
 effects {
@@ -142,7 +114,7 @@ double WorstRelativeDifference(const spec::Scene& scene, double relative_step) {
 }
 
 TEST(StressSensitivity, StaticEquilibriumStressesAgreeWithCentralDifferences) {
-  absl::StatusOr<spec::Scene> scene = LoadText(kProppedCantilever);
+  absl::StatusOr<spec::Scene> scene = spec::io::LoadSceneFile(kProppedCantilever);
   ASSERT_TRUE(scene.ok()) << scene.status();
   EXPECT_EQ(MultibodySensitivityUnavailable(*scene), "");
   const spec::AnalysisReport report = AnalyzeMultibodyScene(*scene, Values(*scene));
