@@ -125,7 +125,7 @@ TEST(StressSensitivity, StaticEquilibriumStressesAgreeWithCentralDifferences) {
   const double area = 1e-4, inertia = area * area / (4 * M_PI), tip_stiffness = 3 * 2e11 * inertia;
   const double root = -10.0 * (tip_stiffness / (500.0 + tip_stiffness)) * std::sqrt(area / M_PI) / inertia;
   EXPECT_NEAR(report.outputs[1].series[0][0] / root, 1.0, 1e-3);
-  // Measured: 3.9e-6 (the tip displacement's derivatives too, so not the
+  // Measured: 4.0e-6 (the tip displacement's derivatives too, so not the
   // stresses' own: at a tenth of the load the A, k and P columns agree to
   // 7e-8, the L column stays at 2.5e-6). Steps 1e-5 and 1e-4 give the same
   // figures: it is not the differences' noise.
