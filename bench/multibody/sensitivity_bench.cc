@@ -3,7 +3,9 @@
 // (IDAS forward sensitivities, 2 parameters), the driven press
 // (differentiated constraint equations, 2 link lengths) and the loaded knee
 // in static equilibrium (the implicit function theorem at 101 equilibria,
-// 3 parameters). Forward differences cost 1 + n plain analyses for the same
+// 3 parameters), and the co-rotational four-bar, whose outputs are its
+// links' bending stresses at every node (IDAS forward sensitivities, the 3
+// section areas). Forward differences cost 1 + n plain analyses for the same
 // gradients; the aim is at most 1 + 0.4 n.
 //
 //   build/bench/multibody/bench_multibody_sensitivity --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
@@ -63,6 +65,10 @@ BENCHMARK_CAPTURE(Plain, press, "examples/press/press.scene.textproto")->Unit(be
 BENCHMARK_CAPTURE(WithSensitivities, press, "examples/press/press.scene.textproto")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(Plain, knee_statics, "tests/multibody/knee_statics.scene.textproto")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(WithSensitivities, knee_statics, "tests/multibody/knee_statics.scene.textproto")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(Plain, fourbar_corotational, "examples/fourbar/fourbar_corotational.scene.textproto")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(WithSensitivities, fourbar_corotational, "examples/fourbar/fourbar_corotational.scene.textproto")
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
