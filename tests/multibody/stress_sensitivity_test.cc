@@ -87,7 +87,10 @@ multibody {
   }
   joints { name: "clamp" kind: JOINT_FIXED a: "ground.wall" b: "rod.a" }
   joints { name: "tip" kind: JOINT_FIXED a: "slider.pin" b: "rod.b" }
-  joints { name: "guide" kind: JOINT_PRISMATIC a: "ground.guide" b: "slider.pin" axis_angle_rad { value: 1.5707963267948966 } }
+  joints {
+    name: "guide" kind: JOINT_PRISMATIC a: "ground.guide" b: "slider.pin"
+    axis_angle_rad { value: 1.5707963267948966 }
+  }
   drivers { joint: "guide" constant_rate { start { value: 0 } rate { param: "rate" } } }
 }
 outputs { name: "tip_y" marker_position { marker: "rod.b" axis: AXIS_Y } }
@@ -167,8 +170,8 @@ TEST(StressSensitivity, StaticEquilibriumStressesAgreeWithCentralDifferences) {
   EXPECT_EQ(report.formulation, spec::Formulation::kStatic);
   // Linear theory: the spring takes k / (k + 3 EI / L^3) of the load, the
   // root carries the rest times L; M r / I with r / I = 7.09e6 / m^3.
-  const double area = 1e-4, inertia = area * area / (4 * M_PI), tip_stiffness = 3 * 2e11 * inertia;
-  const double root = -10.0 * (tip_stiffness / (500.0 + tip_stiffness)) * std::sqrt(area / M_PI) / inertia;
+  const double area = 1e-4, inertia = area * area / (4 * std::numbers::pi), tip_stiffness = 3 * 2e11 * inertia;
+  const double root = -10.0 * (tip_stiffness / (500.0 + tip_stiffness)) * std::sqrt(area / std::numbers::pi) / inertia;
   EXPECT_NEAR(report.outputs[1].series[0][0] / root, 1.0, 1e-3);
   // Measured: 4.0e-6, the tip deflection's derivatives too, and the same
   // at steps 1e-5 and 1e-4: the whole analyses' equilibria stop at the
@@ -226,7 +229,8 @@ Polished PolishedEquilibrium(const spec::Scene& scene, const std::vector<double>
   // The rod's nodes are the only bodies: node 0 at the wall, the tip last.
   BeamLoads root;
   EXPECT_TRUE(m.BeamEndLoads(0, q, zero, &root));
-  const double area = p[0], fibre_per_inertia = std::sqrt(area / std::numbers::pi) / (area * area / (4 * std::numbers::pi));
+  const double area = p[0];
+  const double fibre_per_inertia = std::sqrt(area / std::numbers::pi) / (area * area / (4 * std::numbers::pi));
   return {-root.moment_a_n_m * fibre_per_inertia, q[n - 2]};
 }
 
