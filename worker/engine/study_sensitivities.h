@@ -4,9 +4,10 @@
 // kind (model_kinds.h) and the layout's chain rule (spec/study_gradients.h).
 // Pure: no threads, no I/O, no clock (the budget's).
 //
-// When the scene has no simulator sensitivities (its kind has none, a
-// static multibody analysis, or a lumped design variable that sets
-// something other than a mass, inertia, stiffness or damping) the plain
+// Every series of an output has its derivative series (a flexible link's
+// stress: one per node). When the scene has no simulator sensitivities (its
+// kind has none, or a lumped design variable that sets something other than
+// a mass, inertia, stiffness or damping) the plain
 // analysis is run and `gradients` is empty with the reason: the caller then
 // uses finite differences.
 #pragma once
