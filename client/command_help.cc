@@ -93,7 +93,7 @@ constexpr Help kHelp[] = {
      "                        design, every constraint\n"},
     {"report",
      "usage: mbopt report JOB [-o FILE] [--no-responses] [--no-mechanism] [--plot X:Y ...]\n"
-     "                        [--server HOST:PORT | --db PATH]\n"
+     "                        [--deflection-scale K] [--server HOST:PORT | --db PATH]\n"
      "\n"
      "Writes a self-contained HTML page of the job: history plots, tables, the responses of the\n"
      "initial and final designs, the mechanism drawn at both.\n"
@@ -104,6 +104,7 @@ constexpr Help kHelp[] = {
      "  --plot X:Y            also plot output or response Y against X at both designs, besides\n"
      "                        the study's `plots`; repeatable\n"
      "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"
+     "  --deflection-scale K  draw the flexible links' deflection K times its size (default 1)\n"
      "  --point K             a Pareto front's page: mark point K as the chosen design and show it\n"},
     {"draw",
      "usage: mbopt draw FILE [-o OUT.html] [--case NAME] [--set NAME=VALUE ...] [--deflection-scale K]\n"

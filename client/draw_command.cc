@@ -5,14 +5,12 @@
 // check a model before optimizing it. The worker program computes the
 // drawing; this draws it (its flexible links' deflection magnified K times
 // if asked: the drawing file itself stays true to scale).
-#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "absl/strings/match.h"
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "client/commands.h"
 #include "client/exit_codes.h"
@@ -109,8 +107,7 @@ int DrawCommand(const Args& args) {
   }
   if (file.empty()) return Fail(std::string("no scene or study file given\n") + kDrawUsage, kExitBadInput);
   double deflection_scale = 1.0;
-  if (!scale_text.empty() && (!absl::SimpleAtod(scale_text, &deflection_scale) ||
-                              !std::isfinite(deflection_scale) || !(deflection_scale > 0.0))) {
+  if (!scale_text.empty() && !report::ParseDeflectionScale(scale_text, &deflection_scale)) {
     return Fail("--deflection-scale needs a positive number, not \"" + scale_text + "\"\n" + kDrawUsage,
                 kExitBadInput);
   }

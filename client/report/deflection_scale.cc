@@ -1,5 +1,7 @@
 #include "client/report/deflection_scale.h"
 
+#include <charconv>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,6 +36,15 @@ spec::SceneDrawing MagnifyDeflection(spec::SceneDrawing d, double scale) {
                            "between its ends, magnified";
   d.note = d.note.empty() ? said : d.note + "; " + said;
   return d;
+}
+
+bool ParseDeflectionScale(const std::string& text, double* scale) {
+  double value = 0.0;
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (error != std::errc() || stop != end || !std::isfinite(value) || !(value > 0.0)) return false;
+  *scale = value;
+  return true;
 }
 
 }  // namespace mbopt::report

@@ -8,11 +8,17 @@
 // the drawing back unchanged, bit for bit. Pure.
 #pragma once
 
+#include <string>
+
 #include "spec/scene_drawing.h"
 
 namespace mbopt::report {
 
 // `scale` must be finite and positive.
 spec::SceneDrawing MagnifyDeflection(spec::SceneDrawing drawing, double scale);
+
+// The scale a command line gives (`--deflection-scale K`): false unless
+// `text` is all a finite, positive number.
+bool ParseDeflectionScale(const std::string& text, double* scale);
 
 }  // namespace mbopt::report

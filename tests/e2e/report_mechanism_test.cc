@@ -2,9 +2,10 @@
 // the report's "Mechanism" section (client/report_mechanism.h) of a
 // hand-made job and `mbopt draw` of the study draw every case with the
 // parameters it sets, checked against the slider crank's closed form;
-// `mbopt draw` of a flexible arm magnifies its deflection when asked and
-// says so, and says why a kinematic analysis' arm is drawn rigid. No
-// server is needed.
+// `mbopt draw` and the report's section of a flexible arm magnify its
+// deflection when asked and say so, and say why a kinematic analysis' arm
+// is drawn rigid. No server is needed.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -176,6 +177,55 @@ TEST(DrawDeflection, TheScaleIsDrawnAndSaid) {
   std::ofstream(scene, std::ios::trunc) << kinematic;
   ASSERT_EQ(DrawCommand({scene, "-o", page}), kExitOk);
   EXPECT_THAT(ReadFile(page), HasSubstr("the flexible links are drawn rigid, as the analysis moves them"));
+}
+
+// The report's section: the arm as a study, its section area a design
+// variable; each inner node of the centre line drawn 1000 times as far off
+// the straight line between its ends as true to scale.
+TEST(DrawDeflection, TheReportMagnifiesTheSameDrawing) {
+  setenv("MBOPT_WORKER_BIN", MBOPT_TEST_WORKER, 1);
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "report_deflection";
+  std::filesystem::create_directories(dir);
+  std::string scene = kArm;
+  scene.replace(scene.find("area_m2 { value: 1e-3 }"), std::string("area_m2 { value: 1e-3 }").size(),
+                "area_m2 { param: \"A\" }");
+  scene += "parameters { name: \"A\" value: 1e-3 unit: \"m^2\" }\n";
+  std::ofstream((dir / "arm.scene.textproto").string()) << scene;
+  const std::string study_path = (dir / "arm.study.textproto").string();
+  std::ofstream(study_path) << R"pb(name: "arm" scene_file: "arm.scene.textproto"
+variables { name: "a" parameter: "A" scale: 1e-3 initial: 1 lower: 0.5 upper: 2 }
+objective { minimize_max_of: "torque" reduction: REDUCTION_MAX_ABS }
+)pb";
+  absl::StatusOr<v1::Study> study = spec::io::ReadStudyProto(study_path);
+  ASSERT_TRUE(study.ok()) << study.status();
+  v1::GetJobResponse job;
+  *job.mutable_study() = *study;
+  job.add_cycles()->set_cycle(1);
+  job.mutable_summary()->add_design(1.2e-3);
+  job.mutable_summary()->add_design_names("a");
+  report::ReportData plain, magnified;
+  AddMechanismDrawings(job, &plain);
+  AddMechanismDrawings(job, &magnified, 1000);
+  ASSERT_TRUE(plain.mechanism.final.has_value()) << plain.mechanism.note;
+  ASSERT_TRUE(magnified.mechanism.final.has_value()) << magnified.mechanism.note;
+  const spec::SceneDrawing& p = *plain.mechanism.final;
+  const spec::SceneDrawing& m = *magnified.mechanism.final;
+  EXPECT_EQ(p.note, "");
+  EXPECT_THAT(m.note, HasSubstr("drawn 1000 times its size"));
+  ASSERT_EQ(p.lines.size(), 1u);
+  const std::vector<int>& line = p.lines[0].points;
+  const size_t n = line.size() - 1;
+  const spec::DrawingPosition& a = p.points_m.back()[static_cast<size_t>(line.front())];
+  const spec::DrawingPosition& b = p.points_m.back()[static_cast<size_t>(line.back())];
+  double largest = 0.0;
+  for (size_t k = 1; k < n; ++k) {
+    const double f = static_cast<double>(k) / n;
+    const double cy = a.y_m + (b.y_m - a.y_m) * f;
+    const double off = p.points_m.back()[static_cast<size_t>(line[k])].y_m - cy;
+    EXPECT_NEAR(m.points_m.back()[static_cast<size_t>(line[k])].y_m - cy, 1000 * off, 1e-9) << "point " << k;
+    largest = std::max(largest, std::abs(off));
+  }
+  EXPECT_GT(largest, 1e-7) << "the arm bends";
 }
 
 }  // namespace
