@@ -251,6 +251,7 @@ TEST(CorotationalLinkageDrawing, KeepingTheMotionChangesNoNumberOfTheAnalysis) {
   const spec::AnalysisReport kept = AnalyzeLinkageScene(scene, {}, nullptr, &deflection);
   ASSERT_TRUE(plain.ok()) << plain.failure.reason;
   ASSERT_TRUE(kept.ok()) << kept.failure.reason;
+  EXPECT_EQ(deflection.corotational_q.size(), 11u);
   for (size_t k = 0; k < plain.outputs.size(); ++k) EXPECT_EQ(plain.outputs[k].series, kept.outputs[k].series);
   EXPECT_EQ(plain.counters.time_steps, kept.counters.time_steps);
   EXPECT_EQ(plain.counters.rhs_evaluations, kept.counters.rhs_evaluations);
