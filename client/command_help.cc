@@ -93,7 +93,7 @@ constexpr Help kHelp[] = {
      "                        design, every constraint\n"},
     {"report",
      "usage: mbopt report JOB [-o FILE] [--no-responses] [--no-mechanism] [--plot X:Y ...]\n"
-     "                        [--server HOST:PORT | --db PATH]\n"
+     "                        [--deflection-scale K] [--server HOST:PORT | --db PATH]\n"
      "\n"
      "Writes a self-contained HTML page of the job: history plots, tables, the responses of the\n"
      "initial and final designs, the mechanism drawn at both.\n"
@@ -104,9 +104,10 @@ constexpr Help kHelp[] = {
      "  --plot X:Y            also plot output or response Y against X at both designs, besides\n"
      "                        the study's `plots`; repeatable\n"
      "  --no-mechanism        leave out the drawing of the mechanism (no motion is solved for it)\n"
+     "  --deflection-scale K  draw the flexible links' deflection K times its size (default 1)\n"
      "  --point K             a Pareto front's page: mark point K as the chosen design and show it\n"},
     {"draw",
-     "usage: mbopt draw FILE [-o OUT.html] [--case NAME] [--set NAME=VALUE ...]\n"
+     "usage: mbopt draw FILE [-o OUT.html] [--case NAME] [--set NAME=VALUE ...] [--deflection-scale K]\n"
      "\n"
      "Writes a self-contained HTML page with the drawing of a scene (FILE a .scene.textproto) or\n"
      "of a study's scene at its initial design (once per load case, with the parameters each\n"
@@ -119,7 +120,9 @@ constexpr Help kHelp[] = {
      "options:\n"
      "  -o, --output FILE     the page (default: FILE's name with .html, in this folder)\n"
      "  --case NAME           only the study's load case NAME\n"
-     "  --set NAME=VALUE      a design variable (scaled) or a scene parameter (its unit); repeatable\n"},
+     "  --set NAME=VALUE      a design variable (scaled) or a scene parameter (its unit); repeatable\n"
+     "  --deflection-scale K  draw the flexible links' deflection K times its size (default 1:\n"
+     "                        true to scale); the page says so\n"},
 };
 
 bool TalksToServer(std::string_view command) {

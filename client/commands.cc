@@ -21,6 +21,7 @@
 #include "client/job_format.h"
 #include "client/local_cluster.h"
 #include "client/local_worker_drivers.h"
+#include "client/report/deflection_scale.h"
 #include "client/report/design_set_report.h"
 #include "client/report/pareto_report.h"
 #include "client/report/job_report_html.h"
@@ -371,11 +372,19 @@ int ReportCommand(const Args& args) {
       spelled.push_back(args[i] == "-o" ? "--output" : args[i]);
     }
   }
-  auto parsed = Parse(spelled, {{"--server", "--db", "--output", "--plot", "--point"}, {"--no-responses", "--no-mechanism"}},
+  auto parsed = Parse(spelled,
+                      {{"--server", "--db", "--output", "--plot", "--point", "--deflection-scale"},
+                       {"--no-responses", "--no-mechanism"}},
                       1,
                       "mbopt report JOB [-o|--output FILE] [--server ADDRESS | --db PATH] [--no-responses] "
-                      "[--no-mechanism] [--plot X:Y ...] [--point K (a Pareto front's chosen point)]");
+                      "[--no-mechanism] [--plot X:Y ...] [--point K (a Pareto front's chosen point)] "
+                      "[--deflection-scale K]");
   if (!parsed.ok()) return Fail(std::string(parsed.status().message()), kExitBadInput);
+  double deflection_scale = 1.0;
+  if (const std::string scale = parsed->Value("--deflection-scale");
+      !scale.empty() && !report::ParseDeflectionScale(scale, &deflection_scale)) {
+    return Fail("--deflection-scale needs a positive number, not \"" + scale + "\"", kExitBadInput);
+  }
   auto point = parsed->IntValue("--point", 1);
   if (!point.ok()) return Fail(std::string(point.status().message()), kExitBadInput);
   const std::string job_id = parsed->positional[0];
@@ -423,7 +432,7 @@ int ReportCommand(const Args& args) {
   if (parsed->Has("--no-mechanism")) {
     data.mechanism.note = "Not drawn (mbopt report --no-mechanism).";
   } else {
-    AddMechanismDrawings(response, &data);
+    AddMechanismDrawings(response, &data, deflection_scale);
   }
   return WriteReport(path, report::RenderJobReportHtml(data));
 }

@@ -1,8 +1,10 @@
-// `mbopt draw FILE [-o OUT.html] [--case NAME] [--set NAME=VALUE ...]`: the
+// `mbopt draw FILE [-o OUT.html] [--case NAME] [--set NAME=VALUE ...]
+// [--deflection-scale K]`: the
 // drawing of a scene (or of a study's scene at its initial design, once per
 // load case) as a self-contained HTML page, animated over the time grid, to
 // check a model before optimizing it. The worker program computes the
-// drawing; this draws it.
+// drawing; this draws it (its flexible links' deflection magnified K times
+// if asked: the drawing file itself stays true to scale).
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -12,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/commands.h"
 #include "client/exit_codes.h"
+#include "client/report/deflection_scale.h"
 #include "client/report/load_case_drawings.h"
 #include "client/report/mechanism_drawing.h"
 #include "client/temp_dir.h"
@@ -22,7 +25,7 @@ namespace mbopt::client {
 namespace {
 
 constexpr char kDrawUsage[] =
-    "usage: mbopt draw FILE [-o|--output OUT.html] [--case NAME] [--set NAME=VALUE ...]";
+    "usage: mbopt draw FILE [-o|--output OUT.html] [--case NAME] [--set NAME=VALUE ...] [--deflection-scale K]";
 
 // FILE's name without its folder and its .scene/.study suffix, + ".html".
 std::string DefaultOutput(const std::string& file) {
@@ -44,13 +47,13 @@ bool IsSceneFile(const std::string& path) {
 // that stops in any case making it kExitJobFailed.
 int DrawLoadCases(const std::string& worker, const std::string& file, const std::vector<std::string>& sets,
                   const std::vector<std::string>& cases, const std::string& study_name, const std::string& output,
-                  const TempDir& dir) {
+                  double deflection_scale, const TempDir& dir) {
   std::vector<report::CaseDrawing> drawn;
   for (size_t k = 0; k < cases.size(); ++k) {
     absl::StatusOr<spec::SceneDrawing> drawing =
         RunWorkerDraw(worker, file, sets, dir.path() + "/case-" + std::to_string(k) + ".pb", cases[k]);
     if (!drawing.ok()) return Fail(std::string(drawing.status().message()), kExitBadInput);
-    drawn.push_back(report::CaseDrawing{cases[k], *std::move(drawing)});
+    drawn.push_back(report::CaseDrawing{cases[k], report::MagnifyDeflection(*std::move(drawing), deflection_scale)});
   }
   std::ofstream out(output, std::ios::binary | std::ios::trunc);
   out << report::LoadCaseDrawingsPageHtml(drawn, study_name.empty() ? drawn.front().drawing.scene_name : study_name,
@@ -76,11 +79,16 @@ int DrawLoadCases(const std::string& worker, const std::string& file, const std:
 }  // namespace
 
 int DrawCommand(const Args& args) {
-  std::string file, output, only_case;
+  std::string file, output, only_case, scale_text;
   std::vector<std::string> sets;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "-o" || a == "--output" || a == "--set" || a == "--case") {
+    if (a == "--deflection-scale") {
+      if (i + 1 >= args.size()) return Fail(a + " needs a value\n" + kDrawUsage, kExitBadInput);
+      scale_text = args[++i];
+    } else if (a.rfind("--deflection-scale=", 0) == 0) {
+      scale_text = a.substr(19);
+    } else if (a == "-o" || a == "--output" || a == "--set" || a == "--case") {
       if (i + 1 >= args.size()) return Fail(a + " needs a value\n" + kDrawUsage, kExitBadInput);
       (a == "--set" ? sets.emplace_back() : a == "--case" ? only_case : output) = args[++i];
     } else if (a.rfind("--case=", 0) == 0) {
@@ -98,6 +106,11 @@ int DrawCommand(const Args& args) {
     }
   }
   if (file.empty()) return Fail(std::string("no scene or study file given\n") + kDrawUsage, kExitBadInput);
+  double deflection_scale = 1.0;
+  if (!scale_text.empty() && !report::ParseDeflectionScale(scale_text, &deflection_scale)) {
+    return Fail("--deflection-scale needs a positive number, not \"" + scale_text + "\"\n" + kDrawUsage,
+                kExitBadInput);
+  }
   if (output.empty()) output = DefaultOutput(file);
   absl::StatusOr<std::string> worker = FindWorkerProgram();
   if (!worker.ok()) return Fail(std::string(worker.status().message()), kExitBadInput);
@@ -114,9 +127,10 @@ int DrawCommand(const Args& args) {
     }
   }
   if (!only_case.empty()) cases = {only_case};
-  if (!cases.empty()) return DrawLoadCases(*worker, file, sets, cases, study_name, output, dir);
+  if (!cases.empty()) return DrawLoadCases(*worker, file, sets, cases, study_name, output, deflection_scale, dir);
   absl::StatusOr<spec::SceneDrawing> drawing = RunWorkerDraw(*worker, file, sets, dir.path() + "/drawing.pb");
   if (!drawing.ok()) return Fail(std::string(drawing.status().message()), kExitBadInput);
+  *drawing = report::MagnifyDeflection(*std::move(drawing), deflection_scale);
   std::ofstream out(output, std::ios::binary | std::ios::trunc);
   out << report::SceneDrawingPageHtml(*drawing, file);
   out.close();

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "client/report/deflection_scale.h"
 #include "client/temp_dir.h"
 #include "client/worker_draw.h"
 #include "spec/io/study_io.h"
@@ -28,7 +29,7 @@ std::vector<std::string> DesignSets(const spec::Study& study, const std::vector<
 
 }  // namespace
 
-void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data) {
+void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data, double deflection_scale) {
   report::MechanismDrawings& mechanism = data->mechanism;
   const v1::Scene::ModelCase kind = job.study().scene().model_case();
   if (kind != v1::Scene::kMultibody && kind != v1::Scene::kLinkage && kind != v1::Scene::kLumped &&
@@ -77,7 +78,7 @@ void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* dat
     absl::StatusOr<spec::SceneDrawing> initial =
         RunWorkerDraw(*worker, study_path, DesignSets(study, x0), prefix + "-initial.pb", name);
     if (initial.ok()) {
-      drawn.initial = *std::move(initial);
+      drawn.initial = report::MagnifyDeflection(*std::move(initial), deflection_scale);
     } else {
       notes.push_back(absl::StrCat("The initial design could not be drawn: ", initial.status().message()));
     }
@@ -88,7 +89,7 @@ void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* dat
       absl::StatusOr<spec::SceneDrawing> final =
           RunWorkerDraw(*worker, study_path, DesignSets(study, x_final), prefix + "-final.pb", name);
       if (final.ok()) {
-        drawn.final = *std::move(final);
+        drawn.final = report::MagnifyDeflection(*std::move(final), deflection_scale);
       } else {
         notes.push_back(absl::StrCat("The final design could not be drawn: ", final.status().message()));
       }

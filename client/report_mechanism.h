@@ -12,6 +12,8 @@ namespace mbopt::client {
 // per case in `cases`, each with the parameters the case sets), or a note
 // saying why not (no design yet, a scene kind without a drawing, the
 // worker program not found, a motion that stops early). Prints a line on stderr while it runs.
-void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data);
+// `deflection_scale` magnifies the flexible links' deflection on the page
+// (report/deflection_scale.h; 1: true to scale).
+void AddMechanismDrawings(const v1::GetJobResponse& job, report::ReportData* data, double deflection_scale = 1.0);
 
 }  // namespace mbopt::client

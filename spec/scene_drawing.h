@@ -118,6 +118,9 @@ struct SceneDrawing {
   // Empty when every instant of the grid was drawn; else why the motion
   // stopped (the instants before are kept).
   std::string failure;
+  // Empty, or what the reader must know to read the drawing right (what it
+  // leaves out, and why).
+  std::string note;
   // A spatial scene: positions and directions have three components.
   bool spatial = false;
 

@@ -612,6 +612,10 @@ std::string MechanismFigureHtml(const std::vector<DrawingLayer>& layers_in, cons
   }
   out += "</div>\n";
   for (const DrawingLayer& layer : layers) {
+    if (!layer.drawing->note.empty()) {
+      out += "<p class=\"note\">" + EscapeHtml(layer.label.empty() ? std::string("The drawing") : layer.label) +
+             ": " + EscapeHtml(layer.drawing->note) + ".</p>\n";
+    }
     if (!layer.drawing->failure.empty()) {
       out += "<p class=\"note\">" + EscapeHtml(layer.label.empty() ? std::string("The drawing") : layer.label) +
              ": the motion stops at t = " +

@@ -120,6 +120,7 @@ v1::SceneDrawing DrawingToProto(const SceneDrawing& d) {
   }
   m.mutable_ground_points()->Assign(d.ground_points.begin(), d.ground_points.end());
   m.set_failure(d.failure);
+  m.set_note(d.note);
   m.set_spatial(d.spatial);
   return m;
 }
@@ -129,6 +130,7 @@ absl::StatusOr<SceneDrawing> DrawingFromProto(const v1::SceneDrawing& m) {
   d.scene_name = m.scene_name();
   d.schematic = m.schematic();
   d.failure = m.failure();
+  d.note = m.note();
   d.spatial = m.spatial();
   d.times_s.assign(m.times_s().begin(), m.times_s().end());
   d.point_names.assign(m.point_names().begin(), m.point_names().end());

@@ -1,8 +1,11 @@
 // The drawings of a study with load cases through the real mbopt-worker:
 // the report's "Mechanism" section (client/report_mechanism.h) of a
 // hand-made job and `mbopt draw` of the study draw every case with the
-// parameters it sets, checked against the slider crank's closed form. No
-// server is needed.
+// parameters it sets, checked against the slider crank's closed form;
+// `mbopt draw` and the report's section of a flexible arm magnify its
+// deflection when asked and say so, and say why a kinematic analysis' arm
+// is drawn rigid. No server is needed.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -119,6 +122,110 @@ TEST_F(LoadCaseDrawing, DrawWritesOneFigurePerCase) {
   EXPECT_THAT(one_html.str(), HasSubstr("<h2>Load case long_rod</h2>"));
   EXPECT_EQ(one_html.str().find("as_built"), std::string::npos);
   EXPECT_EQ(DrawCommand({study_path_, "--case", "short_rod", "-o", one}), kExitBadInput);
+}
+
+// A steel arm clamped horizontal by its driver, bending under its weight
+// in the co-rotational formulation (a drive torque output makes its
+// analysis elastic).
+constexpr char kArm[] = R"pb(
+name: "arm"
+effects {
+  gravity { acceleration_m_per_s2 { x { value: 0 } y { value: -9.81 } } }
+  structural_damping { ratio_of_critical: 2 }
+}
+linkage {
+  flexible_formulation: FLEXIBLE_FORMULATION_COROTATIONAL
+  joints { name: "O" position_m { x { value: 0 } y { value: 0 } } ground: true }
+  joints { name: "T" position_m { x { value: 1 } y { value: 0 } } }
+  links {
+    name: "arm" joint_a: "O" joint_b: "T" length_m { value: 1 }
+    section { area_m2 { value: 1e-3 } youngs_modulus_pa { value: 2e11 } density_kg_per_m3 { value: 7850 } }
+    flexible { elements: 4 }
+  }
+  driver { link: "arm" pivot_joint: "O" start_angle_rad { value: 0 } angular_velocity_rad_per_s { value: 0 } }
+}
+outputs { name: "torque" drive_torque {} }
+time_grid { start_s: 0 end_s: 0.2 points: 3 }
+integrator { relative_tolerance: 1e-6 absolute_tolerance: 1e-10 }
+)pb";
+
+std::string ReadFile(const std::string& path) {
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  return text.str();
+}
+
+TEST(DrawDeflection, TheScaleIsDrawnAndSaid) {
+  setenv("MBOPT_WORKER_BIN", MBOPT_TEST_WORKER, 1);
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "draw_deflection";
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "arm.scene.textproto").string(), page = (dir / "arm.html").string();
+  std::ofstream(scene) << kArm;
+  ASSERT_EQ(DrawCommand({scene, "-o", page}), kExitOk);
+  EXPECT_EQ(ReadFile(page).find("times its size"), std::string::npos);
+  ASSERT_EQ(DrawCommand({scene, "-o", page, "--deflection-scale", "1000"}), kExitOk);
+  EXPECT_THAT(ReadFile(page), HasSubstr("deflection is drawn 1000 times its size"));
+  for (const char* bad : {"0", "-2", "inf", "nan", "big"}) {
+    EXPECT_EQ(DrawCommand({scene, "-o", page, "--deflection-scale", bad}), kExitBadInput) << bad;
+  }
+  // With a position output only, its analysis is kinematic: drawn rigid,
+  // and the page says why.
+  std::string kinematic = kArm;
+  kinematic.replace(kinematic.find("outputs { name: \"torque\" drive_torque {} }"),
+                    std::string("outputs { name: \"torque\" drive_torque {} }").size(),
+                    "outputs { name: \"tip\" point_position { point: \"T\" axis: AXIS_Y } }");
+  std::ofstream(scene, std::ios::trunc) << kinematic;
+  ASSERT_EQ(DrawCommand({scene, "-o", page}), kExitOk);
+  EXPECT_THAT(ReadFile(page), HasSubstr("the flexible links are drawn rigid, as the analysis moves them"));
+}
+
+// The report's section: the arm as a study, its section area a design
+// variable; each inner node of the centre line drawn 1000 times as far off
+// the straight line between its ends as true to scale.
+TEST(DrawDeflection, TheReportMagnifiesTheSameDrawing) {
+  setenv("MBOPT_WORKER_BIN", MBOPT_TEST_WORKER, 1);
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "report_deflection";
+  std::filesystem::create_directories(dir);
+  std::string scene = kArm;
+  scene.replace(scene.find("area_m2 { value: 1e-3 }"), std::string("area_m2 { value: 1e-3 }").size(),
+                "area_m2 { param: \"A\" }");
+  scene += "parameters { name: \"A\" value: 1e-3 unit: \"m^2\" }\n";
+  std::ofstream((dir / "arm.scene.textproto").string()) << scene;
+  const std::string study_path = (dir / "arm.study.textproto").string();
+  std::ofstream(study_path) << R"pb(name: "arm" scene_file: "arm.scene.textproto"
+variables { name: "a" parameter: "A" scale: 1e-3 initial: 1 lower: 0.5 upper: 2 }
+objective { minimize_max_of: "torque" reduction: REDUCTION_MAX_ABS }
+)pb";
+  absl::StatusOr<v1::Study> study = spec::io::ReadStudyProto(study_path);
+  ASSERT_TRUE(study.ok()) << study.status();
+  v1::GetJobResponse job;
+  *job.mutable_study() = *study;
+  job.add_cycles()->set_cycle(1);
+  job.mutable_summary()->add_design(1.2e-3);
+  job.mutable_summary()->add_design_names("a");
+  report::ReportData plain, magnified;
+  AddMechanismDrawings(job, &plain);
+  AddMechanismDrawings(job, &magnified, 1000);
+  ASSERT_TRUE(plain.mechanism.final.has_value()) << plain.mechanism.note;
+  ASSERT_TRUE(magnified.mechanism.final.has_value()) << magnified.mechanism.note;
+  const spec::SceneDrawing& p = *plain.mechanism.final;
+  const spec::SceneDrawing& m = *magnified.mechanism.final;
+  EXPECT_EQ(p.note, "");
+  EXPECT_THAT(m.note, HasSubstr("drawn 1000 times its size"));
+  ASSERT_EQ(p.lines.size(), 1u);
+  const std::vector<int>& line = p.lines[0].points;
+  const size_t n = line.size() - 1;
+  const spec::DrawingPosition& a = p.points_m.back()[static_cast<size_t>(line.front())];
+  const spec::DrawingPosition& b = p.points_m.back()[static_cast<size_t>(line.back())];
+  double largest = 0.0;
+  for (size_t k = 1; k < n; ++k) {
+    const double f = static_cast<double>(k) / n;
+    const double cy = a.y_m + (b.y_m - a.y_m) * f;
+    const double off = p.points_m.back()[static_cast<size_t>(line[k])].y_m - cy;
+    EXPECT_NEAR(m.points_m.back()[static_cast<size_t>(line[k])].y_m - cy, 1000 * off, 1e-9) << "point " << k;
+    largest = std::max(largest, std::abs(off));
+  }
+  EXPECT_GT(largest, 1e-7) << "the arm bends";
 }
 
 }  // namespace

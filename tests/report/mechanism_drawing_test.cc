@@ -162,5 +162,12 @@ TEST(MechanismDrawing, AStoppedMotionIsSaid) {
   EXPECT_THAT(html, HasSubstr("the motion stops at t = 0.666667 s: the mechanism locks at joint &#39;A&#39;"));
 }
 
+TEST(MechanismDrawing, TheDrawingsNoteIsSaid) {
+  spec::SceneDrawing d = CrankAndSlider(3);
+  d.note = "the flexible links are drawn rigid <as the analysis moves them>";
+  const std::string html = SceneDrawingPageHtml(d, "crank.scene.textproto");
+  EXPECT_THAT(html, HasSubstr("The drawing: the flexible links are drawn rigid &lt;as the analysis moves them&gt;."));
+}
+
 }  // namespace
 }  // namespace mbopt::report

@@ -86,7 +86,7 @@ std::vector<double> KinematicInstants(const std::vector<double>& grid, double om
   return instants;
 }
 
-bool NeedsLoads(const spec::Output& o) {
+bool OutputNeedsLoads(const spec::Output& o) {
   return std::holds_alternative<spec::BendingStressOutput>(o.kind) ||
          std::holds_alternative<spec::DriveTorqueOutput>(o.kind);
 }
@@ -196,7 +196,7 @@ bool CorotationalMoments(const LinkageSystem& sys, const Mechanism& mech, const 
 // link's root. Positions and rotations are those of the deformed links'
 // ends (a link's rotation: its chord's).
 void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, budget::AnalysisBudget* budget,
-                         AnalysisReport* report) {
+                         AnalysisReport* report, LinkageDeflection* deflection) {
   report->formulation = Formulation::kDynamic;
   for (size_t i = 0; i < sys.links.size(); ++i) {
     if (!sys.links[i].both_ground && sys.links[i].flexible_elements <= 0) {
@@ -257,6 +257,7 @@ void AnalyzeCorotational(const spec::Scene& scene, const LinkageSystem& sys, bud
     for (; next < nt && report->times_s[next] == s.t_s; ++next) {
       RecordMotion(scene, sys, start, state, next, &report->outputs);
       RecordLoads(scene, sys, moments, -s.lambda[mechanism.row_of_driver(0)], next, &report->outputs);
+      if (deflection != nullptr) deflection->corotational_q.push_back(s.q);
     }
     return spec::AnalysisFailure::Ok();
   };
@@ -279,7 +280,17 @@ bool UsesFloatingFrame(const spec::Scene& scene, const LinkageSystem& sys) {
       linkage->flexible_formulation == spec::FlexibleFormulation::kCorotational) {
     return false;
   }
-  return std::any_of(scene.outputs.begin(), scene.outputs.end(), NeedsLoads);
+  return NeedsLoads(scene);
+}
+
+bool UsesCorotational(const spec::Scene& scene, const LinkageSystem& sys) {
+  const auto* linkage = std::get_if<spec::LinkageModel>(&scene.model);
+  return linkage != nullptr && sys.AnyFlexible() &&
+         linkage->flexible_formulation == spec::FlexibleFormulation::kCorotational && NeedsLoads(scene);
+}
+
+bool NeedsLoads(const spec::Scene& scene) {
+  return std::any_of(scene.outputs.begin(), scene.outputs.end(), OutputNeedsLoads);
 }
 
 AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
@@ -313,8 +324,7 @@ AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<d
     }
   }
 
-  bool needs_loads = false;
-  for (const spec::Output& o : scene.outputs) needs_loads = needs_loads || NeedsLoads(o);
+  const bool needs_loads = NeedsLoads(scene);
   report.formulation = !needs_loads        ? Formulation::kKinematic
                        : sys.AnyFlexible() ? Formulation::kElastodynamic
                                            : Formulation::kKinetostatic;
@@ -350,7 +360,7 @@ AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<d
     return report;
   }
   if (elastic && linkage->flexible_formulation == spec::FlexibleFormulation::kCorotational) {
-    AnalyzeCorotational(scene, sys, budget, &report);
+    AnalyzeCorotational(scene, sys, budget, &report, deflection);
     return report;
   }
   const CompiledLinkage compiled = CompileLinkage(sys);

@@ -25,20 +25,24 @@
 
 namespace mbopt::multibody {
 
-// A floating-frame analysis' own motion, for a drawing of the deflected
-// links (linkage_geometry.h): the rigid reference motion and every moving
-// link's elastic node displacements (FloatingFrameResult), at each grid
-// instant solved (those before a failure).
+// An elastic analysis' own motion, for a drawing of the deflected links
+// (linkage_geometry.h), at each grid instant solved (those before a
+// failure). The floating frame: the rigid reference motion and every moving
+// link's elastic node displacements (FloatingFrameResult). The
+// co-rotational formulation: the coordinates of the model
+// CompileCorotationalLinkage builds (every node body's x, y, phi).
 struct LinkageDeflection {
-  std::vector<LinkageState> rigid_states;                                      // [instant]
+  std::vector<LinkageState> rigid_states;                                      // [instant], floating frame
   std::vector<std::vector<std::vector<Eigen::Vector2d>>> node_displacement_m;  // [instant][link][node], world, m
+  std::vector<Eigen::VectorXd> corotational_q;                                 // [instant], co-rotational
 };
 
 // `scene.model` must hold a LinkageModel; `parameter_values_si` has one SI
 // value per scene parameter. `budget` (none: no limit) bounds the kinematic
 // sweep, the integration and every position solve. `deflection`, when
-// given, receives the motion of a floating-frame analysis (left empty by
-// the other formulations); without it nothing is kept for a drawing.
+// given, receives the motion of an elastic analysis (left empty by the
+// kinematic and kinetostatic ones); without it nothing is kept for a
+// drawing.
 spec::AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::vector<double>& parameter_values_si,
                                          budget::AnalysisBudget* budget = nullptr,
                                          LinkageDeflection* deflection = nullptr);
@@ -48,5 +52,14 @@ spec::AnalysisReport AnalyzeLinkageScene(const spec::Scene& scene, const std::ve
 // (bending stress, drive torque), and the scene asks for no co-rotational
 // formulation.
 bool UsesFloatingFrame(const spec::Scene& scene, const LinkageSystem& sys);
+
+// Whether it follows them in the co-rotational formulation: a link is
+// flexible, an output needs loads, and the scene asks for that formulation.
+bool UsesCorotational(const spec::Scene& scene, const LinkageSystem& sys);
+
+// Whether an output of the scene needs loads (bending stress, drive
+// torque): without one a linkage's analysis is kinematic, its flexible
+// links followed rigidly (docs/physics.md, the cheapest formulation).
+bool NeedsLoads(const spec::Scene& scene);
 
 }  // namespace mbopt::multibody

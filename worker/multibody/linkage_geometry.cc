@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "worker/multibody/assembly.h"
+#include "worker/multibody/beam_shape.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/linkage_analysis.h"
 #include "worker/multibody/linkage_front_end.h"
@@ -23,6 +24,10 @@ constexpr double kDrawStepRad = std::numbers::pi / 18.0;
 // A grid that needs more solved instants than this is drawn only up to
 // there: a drawing has no use for millions of frames.
 constexpr int kMaxSolvedInstants = 200000;
+// A co-rotational element is drawn through this many points of its cubic
+// shape between its nodes: with 6 elements a link reads as a smooth curve
+// even magnified (mbopt draw --deflection-scale).
+constexpr int kShapePointsPerElement = 3;
 
 // A link point is carried in the link's frame: origin at joint a, x
 // towards joint b.
@@ -92,6 +97,80 @@ void DrawDeflectedMotion(const spec::Scene& scene, const LinkageSystem& sys, con
   if (!report.ok()) d->failure = report.failure.reason;
 }
 
+// The points a co-rotational link's centre line holds between its pins:
+// per element its shape points, then its end node unless that is joint b.
+int CorotationalInnerPoints(const LinkageLink& l) {
+  return l.flexible_elements * (kShapePointsPerElement + 1) - 1;
+}
+
+// One instant of a co-rotational analysis, its coordinates `q` (model
+// `compiled`): each pin where the analysis puts it (the end nodes it
+// joins), the links' own points on the chord between the pins, then each
+// moving link's centre line between its pins: every element's cubic shape
+// (beam_shape.h) and its inner nodes, the nodes the analysis' own
+// coordinates.
+void AppendCorotationalInstant(const LinkageSystem& sys, const CompiledLinkage& compiled, const Mechanism& mechanism,
+                               const Eigen::VectorXd& q, std::vector<spec::DrawingPosition>* at) {
+  std::vector<Eigen::Vector2d> pins;
+  for (const Point& p : compiled.joint_point) {
+    pins.push_back(p.body == kGround ? p.local_m : mechanism.PointPosition(p, q));
+    at->push_back(spec::DrawingPosition{pins.back().x(), pins.back().y()});
+  }
+  AppendLinkPoints(sys, pins, at);
+  std::vector<Eigen::Vector2d> shape;
+  for (size_t k = 0; k < sys.links.size(); ++k) {
+    const LinkageLink& l = sys.links[k];
+    if (l.both_ground) continue;
+    for (int e = 0; e < l.flexible_elements; ++e) {
+      shape.clear();
+      if (!AppendBeamInnerPoints(mechanism, compiled.link_first_element[k] + e, q, kShapePointsPerElement, &shape)) {
+        // Coincident nodes (the analysis fails there): the node itself.
+        shape.assign(kShapePointsPerElement, q.segment<2>(3 * (compiled.link_first_node[k] + e)));
+      }
+      for (const Eigen::Vector2d& r : shape) at->push_back(spec::DrawingPosition{r.x(), r.y()});
+      if (e + 1 == l.flexible_elements) break;
+      const Eigen::Index node = 3 * (compiled.link_first_node[k] + e + 1);
+      at->push_back(spec::DrawingPosition{q[node], q[node + 1]});
+    }
+  }
+}
+
+// The co-rotational analysis' own motion, every instant it solved.
+void DrawCorotationalMotion(const spec::Scene& scene, const LinkageSystem& sys, const std::vector<double>& p,
+                            budget::AnalysisBudget* budget, spec::SceneDrawing* d) {
+  LinkageDeflection deflection;
+  const spec::AnalysisReport report = AnalyzeLinkageScene(scene, p, budget, &deflection);
+  if (!deflection.corotational_q.empty()) {
+    const CompiledLinkage compiled = CompileCorotationalLinkage(sys);
+    const Mechanism mechanism(compiled.model);
+    for (size_t i = 0; i < deflection.corotational_q.size(); ++i) {
+      d->times_s.push_back(report.times_s[i]);
+      AppendCorotationalInstant(sys, compiled, mechanism, deflection.corotational_q[i], &d->points_m.emplace_back());
+    }
+  } else {
+    // Nothing solved (it does not assemble, a moving link is rigid): the
+    // pins as given, the links straight between them, and why.
+    std::vector<Eigen::Vector2d> pins;
+    std::vector<spec::DrawingPosition>& at = d->points_m.emplace_back();
+    for (const LinkageJoint& j : sys.joints) {
+      pins.push_back(j.position_m);
+      at.push_back(spec::DrawingPosition{j.position_m.x(), j.position_m.y()});
+    }
+    AppendLinkPoints(sys, pins, &at);
+    for (const LinkageLink& l : sys.links) {
+      if (l.both_ground) continue;
+      const Eigen::Vector2d a = pins[static_cast<size_t>(l.joint_a)], b = pins[static_cast<size_t>(l.joint_b)];
+      const int inner = CorotationalInnerPoints(l);
+      for (int k = 1; k <= inner; ++k) {
+        const Eigen::Vector2d r = a + (b - a) * (static_cast<double>(k) / (inner + 1));
+        at.push_back(spec::DrawingPosition{r.x(), r.y()});
+      }
+    }
+    d->times_s.push_back(report.times_s.empty() ? 0.0 : report.times_s.front());
+  }
+  if (!report.ok()) d->failure = report.failure.reason;
+}
+
 }  // namespace
 
 spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<double>& p,
@@ -115,8 +194,11 @@ spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<
   }
   // A linkage the analysis follows elastically is drawn with its links'
   // deflection: the analysis' own motion, each moving link as its centre
-  // line through its nodes (as a multibody scene's flexible links).
-  const bool deflected = UsesFloatingFrame(scene, sys);
+  // line through its nodes (as a multibody scene's flexible links; in the
+  // co-rotational formulation through its elements' cubic shapes too).
+  const bool floating = UsesFloatingFrame(scene, sys);
+  const bool corotational = UsesCorotational(scene, sys);
+  const bool deflected = floating || corotational;
   // Points: the pins, then every link's own points, then the inner nodes of
   // the links drawn deflected.
   for (const LinkageJoint& j : sys.joints) {
@@ -131,7 +213,25 @@ spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<
     for (const LinkagePoint& point : l.points) body.points.push_back(d.AddPoint(l.name + "." + point.name));
     if (!body.points.empty()) d.bodies.push_back(std::move(body));
   }
-  if (deflected) {
+  if (corotational) {
+    for (const LinkageLink& l : sys.links) {
+      if (l.both_ground) continue;
+      spec::SceneDrawing::Line line;
+      line.name = l.name;
+      line.points.push_back(l.joint_a);
+      for (int e = 0; e < l.flexible_elements; ++e) {
+        for (int k = 1; k <= kShapePointsPerElement; ++k) {
+          line.points.push_back(d.AddPoint(absl::StrFormat("%s.element %d.%d", l.name, e, k)));
+        }
+        if (e + 1 < l.flexible_elements) line.points.push_back(d.AddPoint(absl::StrFormat("%s.node %d", l.name, e + 1)));
+      }
+      line.points.push_back(l.joint_b);
+      d.lines.push_back(std::move(line));
+    }
+    DrawCorotationalMotion(scene, sys, p, budget, &d);
+    return d;
+  }
+  if (floating) {
     for (const LinkageLink& l : sys.links) {
       if (l.both_ground) continue;
       spec::SceneDrawing::Line line;
@@ -147,6 +247,14 @@ spec::SceneDrawing DrawLinkageScene(const spec::Scene& scene, const std::vector<
     return d;
   }
 
+  // Flexible links in a linkage whose outputs are all positions and
+  // rotations: its analysis is kinematic by design (the cheapest
+  // formulation, docs/physics.md) and computes no deflection to draw.
+  if (sys.AnyFlexible()) {
+    d.note = "the flexible links are drawn rigid, as the analysis moves them: every output of the scene is a "
+             "position or a rotation, so its analysis is kinematic and computes no deflection (a bending stress "
+             "or drive torque output makes it elastic)";
+  }
   const CompiledLinkage compiled = CompileLinkage(sys);
   const Mechanism mechanism(compiled.model);
   AssemblyOptions assembly_options;
