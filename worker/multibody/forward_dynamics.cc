@@ -51,6 +51,10 @@ struct Problem {
   // Per coordinate and velocity, the largest magnitude it has had at the
   // accepted steps so far (ErrorWeights).
   VectorXd peak_magnitudes;
+  // The step-growth guard (LimitGrowthIfTrapped): counts at the start of
+  // the current window, and when the growth was limited (negative: never).
+  long window_steps = 0, window_error_test_failures = 0;
+  double growth_limited_from_s = -1.0;
 };
 
 // Whether the analysis' budget stops the integration at t (and why, kept).
@@ -219,6 +223,37 @@ constexpr double kPeakMagnitudeFloor = 0.1;
 // round-off of v' = cj (v - v_predicted) over h, and at the first step of a
 // fast start (h of 1e-13 s for Andrews' mechanism) that round-off alone
 // failed Newton's test, at every smaller step IDAS then tried.
+// The step-growth trap: IDAS doubles the step after an accepted one (its
+// largest growth, 2), and on some stiff flexible mechanisms the doubled step
+// fails the error test, the halved one passes, and the cycle repeats at
+// order 1 with one rejection per accepted step, however small the accepted
+// errors (docs/benchmarks.md: the co-rotational four-bar, 38,203 steps
+// instead of some 2,800). A window of accepted steps with nearly as many
+// error-test failures is that cycle and nothing else: a discontinuity costs
+// a few failures while the step shrinks, not one per step for a whole window.
+// Holding the growth to 1.5 breaks it. It stays held for the rest of the
+// integration; a run that never cycles keeps IDAS's default to the bit.
+constexpr long kGrowthWindowSteps = 32;
+constexpr long kTrappedErrorTestFailures = 24;
+constexpr double kTrappedGrowthLimit = 1.5;
+
+void LimitGrowthIfTrapped(Problem* p) {
+  if (p->growth_limited_from_s >= 0.0) return;
+  long steps = 0, failures = 0;
+  if (IDAGetNumSteps(p->ida, &steps) != IDA_SUCCESS || IDAGetNumErrTestFails(p->ida, &failures) != IDA_SUCCESS) {
+    return;
+  }
+  if (steps - p->window_steps < kGrowthWindowSteps) return;
+  if (failures - p->window_error_test_failures >= kTrappedErrorTestFailures) {
+    realtype t = 0.0;
+    if (IDASetEtaMax(p->ida, kTrappedGrowthLimit) == IDA_SUCCESS && IDAGetCurrentTime(p->ida, &t) == IDA_SUCCESS) {
+      p->growth_limited_from_s = t;
+    }
+  }
+  p->window_steps = steps;
+  p->window_error_test_failures = failures;
+}
+
 int ErrorWeights(N_Vector yy, N_Vector ewt, void* user_data) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the error weights", [&]() -> int {
@@ -226,6 +261,9 @@ int ErrorWeights(N_Vector yy, N_Vector ewt, void* user_data) {
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     Map<VectorXd> w(N_VGetArrayPointer(ewt), size);
     const VectorXd& atol = *p->absolute_tolerances;
+    // IDAS asks for the weights once per step, before the step: the place to
+    // watch its step control.
+    LimitGrowthIfTrapped(p);
     if (p->peak_magnitudes.size() != 2 * n) p->peak_magnitudes = VectorXd::Zero(2 * n);
     for (int i = 0; i < 2 * n; ++i) {
       if (!std::isfinite(y[i])) return -1;
@@ -581,6 +619,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     if (t > t_reached) {
       const int flag = IDASolve(ida, t, &t_reached, h.yy.get(), h.yp.get(), IDA_NORMAL);
       Accumulate(ida, counters);
+      counters->step_growth_limited_from_s = p.growth_limited_from_s;
       if (flag < 0) {
         if (!system.FailureReason().empty()) {
           return Failed(spec::FailureKind::kModelValidity,
@@ -645,6 +684,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     if (spec::AnalysisFailure f = at_instant(sample); !f.ok()) return f;
   }
   Accumulate(ida, counters);
+  counters->step_growth_limited_from_s = p.growth_limited_from_s;
   return spec::AnalysisFailure::Ok();
 }
 

@@ -81,6 +81,9 @@ struct ForwardDynamicsCounters {
   // the GGL form keeps at the integration tolerance.
   double max_position_drift = 0.0;
   double max_velocity_drift = 0.0;
+  // When IDAS's step growth was held to 1.5 after the doubling-rejection
+  // cycle (forward_dynamics.cc, LimitGrowthIfTrapped); negative: never.
+  double step_growth_limited_from_s = -1.0;
 };
 
 // Forward sensitivities with respect to parameters (IDAS's forward
