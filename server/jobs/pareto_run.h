@@ -48,6 +48,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "server/jobs/analysis_record.h"
+#include "server/jobs/front_run.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/options.h"
 #include "server/slp/problem.h"
@@ -76,7 +77,7 @@ struct ParetoSetup {
   int refine = 0;              // added points, 0 to points - 1
 };
 
-class ParetoRun {
+class ParetoRun final : public FrontRun {
  public:
   // Point k's request r has id k * kRequestStride + r: far more analyses than
   // a run may use (JobRunOptions::max_analyses).
@@ -86,21 +87,16 @@ class ParetoRun {
   // constraint, rows of different limits, too few points).
   static absl::StatusOr<std::unique_ptr<ParetoRun>> Create(ParetoSetup setup, LpSolverFactory make_lp_solver);
 
-  std::vector<slp::AnalysisRequest> PendingRequests() const;
-  bool IsPending(std::int64_t request_id) const;
-  // One result (validated by the job's intake, in the study's shape).
-  // InvalidArgument for a request that is not pending.
-  absl::Status Submit(const AnalysisRecord& record);
-  std::vector<slp::CycleRecord> TakeNewRecords();
+  std::vector<slp::AnalysisRequest> PendingRequests() const override;
+  bool IsPending(std::int64_t request_id) const override;
+  absl::Status Submit(const AnalysisRecord& record) override;
+  std::vector<slp::CycleRecord> TakeNewRecords() override;
+  void LogRunCycles(bool log) override { log_run_cycles_ = log; }
 
-  // Whether the runs' cycle records are emitted (the default); off for a
-  // job whose log has none, so that its replay emits what it logged.
-  void LogRunCycles(bool log) { log_run_cycles_ = log; }
-
-  bool done() const { return emitted_ == points_.size(); }
-  int size() const { return static_cast<int>(points_.size()); }
-  int points_done() const { return static_cast<int>(emitted_); }
-  std::int64_t analyses_used() const { return analyses_; }
+  bool done() const override { return emitted_ == points_.size(); }
+  int size() const override { return static_cast<int>(points_.size()); }
+  int points_done() const override { return static_cast<int>(emitted_); }
+  std::int64_t analyses_used() const override { return analyses_; }
 
  private:
   // A design a run analysed, with what the point's record needs of it.

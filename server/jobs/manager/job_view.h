@@ -63,16 +63,22 @@ struct JobView {
   // A Pareto front's far end, the point whose run minimizes the second
   // objective (0: not a front): its run's F is no reported objective.
   int pareto_far_end = 0;
+  // A front of three objectives: its points 2 and 3 minimize the second
+  // and third objectives (pareto_far_end is 2).
+  bool pareto_three = false;
   // A front's point record's second objective and level as shown
   // (CycleRecord.pareto_value): factor * the record's. 1 / the unit's SI
   // size for a traded constraint; -1 for a maximized second objective (the
   // runs minimize its negative), else 1.
   double pareto_shown_factor = 1.0;
+  double pareto_third_shown_factor = 1.0;  // the third objective's, as pareto_shown_factor
   std::string study_bytes;
 
   // The sign of record r's F as reported.
   double ReportedSign(const slp::CycleRecord& r) const {
-    return pareto_far_end > 0 && r.pareto_point == pareto_far_end ? 1.0 : objective_sign;
+    const bool far_end = pareto_far_end > 0 && (r.pareto_point == pareto_far_end ||
+                                                (pareto_three && r.pareto_point == pareto_far_end + 1));
+    return far_end ? 1.0 : objective_sign;
   }
 };
 

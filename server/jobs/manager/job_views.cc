@@ -132,7 +132,12 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record, Job
     view.objective_sign = entry.study->objective.ReportedSign();
     const spec::Study& study = *entry.study;
     if (study.pareto.enabled()) {
-      view.pareto_far_end = study.pareto.points;
+      view.pareto_far_end = study.pareto.three_objectives() ? 2 : study.pareto.points;
+      view.pareto_three = study.pareto.three_objectives();
+      if (view.pareto_three && static_cast<size_t>(study.pareto.third_constraint) < study.constraints.size()) {
+        view.pareto_third_shown_factor =
+            1.0 / study.constraints[static_cast<size_t>(study.pareto.third_constraint)].si_per_unit;
+      }
       if (study.pareto.trades_objective) {
         view.pareto_shown_factor = study.second_objective.ReportedSign();
       } else if (study.pareto.constraint >= 0 && static_cast<size_t>(study.pareto.constraint) < study.constraints.size()) {
