@@ -320,7 +320,7 @@ TEST(DesignSetFormat, TableAndJsonListEveryDesign) {
 v1::GetJobResponse FourPointFront(bool infeasible_second = false) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   v1::GetJobResponse job;
-  job.mutable_study()->mutable_pareto()->set_against("travel");
+  job.mutable_study()->mutable_pareto()->add_against("travel");
   v1::Constraint* travel = job.mutable_study()->add_constraints();
   travel->set_name("travel");
   travel->set_unit("mm");
