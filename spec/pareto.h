@@ -18,7 +18,9 @@
 // numbered N+1 to N+R, each halving one segment of the front where it bends
 // or leaves a gap (RefinementSegments). They are chosen from the first N
 // points alone, so they too run side by side and do not depend on the
-// order of results.
+// order of results. `refine_again: R2` adds R2 more, numbered N+R+1 on,
+// once those N+R points have ended, each halving a segment of the front
+// they all make: a second generation chosen the same way.
 #pragma once
 
 #include <vector>
@@ -47,10 +49,13 @@ struct Pareto {
   bool trades_objective = false;
   int points = 0;       // the two anchors included; with three objectives, levels per bounded objective
   int refine = 0;       // points added where the front bends, 0 to points-1
+  // Points added where the refined front (points + refine) bends, 0 to
+  // points + refine - 1; only with refine > 0.
+  int refine_again = 0;
 
   bool three_objectives() const { return third_constraint >= 0; }
   int total_points() const {
-    return three_objectives() ? kParetoAnchorsOfThree + points * points : points + refine;
+    return three_objectives() ? kParetoAnchorsOfThree + points * points : points + refine + refine_again;
   }
 
   bool enabled() const { return constraint >= 0 || trades_objective; }

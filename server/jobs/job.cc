@@ -160,6 +160,7 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateWith(std::shared_ptr<const spec:
     }
     setup.points = study->pareto.points;
     setup.refine = study->pareto.refine;
+    setup.refine_again = study->pareto.refine_again;
     absl::StatusOr<std::unique_ptr<ParetoRun>> made = ParetoRun::Create(std::move(setup), make_lp_solver);
     if (!made.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(study->source_file, ": pareto: ", made.status().message()));

@@ -22,7 +22,9 @@
 //    between its segment's ends' values, warm-started from the end with the
 //    larger value (nearer point 1, as the points between). Added points
 //    the front has no segment for end unrun, saying why, so a front always
-//    has points + refine records;
+//    has points + refine records; refine_again > 0: once those have ended,
+//    a second generation the same way, its segments chosen on the front of
+//    all points + refine points;
 //  - one record per point (a design set's record with the Pareto fields,
 //    slp::CycleRecord), emitted in the points' order: point k's once points
 //    0..k have ended, so the record log does not depend on the order of
@@ -75,6 +77,7 @@ struct ParetoSetup {
   bool traded_sum = false;
   int points = 0;              // >= 3
   int refine = 0;              // added points, 0 to points - 1
+  int refine_again = 0;        // a second generation, 0 to points + refine - 1; only with refine > 0
 };
 
 class ParetoRun final : public FrontRun {
@@ -124,7 +127,9 @@ class ParetoRun final : public FrontRun {
 
   explicit ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
   void StartRuns();
-  void StartRefinement();
+  // Generation `first` (points or points + refine) of `count` points,
+  // chosen on the front of points 0 to first - 1 once they have ended.
+  void StartRefinement(std::size_t first, int count);
   void Start(int k, const Eigen::VectorXd& initial);
   void EndWithoutRun(int k, const std::string& reason);
   void End(int k);

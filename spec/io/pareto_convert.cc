@@ -89,6 +89,9 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
     if (p.refine() != 0) {
       errors->Add(w, "refine", "a front of three objectives is not refined (a grid of levels has no segments)");
     }
+    if (p.refine_again() != 0) {
+      errors->Add(w, "refine_again", "a front of three objectives is not refined (a grid of levels has no segments)");
+    }
   } else {
     pareto.points = p.points() == 0 ? kDefaultParetoPoints : p.points();
     if (pareto.points < kMinParetoPoints || pareto.points > kMaxParetoPoints) {
@@ -102,6 +105,17 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
                   absl::StrFormat("must be between 0 and %d (one point in each segment of the %d points' front at "
                                   "most), got %d",
                                   std::max(pareto.points - 1, 0), pareto.points, p.refine()));
+    }
+    pareto.refine_again = p.refine_again();
+    if (pareto.refine_again != 0 && pareto.refine <= 0) {
+      errors->Add(w, "refine_again",
+                  "refines the refined front again: set `refine` (the first generation of added points) too");
+    } else if (pareto.refine_again < 0 || pareto.refine_again > pareto.points + pareto.refine - 1) {
+      errors->Add(w, "refine_again",
+                  absl::StrFormat("must be between 0 and %d (one point in each segment of the refined front of %d "
+                                  "points at most), got %d",
+                                  std::max(pareto.points + pareto.refine - 1, 0), pareto.points + pareto.refine,
+                                  p.refine_again()));
     }
   }
   if (p.has_objective()) {
@@ -177,6 +191,9 @@ std::string DescribePareto(const Study& study) {
                       " points",
                       study.pareto.refine == 0 ? ""
                                                : absl::StrCat(" and ", study.pareto.refine, " more where it bends"),
+                      study.pareto.refine_again == 0
+                          ? ""
+                          : absl::StrCat(", then ", study.pareto.refine_again, " more where the refined front bends"),
                       " (epsilon-constraint method)");
 }
 

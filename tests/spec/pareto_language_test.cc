@@ -102,6 +102,22 @@ TEST_F(ParetoLanguage, RefineAddsPointsUpToOnePerSegment) {
   EXPECT_THAT(LoadError("pareto { against: \"travel\" refine: -1 }\n"), HasSubstr("got -1"));
 }
 
+TEST_F(ParetoLanguage, RefineAgainAddsASecondGenerationUpToOnePerSegmentOfTheRefinedFront) {
+  absl::StatusOr<Study> study = Load("pareto { against: \"travel\" points: 5 refine: 2 refine_again: 3 }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->pareto.refine_again, 3);
+  EXPECT_EQ(study->pareto.total_points(), 10);
+  EXPECT_EQ(DescribeStudyForm(*study),
+            "a Pareto front of the objective against the largest value of travel (m), 5 points and 2 more where it "
+            "bends, then 3 more where the refined front bends (epsilon-constraint method)");
+  const std::string without = LoadError("pareto {\n  against: \"travel\"\n  refine_again: 2\n}\n");
+  EXPECT_THAT(without, HasSubstr("oscillator.study.textproto:10:"));
+  EXPECT_THAT(without, HasSubstr("pareto.refine_again: refines the refined front again: set `refine`"));
+  EXPECT_THAT(LoadError("pareto { against: \"travel\" points: 5 refine: 2 refine_again: 7 }\n"),
+              HasSubstr("pareto.refine_again: must be between 0 and 6 (one point in each segment of the refined "
+                        "front of 7 points at most), got 7"));
+}
+
 // A front of three objectives names two constraints.
 const char kReach[] = "constraints { name: \"reach\" output: \"x\" reduction: REDUCTION_MAX limit: 0.05 unit: \"m\" }\n";
 
