@@ -431,11 +431,15 @@ absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int p
   }
   const std::vector<const v1::CycleRecord*> cycles = PointRunCycles(job, point);
   if (!cycles.empty()) {
-    // The far end's run minimizes the second objective, not the study's.
+    // The far end's run minimizes the second objective, not the study's;
+    // the server reports its F as that objective is shown, in its unit.
     const bool far_end = IsFarEnd(job.study(), point);
-    const char* minimized = IsFrontOfThree(job.study()) && point == 3 ? "the third objective" : "the second objective";
+    const bool third = IsFrontOfThree(job.study()) && point == 3;
+    const std::string& far_unit = third ? front.unit3 : front.unit;
     out += absl::StrCat("cycles of its run (F: ",
-                        far_end ? absl::StrCat(minimized, " as the run minimizes it, divided by its rows' scale")
+                        far_end ? absl::StrCat(third ? "the third objective " : "the second objective ",
+                                               third ? front.against3 : front.against,
+                                               far_unit.empty() ? "" : " [" + far_unit + "]", ", which the run optimizes")
                                 : "the study's objective",
                         "; maxg: against the run's own limits, its level included):\n");
     out += CycleTableHeader();

@@ -90,16 +90,18 @@ void AddChosenPointHistory(const v1::GetJobResponse& job, report::ParetoReportDa
   for (const v1::CycleRecord* c : cycles) *run.add_cycles() = *c;
   data->chosen_history = report::ReportDataFromJob(run);
   if (IsFarEnd(job.study(), data->chosen)) {
-    // Its run minimizes the second objective, in no unit of the study's.
-    data->chosen_history.objective_unit.clear();
+    // Its run optimizes the second (or third) objective, whose values the
+    // server reports in that objective's unit.
+    const bool third = IsFrontOfThree(job.study()) && data->chosen == 3;
+    data->chosen_history.objective_unit = third ? data->against3_unit : data->against_unit;
     data->chosen_history.objective = std::numeric_limits<double>::quiet_NaN();
+    const std::string name = third ? data->against3 : data->against;
     data->chosen_history_note =
         IsFrontOfThree(job.study())
-            ? absl::StrCat("This is the anchor of the ", data->chosen == 2 ? "second" : "third",
-                           " objective: its run's F is that objective as the run minimizes it, divided by its rows' "
-                           "scale, not the study's objective.")
-            : "This is the front's far end: its run's F is the second objective as the run minimizes it, divided by "
-              "its rows' scale, not the study's objective.";
+            ? absl::StrCat("This is the anchor of the ", third ? "third" : "second", " objective: its run's F is ", name,
+                           ", which the run optimizes, not the study's objective.")
+            : absl::StrCat("This is the front's far end: its run's F is ", data->against_objective ? "" : "the largest value of ",
+                           name, ", which the run optimizes, not the study's objective.");
   }
 }
 

@@ -130,7 +130,7 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
 }
 
 v1::CycleRecord ToProto(const slp::CycleRecord& r, const jobs::manager::JobView& view) {
-  v1::CycleRecord out = ToProto(r, view.layout.get(), view.variable_scales, view.ReportedSign(r));
+  v1::CycleRecord out = ToProto(r, view.layout.get(), view.variable_scales, view.ReportedFactor(r));
   if (r.pareto) {
     out.set_pareto_value(view.pareto_shown_factor * r.pareto_value_si);
     out.set_pareto_level(view.pareto_shown_factor * r.pareto_level_si);

@@ -492,7 +492,8 @@ TEST(ParetoFormat, APointListsItsRunsCyclesAndTheyAreNoPoints) {
   EXPECT_EQ(text->find("           21", table), std::string::npos) << *text;
   absl::StatusOr<std::string> far_end = client::ParetoPointText(with_history, 4);
   ASSERT_TRUE(far_end.ok());
-  EXPECT_NE(far_end->find("cycles of its run (F: the second objective as the run minimizes it"), std::string::npos)
+  EXPECT_NE(far_end->find("cycles of its run (F: the second objective travel [mm], which the run optimizes"),
+            std::string::npos)
       << *far_end;
   const std::string json = client::ResultsJson(with_history);
   EXPECT_NE(json.find("\"history\": ["), std::string::npos) << json;

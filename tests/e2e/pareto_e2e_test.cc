@@ -388,7 +388,7 @@ TEST(ParetoEndToEnd, AFrontOfThreeObjectivesRunsThroughTheCliAndTheReportDrawsIt
   EXPECT_NE(point.stdout_text.find("level3:      s2 <= "), std::string::npos) << point.stdout_text;
   auto anchor = Mbopt({"results", "job-1", "--point", "3", "--db", db}, env);
   ASSERT_EQ(anchor.exit_code, kExitOk) << Describe(anchor);
-  EXPECT_NE(anchor.stdout_text.find("cycles of its run (F: the third objective as the run minimizes it"),
+  EXPECT_NE(anchor.stdout_text.find("cycles of its run (F: the third objective s2 [in], which the run optimizes"),
             std::string::npos)
       << anchor.stdout_text;
   const std::string page = dir.File("front.html");

@@ -171,6 +171,11 @@ class PythonClientTest(unittest.TestCase):
             self.assertIn(p["history"][-1]["cycle"], (p["cycles"], p["cycles"] + 1))
         self.assertIsNone(front.point(1)["level"])
         self.assertLess(front.point(2)["level"], front.point(1)["value"])
+        # The far end's run minimizes |s1|: its F in inches, the point's
+        # value among its accepted designs'.
+        far = [c["objective"] for c in front.point(3)["history"] if c["accepted"]]
+        self.assertTrue(any(abs(f - front.point(3)["value"]) <= 1e-9 * front.point(3)["value"] for f in far),
+                        (front.point(3)["value"], far))
         with self.assertRaises(KeyError) as raised:
             front.point(4)
         self.assertIn(f"job {job} has points 1 to 3 (of 3)", str(raised.exception))
@@ -195,6 +200,13 @@ class PythonClientTest(unittest.TestCase):
             if p["point"] > 3:
                 self.assertLessEqual(p["value3"], p["level3"] * (1 + 1e-3))
         self.assertIsNone(front.point(1)["level3"])
+        # Anchors 2 and 3 optimize |s1| and |s2|: their runs' F is that
+        # objective in inches, and the point's value is one of them.
+        for number, key in ((2, "value"), (3, "value3")):
+            anchor = front.point(number)
+            objectives = [c["objective"] for c in anchor["history"] if c["accepted"]]
+            self.assertTrue(any(abs(f - anchor[key]) <= 1e-9 * anchor[key] for f in objectives),
+                            (number, anchor[key], objectives))
         self.assert_reads_as_the_cli(job, front)
 
     def test_sweep_lists_its_designs_not_cycle_records(self):
