@@ -34,8 +34,8 @@ constexpr int kLevels = 5;
 constexpr int kPoints = spec::kParetoAnchorsOfThree + kLevels * kLevels;
 // Each grid point meets its levels to the runs' violation tolerance (1e-8
 // here, relative to the level); its f1 is then the closed-form least f1 of
-// its levels to 1e-6 (the brief's aim; measured below, see
-// ReproducesTheClosedFormMinimaOfTheThreeSpheres).
+// its levels to 1e-6 (measured: 2.2e-8 at most over the 24 feasible grid
+// points; the test prints it).
 constexpr double kGridTolerance = 1e-6;
 constexpr int kMaxRounds = 40'000;
 
