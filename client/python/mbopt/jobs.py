@@ -283,7 +283,9 @@ class FrontResults:
     "failed" or "not run", and its run's `history`, one dict per LP solve),
     in the points' order. The second objective and its levels are as the
     CLI shows them: a traded constraint's in its unit, a maximized
-    objective as itself."""
+    objective as itself. A front of three objectives names its second
+    traded constraint in `against3` (its unit in `against3_unit`), and each
+    point has its `level3` and `value3`."""
 
     job_id: str
     study: str
