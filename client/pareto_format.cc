@@ -45,8 +45,15 @@ bool IsParetoJob(const v1::GetJobResponse& job) {
   return job.cycles_size() > 0 && (job.cycles(0).pareto() || job.cycles(0).pareto_point() > 0);
 }
 
+bool IsFrontOfThree(const v1::Study& study) { return study.pareto().against_size() == 2; }
+
 int FarEndPoint(const v1::Study& study) {
+  if (IsFrontOfThree(study)) return 2;
   return study.pareto().points() > 0 ? study.pareto().points() : spec::kDefaultParetoPoints;
+}
+
+bool IsFarEnd(const v1::Study& study, int point) {
+  return point == FarEndPoint(study) || (IsFrontOfThree(study) && point == 3);
 }
 
 std::vector<const v1::CycleRecord*> PointRunCycles(const v1::GetJobResponse& job, int point) {
@@ -67,6 +74,11 @@ struct WatchColumns {
   std::string level = "level (raw)";
   double factor = 1.0;
   int width = 14;
+  // A front of three objectives: the third's columns.
+  bool three = false;
+  std::string third = "value3 (raw)";
+  std::string level3 = "level3 (raw)";
+  double factor3 = 1.0;
 };
 
 WatchColumns WatchColumnsOf(const v1::Study* study) {
@@ -76,8 +88,16 @@ WatchColumns WatchColumnsOf(const v1::Study* study) {
     c.second = Heading(shown.label, shown.unit);
     c.level = Heading("level", shown.unit);
     c.factor = shown.factor;
+    c.three = IsFrontOfThree(*study);
+    if (c.three) {
+      const SecondObjectiveShown third = ShowThirdObjective(*study);
+      c.third = Heading(third.label, third.unit);
+      c.level3 = Heading("level", third.unit);
+      c.factor3 = third.factor;
+    }
   }
   c.width = std::max<int>({c.width, static_cast<int>(c.second.size()), static_cast<int>(c.level.size())});
+  if (c.three) c.width = std::max<int>({c.width, static_cast<int>(c.third.size()), static_cast<int>(c.level3.size())});
   return c;
 }
 
@@ -85,15 +105,22 @@ WatchColumns WatchColumnsOf(const v1::Study* study) {
 
 std::string ParetoWatchHeader(const v1::Study* study) {
   const WatchColumns c = WatchColumnsOf(study);
-  return absl::StrFormat("%5s %14s %*s %*s %-10s %6s", "point", "F", c.width, c.second, c.width, c.level, "run",
-                         "cycles");
+  const std::string third =
+      c.three ? absl::StrFormat(" %*s %*s", c.width, c.third, c.width, c.level3) : std::string();
+  return absl::StrFormat("%5s %14s %*s %*s%s %-10s %6s", "point", "F", c.width, c.second, c.width, c.level, third,
+                         "run", "cycles");
 }
 
 std::string ParetoWatchRow(const v1::CycleRecord& r, const v1::Study* study) {
   const WatchColumns c = WatchColumnsOf(study);
-  return absl::StrFormat("%5d %14s %*s %*s %-10s %6d", r.cycle(), CellValue(r.objective_trial(), "-"), c.width,
+  // Without the study, a record of a front of three still shows its third.
+  const bool three = c.three || (study == nullptr && r.pareto_three());
+  const std::string third = three ? absl::StrFormat(" %*s %*s", c.width, CellValue(c.factor3 * r.pareto_value3_si(), "-"),
+                                                    c.width, CellValue(c.factor3 * r.pareto_level3_si(), "-"))
+                                  : std::string();
+  return absl::StrFormat("%5d %14s %*s %*s%s %-10s %6d", r.cycle(), CellValue(r.objective_trial(), "-"), c.width,
                          CellValue(c.factor * r.pareto_value_si(), "-"), c.width,
-                         CellValue(c.factor * r.pareto_level_si(), "-"), r.pareto_state(), r.pareto_cycles());
+                         CellValue(c.factor * r.pareto_level_si(), "-"), third, r.pareto_state(), r.pareto_cycles());
 }
 
 std::string SecondObjectiveLabel(const v1::Objective& o) {
@@ -122,6 +149,23 @@ std::string SharedTermUnit(const v1::Objective& o) {
   return terms[0].unit();
 }
 
+// A traded constraint named `name`, in its unit.
+SecondObjectiveShown ShowConstraint(const v1::Study& study, const std::string& name) {
+  SecondObjectiveShown shown;
+  shown.label = name;
+  for (const auto& c : study.constraints()) {
+    if (c.name() == shown.label) shown.unit = c.unit();
+  }
+  if (!shown.unit.empty()) {
+    if (absl::StatusOr<spec::Unit> unit = spec::FindUnit(shown.unit); unit.ok()) {
+      shown.factor = 1.0 / unit->si_per_unit;
+    } else {
+      shown.unit.clear();  // shown in SI rather than mislabelled
+    }
+  }
+  return shown;
+}
+
 }  // namespace
 
 SecondObjectiveShown ShowSecondObjective(const v1::Study& study) {
@@ -143,18 +187,11 @@ SecondObjectiveShown ShowSecondObjective(const v1::Study& study) {
     }
     return shown;
   }
-  shown.label = pareto.against();
-  for (const auto& c : study.constraints()) {
-    if (c.name() == shown.label) shown.unit = c.unit();
-  }
-  if (!shown.unit.empty()) {
-    if (absl::StatusOr<spec::Unit> unit = spec::FindUnit(shown.unit); unit.ok()) {
-      shown.factor = 1.0 / unit->si_per_unit;
-    } else {
-      shown.unit.clear();  // shown in SI rather than mislabelled
-    }
-  }
-  return shown;
+  return ShowConstraint(study, pareto.against_size() > 0 ? pareto.against(0) : "");
+}
+
+SecondObjectiveShown ShowThirdObjective(const v1::Study& study) {
+  return ShowConstraint(study, IsFrontOfThree(study) ? study.pareto().against(1) : "");
 }
 
 ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
@@ -164,6 +201,10 @@ ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
   front.unit = shown.unit;
   front.against_objective = shown.objective;
   front.against_maximized = shown.maximized;
+  const SecondObjectiveShown third = ShowThirdObjective(job.study());
+  front.three = IsFrontOfThree(job.study());
+  front.against3 = third.label;
+  front.unit3 = third.unit;
   // Dominance is decided on the second objective as the runs minimized it.
   const double second_sign = shown.maximized ? -1.0 : 1.0;
   // The first objective as the optimizer minimized it.
@@ -177,12 +218,17 @@ ParetoFront FrontOfJob(const v1::GetJobResponse& job) {
     row.objective = r.objective_trial();
     row.value = shown.factor * r.pareto_value_si();
     row.level = shown.factor * r.pareto_level_si();
+    if (front.three) {
+      row.value3 = third.factor * r.pareto_value3_si();
+      row.level3 = third.factor * r.pareto_level3_si();
+    }
     if (r.pareto_state() == "not_run") {
       row.status = "not run";
     } else if (!r.accepted()) {
       row.status = r.pareto_state() == "failed" || !std::isfinite(r.objective_trial()) ? "failed" : "infeasible";
     }
-    usable.push_back({sign * row.objective, second_sign * row.value, row.status.empty()});
+    usable.push_back({sign * row.objective, second_sign * row.value, row.status.empty(),
+                      front.three ? row.value3 : 0.0});
     front.points.push_back(std::move(row));
   }
   const std::vector<bool> dominated = spec::DominatedPoints(usable);
@@ -197,9 +243,11 @@ std::string ParetoTable(const v1::GetJobResponse& job) {
   const ParetoFront front = FrontOfJob(job);
   std::string out = SummaryText(s, job.has_study() ? &job.study() : nullptr);
   out += '\n';
-  std::vector<std::string> header = {"point", Heading("level", front.unit),
-                                     Heading("F", s.objective_unit()), Heading(front.against, front.unit),
-                                     "maxg", "run", "cycles"};
+  std::vector<std::string> header = {"point", Heading("level", front.unit)};
+  if (front.three) header.push_back(Heading("level3", front.unit3));
+  header.insert(header.end(), {Heading("F", s.objective_unit()), Heading(front.against, front.unit)});
+  if (front.three) header.push_back(Heading(front.against3, front.unit3));
+  header.insert(header.end(), {"maxg", "run", "cycles"});
   for (int i = 0; i < s.design_names_size(); ++i) {
     header.push_back(Heading(s.design_names(i), i < s.design_units_size() ? s.design_units(i) : ""));
   }
@@ -207,9 +255,11 @@ std::string ParetoTable(const v1::GetJobResponse& job) {
   std::vector<std::vector<std::string>> rows = {header};
   for (const ParetoPointRow& p : front.points) {
     const v1::CycleRecord& r = *p.record;
-    std::vector<std::string> row = {std::to_string(p.point), CellValue(p.level, "-"), CellValue(p.objective, "-"),
-                                    CellValue(p.value, "-"), CellValue(r.max_violation_trial(), "-"), r.pareto_state(),
-                                    std::to_string(r.pareto_cycles())};
+    std::vector<std::string> row = {std::to_string(p.point), CellValue(p.level, "-")};
+    if (front.three) row.push_back(CellValue(p.level3, "-"));
+    row.insert(row.end(), {CellValue(p.objective, "-"), CellValue(p.value, "-")});
+    if (front.three) row.push_back(CellValue(p.value3, "-"));
+    row.insert(row.end(), {CellValue(r.max_violation_trial(), "-"), r.pareto_state(), std::to_string(r.pareto_cycles())});
     for (int i = 0; i < s.design_names_size(); ++i) {
       row.push_back(p.status == "not run" ? "-" : CellValue(TrialPhysical(r, i), "-"));
     }
@@ -217,8 +267,14 @@ std::string ParetoTable(const v1::GetJobResponse& job) {
     rows.push_back(std::move(row));
   }
   out += AlignedRows(rows);
-  out += absl::StrCat("level: the limit on ", front.against,
-                      " for the point (none at the two ends); maxg: the point's run's largest (g - limit) / scale\n");
+  if (front.three) {
+    out += absl::StrCat("level, level3: the limits on ", front.against, " and ", front.against3,
+                        " for the point (none at the three anchors, points 1 to 3: each objective's own least "
+                        "value); maxg: the point's run's largest (g - limit) / scale\n");
+  } else {
+    out += absl::StrCat("level: the limit on ", front.against,
+                        " for the point (none at the two ends); maxg: the point's run's largest (g - limit) / scale\n");
+  }
   for (const ParetoPointRow& p : front.points) {
     if (!p.record->rejection_reason().empty()) {
       out += absl::StrCat("point ", p.point, ": ", p.record->rejection_reason(), "\n");
@@ -232,13 +288,15 @@ std::string ParetoCsv(const v1::GetJobResponse& job) {
   const ParetoFront front = FrontOfJob(job);
   auto cell = [](double v) { return std::isfinite(v) ? JsonWriter::FormatDouble(v) : std::string(); };
   // A label with spaces is no column name: an objective's column is "second_objective".
-  std::string out = absl::StrCat("point,level,objective,", front.against_objective ? "second_objective" : front.against,
-                                 ",max_violation,run_state,cycles,analyses");
+  std::string out = absl::StrCat("point,level,", front.three ? "level3," : "", "objective,",
+                                 front.against_objective ? "second_objective" : front.against,
+                                 front.three ? "," + front.against3 : "", ",max_violation,run_state,cycles,analyses");
   for (const auto& name : s.design_names()) out += "," + name;
   out += ",status,reason\n";
   for (const ParetoPointRow& p : front.points) {
     const v1::CycleRecord& r = *p.record;
-    out += absl::StrCat(p.point, ",", cell(p.level), ",", cell(p.objective), ",", cell(p.value), ",",
+    out += absl::StrCat(p.point, ",", cell(p.level), ",", front.three ? cell(p.level3) + "," : "",
+                        cell(p.objective), ",", cell(p.value), ",", front.three ? cell(p.value3) + "," : "",
                         cell(r.max_violation_trial()), ",", r.pareto_state(), ",", r.pareto_cycles(), ",",
                         r.pareto_analyses());
     for (int i = 0; i < s.design_names_size(); ++i) out += "," + cell(TrialPhysical(r, i));
@@ -259,6 +317,10 @@ void PointObject(const v1::GetJobResponse& job, const ParetoPointRow& p, JsonWri
   w.Field("level", p.level);
   w.Field("objective", p.objective);
   w.Field("value", p.value);
+  if (r.pareto_three()) {
+    w.Field("level3", p.level3);
+    w.Field("value3", p.value3);
+  }
   w.Field("max_violation", r.max_violation_trial());
   w.Field("run_state", r.pareto_state());
   w.Field("cycles", r.pareto_cycles());
@@ -310,6 +372,10 @@ std::string ParetoJson(const v1::GetJobResponse& job, const std::string& databas
   w.Field("form", "pareto");
   w.Field("against", front.against);
   w.Field("against_unit", front.unit);
+  if (front.three) {
+    w.Field("against3", front.against3);
+    w.Field("against3_unit", front.unit3);
+  }
   w.Field("objective_unit", s.objective_unit());
   w.Field("points_total", s.max_cycles());
   w.Field("points_done", s.cycles());
@@ -337,10 +403,18 @@ absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int p
   const std::string unit = front.unit.empty() ? "" : " " + front.unit;
   out += std::isfinite(p->level) ? absl::StrFormat("level:       %s %s %.9g%s\n", front.against,
                                                     front.against_maximized ? ">=" : "<=", p->level, unit)
-                                  : absl::StrFormat("level:       none (an end of the front)\n");
+                                  : absl::StrFormat("level:       none (%s)\n",
+                                                    front.three ? "an anchor" : "an end of the front");
   out += absl::StrFormat("objective:   %s%s\n", CellValue(p->objective, "-"),
                          s.objective_unit().empty() ? "" : " " + s.objective_unit());
   out += absl::StrFormat("%-12s %s%s\n", front.against + ":", CellValue(p->value, "-"), unit);
+  if (front.three) {
+    const std::string unit3 = front.unit3.empty() ? "" : " " + front.unit3;
+    out += std::isfinite(p->level3)
+               ? absl::StrFormat("level3:      %s <= %.9g%s\n", front.against3, p->level3, unit3)
+               : absl::StrFormat("level3:      none (an anchor)\n");
+    out += absl::StrFormat("%-12s %s%s\n", front.against3 + ":", CellValue(p->value3, "-"), unit3);
+  }
   out += absl::StrFormat("maxg:        %s\n", CellValue(r.max_violation_trial(), "-"));
   out += absl::StrFormat("run:         %s after %d cycles, %d analyses\n", r.pareto_state(), r.pareto_cycles(),
                          static_cast<long long>(r.pareto_analyses()));
@@ -357,10 +431,15 @@ absl::StatusOr<std::string> ParetoPointText(const v1::GetJobResponse& job, int p
   }
   const std::vector<const v1::CycleRecord*> cycles = PointRunCycles(job, point);
   if (!cycles.empty()) {
-    // The far end's run minimizes the second objective, not the study's.
-    const bool far_end = point == FarEndPoint(job.study());
+    // The far end's run minimizes the second objective, not the study's;
+    // the server reports its F as that objective is shown, in its unit.
+    const bool far_end = IsFarEnd(job.study(), point);
+    const bool third = IsFrontOfThree(job.study()) && point == 3;
+    const std::string& far_unit = third ? front.unit3 : front.unit;
     out += absl::StrCat("cycles of its run (F: ",
-                        far_end ? "the second objective as the run minimizes it, divided by its rows' scale"
+                        far_end ? absl::StrCat(third ? "the third objective " : "the second objective ",
+                                               third ? front.against3 : front.against,
+                                               far_unit.empty() ? "" : " [" + far_unit + "]", ", which the run optimizes")
                                 : "the study's objective",
                         "; maxg: against the run's own limits, its level included):\n");
     out += CycleTableHeader();

@@ -6,6 +6,7 @@
 // I/O.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct ParetoPointRow {
   double objective = 0;  // as reported (a maximized value as itself)
   double value = 0;      // the traded constraint's largest value, in its unit
   double level = 0;      // its level at this point, in its unit; NaN at the anchors
+  // A front of three objectives: the second traded constraint's largest
+  // value and level, in its unit (NaN on a front of two).
+  double value3 = std::numeric_limits<double>::quiet_NaN();
+  double level3 = std::numeric_limits<double>::quiet_NaN();
   std::string status;
 };
 
@@ -42,6 +47,10 @@ struct SecondObjectiveShown {
   double factor = 1.0;
 };
 SecondObjectiveShown ShowSecondObjective(const v1::Study& study);
+// A front of three objectives' third: the second `against` constraint
+// (label "" on a front of two).
+SecondObjectiveShown ShowThirdObjective(const v1::Study& study);
+bool IsFrontOfThree(const v1::Study& study);
 
 // The watch's lines as each point's record arrives: "point" (1-based), F,
 // the second objective and the level as the tables show them, the run's
@@ -60,6 +69,10 @@ struct ParetoFront {
   std::string unit;
   bool against_objective = false;
   bool against_maximized = false;  // its level is a least value, not a largest
+  // A front of three objectives: the third's constraint and unit.
+  bool three = false;
+  std::string against3;
+  std::string unit3;
   std::vector<ParetoPointRow> points;
 };
 ParetoFront FrontOfJob(const v1::GetJobResponse& job);
@@ -73,7 +86,9 @@ std::string ParetoJson(const v1::GetJobResponse& job, const std::string& databas
 
 // The point at the front's far end (1-based), whose run minimizes the
 // second objective: its cycles' F is that, not the study's objective.
+// A front of three objectives has two, points 2 and 3 (IsFarEnd).
 int FarEndPoint(const v1::Study& study);
+bool IsFarEnd(const v1::Study& study, int point);
 
 // The cycle records of point `point`'s run (1-based), in their order:
 // none for a point not run, and for a job logged before the runs' cycles

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "client/job_format.h"
 #include "client/pareto_format.h"
 #include "client/report/report_from_proto.h"
@@ -27,6 +28,9 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
   data.against_unit = front.unit;
   data.against_objective = front.against_objective;
   data.against_maximized = front.against_maximized;
+  data.three = front.three;
+  data.against3 = front.against3;
+  data.against3_unit = front.unit3;
   data.points_total = s.max_cycles();
   data.variable_names.assign(s.design_names().begin(), s.design_names().end());
   data.variable_units.assign(s.design_units().begin(), s.design_units().end());
@@ -40,6 +44,8 @@ report::ParetoReportData ParetoReportFromJob(const v1::GetJobResponse& job, int 
     p.level = row.level;
     p.objective = row.objective;
     p.value = row.value;
+    p.level3 = row.level3;
+    p.value3 = row.value3;
     p.max_violation = r.max_violation_trial();
     p.run_state = r.pareto_state();
     p.cycles = r.pareto_cycles();
@@ -83,13 +89,19 @@ void AddChosenPointHistory(const v1::GetJobResponse& job, report::ParetoReportDa
   }
   for (const v1::CycleRecord* c : cycles) *run.add_cycles() = *c;
   data->chosen_history = report::ReportDataFromJob(run);
-  if (data->chosen == FarEndPoint(job.study())) {
-    // Its run minimizes the second objective, in no unit of the study's.
-    data->chosen_history.objective_unit.clear();
+  if (IsFarEnd(job.study(), data->chosen)) {
+    // Its run optimizes the second (or third) objective, whose values the
+    // server reports in that objective's unit.
+    const bool third = IsFrontOfThree(job.study()) && data->chosen == 3;
+    data->chosen_history.objective_unit = third ? data->against3_unit : data->against_unit;
     data->chosen_history.objective = std::numeric_limits<double>::quiet_NaN();
+    const std::string name = third ? data->against3 : data->against;
     data->chosen_history_note =
-        "This is the front's far end: its run's F is the second objective as the run minimizes it, divided by "
-        "its rows' scale, not the study's objective.";
+        IsFrontOfThree(job.study())
+            ? absl::StrCat("This is the anchor of the ", third ? "third" : "second", " objective: its run's F is ", name,
+                           ", which the run optimizes, not the study's objective.")
+            : absl::StrCat("This is the front's far end: its run's F is ", data->against_objective ? "" : "the largest value of ",
+                           name, ", which the run optimizes, not the study's objective.");
   }
 }
 

@@ -34,14 +34,40 @@ std::vector<int> ParetoWarmStartParents(int points) {
   return parent;
 }
 
+double ParetoGridLevel(int i, int levels, double upper, double lower) {
+  MBOPT_CHECK(levels >= 1 && i >= 0 && i < levels, "ParetoGridLevel: level out of range");
+  const double t = static_cast<double>(i + 1) / static_cast<double>(levels + 1);
+  return upper - t * (upper - lower);
+}
+
+std::vector<int> ParetoGridWarmStartParents(int levels) {
+  const int n = levels < 0 ? 0 : levels;
+  std::vector<int> parent(static_cast<size_t>(kParetoAnchorsOfThree + n * n), -1);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int k = kParetoAnchorsOfThree + i * n + j;
+      int from = 0;
+      if (i > 0) {
+        from = k - n;
+      } else if (j > 0) {
+        from = k - 1;
+      }
+      parent[static_cast<size_t>(k)] = from;
+    }
+  }
+  return parent;
+}
+
 std::vector<bool> DominatedPoints(const std::vector<FrontPoint>& points) {
   std::vector<bool> dominated(points.size(), false);
   for (size_t i = 0; i < points.size(); ++i) {
     if (!points[i].usable) continue;
     for (size_t j = 0; j < points.size() && !dominated[i]; ++j) {
       if (j == i || !points[j].usable) continue;
-      const bool no_worse = points[j].first <= points[i].first && points[j].second <= points[i].second;
-      const bool better = points[j].first < points[i].first || points[j].second < points[i].second;
+      const bool no_worse = points[j].first <= points[i].first && points[j].second <= points[i].second &&
+                            points[j].third <= points[i].third;
+      const bool better = points[j].first < points[i].first || points[j].second < points[i].second ||
+                          points[j].third < points[i].third;
       dominated[i] = no_worse && better;
     }
   }

@@ -18,7 +18,9 @@
 // numbered N+1 to N+R, each halving one segment of the front where it bends
 // or leaves a gap (RefinementSegments). They are chosen from the first N
 // points alone, so they too run side by side and do not depend on the
-// order of results.
+// order of results. `refine_again: R2` adds R2 more, numbered N+R+1 on,
+// once those N+R points have ended, each halving a segment of the front
+// they all make: a second generation chosen the same way.
 #pragma once
 
 #include <vector>
@@ -28,16 +30,33 @@ namespace mbopt::spec {
 inline constexpr int kDefaultParetoPoints = 9;
 inline constexpr int kMinParetoPoints = 3;
 inline constexpr int kMaxParetoPoints = 65;
+// A front of three objectives: levels per bounded objective.
+inline constexpr int kDefaultParetoGridLevels = 5;
+inline constexpr int kMinParetoGridLevels = 2;
+inline constexpr int kMaxParetoGridLevels = 9;
+// A front of three objectives has its three anchors first (points 0, 1, 2:
+// each objective's own optimum), then the grid, level i of the second
+// objective and level j of the third at 3 + i * levels + j.
+inline constexpr int kParetoAnchorsOfThree = 3;
 
 struct Pareto {
   // The second objective: constraint `constraint`'s largest value, or
   // (trades_objective) Study::second_objective.
   int constraint = -1;  // index into Study::constraints; -1: none
+  // The third objective, constraint `third_constraint`'s largest value;
+  // -1: a front of two objectives.
+  int third_constraint = -1;
   bool trades_objective = false;
-  int points = 0;       // the two anchors included
+  int points = 0;       // the two anchors included; with three objectives, levels per bounded objective
   int refine = 0;       // points added where the front bends, 0 to points-1
+  // Points added where the refined front (points + refine) bends, 0 to
+  // points + refine - 1; only with refine > 0.
+  int refine_again = 0;
 
-  int total_points() const { return points + refine; }
+  bool three_objectives() const { return third_constraint >= 0; }
+  int total_points() const {
+    return three_objectives() ? kParetoAnchorsOfThree + points * points : points + refine + refine_again;
+  }
 
   bool enabled() const { return constraint >= 0 || trades_objective; }
 };
@@ -52,16 +71,33 @@ double ParetoLevel(int k, int points, double value_at_first, double value_at_las
 // anchors (they start from the study's initial design).
 std::vector<int> ParetoWarmStartParents(int points);
 
+// A front of three objectives: level i (0 to levels-1) of a bounded
+// objective, strictly between its value `upper` (the largest any anchor
+// has, where the bound starts to matter) and its own least value `lower`:
+// upper - (i + 1) / (levels + 1) * (upper - lower). The anchors hold the
+// ends, and a level at the least value itself would leave one design.
+double ParetoGridLevel(int i, int levels, double upper, double lower);
+
+// parent[k] of a front of three objectives' points (anchors first, then
+// the grid by rows): -1 for the anchors (the study's initial design); grid
+// point (0, 0) from anchor 0, the objective's own optimum; (0, j) from
+// (0, j-1); (i, j) from (i-1, j). Each bound is tightened one level from a
+// point that already meets the other; the first row is a chain, and each
+// later row a generation whose points run side by side.
+std::vector<int> ParetoGridWarmStartParents(int levels);
+
 // A point of a front as the client sees it: both objectives (minimized),
-// and whether its run gave a usable, feasible result.
+// and whether its run gave a usable, feasible result. `third`: the third
+// objective of a front of three (minimized), 0 on a front of two.
 struct FrontPoint {
   double first = 0;
   double second = 0;
   bool usable = false;
+  double third = 0;
 };
 
 // dominated[k]: usable point k is dominated by another usable point (no
-// worse in both objectives and better in one). Unusable points: false.
+// worse in every objective and better in one). Unusable points: false.
 std::vector<bool> DominatedPoints(const std::vector<FrontPoint>& points);
 
 // A segment of the front to halve: between points `from` and `to` (indices

@@ -95,11 +95,72 @@ std::string FrontPlot(const ParetoReportData& data) {
   return "<div class=\"figure\">\n" + RenderLinePlotSvg(spec) + "</div>\n";
 }
 
+// A front of three objectives seen along one axis: the points of one
+// status as markers at (x_of, y_of), labelled with their numbers. A
+// surface has no order along a line, so none is drawn.
+PlotSeries ProjectionSeries(const ParetoReportData& data, const std::string& status, const std::string& name,
+                            const std::string& color, MarkerShape marker, double (*x_of)(const Point&),
+                            double (*y_of)(const Point&)) {
+  PlotSeries s;
+  s.name = name;
+  s.color = color;
+  s.marker = marker;
+  s.draw_line = false;
+  s.marker_radius_px = 4.0;
+  for (const Point& p : data.points) {
+    if (p.status != status || !std::isfinite(x_of(p)) || !std::isfinite(y_of(p))) continue;
+    s.x.push_back(x_of(p));
+    s.y.push_back(y_of(p));
+    s.point_labels.push_back(std::to_string(p.index));
+  }
+  return s;
+}
+
+double ObjectiveOf(const Point& p) { return p.objective; }
+double ValueOf(const Point& p) { return p.value; }
+double Value3Of(const Point& p) { return p.value3; }
+
+std::string Projection(const ParetoReportData& data, const std::string& title, const std::string& x_label,
+                       const std::string& y_label, double (*x_of)(const Point&), double (*y_of)(const Point&)) {
+  PlotSpec spec;
+  spec.title = title;
+  spec.x_label = x_label;
+  spec.y_label = y_label;
+  spec.height_px = 360.0;
+  spec.series.push_back(ProjectionSeries(data, "front", "on the front", "#1f77b4", MarkerShape::kCircle, x_of, y_of));
+  spec.series.push_back(
+      ProjectionSeries(data, "dominated", "dominated", "#7f7f7f", MarkerShape::kHollowCircle, x_of, y_of));
+  for (const Point& p : data.points) {
+    if (p.index != data.chosen || !std::isfinite(x_of(p)) || !std::isfinite(y_of(p))) continue;
+    PlotSeries chosen;
+    chosen.name = "chosen: point " + std::to_string(p.index);
+    chosen.color = "#ff7f0e";
+    chosen.draw_line = false;
+    chosen.marker = MarkerShape::kHollowCircle;
+    chosen.marker_radius_px = 9.0;
+    chosen.x = {x_of(p)};
+    chosen.y = {y_of(p)};
+    spec.series.push_back(std::move(chosen));
+  }
+  return "<div class=\"figure\">\n" + RenderLinePlotSvg(spec) + "</div>\n";
+}
+
+std::string FrontProjections(const ParetoReportData& data) {
+  const std::string f = WithUnit("F", data.objective_unit);
+  const std::string second = WithUnit(data.against, data.against_unit);
+  const std::string third = WithUnit(data.against3, data.against3_unit);
+  return Projection(data, "F against " + data.against, second, f, ValueOf, ObjectiveOf) +
+         Projection(data, "F against " + data.against3, third, f, Value3Of, ObjectiveOf) +
+         Projection(data, data.against3 + " against " + data.against, second, third, ValueOf, Value3Of);
+}
+
 std::string PointsTable(const ParetoReportData& data) {
   std::string out = "<div class=\"wide\">\n<table>\n<thead><tr><th>point</th>";
   out += "<th>" + EscapeHtml(WithUnit("level", data.against_unit)) + "</th>";
+  if (data.three) out += "<th>" + EscapeHtml(WithUnit("level3", data.against3_unit)) + "</th>";
   out += "<th>" + EscapeHtml(WithUnit("F", data.objective_unit)) + "</th>";
   out += "<th>" + EscapeHtml(WithUnit(data.against, data.against_unit)) + "</th>";
+  if (data.three) out += "<th>" + EscapeHtml(WithUnit(data.against3, data.against3_unit)) + "</th>";
   out += "<th>maxg</th><th>run</th><th>cycles</th>";
   for (size_t v = 0; v < data.variable_names.size(); ++v) {
     out += "<th>" + EscapeHtml(WithUnit(data.variable_names[v], data.variable_units[v])) + "</th>";
@@ -112,7 +173,8 @@ std::string PointsTable(const ParetoReportData& data) {
            : p.status == "dominated"    ? "<tr class=\"dominated\">"
                                         : "<tr>";
     out += "<td class=\"num\">" + std::to_string(p.index) + "</td>";
-    out += Cell(p.level) + Cell(p.objective) + Cell(p.value) + Cell(p.max_violation, true);
+    out += Cell(p.level) + (data.three ? Cell(p.level3) : "") + Cell(p.objective) + Cell(p.value) +
+           (data.three ? Cell(p.value3) : "") + Cell(p.max_violation, true);
     out += "<td>" + EscapeHtml(p.run_state) + "</td><td class=\"num\">" + std::to_string(p.cycles) + "</td>";
     for (size_t v = 0; v < data.variable_names.size(); ++v) {
       out += Cell(v < p.design.size() && p.status != "not run" ? p.design[v] : std::nan(""));
@@ -202,12 +264,23 @@ std::string RenderParetoReportHtml(const ParetoReportData& data) {
   out += "<tr><th>state</th><td><strong>" + EscapeHtml(data.state) + "</strong></td></tr>\n";
   out += "<tr><th>points computed</th><td>" + std::to_string(data.points.size()) + " of " +
          std::to_string(data.points_total) + "</td></tr>\n";
-  out += "<tr><th>traded against</th><td>" + EscapeHtml(SecondObjectivePhrase(data)) + "</td></tr>\n";
+  out += "<tr><th>traded against</th><td>" + EscapeHtml(SecondObjectivePhrase(data)) +
+         (data.three ? " and the largest value of " + EscapeHtml(data.against3) : "") + "</td></tr>\n";
   if (!data.message.empty()) out += "<tr><th>message</th><td>" + EscapeHtml(data.message) + "</td></tr>\n";
   out += "</tbody>\n</table>\n";
   out += "<h2>Pareto front</h2>\n";
   if (data.points.empty()) {
     out += "<p class=\"note\">No point has been computed yet.</p>\n";
+  } else if (data.three) {
+    out += std::string("<p class=\"note\">A front of three objectives, seen along each axis in turn. Each point is "
+                       "one optimization: the ") +
+           (data.objective_maximized ? "greatest" : "least") + " F with " + EscapeHtml(data.against) + " and " +
+           EscapeHtml(data.against3) +
+           " held below the point's levels (points 1 to 3: the least F, the least " + EscapeHtml(data.against) +
+           " and the least " + EscapeHtml(data.against3) +
+           ", each with both levels free). Points are numbered as in the table; a point another beats in all three "
+           "is dominated; infeasible points (no design meets both levels) are in the table only.</p>\n";
+    out += FrontProjections(data);
   } else {
     // A maximized second objective is held above its level, and its
     // best value is the greatest.

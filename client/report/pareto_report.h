@@ -1,6 +1,7 @@
 // The report page of a Pareto front's job (docs/report.md, "Pareto
 // fronts"): the front drawn as the objective against the traded
-// constraint's largest value, every point labelled with its number, the
+// constraint's largest value (a front of three objectives: its three
+// pairwise projections), every point labelled with its number, the
 // dominated and the failed points set apart, the chosen point (if one was
 // picked) marked; then the table of the points and, for the chosen one, its
 // design and its constraints, its run's cycle history (the single job's
@@ -33,6 +34,12 @@ struct ParetoReportData {
   bool against_objective = false;  // the second objective is an objective, not a constraint's value
   bool against_maximized = false;  // ... a maximized one: values as themselves, a level a least value
   std::string against_unit;
+  // A front of three objectives: the second traded constraint, drawn as
+  // the three pairwise projections of the points (F against each traded
+  // value, and the two traded values against each other).
+  bool three = false;
+  std::string against3;
+  std::string against3_unit;
   int points_total = 0;
   std::vector<std::string> variable_names;
   std::vector<std::string> variable_units;
@@ -43,6 +50,8 @@ struct ParetoReportData {
     double level = 0;               // NaN at the two ends
     double objective = 0;           // NaN without a result
     double value = 0;               // the traded constraint's largest value
+    double level3 = 0;              // a front of three objectives: the third's level and value
+    double value3 = 0;
     double max_violation = 0;
     std::string run_state;          // "converged", ..., "not_run"
     int cycles = 0;

@@ -131,8 +131,21 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateWith(std::shared_ptr<const spec:
     design_set = std::make_unique<DesignSetRun>(problem, std::move(designs), std::move(row_constraints),
                                                 static_cast<int>(study->constraints.size()));
   }
-  std::unique_ptr<ParetoRun> pareto;
-  if (study->pareto.enabled()) {
+  std::unique_ptr<FrontRun> pareto;
+  if (study->pareto.three_objectives()) {
+    ParetoGridSetup setup;
+    setup.problem = problem;
+    setup.options = settings;
+    for (const spec::ConstraintRow& row : layout.rows) setup.row_constraints.push_back(row.constraint);
+    setup.num_constraints = static_cast<int>(study->constraints.size());
+    setup.traded_constraints = {study->pareto.constraint, study->pareto.third_constraint};
+    setup.levels = study->pareto.points;
+    absl::StatusOr<std::unique_ptr<ParetoGridRun>> made = ParetoGridRun::Create(std::move(setup), make_lp_solver);
+    if (!made.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(study->source_file, ": pareto: ", made.status().message()));
+    }
+    pareto = *std::move(made);
+  } else if (study->pareto.enabled()) {
     ParetoSetup setup;
     setup.problem = problem;
     setup.options = settings;
@@ -147,6 +160,7 @@ absl::StatusOr<std::unique_ptr<Job>> Job::CreateWith(std::shared_ptr<const spec:
     }
     setup.points = study->pareto.points;
     setup.refine = study->pareto.refine;
+    setup.refine_again = study->pareto.refine_again;
     absl::StatusOr<std::unique_ptr<ParetoRun>> made = ParetoRun::Create(std::move(setup), make_lp_solver);
     if (!made.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(study->source_file, ": pareto: ", made.status().message()));

@@ -2,7 +2,8 @@
 // problem), its layout, and the SLP optimizer that runs it; or, for a study
 // with a design set (a sweep or sample), the DesignSetRun that analyses its
 // designs in the optimizer's place (design_set_run.h); or, for a study with
-// a Pareto front, the ParetoRun of its points' SLP runs (pareto_run.h);
+// a Pareto front, the ParetoRun (or, of three objectives, ParetoGridRun) of
+// its points' SLP runs (pareto_run.h, pareto_grid_run.h);
 // all behind the same calls. The Job is the only thing that drives the SLP core, in one of two
 // ways that share every step that matters:
 //  - Run(evaluator): the job asks, the evaluator answers each batch, and the
@@ -37,6 +38,7 @@
 #include "server/jobs/design_set_run.h"
 #include "server/jobs/evaluator.h"
 #include "server/jobs/job_state.h"
+#include "server/jobs/pareto_grid_run.h"
 #include "server/jobs/pareto_run.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/slp_optimizer.h"
@@ -163,7 +165,7 @@ class Job {
   slp::SlpOptions options_;
   std::unique_ptr<slp::SlpOptimizer> optimizer_;
   std::unique_ptr<DesignSetRun> design_set_;  // null: an optimization
-  std::unique_ptr<ParetoRun> pareto_;         // null: not a Pareto front
+  std::unique_ptr<FrontRun> pareto_;         // null: not a Pareto front
   std::map<spec::FailureKind, std::int64_t> failures_by_kind_;
   spec::AnalysisFailure last_failure_;
 };

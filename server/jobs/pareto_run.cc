@@ -43,6 +43,12 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
     return absl::InvalidArgumentError(absl::StrFormat(
         "a front of %d points can be refined by 0 to %d points, got %d", setup.points, setup.points - 1, setup.refine));
   }
+  if (setup.refine_again < 0 || (setup.refine_again > 0 && setup.refine == 0) ||
+      setup.refine_again > setup.points + setup.refine - 1) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "a refined front of %d points can be refined again by 0 to %d points (with refine above 0), got %d",
+        setup.points + setup.refine, setup.points + setup.refine - 1, setup.refine_again));
+  }
   if (!make_lp_solver) return absl::InvalidArgumentError("a Pareto front needs an LP solver for each of its points");
   std::vector<int> traded;
   for (size_t h = 0; h < setup.row_constraints.size(); ++h) {
@@ -83,7 +89,7 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
 
 ParetoRun::ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver)
     : setup_(std::move(setup)), make_lp_solver_(std::move(make_lp_solver)) {
-  points_.resize(static_cast<std::size_t>(setup_.points + setup_.refine));
+  points_.resize(static_cast<std::size_t>(setup_.points + setup_.refine + setup_.refine_again));
   const std::vector<int> parents = spec::ParetoWarmStartParents(setup_.points);
   for (std::size_t k = 0; k < points_.size(); ++k) {
     points_[k].parent = k < parents.size() ? parents[k] : -1;
@@ -145,12 +151,12 @@ void ParetoRun::StartRuns() {
     point.level_si = spec::ParetoLevel(k, setup_.points, first.record.pareto_value_si, least.record.pareto_value_si);
     Start(k, parent.record.x0);
   }
-  StartRefinement();
+  StartRefinement(static_cast<std::size_t>(setup_.points), setup_.refine);
+  StartRefinement(static_cast<std::size_t>(setup_.points + setup_.refine), setup_.refine_again);
 }
 
-void ParetoRun::StartRefinement() {
-  const auto base = static_cast<std::size_t>(setup_.points);
-  if (points_.size() == base || points_[base].ended || points_[base].run != nullptr) return;
+void ParetoRun::StartRefinement(std::size_t base, int count) {
+  if (count <= 0 || points_[base].ended || points_[base].run != nullptr) return;
   for (std::size_t k = 0; k < base; ++k) {
     if (!points_[k].ended) return;
   }
@@ -161,14 +167,14 @@ void ParetoRun::StartRefinement() {
     const slp::CycleRecord& r = points_[k].record;
     front.push_back({r.objective_x0, r.pareto_value_si, points_[k].usable});
   }
-  const std::vector<spec::RefinementSegment> segments = spec::RefinementSegments(front, setup_.refine);
-  for (std::size_t j = 0; j < static_cast<std::size_t>(setup_.refine); ++j) {
+  const std::vector<spec::RefinementSegment> segments = spec::RefinementSegments(front, count);
+  for (std::size_t j = 0; j < static_cast<std::size_t>(count); ++j) {
     const int k = static_cast<int>(base + j);
     Point& point = points_[base + j];
     if (j >= segments.size()) {
       point.level_si = kNaN;
       EndWithoutRun(k, absl::StrFormat("the front of the first %d points has only %d segments to refine",
-                                       setup_.points, static_cast<int>(segments.size())));
+                                       static_cast<int>(base), static_cast<int>(segments.size())));
       continue;
     }
     const Point& upper = points_[static_cast<std::size_t>(segments[j].from)];

@@ -22,7 +22,9 @@
 //    between its segment's ends' values, warm-started from the end with the
 //    larger value (nearer point 1, as the points between). Added points
 //    the front has no segment for end unrun, saying why, so a front always
-//    has points + refine records;
+//    has points + refine records; refine_again > 0: once those have ended,
+//    a second generation the same way, its segments chosen on the front of
+//    all points + refine points;
 //  - one record per point (a design set's record with the Pareto fields,
 //    slp::CycleRecord), emitted in the points' order: point k's once points
 //    0..k have ended, so the record log does not depend on the order of
@@ -48,6 +50,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "server/jobs/analysis_record.h"
+#include "server/jobs/front_run.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/options.h"
 #include "server/slp/problem.h"
@@ -74,9 +77,10 @@ struct ParetoSetup {
   bool traded_sum = false;
   int points = 0;              // >= 3
   int refine = 0;              // added points, 0 to points - 1
+  int refine_again = 0;        // a second generation, 0 to points + refine - 1; only with refine > 0
 };
 
-class ParetoRun {
+class ParetoRun final : public FrontRun {
  public:
   // Point k's request r has id k * kRequestStride + r: far more analyses than
   // a run may use (JobRunOptions::max_analyses).
@@ -86,21 +90,16 @@ class ParetoRun {
   // constraint, rows of different limits, too few points).
   static absl::StatusOr<std::unique_ptr<ParetoRun>> Create(ParetoSetup setup, LpSolverFactory make_lp_solver);
 
-  std::vector<slp::AnalysisRequest> PendingRequests() const;
-  bool IsPending(std::int64_t request_id) const;
-  // One result (validated by the job's intake, in the study's shape).
-  // InvalidArgument for a request that is not pending.
-  absl::Status Submit(const AnalysisRecord& record);
-  std::vector<slp::CycleRecord> TakeNewRecords();
+  std::vector<slp::AnalysisRequest> PendingRequests() const override;
+  bool IsPending(std::int64_t request_id) const override;
+  absl::Status Submit(const AnalysisRecord& record) override;
+  std::vector<slp::CycleRecord> TakeNewRecords() override;
+  void LogRunCycles(bool log) override { log_run_cycles_ = log; }
 
-  // Whether the runs' cycle records are emitted (the default); off for a
-  // job whose log has none, so that its replay emits what it logged.
-  void LogRunCycles(bool log) { log_run_cycles_ = log; }
-
-  bool done() const { return emitted_ == points_.size(); }
-  int size() const { return static_cast<int>(points_.size()); }
-  int points_done() const { return static_cast<int>(emitted_); }
-  std::int64_t analyses_used() const { return analyses_; }
+  bool done() const override { return emitted_ == points_.size(); }
+  int size() const override { return static_cast<int>(points_.size()); }
+  int points_done() const override { return static_cast<int>(emitted_); }
+  std::int64_t analyses_used() const override { return analyses_; }
 
  private:
   // A design a run analysed, with what the point's record needs of it.
@@ -128,7 +127,9 @@ class ParetoRun {
 
   explicit ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
   void StartRuns();
-  void StartRefinement();
+  // Generation `first` (points or points + refine) of `count` points,
+  // chosen on the front of points 0 to first - 1 once they have ended.
+  void StartRefinement(std::size_t first, int count);
   void Start(int k, const Eigen::VectorXd& initial);
   void EndWithoutRun(int k, const std::string& reason);
   void End(int k);

@@ -20,7 +20,10 @@ namespace {
 // written as 5, so a design set logged before resumes byte for byte.
 // 6: a cycle record of a Pareto point's run: an optimization's record (the
 // fields of 3) and the point's number. Only those are written as 6.
-constexpr unsigned char kVersion = 6;
+// 7: a point of a front of three objectives: the fields of 5 and the third
+// objective's level and value. Only those are written as 7.
+constexpr unsigned char kVersion = 7;
+constexpr unsigned char kParetoThreeVersion = 7;
 constexpr unsigned char kParetoRunVersion = 6;
 constexpr unsigned char kParetoPointVersion = 5;
 constexpr unsigned char kDesignSetVersion = 4;
@@ -123,6 +126,7 @@ class Reader {
 std::string EncodeCycleRecord(const slp::CycleRecord& r) {
   Writer w;
   w.out().push_back(static_cast<char>(r.pareto_point > 0 ? kParetoRunVersion
+                                      : r.pareto_three   ? kParetoThreeVersion
                                       : r.pareto         ? kParetoPointVersion
                                       : r.design_set     ? kDesignSetVersion
                                                          : kOptimizationVersion));
@@ -165,6 +169,10 @@ std::string EncodeCycleRecord(const slp::CycleRecord& r) {
     w.String(r.pareto_state);
     w.Int(r.pareto_cycles);
     w.Int64(r.pareto_analyses);
+  }
+  if (r.pareto_three) {
+    w.Double(r.pareto_level3_si);
+    w.Double(r.pareto_value3_si);
   }
   if (r.pareto_point > 0) w.Int(r.pareto_point);
   return std::move(w.out());
@@ -216,13 +224,18 @@ absl::StatusOr<slp::CycleRecord> DecodeCycleRecord(const std::string& bytes) {
     c.constraint_violations.assign(violations.data(), violations.data() + violations.size());
     c.failure_kind = r.String();
   }
-  if (version == kParetoPointVersion) {
+  if (version == kParetoPointVersion || version == kParetoThreeVersion) {
     c.pareto = true;
     c.pareto_level_si = r.Double();
     c.pareto_value_si = r.Double();
     c.pareto_state = r.String();
     c.pareto_cycles = r.Int();
     c.pareto_analyses = r.Int64();
+  }
+  if (version == kParetoThreeVersion) {
+    c.pareto_three = true;
+    c.pareto_level3_si = r.Double();
+    c.pareto_value3_si = r.Double();
   }
   if (!r.ok() || !r.at_end()) {
     return absl::DataLossError(absl::StrCat("a cycle record of ", bytes.size(), " bytes is truncated or too long"));

@@ -120,15 +120,24 @@ v1::CycleRecord ToProto(const slp::CycleRecord& r, const spec::StudyLayout* layo
     out.set_pareto_state(r.pareto_state);
     out.set_pareto_cycles(r.pareto_cycles);
     out.set_pareto_analyses(r.pareto_analyses);
+    if (r.pareto_three) {
+      out.set_pareto_three(true);
+      out.set_pareto_level3_si(r.pareto_level3_si);
+      out.set_pareto_value3_si(r.pareto_value3_si);
+    }
   }
   return out;
 }
 
 v1::CycleRecord ToProto(const slp::CycleRecord& r, const jobs::manager::JobView& view) {
-  v1::CycleRecord out = ToProto(r, view.layout.get(), view.variable_scales, view.ReportedSign(r));
+  v1::CycleRecord out = ToProto(r, view.layout.get(), view.variable_scales, view.ReportedFactor(r));
   if (r.pareto) {
     out.set_pareto_value(view.pareto_shown_factor * r.pareto_value_si);
     out.set_pareto_level(view.pareto_shown_factor * r.pareto_level_si);
+    if (r.pareto_three) {
+      out.set_pareto_value3(view.pareto_third_shown_factor * r.pareto_value3_si);
+      out.set_pareto_level3(view.pareto_third_shown_factor * r.pareto_level3_si);
+    }
   }
   return out;
 }

@@ -156,6 +156,11 @@ struct CycleRecord {
   std::string pareto_state;
   int pareto_cycles = 0;
   std::int64_t pareto_analyses = 0;
+  // A point of a front of three objectives (pareto set too): the third
+  // objective's level and value, as pareto_level_si and pareto_value_si.
+  bool pareto_three = false;
+  double pareto_level3_si = 0;
+  double pareto_value3_si = 0;
   // Set only in the cycle records of a Pareto front's point's run (its own
   // history, logged just before the point's record): the point's 1-based
   // number. The record is that run's as this core emitted it (its F, its

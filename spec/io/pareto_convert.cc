@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -70,24 +71,61 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
     errors->Add(where, "pareto",
                 "a Pareto front trades the study's objective against a second objective: add an objective");
   }
-  pareto.points = p.points() == 0 ? kDefaultParetoPoints : p.points();
-  if (pareto.points < kMinParetoPoints || pareto.points > kMaxParetoPoints) {
-    errors->Add(w, "points",
-                absl::StrFormat("must be between %d and %d (the two ends included), got %d", kMinParetoPoints,
-                                kMaxParetoPoints, p.points()));
+  const bool three = p.against_size() == 2;
+  if (p.against_size() > 2) {
+    errors->Add(w, "against",
+                absl::StrFormat("a front has two or three objectives: name one or two constraints, got %d",
+                                p.against_size()));
+    return pareto;
   }
-  pareto.refine = p.refine();
-  if (pareto.refine < 0 || (pareto.points >= kMinParetoPoints && pareto.refine > pareto.points - 1)) {
-    errors->Add(w, "refine",
-                absl::StrFormat("must be between 0 and %d (one point in each segment of the %d points' front at "
-                                "most), got %d",
-                                std::max(pareto.points - 1, 0), pareto.points, p.refine()));
+  if (three) {
+    pareto.points = p.points() == 0 ? kDefaultParetoGridLevels : p.points();
+    if (pareto.points < kMinParetoGridLevels || pareto.points > kMaxParetoGridLevels) {
+      errors->Add(w, "points",
+                  absl::StrFormat("a front of three objectives has `points` levels of each bounded objective, "
+                                  "from %d to %d, got %d",
+                                  kMinParetoGridLevels, kMaxParetoGridLevels, p.points()));
+    }
+    if (p.refine() != 0) {
+      errors->Add(w, "refine", "a front of three objectives is not refined (a grid of levels has no segments)");
+    }
+    if (p.refine_again() != 0) {
+      errors->Add(w, "refine_again", "a front of three objectives is not refined (a grid of levels has no segments)");
+    }
+  } else {
+    pareto.points = p.points() == 0 ? kDefaultParetoPoints : p.points();
+    if (pareto.points < kMinParetoPoints || pareto.points > kMaxParetoPoints) {
+      errors->Add(w, "points",
+                  absl::StrFormat("must be between %d and %d (the two ends included), got %d", kMinParetoPoints,
+                                  kMaxParetoPoints, p.points()));
+    }
+    pareto.refine = p.refine();
+    if (pareto.refine < 0 || (pareto.points >= kMinParetoPoints && pareto.refine > pareto.points - 1)) {
+      errors->Add(w, "refine",
+                  absl::StrFormat("must be between 0 and %d (one point in each segment of the %d points' front at "
+                                  "most), got %d",
+                                  std::max(pareto.points - 1, 0), pareto.points, p.refine()));
+    }
+    pareto.refine_again = p.refine_again();
+    if (pareto.refine_again != 0 && pareto.refine <= 0) {
+      errors->Add(w, "refine_again",
+                  "refines the refined front again: set `refine` (the first generation of added points) too");
+    } else if (pareto.refine_again < 0 || pareto.refine_again > pareto.points + pareto.refine - 1) {
+      errors->Add(w, "refine_again",
+                  absl::StrFormat("must be between 0 and %d (one point in each segment of the refined front of %d "
+                                  "points at most), got %d",
+                                  std::max(pareto.points + pareto.refine - 1, 0), pareto.points + pareto.refine,
+                                  p.refine_again()));
+    }
   }
   if (p.has_objective()) {
-    if (!p.against().empty()) {
+    if (p.against_size() > 0) {
       errors->Add(w, "against",
-                  absl::StrCat("a front has one second objective: a constraint's largest value (`against: \"",
-                               p.against(), "\"`) or an `objective`, not both"));
+                  absl::StrCat(three ? "a front of three objectives trades two constraints (`against` twice), not "
+                                       "an `objective`: "
+                                     : "a front has one second objective: ",
+                               "a constraint's largest value (`against: \"", p.against(0),
+                               "\"`) or an `objective`, not both"));
       return pareto;
     }
     if (const std::string why = WhyNotSecondObjective(study.second_objective); !why.empty()) {
@@ -97,7 +135,7 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
     pareto.trades_objective = true;
     return pareto;
   }
-  if (p.against().empty()) {
+  if (p.against_size() == 0 || p.against(0).empty()) {
     errors->Add(w, "against",
                 absl::StrCat("name the constraint whose largest value is the second objective (the study's "
                              "constraints: ",
@@ -105,21 +143,31 @@ Pareto ConvertPareto(const v1::Study& m, const Study& study, const Where& where,
                              "), or write the second objective as the study's is (`objective { minimize: ... }`)"));
     return pareto;
   }
-  int found = -1;
-  for (size_t k = 0; k < study.constraints.size(); ++k) {
-    if (study.constraints[k].name == p.against()) found = static_cast<int>(k);
+  std::vector<int> traded;
+  for (const std::string& name : p.against()) {
+    int found = -1;
+    for (size_t k = 0; k < study.constraints.size(); ++k) {
+      if (study.constraints[k].name == name) found = static_cast<int>(k);
+    }
+    if (found < 0) {
+      errors->Add(w, "against",
+                  absl::StrCat("unknown constraint \"", name, "\"; the study's constraints: ", ConstraintNames(study)));
+      return pareto;
+    }
+    if (const std::string why = WhyNotTradable(study.constraints[static_cast<size_t>(found)]); !why.empty()) {
+      errors->Add(w, "against", absl::StrCat("constraint \"", name, "\" cannot be traded: ", why));
+      return pareto;
+    }
+    if (!traded.empty() && traded.front() == found) {
+      errors->Add(w, "against",
+                  absl::StrCat("constraint \"", name,
+                               "\" is named twice; a front of three objectives trades two different constraints"));
+      return pareto;
+    }
+    traded.push_back(found);
   }
-  if (found < 0) {
-    errors->Add(w, "against",
-                absl::StrCat("unknown constraint \"", p.against(), "\"; the study's constraints: ",
-                             ConstraintNames(study)));
-    return pareto;
-  }
-  if (const std::string why = WhyNotTradable(study.constraints[static_cast<size_t>(found)]); !why.empty()) {
-    errors->Add(w, "against", absl::StrCat("constraint \"", p.against(), "\" cannot be traded: ", why));
-    return pareto;
-  }
-  pareto.constraint = found;
+  pareto.constraint = traded[0];
+  if (three) pareto.third_constraint = traded[1];
   return pareto;
 }
 
@@ -132,10 +180,20 @@ std::string DescribePareto(const Study& study) {
     const Constraint& c = study.constraints[static_cast<size_t>(study.pareto.constraint)];
     second = absl::StrCat("the largest value of ", c.name, c.unit.empty() ? "" : absl::StrCat(" (", c.unit, ")"));
   }
+  if (study.pareto.three_objectives()) {
+    const Constraint& c = study.constraints[static_cast<size_t>(study.pareto.third_constraint)];
+    return absl::StrCat("a Pareto front of three objectives: the objective, ", second, " and the largest value of ",
+                        c.name, c.unit.empty() ? "" : absl::StrCat(" (", c.unit, ")"), "; ",
+                        kParetoAnchorsOfThree, " anchors and a grid of ", study.pareto.points, " x ",
+                        study.pareto.points, " levels (epsilon-constraint method)");
+  }
   return absl::StrCat("a Pareto front of the objective against ", second, ", ", study.pareto.points,
                       " points",
                       study.pareto.refine == 0 ? ""
                                                : absl::StrCat(" and ", study.pareto.refine, " more where it bends"),
+                      study.pareto.refine_again == 0
+                          ? ""
+                          : absl::StrCat(", then ", study.pareto.refine_again, " more where the refined front bends"),
                       " (epsilon-constraint method)");
 }
 

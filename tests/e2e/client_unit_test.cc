@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "absl/strings/str_split.h"
 #include "client/args.h"
 #include "client/design_set_format.h"
 #include "client/job_format.h"
@@ -320,7 +321,7 @@ TEST(DesignSetFormat, TableAndJsonListEveryDesign) {
 v1::GetJobResponse FourPointFront(bool infeasible_second = false) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   v1::GetJobResponse job;
-  job.mutable_study()->mutable_pareto()->set_against("travel");
+  job.mutable_study()->mutable_pareto()->add_against("travel");
   v1::Constraint* travel = job.mutable_study()->add_constraints();
   travel->set_name("travel");
   travel->set_unit("mm");
@@ -491,7 +492,8 @@ TEST(ParetoFormat, APointListsItsRunsCyclesAndTheyAreNoPoints) {
   EXPECT_EQ(text->find("           21", table), std::string::npos) << *text;
   absl::StatusOr<std::string> far_end = client::ParetoPointText(with_history, 4);
   ASSERT_TRUE(far_end.ok());
-  EXPECT_NE(far_end->find("cycles of its run (F: the second objective as the run minimizes it"), std::string::npos)
+  EXPECT_NE(far_end->find("cycles of its run (F: the second objective travel [mm], which the run optimizes"),
+            std::string::npos)
       << *far_end;
   const std::string json = client::ResultsJson(with_history);
   EXPECT_NE(json.find("\"history\": ["), std::string::npos) << json;
@@ -522,6 +524,75 @@ TEST(ParetoFormat, TheWatchShowsAMaximizedSecondObjectiveAsItself) {
   const std::string in_mm = client::ParetoWatchRow(against.cycles(2), &against.study());
   EXPECT_NE(in_mm.find(" 2.5 "), std::string::npos) << in_mm;
   EXPECT_NE(client::ParetoWatchHeader(&against.study()).find("travel [mm]"), std::string::npos);
+}
+
+// A front of three objectives against "travel" and "reach" (both in mm):
+// anchors 1 to 3, then grid points 4 to 6. Point 5 is beaten by point 4 in
+// F and travel but not in reach, so it is on the front in 3-D; point 6 is
+// beaten by point 4 in all three.
+v1::GetJobResponse SixPointFrontOfThree() {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  v1::GetJobResponse job = FourPointFront();
+  job.mutable_study()->mutable_pareto()->add_against("reach");
+  v1::Constraint* reach = job.mutable_study()->add_constraints();
+  reach->set_name("reach");
+  reach->set_unit("mm");
+  job.mutable_summary()->set_cycles(6);
+  job.mutable_summary()->set_max_cycles(6);
+  job.clear_cycles();
+  const double objective[] = {1.0, 3.0, 3.0, 2.0, 2.5, 2.75};
+  const double travel_mm[] = {4, 1, 3, 2, 2.5, 2.5};
+  const double reach_mm[] = {4, 3, 1, 3.5, 2, 3.75};
+  for (int k = 0; k < 6; ++k) {
+    v1::CycleRecord* r = job.add_cycles();
+    r->set_cycle(k + 1);
+    r->set_design_set(true);
+    r->set_pareto(true);
+    r->set_pareto_three(true);
+    r->set_accepted(true);
+    r->add_x_trial_physical(10.0 * (k + 1));
+    r->set_objective_trial(objective[k]);
+    r->set_max_violation_trial(-0.01);
+    r->set_pareto_value_si(travel_mm[k] / 1000);
+    r->set_pareto_value3_si(reach_mm[k] / 1000);
+    r->set_pareto_level_si(k < 3 ? kNaN : 0.0025);
+    r->set_pareto_level3_si(k < 3 ? kNaN : 0.004);
+    r->set_pareto_state("converged");
+    r->set_pareto_cycles(3);
+    for (int c = 0; c < 3; ++c) r->add_constraint_violations(-0.5);
+  }
+  return job;
+}
+
+TEST(ParetoFormat, AFrontOfThreeObjectivesListsBothValuesAndDecidesDominanceInThreeDimensions) {
+  const v1::GetJobResponse job = SixPointFrontOfThree();
+  const std::string csv = client::ResultsCsv(job);
+  const std::vector<std::string> lines = absl::StrSplit(csv, '\n', absl::SkipEmpty());
+  ASSERT_EQ(lines.size(), 7u) << csv;
+  EXPECT_EQ(lines[0],
+            "point,level,level3,objective,travel,reach,max_violation,run_state,cycles,analyses,x1,status,reason");
+  EXPECT_EQ(lines[1], "1,,,1,4,4,-0.01,converged,3,0,10,front,");
+  EXPECT_EQ(lines[4], "4,2.5,4,2,2,3.5,-0.01,converged,3,0,40,front,");
+  EXPECT_EQ(lines[5], "5,2.5,4,2.5,2.5,2,-0.01,converged,3,0,50,front,");
+  EXPECT_EQ(lines[6], "6,2.5,4,2.75,2.5,3.75,-0.01,converged,3,0,60,dominated,");
+  const std::string table = client::ResultsTable(job);
+  EXPECT_NE(table.find("level3 [mm]"), std::string::npos) << table;
+  EXPECT_NE(table.find("reach [mm]"), std::string::npos) << table;
+  EXPECT_NE(table.find("level, level3: the limits on travel and reach"), std::string::npos) << table;
+  const std::string json = client::ResultsJson(job);
+  EXPECT_NE(json.find("\"against3\": \"reach\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"value3\": 3.5"), std::string::npos) << json;
+  absl::StatusOr<std::string> point = client::ParetoPointText(job, 5);
+  ASSERT_TRUE(point.ok()) << point.status();
+  EXPECT_NE(point->find("level3:      reach <= 4 mm"), std::string::npos) << *point;
+  EXPECT_NE(point->find("reach:       2 mm"), std::string::npos) << *point;
+  const std::string header = client::ParetoWatchHeader(&job.study());
+  EXPECT_NE(header.find("reach [mm]"), std::string::npos) << header;
+  const std::string row = client::ParetoWatchRow(job.cycles(3), &job.study());
+  EXPECT_NE(row.find(" 3.5 "), std::string::npos) << row;
+  EXPECT_TRUE(client::IsFarEnd(job.study(), 2));
+  EXPECT_TRUE(client::IsFarEnd(job.study(), 3));
+  EXPECT_FALSE(client::IsFarEnd(job.study(), 6));
 }
 
 TEST(Backoff, GrowsGeometricallyUpToTheCapWithBoundedJitter) {

@@ -344,6 +344,70 @@ TEST(ParetoEndToEnd, ServerKilledWhileRefiningResumesWithTheSameFront) {
   KillAndResume(dir.Write("vehicle_pareto_refined.study.textproto", study), kPoints + 2, kPoints + 1);
 }
 
+std::string ThreeObjectiveStudy() {
+  return std::string(MBOPT_E2E_SOURCE_DIR) + "/examples/vehicle/vehicle_pareto3.study.textproto";
+}
+
+// The front of three objectives (comfort against |s1| and |s2|, 3 anchors
+// and a 3 x 3 grid) through `mbopt run`, `results` and `report`: both
+// traded constraints' values and levels in every listing, and the page's
+// three projections.
+TEST(ParetoEndToEnd, AFrontOfThreeObjectivesRunsThroughTheCliAndTheReportDrawsItsProjections) {
+  constexpr int kThreePoints = 3 + 3 * 3;
+  const std::vector<std::string> env = {"MBOPT_SERVER_BIN=" + ServerBinary(), "MBOPT_WORKER_BIN=" + WorkerBinary()};
+  ScratchDir dir;
+  const std::string db = dir.File("run.db");
+  auto run = Mbopt({"run", ThreeObjectiveStudy(), "--workers", "2", "--db", db}, env);
+  ASSERT_EQ(run.exit_code, kExitOk) << Describe(run);
+  const std::string& text = run.stdout_text;
+  EXPECT_NE(text.find("points:        12 of 12 on the Pareto front computed"), std::string::npos) << text;
+  const size_t header = text.find("point ");
+  ASSERT_NE(header, std::string::npos) << text;
+  for (const char* column : {"level [in]", "level3 [in]", "F [m/s^2]", "s1 [in]", "s2 [in]", "status"}) {
+    EXPECT_NE(text.find(column, header), std::string::npos) << column << "\n" << text;
+  }
+  auto csv = Mbopt({"results", "job-1", "--csv", "--db", db}, env);
+  ASSERT_EQ(csv.exit_code, kExitOk) << Describe(csv);
+  const std::vector<std::string> lines = SplitOn(csv.stdout_text, '\n');
+  ASSERT_EQ(lines.size(), static_cast<size_t>(kThreePoints + 1)) << csv.stdout_text;
+  EXPECT_EQ(lines[0].rfind("point,level,level3,objective,s1,s2,max_violation,", 0), 0u) << lines[0];
+  // Every grid point meets both its levels (the method's violation
+  // tolerance, 1e-3 relative).
+  for (int k = 4; k <= kThreePoints; ++k) {
+    const std::vector<std::string> cells = SplitOn(lines[static_cast<size_t>(k)], ',');
+    ASSERT_GE(cells.size(), 6u) << lines[static_cast<size_t>(k)];
+    EXPECT_LE(std::atof(cells[4].c_str()), std::atof(cells[1].c_str()) * (1 + 1e-3)) << lines[static_cast<size_t>(k)];
+    EXPECT_LE(std::atof(cells[5].c_str()), std::atof(cells[2].c_str()) * (1 + 1e-3)) << lines[static_cast<size_t>(k)];
+  }
+  auto json = Mbopt({"results", "job-1", "--json", "--db", db}, env);
+  ASSERT_EQ(json.exit_code, kExitOk) << Describe(json);
+  EXPECT_NE(json.stdout_text.find("\"against3\": \"s2\""), std::string::npos) << json.stdout_text;
+  EXPECT_EQ(Count(json.stdout_text, "\"value3\": "), kThreePoints) << json.stdout_text;
+  auto point = Mbopt({"results", "job-1", "--point", "8", "--db", db}, env);
+  ASSERT_EQ(point.exit_code, kExitOk) << Describe(point);
+  EXPECT_NE(point.stdout_text.find("level3:      s2 <= "), std::string::npos) << point.stdout_text;
+  auto anchor = Mbopt({"results", "job-1", "--point", "3", "--db", db}, env);
+  ASSERT_EQ(anchor.exit_code, kExitOk) << Describe(anchor);
+  EXPECT_NE(anchor.stdout_text.find("cycles of its run (F: the third objective s2 [in], which the run optimizes"),
+            std::string::npos)
+      << anchor.stdout_text;
+  const std::string page = dir.File("front.html");
+  auto report = Mbopt({"report", "job-1", "--db", db, "-o", page, "--point", "8", "--no-responses"}, env);
+  ASSERT_EQ(report.exit_code, kExitOk) << Describe(report);
+  const std::string html = ReadText(page);
+  for (const char* title : {"F against s1", "F against s2", "s2 against s1"}) {
+    EXPECT_NE(html.find(title), std::string::npos) << title;
+  }
+  EXPECT_EQ(Count(html, "chosen: point 8"), 3) << html;
+  EXPECT_NE(html.find("<h2>Cycle history of point 8's run</h2>"), std::string::npos);
+}
+
+// Killed once five of its twelve points are logged, the front of three
+// objectives resumes to the front of an undisturbed run with three workers.
+TEST(ParetoEndToEnd, ServerKilledMidFrontOfThreeObjectivesResumesWithTheSameFront) {
+  KillAndResume(ThreeObjectiveStudy(), 3 + 3 * 3, 5);
+}
+
 TEST(ParetoEndToEnd, ValidateNamesTheFront) {
   auto validated = Mbopt({"validate", ParetoStudy()});
   ASSERT_EQ(validated.exit_code, kExitOk) << Describe(validated);

@@ -176,6 +176,68 @@ TEST(VehicleParetoFront, EachInteriorPointOfTheTravelFrontIsASingleRunsOptimum) 
   }
 }
 
+// The front of three objectives (vehicle_pareto3.study.textproto: comfort
+// against |s1| and |s2|, a 3 x 3 grid) through the job as the server runs
+// it: the anchors end feasible, every feasible grid point meets both its
+// levels, no feasible point is beaten in all three objectives by one it
+// does not repeat, and the middle grid point is the optimum of a single
+// run of the ride-comfort study with both levels written as the ordinary
+// limits of s1 and s2.
+TEST(VehicleParetoFront, AFrontOfThreeObjectivesMeetsItsLevelsAndItsMiddlePointIsASingleRunsOptimum) {
+  absl::StatusOr<spec::Study> study = spec::io::LoadStudyFile("examples/vehicle/vehicle_pareto3.study.textproto");
+  ASSERT_TRUE(study.ok()) << study.status();
+  ASSERT_TRUE(study->pareto.three_objectives());
+  const std::vector<slp::CycleRecord> front = RunFront(*study);
+  ASSERT_EQ(front.size(), static_cast<size_t>(study->pareto.total_points()));
+  const spec::Constraint& s1 = study->constraints[static_cast<size_t>(study->pareto.constraint)];
+  const spec::Constraint& s2 = study->constraints[static_cast<size_t>(study->pareto.third_constraint)];
+  std::vector<spec::FrontPoint> points;
+  for (const slp::CycleRecord& r : front) {
+    std::cout << std::setprecision(7) << "point " << r.cycle << ": F " << r.objective_x0 << " m/s^2, |s1| "
+              << r.pareto_value_si / s1.si_per_unit << " in (level " << r.pareto_level_si / s1.si_per_unit
+              << "), |s2| " << r.pareto_value3_si / s2.si_per_unit << " in (level "
+              << r.pareto_level3_si / s2.si_per_unit << "), " << r.pareto_state << ", " << r.pareto_analyses
+              << " analyses" << (r.accepted ? "" : ": " + r.rejection_reason) << "\n";
+    EXPECT_TRUE(r.pareto_three);
+    if (r.cycle <= spec::kParetoAnchorsOfThree) {
+      EXPECT_TRUE(r.accepted) << "anchor " << r.cycle << ": " << r.rejection_reason;
+    }
+    if (r.accepted && r.cycle > spec::kParetoAnchorsOfThree) {
+      // Met to the method's violation tolerance (docs/method.md section 3).
+      EXPECT_LE(r.pareto_value_si, r.pareto_level_si * (1 + 1e-3)) << "point " << r.cycle;
+      EXPECT_LE(r.pareto_value3_si, r.pareto_level3_si * (1 + 1e-3)) << "point " << r.cycle;
+    }
+    points.push_back({r.objective_x0, r.pareto_value_si, r.accepted, r.pareto_value3_si});
+  }
+  const std::vector<bool> dominated = spec::DominatedPoints(points);
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (!dominated[k]) continue;
+    bool repeats = false;
+    for (size_t m = 0; m < points.size(); ++m) {
+      repeats |= m != k && points[m].usable &&
+                 std::abs(points[m].first - points[k].first) <= kSameOptimumRelative * points[k].first &&
+                 std::abs(points[m].second - points[k].second) <= kSameOptimumRelative * points[k].second &&
+                 std::abs(points[m].third - points[k].third) <= kSameOptimumRelative * points[k].third;
+    }
+    EXPECT_TRUE(repeats) << "point " << k + 1 << " is beaten in all three objectives";
+  }
+  // The middle of the grid: level 1 of each (point 3 + 1 * 3 + 1 + 1 = 8).
+  const slp::CycleRecord& middle = front[spec::kParetoAnchorsOfThree + 1 * 3 + 1];
+  ASSERT_TRUE(middle.accepted) << middle.rejection_reason;
+  spec::Study single = *study;
+  single.pareto = spec::Pareto{};
+  single.constraints[static_cast<size_t>(study->pareto.constraint)].limit = middle.pareto_level_si / s1.si_per_unit;
+  single.constraints[static_cast<size_t>(study->pareto.third_constraint)].limit =
+      middle.pareto_level3_si / s2.si_per_unit;
+  absl::StatusOr<LocalRunResult> run = RunStudyLocally(single, LocalRunOptions{});
+  ASSERT_TRUE(run.ok()) << run.status();
+  EXPECT_EQ(run->outcome.state, slp::RunState::kConverged) << run->end_reason;
+  EXPECT_LE(run->outcome.max_violation, 0.0);
+  EXPECT_NEAR(run->outcome.objective, middle.objective_x0, kSameOptimumRelative * middle.objective_x0);
+  std::cout << "single run at the middle point's levels: F " << run->outcome.objective << " (the front's "
+            << middle.objective_x0 << "), " << run->outcome.analyses << " analyses\n";
+}
+
 // A front's job logged before its points' runs logged their cycles holds
 // the points' records alone: its replay emits those again (the runs' cycles
 // left out), so it resumes; a log with the cycles replays them.

@@ -24,6 +24,7 @@ SOURCE_DIR = os.environ["MBOPT_TEST_SOURCE_DIR"]
 VEHICLE_STUDY = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle.study.textproto")
 VEHICLE_SCENE = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle.scene.textproto")
 VEHICLE_PARETO = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle_pareto.study.textproto")
+VEHICLE_PARETO3 = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle_pareto3.study.textproto")
 VEHICLE_SWEEP = os.path.join(SOURCE_DIR, "examples", "vehicle", "vehicle_sweep.study.textproto")
 
 # The tests' servers are their own: settings for another in the caller's
@@ -170,9 +171,42 @@ class PythonClientTest(unittest.TestCase):
             self.assertIn(p["history"][-1]["cycle"], (p["cycles"], p["cycles"] + 1))
         self.assertIsNone(front.point(1)["level"])
         self.assertLess(front.point(2)["level"], front.point(1)["value"])
+        # The far end's run minimizes |s1|: its F in inches, the point's
+        # value among its accepted designs'.
+        far = [c["objective"] for c in front.point(3)["history"] if c["accepted"]]
+        self.assertTrue(any(abs(f - front.point(3)["value"]) <= 1e-9 * front.point(3)["value"] for f in far),
+                        (front.point(3)["value"], far))
         with self.assertRaises(KeyError) as raised:
             front.point(4)
         self.assertIn(f"job {job} has points 1 to 3 (of 3)", str(raised.exception))
+        self.assert_reads_as_the_cli(job, front)
+
+    def test_front_of_three_objectives_lists_both_traded_values_as_the_cli(self):
+        shutil.copy(VEHICLE_SCENE, self.folder)
+        with open(VEHICLE_PARETO3) as f:
+            text = f.read()
+        self.assertIn("points: 3", text)
+        study = self.write("vehicle_pareto3_small.study.textproto", text.replace("points: 3", "points: 2", 1))
+        job = self.client.submit(study)
+        self.assertEqual(self.client.wait(job).status, "completed")
+        front = self.client.results(job)
+        self.assertIsInstance(front, mbopt.FrontResults)
+        self.assertEqual((front.against, front.against3, front.against3_unit), ("s1", "s2", "in"))
+        self.assertEqual([p["point"] for p in front.points], list(range(1, 3 + 2 * 2 + 1)))
+        records = {r.cycle: r for r in self.client.get(job).cycles if r.pareto}
+        for p in front.points:
+            # The second traded constraint in its unit (inches), not SI.
+            self.assertAlmostEqual(p["value3"] * 0.0254, records[p["point"]].pareto_value3_si, delta=1e-12)
+            if p["point"] > 3:
+                self.assertLessEqual(p["value3"], p["level3"] * (1 + 1e-3))
+        self.assertIsNone(front.point(1)["level3"])
+        # Anchors 2 and 3 optimize |s1| and |s2|: their runs' F is that
+        # objective in inches, and the point's value is one of them.
+        for number, key in ((2, "value"), (3, "value3")):
+            anchor = front.point(number)
+            objectives = [c["objective"] for c in anchor["history"] if c["accepted"]]
+            self.assertTrue(any(abs(f - anchor[key]) <= 1e-9 * anchor[key] for f in objectives),
+                            (number, anchor[key], objectives))
         self.assert_reads_as_the_cli(job, front)
 
     def test_sweep_lists_its_designs_not_cycle_records(self):

@@ -246,5 +246,37 @@ TEST(ParetoReport, UnrunPointsAreListedWithTheirReasonAndNotDrawn) {
   }
 }
 
+// A front of three objectives: the same five points with a third value
+// (s2, in inches), drawn as its three pairwise projections.
+TEST(ParetoReport, AFrontOfThreeObjectivesIsDrawnAsItsThreeProjections) {
+  ParetoReportData data = Front();
+  data.three = true;
+  data.against3 = "s2";
+  data.against3_unit = "in";
+  data.chosen = 4;
+  for (size_t k = 0; k < data.points.size(); ++k) {
+    data.points[k].value3 = 0.1 * static_cast<double>(k + 1);
+    data.points[k].level3 = k < 3 ? std::nan("") : 0.42;
+  }
+  const std::string html = RenderParetoReportHtml(data);
+  EXPECT_EQ(testing::CheckMarkup(html, /*xml_strict=*/false), "");
+  const std::vector<std::string> svgs = testing::SvgFragments(html);
+  ASSERT_EQ(svgs.size(), 3u);
+  EXPECT_NE(svgs[0].find("F against s1"), std::string::npos);
+  EXPECT_NE(svgs[1].find("F against s2"), std::string::npos);
+  EXPECT_NE(svgs[2].find("s2 against s1"), std::string::npos);
+  for (const std::string& svg : svgs) {
+    EXPECT_EQ(testing::CheckMarkup(svg, /*xml_strict=*/true), "");
+    EXPECT_NE(svg.find("chosen: point 4"), std::string::npos);
+    for (int k = 1; k <= 5; ++k) {
+      EXPECT_NE(svg.find("class=\"point-label\">" + std::to_string(k) + "</text>"), std::string::npos) << k;
+    }
+  }
+  EXPECT_NE(svgs[2].find("s2 [in]"), std::string::npos);
+  EXPECT_NE(html.find("level3 [in]"), std::string::npos);
+  EXPECT_NE(html.find("and the largest value of s2"), std::string::npos);
+  EXPECT_NE(html.find("0.42"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace mbopt::report

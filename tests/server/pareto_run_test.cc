@@ -384,6 +384,104 @@ TEST(ParetoRun, AddedPointsWithoutASegmentEndUnrunAndSayWhy) {
   }
 }
 
+ParetoSetup TwiceRefinedTwoSpheres(int refine, int refine_again) {
+  ParetoSetup setup = RefinedTwoSpheres(refine);
+  setup.refine_again = refine_again;
+  return setup;
+}
+
+// A second generation (refine_again): once the nine points and the three
+// added ones have ended, three more halve the segments the front of all
+// twelve scores highest, their levels halfway between those segments'
+// ends, and they too lie on the closed-form front.
+TEST(ParetoRun, ARefinedFrontRefinedAgainHalvesTheSegmentsOfTheWholeRefinedFront) {
+  constexpr int kRefine = 3;
+  constexpr int kAgain = 3;
+  std::vector<slp::CycleRecord> records;
+  RunFront(TwiceRefinedTwoSpheres(kRefine, kAgain), /*workers=*/4, /*seed=*/9, &records);
+  ASSERT_EQ(records.size(), static_cast<size_t>(kPoints + kRefine + kAgain));
+  std::vector<spec::FrontPoint> refined;
+  for (int k = 0; k < kPoints + kRefine; ++k) {
+    const slp::CycleRecord& r = records[static_cast<size_t>(k)];
+    refined.push_back({r.objective_x0, r.pareto_value_si, r.accepted});
+  }
+  const std::vector<spec::RefinementSegment> segments = spec::RefinementSegments(refined, kAgain);
+  ASSERT_EQ(segments.size(), static_cast<size_t>(kAgain));
+  bool halves_an_added_points_segment = false;
+  for (int j = 0; j < kAgain; ++j) {
+    const slp::CycleRecord& r = records[static_cast<size_t>(kPoints + kRefine + j)];
+    SCOPED_TRACE(::testing::Message() << "point " << kPoints + kRefine + j + 1 << " (" << r.pareto_state << ")");
+    EXPECT_TRUE(r.accepted) << r.rejection_reason;
+    const spec::RefinementSegment& segment = segments[static_cast<size_t>(j)];
+    halves_an_added_points_segment |= segment.from >= kPoints || segment.to >= kPoints;
+    const double upper = records[static_cast<size_t>(segment.from)].pareto_value_si;
+    const double lower = records[static_cast<size_t>(segment.to)].pareto_value_si;
+    EXPECT_EQ(r.pareto_level_si, 0.5 * (upper + lower));
+    EXPECT_LE(r.pareto_value_si, r.pareto_level_si * (1 + 1e-5));
+    EXPECT_GT(r.pareto_value_si, lower);
+    EXPECT_NEAR(F1(r.x0), FrontF1(F2(r.x0)), kFrontTolerance);
+  }
+  // The second generation refines the first's work, not only the nine
+  // points' segments: one of its segments ends at an added point.
+  EXPECT_TRUE(halves_an_added_points_segment);
+  for (bool dominated : spec::DominatedPoints(refined)) EXPECT_FALSE(dominated);
+}
+
+TEST(ParetoRun, ATwiceRefinedFrontIsTheSameWhateverTheWorkersAndAfterAReplay) {
+  const std::vector<std::string> one = RunFront(TwiceRefinedTwoSpheres(2, 3), 1, 7, nullptr);
+  ASSERT_EQ(PointsIn(one), static_cast<size_t>(kPoints + 2 + 3));
+  EXPECT_EQ(RunFront(TwiceRefinedTwoSpheres(2, 3), 3, 11, nullptr), one);
+  EXPECT_EQ(RunFront(TwiceRefinedTwoSpheres(2, 3), 64, 12345, nullptr), one);
+  // Replayed from the first run's results in the order they came, cut off
+  // once the second generation has started, then continued.
+  auto make = [] {
+    absl::StatusOr<std::unique_ptr<ParetoRun>> run =
+        ParetoRun::Create(TwiceRefinedTwoSpheres(2, 3), [] { return lp::MakeClpLpSolver(); });
+    EXPECT_TRUE(run.ok()) << run.status();
+    return *std::move(run);
+  };
+  std::unique_ptr<ParetoRun> first = make();
+  std::vector<AnalysisRecord> logged;
+  std::mt19937 random(3);
+  bool second_generation = false;
+  for (int round = 0; round < kMaxRounds && !first->done() && !second_generation; ++round) {
+    std::vector<slp::AnalysisRequest> pending = first->PendingRequests();
+    std::shuffle(pending.begin(), pending.end(), random);
+    const AnalysisRecord answer = Answer(pending.front());
+    ASSERT_TRUE(first->Submit(answer).ok());
+    logged.push_back(answer);
+    first->TakeNewRecords();
+    for (const slp::AnalysisRequest& r : first->PendingRequests()) {
+      second_generation |= r.id / ParetoRun::kRequestStride >= kPoints + 2;
+    }
+  }
+  ASSERT_TRUE(second_generation);
+  std::unique_ptr<ParetoRun> resumed = make();
+  std::vector<std::string> replayed;
+  for (const AnalysisRecord& record : logged) {
+    ASSERT_TRUE(resumed->Submit(record).ok());
+    for (slp::CycleRecord& r : resumed->TakeNewRecords()) replayed.push_back(EncodeCycleRecord(r));
+  }
+  for (int round = 0; round < kMaxRounds && !resumed->done(); ++round) {
+    for (const slp::AnalysisRequest& request : resumed->PendingRequests()) {
+      ASSERT_TRUE(resumed->Submit(Answer(request)).ok());
+      for (slp::CycleRecord& r : resumed->TakeNewRecords()) replayed.push_back(EncodeCycleRecord(r));
+    }
+  }
+  EXPECT_EQ(replayed, one);
+}
+
+TEST(ParetoRun, RefusesASecondGenerationWithoutAFirstOrWithMorePointsThanSegments) {
+  absl::StatusOr<std::unique_ptr<ParetoRun>> without =
+      ParetoRun::Create(TwiceRefinedTwoSpheres(0, 2), [] { return lp::MakeClpLpSolver(); });
+  EXPECT_FALSE(without.ok());
+  absl::StatusOr<std::unique_ptr<ParetoRun>> too_many =
+      ParetoRun::Create(TwiceRefinedTwoSpheres(2, kPoints + 2), [] { return lp::MakeClpLpSolver(); });
+  ASSERT_FALSE(too_many.ok());
+  EXPECT_EQ(too_many.status().message(),
+            "a refined front of 11 points can be refined again by 0 to 10 points (with refine above 0), got 11");
+}
+
 TEST(ParetoRun, RefusesMoreAddedPointsThanSegments) {
   absl::StatusOr<std::unique_ptr<ParetoRun>> run =
       ParetoRun::Create(RefinedTwoSpheres(kPoints), [] { return lp::MakeClpLpSolver(); });

@@ -102,5 +102,61 @@ TEST_F(ParetoLanguage, RefineAddsPointsUpToOnePerSegment) {
   EXPECT_THAT(LoadError("pareto { against: \"travel\" refine: -1 }\n"), HasSubstr("got -1"));
 }
 
+TEST_F(ParetoLanguage, RefineAgainAddsASecondGenerationUpToOnePerSegmentOfTheRefinedFront) {
+  absl::StatusOr<Study> study = Load("pareto { against: \"travel\" points: 5 refine: 2 refine_again: 3 }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_EQ(study->pareto.refine_again, 3);
+  EXPECT_EQ(study->pareto.total_points(), 10);
+  EXPECT_EQ(DescribeStudyForm(*study),
+            "a Pareto front of the objective against the largest value of travel (m), 5 points and 2 more where it "
+            "bends, then 3 more where the refined front bends (epsilon-constraint method)");
+  const std::string without = LoadError("pareto {\n  against: \"travel\"\n  refine_again: 2\n}\n");
+  EXPECT_THAT(without, HasSubstr("oscillator.study.textproto:10:"));
+  EXPECT_THAT(without, HasSubstr("pareto.refine_again: refines the refined front again: set `refine`"));
+  EXPECT_THAT(LoadError("pareto { against: \"travel\" points: 5 refine: 2 refine_again: 7 }\n"),
+              HasSubstr("pareto.refine_again: must be between 0 and 6 (one point in each segment of the refined "
+                        "front of 7 points at most), got 7"));
+}
+
+// A front of three objectives names two constraints.
+const char kReach[] = "constraints { name: \"reach\" output: \"x\" reduction: REDUCTION_MAX limit: 0.05 unit: \"m\" }\n";
+
+TEST_F(ParetoLanguage, TwoConstraintsMakeAFrontOfThreeObjectivesOverAGrid) {
+  absl::StatusOr<Study> study = Load(std::string(kReach) + "pareto { against: \"travel\" against: \"reach\" }\n");
+  ASSERT_TRUE(study.ok()) << study.status();
+  EXPECT_TRUE(study->pareto.three_objectives());
+  EXPECT_EQ(study->pareto.constraint, 0);
+  EXPECT_EQ(study->pareto.third_constraint, 3);
+  EXPECT_EQ(study->pareto.points, 5);
+  EXPECT_EQ(study->pareto.total_points(), 28);
+  EXPECT_EQ(DescribeStudyForm(*study),
+            "a Pareto front of three objectives: the objective, the largest value of travel (m) and the largest "
+            "value of reach (m); 3 anchors and a grid of 5 x 5 levels (epsilon-constraint method)");
+  absl::StatusOr<Study> three = Load(std::string(kReach) + "pareto { against: \"reach\" against: \"travel\" points: 3 }\n");
+  ASSERT_TRUE(three.ok()) << three.status();
+  EXPECT_EQ(three->pareto.constraint, 3);
+  EXPECT_EQ(three->pareto.total_points(), 12);
+}
+
+TEST_F(ParetoLanguage, AFrontOfThreeObjectivesRefusesBadCombinationsNamingLineAndField) {
+  const std::string twice = LoadError("pareto {\n  against: \"travel\"\n  against: \"travel\"\n}\n");
+  EXPECT_THAT(twice, HasSubstr("oscillator.study.textproto:"));
+  EXPECT_THAT(twice, HasSubstr("pareto.against"));
+  EXPECT_THAT(twice, HasSubstr("constraint \"travel\" is named twice"));
+  EXPECT_THAT(LoadError(std::string(kReach) + "pareto { against: \"travel\" against: \"low\" }\n"),
+              HasSubstr("constraint \"low\" cannot be traded: it is a lower limit"));
+  EXPECT_THAT(LoadError(std::string(kReach) + "pareto { against: \"travel\" against: \"reach\" against: \"low\" }\n"),
+              HasSubstr("pareto.against: a front has two or three objectives: name one or two constraints, got 3"));
+  const std::string points = LoadError(std::string(kReach) + "pareto {\n  against: \"travel\"\n  against: \"reach\"\n  points: 12\n}\n");
+  EXPECT_THAT(points, HasSubstr("pareto.points: a front of three objectives has `points` levels of each bounded "
+                                "objective, from 2 to 9, got 12"));
+  EXPECT_THAT(points, HasSubstr(":12:"));  // the line of `points`
+  EXPECT_THAT(LoadError(std::string(kReach) + "pareto { against: \"travel\" against: \"reach\" refine: 2 }\n"),
+              HasSubstr("pareto.refine: a front of three objectives is not refined"));
+  EXPECT_THAT(LoadError(std::string(kReach) +
+                        "pareto { against: \"travel\" against: \"reach\" objective { minimize: \"x\" } }\n"),
+              HasSubstr("a front of three objectives trades two constraints (`against` twice), not an `objective`"));
+}
+
 }  // namespace
 }  // namespace mbopt::spec::io

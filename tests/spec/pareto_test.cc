@@ -28,6 +28,23 @@ TEST(DominatedPoints, MarksAPointAnotherBeatsInOneObjectiveAndMatchesInTheOther)
   EXPECT_EQ(DominatedPoints(points), (std::vector<bool>{false, false, true, false, false}));
 }
 
+TEST(DominatedPoints, OnAFrontOfThreeAPointBeatenInTwoObjectivesButNotTheThirdIsNotDominated) {
+  const std::vector<FrontPoint> points = {
+      {1.0, 1.0, true, 3.0}, {2.0, 2.0, true, 1.0}, {2.0, 2.0, true, 3.0}, {1.0, 1.0, true, 3.0}};
+  // Point 2 is beaten by 1 in the first two, not in the third; point 3 by
+  // 1 in all; 1 and 4 repeat each other.
+  EXPECT_EQ(DominatedPoints(points), (std::vector<bool>{false, false, true, false}));
+}
+
+TEST(ParetoGrid, LevelsLieStrictlyBetweenTheEndsAndTheGridGrowsFromTheObjectivesOwnOptimum) {
+  EXPECT_DOUBLE_EQ(ParetoGridLevel(0, 3, 5.0, 1.0), 4.0);
+  EXPECT_DOUBLE_EQ(ParetoGridLevel(1, 3, 5.0, 1.0), 3.0);
+  EXPECT_DOUBLE_EQ(ParetoGridLevel(2, 3, 5.0, 1.0), 2.0);
+  // Anchors 0 to 2 from the initial design; (0, 0) = 3 from anchor 0,
+  // (0, 1) = 4 from 3, (1, 0) = 5 from 3, (1, 1) = 6 from 4.
+  EXPECT_EQ(ParetoGridWarmStartParents(2), (std::vector<int>{-1, -1, -1, 0, 3, 3, 4}));
+}
+
 // An L-shaped front with its knee at (0.1, 0.1): the turn there is nearly a
 // right angle, the turns elsewhere a few hundredths of a radian, so the two
 // segments that meet at the knee score about 0.95 and the outer ones, though

@@ -210,11 +210,17 @@ def _run_status(r):
 def _front_point(r, names, constraints, history):
     """One point of a front from its record, as FrontResults.points lists it
     but without "status" (which needs the other points)."""
-    return {
+    point = {
         "point": r.cycle,
         "level": _number(r.pareto_level),
         "objective": _number(r.objective_trial),
         "value": _number(r.pareto_value),
+    }
+    if r.pareto_three:
+        # A front of three objectives: the third's level and value.
+        point["level3"] = _number(r.pareto_level3)
+        point["value3"] = _number(r.pareto_value3)
+    point.update({
         "max_violation": _number(r.max_violation_trial),
         "run_state": r.pareto_state,
         "cycles": r.pareto_cycles,
@@ -224,7 +230,8 @@ def _front_point(r, names, constraints, history):
         "constraints": {n: _at(r.constraint_violations, c) for c, n in enumerate(constraints)},
         "reason": r.rejection_reason,
         "history": history,
-    }
+    })
+    return point
 
 
 class FrontPointFollower:
@@ -249,18 +256,18 @@ class FrontPointFollower:
 
 
 def _dominated(points):
-    """Which of (first, second, usable) points another usable point beats:
-    no worse in both objectives (as minimized) and better in one
-    (spec/pareto.h, DominatedPoints)."""
+    """Which of (first, second, usable, third) points another usable point
+    beats: no worse in every objective (as minimized) and better in one
+    (spec/pareto.h, DominatedPoints); third is 0 on a front of two."""
     dominated = [False] * len(points)
-    for i, (first, second, usable) in enumerate(points):
+    for i, (first, second, usable, third) in enumerate(points):
         if not usable:
             continue
-        for j, (other_first, other_second, other_usable) in enumerate(points):
+        for j, (other_first, other_second, other_usable, other_third) in enumerate(points):
             if j == i or not other_usable:
                 continue
-            no_worse = other_first <= first and other_second <= second
-            better = other_first < first or other_second < second
+            no_worse = other_first <= first and other_second <= second and other_third <= third
+            better = other_first < first or other_second < second or other_third < third
             if no_worse and better:
                 dominated[i] = True
                 break
@@ -276,7 +283,9 @@ class FrontResults:
     "failed" or "not run", and its run's `history`, one dict per LP solve),
     in the points' order. The second objective and its levels are as the
     CLI shows them: a traded constraint's in its unit, a maximized
-    objective as itself."""
+    objective as itself. A front of three objectives names its second
+    traded constraint in `against3` (its unit in `against3_unit`), and each
+    point has its `level3` and `value3`."""
 
     job_id: str
     study: str
@@ -289,6 +298,8 @@ class FrontResults:
     analyses: int
     message: str
     points: list
+    against3: str = ""       # a front of three objectives: the second traded constraint
+    against3_unit: str = ""
 
     def point(self, number):
         """Point `number` (1-based) of the front; KeyError naming the points
@@ -311,8 +322,12 @@ class FrontResults:
             against_unit = pareto.objective.unit
             maximized = pareto.objective.WhichOneof("form") == "maximize"
         else:
-            against = pareto.against
+            against = pareto.against[0] if pareto.against else ""
             against_unit = next((c.unit for c in study.constraints if c.name == against), "")
+        # A front of three objectives names a second constraint.
+        three = len(pareto.against) == 2
+        against3 = pareto.against[1] if three else ""
+        against3_unit = next((c.unit for c in study.constraints if c.name == against3), "") if three else ""
         # Dominance on both objectives as the runs minimize them.
         first_sign = -1.0 if study.objective.WhichOneof("form") == "maximize" else 1.0
         second_sign = -1.0 if maximized else 1.0
@@ -329,22 +344,30 @@ class FrontResults:
             point = _front_point(r, names, constraints, histories.get(r.cycle, []))
             point["status"] = _run_status(r)
             points.append(point)
-            ranked.append((first_sign * r.objective_trial, second_sign * r.pareto_value, point["status"] == ""))
+            ranked.append((first_sign * r.objective_trial, second_sign * r.pareto_value, point["status"] == "",
+                           r.pareto_value3 if three else 0.0))
         for p, dominated in zip(points, _dominated(ranked)):
             if p["status"] == "":
                 p["status"] = "dominated" if dominated else "front"
         return cls(job_id=s.job_id, study=s.study_name, status=state_name(s.state), against=against,
                    against_unit=against_unit, objective_unit=s.objective_unit, points_total=s.max_cycles,
-                   points_done=s.cycles, analyses=s.analyses, message=s.message, points=points)
+                   points_done=s.cycles, analyses=s.analyses, message=s.message, points=points,
+                   against3=against3, against3_unit=against3_unit)
 
     def as_dict(self):
         """The same object as `mbopt results --json` parsed with json.loads."""
-        return {
+        out = {
             "job_id": self.job_id, "study": self.study, "status": self.status, "form": "pareto",
-            "against": self.against, "against_unit": self.against_unit, "objective_unit": self.objective_unit,
+            "against": self.against, "against_unit": self.against_unit,
+        }
+        if self.against3:
+            out.update({"against3": self.against3, "against3_unit": self.against3_unit})
+        out.update({
+            "objective_unit": self.objective_unit,
             "points_total": self.points_total, "points_done": self.points_done, "analyses": self.analyses,
             "message": self.message, "points": [dict(p) for p in self.points],
-        }
+        })
+        return out
 
 
 @dataclass

@@ -61,18 +61,31 @@ struct JobView {
   std::vector<double> variable_scales;    // physical = scale * x
   double objective_sign = 1.0;            // reported F = sign * the records' F (-1: maximized)
   // A Pareto front's far end, the point whose run minimizes the second
-  // objective (0: not a front): its run's F is no reported objective.
+  // objective (0: not a front): its run's F is no reported objective but
+  // the second objective divided by its rows' scale, reported in the second
+  // objective's unit (times pareto_far_end_factor: the rows' scale times
+  // pareto_shown_factor).
   int pareto_far_end = 0;
+  double pareto_far_end_factor = 1.0;
+  double pareto_third_end_factor = 1.0;  // point 3 of a front of three objectives, the third's
+  // A front of three objectives: its points 2 and 3 minimize the second
+  // and third objectives (pareto_far_end is 2).
+  bool pareto_three = false;
   // A front's point record's second objective and level as shown
   // (CycleRecord.pareto_value): factor * the record's. 1 / the unit's SI
   // size for a traded constraint; -1 for a maximized second objective (the
   // runs minimize its negative), else 1.
   double pareto_shown_factor = 1.0;
+  double pareto_third_shown_factor = 1.0;  // the third objective's, as pareto_shown_factor
   std::string study_bytes;
 
-  // The sign of record r's F as reported.
-  double ReportedSign(const slp::CycleRecord& r) const {
-    return pareto_far_end > 0 && r.pareto_point == pareto_far_end ? 1.0 : objective_sign;
+  // What record r's F is multiplied by as reported: the objective's sign,
+  // or at a front's far end the factor to the objective its run minimizes,
+  // in that objective's unit.
+  double ReportedFactor(const slp::CycleRecord& r) const {
+    if (pareto_far_end > 0 && r.pareto_point == pareto_far_end) return pareto_far_end_factor;
+    if (pareto_three && pareto_far_end > 0 && r.pareto_point == pareto_far_end + 1) return pareto_third_end_factor;
+    return objective_sign;
   }
 };
 

@@ -132,12 +132,30 @@ JobView JobManager::ViewLocked(const Entry& entry, std::size_t first_record, Job
     view.objective_sign = entry.study->objective.ReportedSign();
     const spec::Study& study = *entry.study;
     if (study.pareto.enabled()) {
-      view.pareto_far_end = study.pareto.points;
+      view.pareto_far_end = study.pareto.three_objectives() ? 2 : study.pareto.points;
+      // The scale of the traded rows (the first's: they share it), by
+      // which a far end's run divides the objective it minimizes.
+      auto traded_scale = [&](int constraint) {
+        if (entry.layout == nullptr) return 1.0;
+        for (const spec::ConstraintRow& row : entry.layout->rows) {
+          if (row.constraint == constraint) return row.scale;
+        }
+        return 1.0;
+      };
+      view.pareto_three = study.pareto.three_objectives();
+      if (view.pareto_three && static_cast<size_t>(study.pareto.third_constraint) < study.constraints.size()) {
+        view.pareto_third_shown_factor =
+            1.0 / study.constraints[static_cast<size_t>(study.pareto.third_constraint)].si_per_unit;
+        view.pareto_third_end_factor = view.pareto_third_shown_factor * traded_scale(study.pareto.third_constraint);
+      }
       if (study.pareto.trades_objective) {
         view.pareto_shown_factor = study.second_objective.ReportedSign();
       } else if (study.pareto.constraint >= 0 && static_cast<size_t>(study.pareto.constraint) < study.constraints.size()) {
         view.pareto_shown_factor = 1.0 / study.constraints[static_cast<size_t>(study.pareto.constraint)].si_per_unit;
       }
+      view.pareto_far_end_factor =
+          view.pareto_shown_factor *
+          traded_scale(study.pareto.trades_objective ? spec::kSecondObjectiveRow : study.pareto.constraint);
     }
   }
   if (view_for == JobViewFor::kReader) view.study_bytes = entry.row.study;
