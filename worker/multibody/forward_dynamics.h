@@ -55,6 +55,17 @@ struct ForwardDynamicsOptions {
   LinearSolver linear_solver = LinearSolver::kAutomatic;
   static constexpr int kSparseFromUnknowns = 40;
 
+  // The integrator: IDAS's variable-order BDF on the stabilized index-2
+  // form (above), or an explicit Runge-Kutta pair on the index-1 form with
+  // projection onto the constraints (explicit_dynamics.h) for non-stiff
+  // motions, where it takes fewer, cheaper steps. The explicit path carries
+  // no sensitivities.
+  enum class Method { kImplicitBdf, kExplicitRungeKutta };
+  Method method = Method::kImplicitBdf;
+  // The explicit path's embedded pair (ARKODE's tables of those names).
+  enum class ExplicitPair { kDormandPrince54, kVerner65, kFehlberg87 };
+  ExplicitPair explicit_pair = ExplicitPair::kVerner65;
+
   // A scene's integrator settings (tolerances, step budget) within `budget`.
   static ForwardDynamicsOptions Of(const spec::IntegratorSettings& integrator, const budget::AnalysisBudget* budget) {
     ForwardDynamicsOptions options;
@@ -62,6 +73,9 @@ struct ForwardDynamicsOptions {
     options.absolute_tolerance = integrator.absolute_tolerance;
     options.max_steps = integrator.max_steps;
     options.budget = budget;
+    if (integrator.method == spec::IntegratorMethod::kExplicitRungeKutta) {
+      options.method = Method::kExplicitRungeKutta;
+    }
     return options;
   }
 };
