@@ -21,7 +21,7 @@
 // CPodes' BDF, accuracy = tolerance.
 //
 //   build/bench/multibody/bench_multibody_workprec [--repeats=5] [--only=MECHANISM]
-//       [--out=docs/svg/workprec_multibody.csv]
+//       [--out=docs/svg/workprec_multibody.csv] [--explicit-pair=verner-6-5]
 //
 // Writes one CSV row per run (code, integrator, tolerance, error, CPU,
 // counters), the ratios to OUT's name with _ratios before .csv, and prints
@@ -107,6 +107,9 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The explicit path's pair (--explicit-pair): the default unless measured.
+ForwardDynamicsOptions::ExplicitPair explicit_pair = ForwardDynamicsOptions{}.explicit_pair;
+
 Run RunMbopt(const Bench& b, double tolerance, int repeats,
              ForwardDynamicsOptions::Method method = ForwardDynamicsOptions::Method::kImplicitBdf) {
   Run run;
@@ -121,6 +124,7 @@ Run RunMbopt(const Bench& b, double tolerance, int repeats,
   }
   ForwardDynamicsOptions options;
   options.method = method;
+  options.explicit_pair = explicit_pair;
   options.relative_tolerance = tolerance;
   options.absolute_tolerance = tolerance * b.absolute_per_relative;
   std::vector<double> cpu;
@@ -264,11 +268,18 @@ int main(int argc, char** argv) {
       repeats = std::atoi(a.c_str() + 10);
     } else if (a.rfind("--only=", 0) == 0) {
       only = a.substr(7);
+    } else if (a == "--explicit-pair=dormand-prince-5-4") {
+      explicit_pair = ForwardDynamicsOptions::ExplicitPair::kDormandPrince54;
+    } else if (a == "--explicit-pair=verner-6-5") {
+      explicit_pair = ForwardDynamicsOptions::ExplicitPair::kVerner65;
+    } else if (a == "--explicit-pair=fehlberg-8-7") {
+      explicit_pair = ForwardDynamicsOptions::ExplicitPair::kFehlberg87;
     } else if (a.rfind("--out=", 0) == 0) {
       out = a.substr(6);
     } else {
       std::cerr << "unknown argument '" << a
-                << "' (expected --repeats=N > 0, --only=ten_body_chain|rod_chain|andrews, --out=FILE.csv)\n";
+                << "' (expected --repeats=N > 0, --only=ten_body_chain|rod_chain|andrews, --out=FILE.csv, "
+                   "--explicit-pair=dormand-prince-5-4|verner-6-5|fehlberg-8-7)\n";
       return 2;
     }
   }
