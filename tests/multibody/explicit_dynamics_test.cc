@@ -5,15 +5,19 @@
 #include "worker/multibody/explicit_dynamics.h"
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <numbers>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
+#include "spec/io/study_io.h"
 #include "tests/multibody/mechanisms.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/mechanism.h"
+#include "worker/multibody/scene_analysis.h"
 
 namespace mbopt::multibody {
 namespace {
@@ -247,6 +251,76 @@ TEST(MultibodyExplicitDynamics, RefusesSimulatorSensitivities) {
   ASSERT_FALSE(f.ok());
   EXPECT_EQ(f.kind, spec::FailureKind::kInvalidModel);
   EXPECT_NE(f.reason.find("sensitivities"), std::string::npos) << f.reason;
+}
+
+std::string FileText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A scene chooses the path by `integrator { method: EXPLICIT_RUNGE_KUTTA }`:
+// Andrews' mechanism analysed whole on it gives the IDAS analysis' outputs
+// (the seven angles at every millisecond) within both runs' errors at rtol
+// 1e-8 (each about 3e-7 rad from its reference, bench_multibody_workprec).
+TEST(MultibodyExplicitDynamics, SceneSettingChoosesThePathForAWholeAnalysis) {
+  const std::string text = FileText("examples/andrews/andrews.scene.textproto");
+  ASSERT_FALSE(text.empty());
+  const std::string tolerances = " relative_tolerance: 1e-8 absolute_tolerance: 1e-10 }\n";
+  absl::StatusOr<spec::Scene> bdf = spec::io::ParseSceneText(text + "integrator {" + tolerances, "andrews.textproto");
+  absl::StatusOr<spec::Scene> erk = spec::io::ParseSceneText(
+      text + "integrator { method: EXPLICIT_RUNGE_KUTTA" + tolerances, "andrews.textproto");
+  ASSERT_TRUE(bdf.ok()) << bdf.status();
+  ASSERT_TRUE(erk.ok()) << erk.status();
+  EXPECT_EQ(bdf->integrator.method, spec::IntegratorMethod::kIdas);
+  EXPECT_EQ(erk->integrator.method, spec::IntegratorMethod::kExplicitRungeKutta);
+  const spec::AnalysisReport a = AnalyzeMultibodyScene(*bdf, bdf->DefaultParameterValues(), nullptr);
+  const spec::AnalysisReport b = AnalyzeMultibodyScene(*erk, erk->DefaultParameterValues(), nullptr);
+  ASSERT_TRUE(a.ok()) << a.failure.reason;
+  ASSERT_TRUE(b.ok()) << b.failure.reason;
+  ASSERT_EQ(a.outputs.size(), b.outputs.size());
+  double worst = 0.0;
+  for (size_t k = 0; k < a.outputs.size(); ++k) {
+    ASSERT_EQ(a.outputs[k].series.size(), b.outputs[k].series.size());
+    for (size_t s = 0; s < a.outputs[k].series.size(); ++s) {
+      ASSERT_EQ(a.outputs[k].series[s].size(), 31u);
+      ASSERT_EQ(b.outputs[k].series[s].size(), 31u);
+      for (size_t i = 0; i < 31; ++i) {
+        worst = std::max(worst, std::abs(a.outputs[k].series[s][i] - b.outputs[k].series[s][i]));
+      }
+    }
+  }
+  constexpr double kAgreement = 2e-6;  // rad
+  EXPECT_LT(worst, kAgreement);
+  // Not the same integration: the explicit path takes far fewer steps.
+  EXPECT_LT(b.counters.time_steps, a.counters.time_steps / 2);
+  std::cout << "Andrews, scene on each path: largest difference " << worst << " rad, steps "
+            << a.counters.time_steps << " (IDAS) and " << b.counters.time_steps << " (explicit)\n";
+}
+
+// The scene's text with the explicit method in its integrator settings.
+std::string WithExplicitMethod(std::string text) {
+  const std::string block = "integrator {";
+  const size_t at = text.find(block);
+  if (at == std::string::npos) return text + "\nintegrator { method: EXPLICIT_RUNGE_KUTTA }\n";
+  return text.insert(at + block.size(), " method: EXPLICIT_RUNGE_KUTTA");
+}
+
+TEST(MultibodyExplicitDynamics, SceneLoaderRefusesItWhereItDoesNotApply) {
+  // A lumped model has its own integrator (CVODES).
+  const std::string vehicle = FileText("examples/vehicle/vehicle.scene.textproto");
+  ASSERT_TRUE(spec::io::ParseSceneText(vehicle, "vehicle.textproto").ok());
+  absl::StatusOr<spec::Scene> lumped = spec::io::ParseSceneText(WithExplicitMethod(vehicle), "vehicle.textproto");
+  ASSERT_FALSE(lumped.ok());
+  EXPECT_NE(lumped.status().message().find("`multibody` scenes only"), std::string::npos) << lumped.status();
+  // Flexible links are stiff.
+  const std::string flexible = FileText("examples/fourbar/fourbar_corotational.scene.textproto");
+  ASSERT_TRUE(spec::io::ParseSceneText(flexible, "fourbar.textproto").ok());
+  absl::StatusOr<spec::Scene> corotational =
+      spec::io::ParseSceneText(WithExplicitMethod(flexible), "fourbar.textproto");
+  ASSERT_FALSE(corotational.ok());
+  EXPECT_NE(corotational.status().message().find("flexible links"), std::string::npos) << corotational.status();
 }
 
 }  // namespace
