@@ -30,9 +30,9 @@ namespace mbopt::multibody {
 
 // As IntegrateForward with options.method == kExplicitRungeKutta (which
 // calls this): from (t0, q0, v0), consistent with the constraints, to every
-// instant of `times_s`. The samples' q and v are the integrator's
-// interpolant at the instant projected like the steps; a and lambda are the
-// augmented system's at that state.
+// instant of `times_s`. Every step ends at most at the next instant, so the
+// samples' q and v are the integrator's projected state there; a and lambda
+// are the augmented system's at that state.
 spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, double t0_s,
                                                const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
                                                const std::vector<double>& times_s,
