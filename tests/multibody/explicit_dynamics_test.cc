@@ -323,5 +323,24 @@ TEST(MultibodyExplicitDynamics, SceneLoaderRefusesItWhereItDoesNotApply) {
   EXPECT_NE(corotational.status().message().find("flexible links"), std::string::npos) << corotational.status();
 }
 
+// A study asking for simulator sensitivities of a scene on the explicit
+// path is refused when it is loaded, not analysis by analysis.
+TEST(MultibodyExplicitDynamics, StudyLoaderRefusesSimulatorSensitivitiesOnIt) {
+  std::string study = FileText("examples/isolator/isolator_sensitivity.study.textproto");
+  const std::string scene = FileText("examples/isolator/isolator.scene.textproto");
+  const std::string file_line = "scene_file: \"isolator.scene.textproto\"";
+  const size_t at = study.find(file_line);
+  ASSERT_NE(at, std::string::npos);
+  const std::string plain = std::string(study).replace(at, file_line.size(), "scene {\n" + scene + "\n}");
+  absl::StatusOr<v1::Study> idas = spec::io::ParseStudyText(plain, "isolator.study.textproto");
+  ASSERT_TRUE(idas.ok()) << idas.status();
+  const std::string with_explicit =
+      study.replace(at, file_line.size(), "scene {\n" + WithExplicitMethod(scene) + "\n}");
+  absl::StatusOr<v1::Study> erk = spec::io::ParseStudyText(with_explicit, "isolator.study.textproto");
+  ASSERT_FALSE(erk.ok());
+  EXPECT_NE(erk.status().message().find("EXPLICIT_RUNGE_KUTTA"), std::string::npos) << erk.status();
+  EXPECT_NE(erk.status().message().find("SENSITIVITY_METHOD_SIMULATOR"), std::string::npos) << erk.status();
+}
+
 }  // namespace
 }  // namespace mbopt::multibody
