@@ -22,6 +22,7 @@
 //
 //   build/bench/multibody/bench_multibody_workprec [--repeats=5] [--only=MECHANISM]
 //       [--out=docs/svg/workprec_multibody.csv] [--explicit-pair=verner-6-5]
+//       [--explicit-outputs=interpolated|stop]
 //
 // Writes one CSV row per run (code, integrator, tolerance, error, CPU,
 // counters), the ratios to OUT's name with _ratios before .csv, and prints
@@ -109,6 +110,8 @@ double Median(std::vector<double> v) {
 
 // The explicit path's pair (--explicit-pair): the default unless measured.
 ForwardDynamicsOptions::ExplicitPair explicit_pair = ForwardDynamicsOptions{}.explicit_pair;
+// Its outputs (--explicit-outputs=interpolated|stop): the default unless measured.
+bool explicit_stop_at_instants = ForwardDynamicsOptions{}.explicit_stop_at_instants;
 
 Run RunMbopt(const Bench& b, double tolerance, int repeats,
              ForwardDynamicsOptions::Method method = ForwardDynamicsOptions::Method::kImplicitBdf) {
@@ -125,6 +128,7 @@ Run RunMbopt(const Bench& b, double tolerance, int repeats,
   ForwardDynamicsOptions options;
   options.method = method;
   options.explicit_pair = explicit_pair;
+  options.explicit_stop_at_instants = explicit_stop_at_instants;
   options.relative_tolerance = tolerance;
   options.absolute_tolerance = tolerance * b.absolute_per_relative;
   std::vector<double> cpu;
@@ -274,12 +278,14 @@ int main(int argc, char** argv) {
       explicit_pair = ForwardDynamicsOptions::ExplicitPair::kVerner65;
     } else if (a == "--explicit-pair=fehlberg-8-7") {
       explicit_pair = ForwardDynamicsOptions::ExplicitPair::kFehlberg87;
+    } else if (a == "--explicit-outputs=interpolated" || a == "--explicit-outputs=stop") {
+      explicit_stop_at_instants = a == "--explicit-outputs=stop";
     } else if (a.rfind("--out=", 0) == 0) {
       out = a.substr(6);
     } else {
       std::cerr << "unknown argument '" << a
                 << "' (expected --repeats=N > 0, --only=ten_body_chain|rod_chain|andrews, --out=FILE.csv, "
-                   "--explicit-pair=dormand-prince-5-4|verner-6-5|fehlberg-8-7)\n";
+                   "--explicit-pair=dormand-prince-5-4|verner-6-5|fehlberg-8-7, --explicit-outputs=interpolated|stop)\n";
       return 2;
     }
   }

@@ -65,6 +65,14 @@ struct ForwardDynamicsOptions {
   // The explicit path's embedded pair (ARKODE's tables of those names).
   enum class ExplicitPair { kDormandPrince54, kVerner65, kFehlberg87 };
   ExplicitPair explicit_pair = ExplicitPair::kVerner65;
+  // The explicit path's outputs: every step ending at most at the next
+  // instant (true: a floor of a step or two per output interval), or from
+  // ERKStep's degree-5 Hermite interpolant over the step that spans each
+  // instant, projected (false). Measured on the work-precision bench
+  // (docs/benchmarks.md): interpolated outputs took 10-30 % fewer steps but
+  // were 20-500x less accurate at the same tolerance, and slower at equal
+  // error on both chains.
+  bool explicit_stop_at_instants = true;
 
   // A scene's integrator settings (tolerances, step budget) within `budget`.
   static ForwardDynamicsOptions Of(const spec::IntegratorSettings& integrator, const budget::AnalysisBudget* budget) {
