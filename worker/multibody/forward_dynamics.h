@@ -69,9 +69,9 @@ struct ForwardDynamicsOptions {
   // instant (true: a floor of a step or two per output interval), or from
   // ERKStep's degree-5 Hermite interpolant over the step that spans each
   // instant, projected (false). Measured on the work-precision bench
-  // (docs/benchmarks.md): interpolated outputs took 10-30 % fewer steps but
-  // were 20-500x less accurate at the same tolerance, and slower at equal
-  // error on both chains.
+  // (docs/benchmarks.md): interpolated outputs took 4-66 % fewer steps but
+  // were 2-500x less accurate at the same tolerance, and no faster at equal
+  // error (slower on the ten-body chain).
   bool explicit_stop_at_instants = true;
 
   // A scene's integrator settings (tolerances, step budget) within `budget`.
