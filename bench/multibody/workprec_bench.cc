@@ -285,7 +285,8 @@ int main(int argc, char** argv) {
     } else {
       std::cerr << "unknown argument '" << a
                 << "' (expected --repeats=N > 0, --only=ten_body_chain|rod_chain|andrews, --out=FILE.csv, "
-                   "--explicit-pair=dormand-prince-5-4|verner-6-5|fehlberg-8-7, --explicit-outputs=interpolated|stop)\n";
+                   "--explicit-pair=dormand-prince-5-4|verner-6-5|fehlberg-8-7, "
+                   "--explicit-outputs=interpolated|stop)\n";
       return 2;
     }
   }
