@@ -246,12 +246,12 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
   // the next instant and there are no bounds nothing reads it, and
   // Lagrange's, which costs no right-hand side, saves those (11 % of the
   // evaluations on the rod chain, the same steps and results).
-  const bool interpolated_outputs = !options.explicit_stop_at_instants || system.num_validity_bounds() > 0;
+  const bool reads_interpolant = !options.explicit_stop_at_instants || system.num_validity_bounds() > 0;
   bool ok = check(ERKStepSetErrHandlerFn(erk, &sundials::CaptureMessage, &sundials_message),
                   "ERKStepSetErrHandlerFn") &&
             check(ERKStepSetUserData(erk, &p), "ERKStepSetUserData") &&
             check(ERKStepSetTableNum(erk, TableOf(options.explicit_pair)), "ERKStepSetTableNum") &&
-            (interpolated_outputs
+            (reads_interpolant
                  ? check(ERKStepSetInterpolantDegree(erk, ARK_INTERP_MAX_DEGREE), "ERKStepSetInterpolantDegree")
                  : check(ERKStepSetInterpolantType(erk, ARK_INTERP_LAGRANGE), "ERKStepSetInterpolantType")) &&
             check(ERKStepSStolerances(erk, options.relative_tolerance, options.absolute_tolerance),
@@ -286,13 +286,14 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
                64.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, MaxAbs(q0)));
   const double defined_until = system.DefinedUntil_s();
 
-  // One step at a time. The outputs inside a step come from ERKStep's
-  // interpolant over it, each projected like the steps (the step's own
-  // state is left as it is); then the step's state is projected and the
+  // One step at a time; after each, the step's state is projected and the
   // integrator restarts from it (ERKStepReset) with the step it had chosen.
   // The restart drops the error controller's history, and the pair
-  // recomputes its first stage at the new state anyway. With
-  // stop_at_instants every step ends at most at the next instant instead.
+  // recomputes its first stage at the new state anyway. By default
+  // (explicit_stop_at_instants) every step ends at most at the next output
+  // instant, so an output is a step's state; otherwise the outputs inside a
+  // step come from ERKStep's interpolant over it, each projected like the
+  // steps (the step's own state left as it is).
   std::string why;
   double t_reached = t0;
   long steps = 0, error_test_failures = 0, last_error_test_failures = 0;
