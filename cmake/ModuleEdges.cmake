@@ -122,7 +122,7 @@ function(mbopt_declare_modules)
     SUMMARY "FMI 2.0 and 3.0 FMUs: the archive unpacked (libzip), the model description (pugixml), the binary loaded (dlopen), Model Exchange integrated with CVODES with state and time events, Co-Simulation stepped, and the `fmu` scene's analysis")
   mbopt_module(multibody DIRS worker/multibody USES budget sundials spec common PURE
     LIBS mbopt_multibody
-    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")
+    SUMMARY "general planar multibody systems: equations in absolute coordinates, assembly, kinematics and inverse dynamics, static equilibrium (KINSOL), forward dynamics (IDAS, or ARKODE's explicit Runge-Kutta with projection), simulator sensitivities, the linkage scenes' front end and the floating-frame formulation of flexible links (CVODES)")
   mbopt_module(spatial DIRS worker/spatial USES multibody budget spec common PURE
     LIBS mbopt_spatial
     SUMMARY "spatial multibody systems: the model, equations in absolute coordinates with Euler parameters as a multibody ConstrainedSystem (integrated by its IDAS forward dynamics), assembly, Euler angles, the `spatial` scene's analysis and its drawing")

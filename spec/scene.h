@@ -426,7 +426,13 @@ struct TimeGrid {
   std::vector<double> Instants() const;
 };
 
+// Which integrator a multibody scene's forward dynamics uses: IDAS's BDF on
+// the stabilized index-2 form, or an explicit Runge-Kutta pair with
+// projection onto the constraints (non-stiff planar multibody scenes only).
+enum class IntegratorMethod { kIdas, kExplicitRungeKutta };
+
 struct IntegratorSettings {
+  IntegratorMethod method = IntegratorMethod::kIdas;
   double relative_tolerance = 1e-6;
   double absolute_tolerance = 1e-9;
   long max_steps = 100000;

@@ -15,7 +15,8 @@
 //
 // <solver>: 0 dense LU, 1 KLU, 2 the automatic choice (ForwardDynamicsOptions),
 // 3 IDAS's difference quotients with dense LU (the engine before the
-// analytic Newton matrix).
+// analytic Newton matrix), 4 the explicit Runge-Kutta path with projection
+// (explicit_dynamics.h; no linear solver of Newton systems).
 // mbopt is timed by Google Benchmark (assembly included); Simbody by its own
 // program (it cannot share a process with the engine), as the median of as
 // many integrations of the ten-body mechanism. Prints the ratio at the end,
@@ -105,6 +106,7 @@ void Integrate(benchmark::State& state, const Model& model, int64_t solver_arg, 
     options.relative_tolerance = kTolerance;
     options.absolute_tolerance = kTolerance;
     options.linear_solver = solver;
+    if (solver_arg == 4) options.method = ForwardDynamicsOptions::Method::kExplicitRungeKutta;
     counters = ForwardDynamicsCounters{};
     const DifferenceQuotients without_derivatives(m);
     const ConstrainedSystem& system = solver_arg == 3 ? static_cast<const ConstrainedSystem&>(without_derivatives) : m;
@@ -132,7 +134,7 @@ std::vector<double> g_mbopt_seconds;
 void BM_TenBodyChain(benchmark::State& state) {
   Integrate(state, testing::TenBodyChain(), state.range(0), state.range(0) == 2 ? &g_mbopt_seconds : nullptr);
 }
-BENCHMARK(BM_TenBodyChain)->Arg(3)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TenBodyChain)->Arg(3)->Arg(0)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond);
 
 void BM_RodChain(benchmark::State& state) {
   Integrate(state, testing::RodChain(static_cast<int>(state.range(0))), state.range(1), nullptr);
@@ -142,6 +144,7 @@ void BM_RodChain(benchmark::State& state) {
 BENCHMARK(BM_RodChain)
     ->ArgsProduct({{4, 6, 10}, {3, 0, 1}})
     ->ArgsProduct({{20, 40}, {0, 1}})
+    ->ArgsProduct({{4, 6, 10, 20, 40}, {4}})
     ->Unit(benchmark::kMillisecond);
 
 // MultibodyHardcase.StiffnessRatioOfAMillion's model: two 1 kg masses in

@@ -12,14 +12,17 @@
 //   andrews         examples/andrews/andrews.scene.textproto, 0.03 s; also
 //                   the error against the published reference at 0.03 s
 //
-// mbopt runs in this process (IDAS, the engine's automatic linear solver,
-// rtol = tolerance, atol = tolerance times the mechanism's length scale);
+// mbopt runs in this process, with each of its integrators: IDAS (the
+// engine's automatic linear solver) and the explicit Runge-Kutta path with
+// projection (explicit_dynamics.h), rtol = tolerance, atol = tolerance
+// times the mechanism's length scale; both against the IDAS reference;
 // Simbody runs as the oracle program of tests/oracle (it cannot share a
 // process with the engine), with Runge-Kutta-Merson (its default) and with
 // CPodes' BDF, accuracy = tolerance.
 //
 //   build/bench/multibody/bench_multibody_workprec [--repeats=5] [--only=MECHANISM]
-//       [--out=docs/svg/workprec_multibody.csv]
+//       [--out=docs/svg/workprec_multibody.csv] [--explicit-pair=verner-6-5]
+//       [--explicit-outputs=interpolated|stop]
 //
 // Writes one CSV row per run (code, integrator, tolerance, error, CPU,
 // counters), the ratios to OUT's name with _ratios before .csv, and prints
@@ -105,10 +108,16 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-Run RunMbopt(const Bench& b, double tolerance, int repeats) {
+// The explicit path's pair (--explicit-pair): the default unless measured.
+ForwardDynamicsOptions::ExplicitPair explicit_pair = ForwardDynamicsOptions{}.explicit_pair;
+// Its outputs (--explicit-outputs=interpolated|stop): the default unless measured.
+bool explicit_stop_at_instants = ForwardDynamicsOptions{}.explicit_stop_at_instants;
+
+Run RunMbopt(const Bench& b, double tolerance, int repeats,
+             ForwardDynamicsOptions::Method method = ForwardDynamicsOptions::Method::kImplicitBdf) {
   Run run;
   run.code = "mbopt";
-  run.integrator = "idas";
+  run.integrator = method == ForwardDynamicsOptions::Method::kImplicitBdf ? "idas" : "erk";
   run.tolerance = tolerance;
   const Mechanism m(b.model);
   const Assembly assembled = Assemble(m, 0.0);
@@ -117,6 +126,9 @@ Run RunMbopt(const Bench& b, double tolerance, int repeats) {
     return run;
   }
   ForwardDynamicsOptions options;
+  options.method = method;
+  options.explicit_pair = explicit_pair;
+  options.explicit_stop_at_instants = explicit_stop_at_instants;
   options.relative_tolerance = tolerance;
   options.absolute_tolerance = tolerance * b.absolute_per_relative;
   std::vector<double> cpu;
@@ -260,11 +272,21 @@ int main(int argc, char** argv) {
       repeats = std::atoi(a.c_str() + 10);
     } else if (a.rfind("--only=", 0) == 0) {
       only = a.substr(7);
+    } else if (a == "--explicit-pair=dormand-prince-5-4") {
+      explicit_pair = ForwardDynamicsOptions::ExplicitPair::kDormandPrince54;
+    } else if (a == "--explicit-pair=verner-6-5") {
+      explicit_pair = ForwardDynamicsOptions::ExplicitPair::kVerner65;
+    } else if (a == "--explicit-pair=fehlberg-8-7") {
+      explicit_pair = ForwardDynamicsOptions::ExplicitPair::kFehlberg87;
+    } else if (a == "--explicit-outputs=interpolated" || a == "--explicit-outputs=stop") {
+      explicit_stop_at_instants = a == "--explicit-outputs=stop";
     } else if (a.rfind("--out=", 0) == 0) {
       out = a.substr(6);
     } else {
       std::cerr << "unknown argument '" << a
-                << "' (expected --repeats=N > 0, --only=ten_body_chain|rod_chain|andrews, --out=FILE.csv)\n";
+                << "' (expected --repeats=N > 0, --only=ten_body_chain|rod_chain|andrews, --out=FILE.csv, "
+                   "--explicit-pair=dormand-prince-5-4|verner-6-5|fehlberg-8-7, "
+                   "--explicit-outputs=interpolated|stop)\n";
       return 2;
     }
   }
@@ -278,7 +300,8 @@ int main(int argc, char** argv) {
   // NaN where Simbody's curve does not reach mbopt's error.
   const std::string ratios_path = out.substr(0, out.rfind(".csv")) + "_ratios.csv";
   std::ofstream ratios(ratios_path);
-  ratios << "mechanism,mbopt_tolerance,error_rad,mbopt_cpu_s,ratio_to_rkm,ratio_to_cpodes,ratio_to_fastest\n";
+  ratios << "mechanism,mbopt_integrator,mbopt_tolerance,error_rad,mbopt_cpu_s,ratio_to_rkm,ratio_to_cpodes,"
+            "ratio_to_fastest\n";
   const std::vector<std::string> integrators = {"rkm", "cpodes"};
   for (const Bench& b : Benches()) {
     if (!only.empty() && b.name != only) continue;
@@ -288,6 +311,10 @@ int main(int argc, char** argv) {
     std::vector<Run> mbopt_runs;
     for (double tol : b.tolerances) mbopt_runs.push_back(RunMbopt(b, tol, repeats));
     curves.push_back(mbopt_runs);
+    std::vector<Run> explicit_runs;
+    for (double tol : b.tolerances) {
+      explicit_runs.push_back(RunMbopt(b, tol, repeats, ForwardDynamicsOptions::Method::kExplicitRungeKutta));
+    }
     // Simbody's reference: Runge-Kutta-Merson's (see kCpodesTightest);
     // CPodes' runs are measured against it too.
     const Run simbody_reference = RunSimbody(b, "rkm", b.simbody_reference_tolerance, 1);
@@ -299,6 +326,7 @@ int main(int argc, char** argv) {
       }
       curves.push_back(runs);
     }
+    curves.push_back(explicit_runs);  // last: curves[1], curves[2] stay Simbody's
     std::printf("references: mbopt rtol %.0e (%s), Simbody rkm accuracy %.0e (%s); they differ by %.3g rad\n",
                 b.mbopt_reference_tolerance, mbopt_reference.ok ? "ok" : mbopt_reference.failure.c_str(),
                 b.simbody_reference_tolerance, simbody_reference.ok ? "ok" : simbody_reference.failure.c_str(),
@@ -330,18 +358,21 @@ int main(int argc, char** argv) {
     }
     // mbopt's time over Simbody's at each of mbopt's errors (against each
     // integrator and the faster of the two); the target is 1/3 or less.
-    for (const Run& r : curves.front()) {
-      if (!r.ok) continue;
+    auto ratio_row = [&](const Run& r) {
+      if (!r.ok) return;
       const std::optional<double> rkm = TimeAtError(curves[1], r.error_rad);
       const std::optional<double> cpodes = TimeAtError(curves[2], r.error_rad);
       std::optional<double> fastest = rkm;
       if (cpodes && (!fastest || *cpodes < *fastest)) fastest = cpodes;
       auto ratio = [&](const std::optional<double>& simbody_s) { return simbody_s ? r.cpu_s / *simbody_s : NAN; };
-      std::printf("  ratio mbopt / Simbody at error %.3g rad (mbopt tol %.0e): rkm %.3g, cpodes %.3g, fastest %.3g\n",
-                  r.error_rad, r.tolerance, ratio(rkm), ratio(cpodes), ratio(fastest));
-      ratios << b.name << "," << r.tolerance << "," << r.error_rad << "," << r.cpu_s << "," << ratio(rkm) << ","
-             << ratio(cpodes) << "," << ratio(fastest) << "\n";
-    }
+      std::printf(
+          "  ratio mbopt %s / Simbody at error %.3g rad (mbopt tol %.0e): rkm %.3g, cpodes %.3g, fastest %.3g\n",
+          r.integrator.c_str(), r.error_rad, r.tolerance, ratio(rkm), ratio(cpodes), ratio(fastest));
+      ratios << b.name << "," << r.integrator << "," << r.tolerance << "," << r.error_rad << "," << r.cpu_s << ","
+             << ratio(rkm) << "," << ratio(cpodes) << "," << ratio(fastest) << "\n";
+    };
+    for (const Run& r : curves.front()) ratio_row(r);
+    for (const Run& r : curves.back()) ratio_row(r);
     std::fflush(stdout);
   }
   return 0;

@@ -24,6 +24,7 @@ TITLES = {
 }
 STYLES = {  # (code, integrator) -> colour, label
     ("mbopt", "idas"): ("#c0392b", "mbopt (IDAS)"),
+    ("mbopt", "erk"): ("#27ae60", "mbopt (explicit RK 6(5), projected)"),
     ("simbody", "rkm"): ("#2c3e50", "Simbody (Runge-Kutta-Merson, RKM)"),
     ("simbody", "cpodes"): ("#7f8c8d", "Simbody (CPodes BDF)"),
 }
@@ -104,8 +105,8 @@ def diagram(mechanism, curves):
         out.append(polyline([(e, t / 3) for _, e, t in pts], STYLES[("simbody", "rkm")][0], dashed=True))
         legend.append((STYLES[("simbody", "rkm")][0], "3x target: Simbody RKM time / 3", True))
     for i, (colour, label, dashed) in enumerate(legend):
-        y = TOP + plot_h + 50 + 13 * (i % 2)
-        x = LEFT + (i // 2) * 280
+        y = TOP + plot_h + 50 + 13 * (i % 3)
+        x = LEFT + (i // 3) * 280
         dash = ' stroke-dasharray="5,4"' if dashed else ""
         out.append(f'<line x1="{x}" y1="{y - 4}" x2="{x + 20}" y2="{y - 4}" stroke="{colour}" '
                    f'stroke-width="1.5"{dash}/>')

@@ -183,6 +183,27 @@ void SceneConverter::ConvertIntegrator() {
   } else if (s.max_steps() > 0) {
     out.max_steps = static_cast<long>(s.max_steps());
   }
+  switch (s.method()) {
+    case v1::IDAS:
+      out.method = IntegratorMethod::kIdas;
+      break;
+    case v1::EXPLICIT_RUNGE_KUTTA:
+      // Only the planar multibody engine has the explicit path; a flexible
+      // link's stiff axial and bending modes would hold its step to their
+      // stability limit.
+      if (msg_.model_case() != v1::Scene::kMultibody) {
+        errors_.Add(w, "method", "EXPLICIT_RUNGE_KUTTA applies to `multibody` scenes only");
+      } else if (msg_.multibody().flexible_links_size() > 0) {
+        errors_.Add(w, "method",
+                    "EXPLICIT_RUNGE_KUTTA does not apply to a scene with flexible links: their axial and bending "
+                    "vibrations are stiff; use IDAS (the default)");
+      } else {
+        out.method = IntegratorMethod::kExplicitRungeKutta;
+      }
+      break;
+    default:
+      errors_.Add(w, "method", absl::StrCat("unknown integrator method ", static_cast<int>(s.method())));
+  }
   if (s.max_wall_seconds() < 0.0 || !std::isfinite(s.max_wall_seconds())) {
     errors_.Add(w, "max_wall_seconds",
                 absl::StrCat("must be positive (0 for the default ", kDefaultAnalysisWallSeconds, " s)"));

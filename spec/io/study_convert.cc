@@ -812,6 +812,13 @@ Study ConvertStudy(const v1::Study& m, Scene scene_in, const Where& where, Error
                   "SENSITIVITY_METHOD_SIMULATOR is not available for this formulation: linkage scenes have no "
                   "simulator sensitivities (write the mechanism as a multibody scene, or use finite differences)");
     }
+    // The explicit path carries no sensitivity equations; the derivatives
+    // would have to come from IDAS, another integrator than the values'.
+    if (s.simulator_sensitivities && scene.integrator.method == IntegratorMethod::kExplicitRungeKutta) {
+      errors->Add(w, "sensitivity",
+                  "SENSITIVITY_METHOD_SIMULATOR is not available with the scene's integrator { method: "
+                  "EXPLICIT_RUNGE_KUTTA }: use integrator method IDAS (the default), or finite differences");
+    }
   }
 
   study.design_set = ConvertDesignSet(m, study, where, errors);

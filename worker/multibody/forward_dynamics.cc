@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "worker/multibody/explicit_dynamics.h"
 #include "worker/multibody/ggl_residual.h"
 #include "worker/multibody/mechanism.h"
 #include "worker/multibody/parameter_derivatives.h"
@@ -417,6 +418,14 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
                                        const ForwardDynamicsOptions& options, const MotionCallback& at_instant,
                                        ForwardDynamicsCounters* counters,
                                        const ForwardSensitivityInput* sensitivities) {
+  if (options.method == ForwardDynamicsOptions::Method::kExplicitRungeKutta) {
+    if (sensitivities != nullptr && !sensitivities->parameters.empty()) {
+      return Failed(spec::FailureKind::kInvalidModel,
+                    "the explicit Runge-Kutta integrator carries no simulator sensitivities: use integrator "
+                    "{ method: IDAS } (the default) for a study with simulator sensitivities");
+    }
+    return IntegrateForwardExplicit(system, t0, q0, v0, times, options, at_instant, counters);
+  }
   Problem p;
   p.system = &system;
   p.n = system.num_coordinates();

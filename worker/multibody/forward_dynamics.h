@@ -55,6 +55,25 @@ struct ForwardDynamicsOptions {
   LinearSolver linear_solver = LinearSolver::kAutomatic;
   static constexpr int kSparseFromUnknowns = 40;
 
+  // The integrator: IDAS's variable-order BDF on the stabilized index-2
+  // form (above), or an explicit Runge-Kutta pair on the index-1 form with
+  // projection onto the constraints (explicit_dynamics.h) for non-stiff
+  // motions, where it takes fewer, cheaper steps. The explicit path carries
+  // no sensitivities.
+  enum class Method { kImplicitBdf, kExplicitRungeKutta };
+  Method method = Method::kImplicitBdf;
+  // The explicit path's embedded pair (ARKODE's tables of those names).
+  enum class ExplicitPair { kDormandPrince54, kVerner65, kFehlberg87 };
+  ExplicitPair explicit_pair = ExplicitPair::kVerner65;
+  // The explicit path's outputs: every step ending at most at the next
+  // instant (true: a floor of a step or two per output interval), or from
+  // ERKStep's degree-5 Hermite interpolant over the step that spans each
+  // instant, projected (false). Measured on the work-precision bench
+  // (docs/benchmarks.md): interpolated outputs took 4-66 % fewer steps but
+  // were 2-500x less accurate at the same tolerance, and no faster at equal
+  // error (slower on the ten-body chain).
+  bool explicit_stop_at_instants = true;
+
   // A scene's integrator settings (tolerances, step budget) within `budget`.
   static ForwardDynamicsOptions Of(const spec::IntegratorSettings& integrator, const budget::AnalysisBudget* budget) {
     ForwardDynamicsOptions options;
@@ -62,6 +81,9 @@ struct ForwardDynamicsOptions {
     options.absolute_tolerance = integrator.absolute_tolerance;
     options.max_steps = integrator.max_steps;
     options.budget = budget;
+    if (integrator.method == spec::IntegratorMethod::kExplicitRungeKutta) {
+      options.method = Method::kExplicitRungeKutta;
+    }
     return options;
   }
 };
