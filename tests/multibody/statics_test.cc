@@ -35,12 +35,13 @@ struct Solved {
   StaticCounters counters;
 };
 
-Solved SolveStatic(const Mechanism& mechanism, const std::vector<double>& times) {
+Solved SolveStatic(const Mechanism& mechanism, const std::vector<double>& times,
+                   const StaticOptions& options = StaticOptions{}) {
   Solved out;
   const Assembly assembled = Assemble(mechanism, times.front());
   EXPECT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
   out.failure = RunStaticEquilibrium(
-      mechanism, assembled.q, times, StaticOptions{},
+      mechanism, assembled.q, times, options,
       [&](const MotionSample& s) {
         out.samples.push_back(s);
         return spec::AnalysisFailure::Ok();
@@ -152,6 +153,85 @@ TEST(MultibodyStatics, SliderCrankDriverTorqueIsTheVirtualWorkOfTheLoad) {
   }
   EXPECT_LT(worst, 1e-8);
   EXPECT_EQ(solved.counters.position_solves, static_cast<long>(times.size()));
+}
+
+// KINSOL's Newton matrix is the analytic one where the mechanism's
+// derivatives are exact (EquilibriumJacobian): it matches central
+// differences of the equilibrium equations away from an equilibrium, and a
+// slider-crank held by a spring and a force comes to the same 31
+// equilibria as with KINSOL's difference quotients (to 1e-9), for fewer
+// residual evaluations.
+TEST(MultibodyStatics, KinsolGetsTheAnalyticNewtonMatrix) {
+  const double r = 0.1, l = 0.35, omega = 2.0;
+  Model model = testing::SliderCrank(r, l, omega);
+  model.point_forces.push_back(PointForce{At(2, 0.0), Eigen::Vector2d(-250.0, 0.0), std::nullopt});
+  SpringDamper spring;
+  spring.name = "spring";
+  spring.a = At(kGround, 0.0, 0.2);
+  spring.b = At(1, 0.1);
+  spring.free_length_m = 0.1;
+  spring.stiffness_n_per_m = 800.0;
+  model.springs.push_back(spring);
+  model.gravity_m_per_s2 = Eigen::Vector2d(0.0, -9.81);
+  ASSERT_TRUE(model.Validate().ok());
+  const Mechanism mechanism(model);
+  ASSERT_TRUE(mechanism.has_exact_state_jacobian());
+  std::vector<double> times;
+  for (int i = 0; i <= 30; ++i) times.push_back(0.1 * i);
+  StaticOptions differenced;
+  differenced.analytic_newton_matrix = false;
+  const Solved analytic = SolveStatic(mechanism, times), quotients = SolveStatic(mechanism, times, differenced);
+  ASSERT_TRUE(analytic.failure.ok()) << analytic.failure.reason;
+  ASSERT_TRUE(quotients.failure.ok()) << quotients.failure.reason;
+  ASSERT_EQ(analytic.samples.size(), times.size());
+  ASSERT_EQ(quotients.samples.size(), times.size());
+  for (size_t i = 0; i < times.size(); ++i) {
+    const MotionSample &a = analytic.samples[i], &d = quotients.samples[i];
+    for (int k = 0; k < a.q.size(); ++k) EXPECT_NEAR(a.q[k], d.q[k], 1e-9) << "t = " << a.t_s << ", q" << k;
+    for (int k = 0; k < a.lambda.size(); ++k) {
+      EXPECT_NEAR(a.lambda[k], d.lambda[k], 1e-9 * std::max(1.0, std::abs(d.lambda[k])))
+          << "t = " << a.t_s << ", lambda" << k;
+    }
+  }
+  EXPECT_GT(analytic.counters.newton_matrices, 0);
+  EXPECT_EQ(quotients.counters.newton_matrices, 0);
+  EXPECT_LT(analytic.counters.residual_evaluations, quotients.counters.residual_evaluations);
+  std::cout << "residual evaluations: " << analytic.counters.residual_evaluations << " analytic ("
+            << analytic.counters.newton_matrices << " matrices), " << quotients.counters.residual_evaluations
+            << " with difference quotients; Newton iterations " << analytic.counters.newton_iterations << " and "
+            << quotients.counters.newton_iterations << "\n";
+
+  // Off the equilibrium: G(q, lambda) = (Q(t, q, 0) - Phi_q^T lambda, Phi(t, q)).
+  const int n = mechanism.num_coordinates(), m = mechanism.num_constraints();
+  const double t = times[7];
+  Eigen::VectorXd q = analytic.samples[7].q, lambda = analytic.samples[7].lambda;
+  for (int k = 0; k < n; ++k) q[k] += 1e-3 * (k + 1);
+  for (int k = 0; k < m; ++k) lambda[k] += 10.0 * (k + 1);
+  auto equations = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd forces, phi;
+    Eigen::MatrixXd phi_q;
+    const Eigen::VectorXd qx = x.head(n);
+    EXPECT_EQ(mechanism.AppliedForces(t, qx, Eigen::VectorXd::Zero(n), &forces), 0);
+    EXPECT_EQ(mechanism.ConstraintJacobian(t, qx, &phi_q), 0);
+    EXPECT_EQ(mechanism.Constraints(t, qx, &phi), 0);
+    Eigen::VectorXd g(n + m);
+    g.head(n) = forces - phi_q.transpose() * x.tail(m);
+    g.tail(m) = phi;
+    return g;
+  };
+  Eigen::MatrixXd jacobian;
+  ASSERT_TRUE(EquilibriumJacobian(mechanism, t, q, lambda, &jacobian));
+  Eigen::VectorXd x(n + m);
+  x << q, lambda;
+  const double scale = jacobian.cwiseAbs().maxCoeff();
+  for (int k = 0; k < n + m; ++k) {
+    const double h = 1e-6 * std::max(1.0, std::abs(x[k]));
+    Eigen::VectorXd plus = x, minus = x;
+    plus[k] += h;
+    minus[k] -= h;
+    const Eigen::VectorXd column = (equations(plus) - equations(minus)) / (2 * h);
+    EXPECT_LT((column - jacobian.col(k)).cwiseAbs().maxCoeff(), 1e-6 * scale) << "column " << k;
+  }
 }
 
 // An inverted pendulum is in equilibrium straight up, but not a stable one.

@@ -551,6 +551,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     report.counters.position_solves += counters.position_solves;
     report.counters.newton_iterations += counters.newton_iterations;
     report.counters.rhs_evaluations += counters.residual_evaluations;
+    report.counters.jacobian_evaluations += counters.newton_matrices;
   } else if (driven) {
     KinematicOptions options;
     options.inverse_dynamics = NeedsMultipliers(scene);

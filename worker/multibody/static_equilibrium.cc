@@ -31,6 +31,8 @@ struct Problem {
   VectorXd zero_velocity, forces, phi;
   MatrixXd phi_q;
   VectorXd offset;  // the homotopy's (1 - s) F(start), subtracted from F; empty otherwise
+  MatrixXd newton;  // NewtonMatrix's
+  std::int64_t newton_matrices = 0;
 };
 
 // F(q, lambda) = (Q(t, q, 0) - Phi_q^T lambda, Phi(t, q)).
@@ -128,7 +130,42 @@ double RelativeLeastStiffness(Problem* p, const VectorXd& x, bool* ok) {
   return values.minCoeff() / largest;
 }
 
+// KINSOL's Newton matrix, analytic (EquilibriumJacobian) instead of
+// KINSOL's n + m residuals a matrix by difference quotients.
+int NewtonMatrix(N_Vector uu, N_Vector /*fu*/, SUNMatrix matrix, void* user_data, N_Vector /*tmp1*/,
+                 N_Vector /*tmp2*/) {
+  auto* p = static_cast<Problem*>(user_data);
+  return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
+    const int n = p->n, m = p->m, size = n + m;
+    const Map<const VectorXd> x(N_VGetArrayPointer(uu), size);
+    if (!EquilibriumJacobian(*p->system, p->t, x.head(n), x.tail(m), &p->newton)) return 1;
+    if (!p->newton.allFinite()) return 1;
+    ++p->newton_matrices;
+    Map<MatrixXd>(SUNDenseMatrix_Data(matrix), size, size) = p->newton;
+    return 0;
+  });
+}
+
 }  // namespace
+
+bool EquilibriumJacobian(const ConstrainedSystem& system, double t, const VectorXd& q, const VectorXd& lambda,
+                         MatrixXd* jacobian) {
+  if (!system.has_exact_state_jacobian()) return false;
+  const int n = system.num_coordinates(), m = system.num_constraints();
+  MatrixXd force_q, force_v, phi_q, curvature;
+  if (system.ForceJacobians(t, q, VectorXd::Zero(n), &force_q, &force_v) != 0) return false;
+  jacobian->setZero(n + m, n + m);
+  jacobian->topLeftCorner(n, n) = force_q;
+  if (m > 0) {
+    if (system.ConstraintJacobian(t, q, &phi_q) != 0 || system.ConstraintCurvature(t, q, lambda, &curvature) != 0) {
+      return false;
+    }
+    jacobian->topLeftCorner(n, n) -= curvature;
+    jacobian->topRightCorner(n, m) = -phi_q.transpose();
+    jacobian->bottomLeftCorner(m, n) = phi_q;
+  }
+  return true;
+}
 
 bool StaticStateSensitivities(const ConstrainedSystem& system, const std::vector<ParameterPerturbation>& parameters,
                               const MotionSample& sample, std::vector<StateSensitivity>* sensitivities) {
@@ -137,18 +174,8 @@ bool StaticStateSensitivities(const ConstrainedSystem& system, const std::vector
   const double t = sample.t_s;
   const VectorXd& q = sample.q;
   const VectorXd lambda = m > 0 ? sample.lambda : VectorXd();
-  MatrixXd force_q, force_v, phi_q, curvature;
-  if (system.ForceJacobians(t, q, VectorXd::Zero(n), &force_q, &force_v) != 0) return false;
-  MatrixXd jacobian = MatrixXd::Zero(n + m, n + m);
-  jacobian.topLeftCorner(n, n) = force_q;
-  if (m > 0) {
-    if (system.ConstraintJacobian(t, q, &phi_q) != 0 || system.ConstraintCurvature(t, q, lambda, &curvature) != 0) {
-      return false;
-    }
-    jacobian.topLeftCorner(n, n) -= curvature;
-    jacobian.topRightCorner(n, m) = -phi_q.transpose();
-    jacobian.bottomLeftCorner(m, n) = phi_q;
-  }
+  MatrixXd jacobian;
+  if (!EquilibriumJacobian(system, t, q, lambda, &jacobian)) return false;
   const Eigen::FullPivLU<MatrixXd> lu(jacobian);
   if (!lu.isInvertible()) return false;
   sensitivities->resize(parameters.size());
@@ -240,9 +267,14 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     fs[n + j] = constraint_tolerance[j] > options.tolerance ? options.tolerance / constraint_tolerance[j] : 1.0;
   }
   void* mem = kinsol.get();
+  // The analytic matrix where the system's derivatives are its exact state
+  // Jacobian; a spatial system's (which leaves out terms) would slow Newton
+  // down to linear convergence, so KINSOL differences its residual there.
+  const bool analytic = options.analytic_newton_matrix && system.has_exact_state_jacobian();
   if (KINInit(mem, Residual, u.get()) != KIN_SUCCESS || KINSetUserData(mem, &p) != KIN_SUCCESS ||
       KINSetErrHandlerFn(mem, sundials::CaptureMessage, &message) != KIN_SUCCESS ||
       KINSetLinearSolver(mem, solver.get(), jacobian.get()) != KIN_SUCCESS ||
+      (analytic && KINSetJacFn(mem, NewtonMatrix) != KIN_SUCCESS) ||
       // A fresh Jacobian every iteration: plain Newton, quadratic near the
       // solution; the systems are small.
       KINSetMaxSetupCalls(mem, 1) != KIN_SUCCESS || KINSetFuncNormTol(mem, options.tolerance) != KIN_SUCCESS ||
@@ -280,6 +312,7 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     p.t = t;
     if (spec::AnalysisFailure f = charge(t); !f.ok()) {
       counters->residual_evaluations += p.evaluations;
+      counters->newton_matrices += p.newton_matrices;
       return f;
     }
     ++counters->position_solves;
@@ -297,6 +330,7 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
         while (s_done < 1.0 && step >= 1.0 / 4096) {
           if (spec::AnalysisFailure f = charge(t); !f.ok()) {
             counters->residual_evaluations += p.evaluations;
+            counters->newton_matrices += p.newton_matrices;
             return f;
           }
           const double s_next = std::min(1.0, s_done + step);
@@ -318,6 +352,7 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     x = u_values;
     if (!converged) {
       counters->residual_evaluations += p.evaluations;
+      counters->newton_matrices += p.newton_matrices;
       if (!system.FailureReason().empty()) return Failed(spec::FailureKind::kModelValidity, system.FailureReason());
       const std::string why = !p.callback_failure.empty() ? p.callback_failure
                               : !message.empty()          ? message
@@ -329,11 +364,13 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     const double least = RelativeLeastStiffness(&p, x, &stiffness_ok);
     if (!stiffness_ok) {
       counters->residual_evaluations += p.evaluations;
+      counters->newton_matrices += p.newton_matrices;
       return Failed(spec::FailureKind::kNonFiniteValue,
                     absl::StrFormat("the stiffness at the equilibrium at t = %.6g s is not finite", t));
     }
     if (least < -options.stability_tolerance) {
       counters->residual_evaluations += p.evaluations;
+      counters->newton_matrices += p.newton_matrices;
       return Failed(spec::FailureKind::kModelValidity,
                     absl::StrFormat("the static equilibrium at t = %.6g s is unstable (reduced stiffness "
                                     "eigenvalue %.3g of the largest): the mechanism would move away from it",
@@ -345,10 +382,12 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     const spec::AnalysisFailure seen = at_instant(sample);
     if (!seen.ok()) {
       counters->residual_evaluations += p.evaluations;
+      counters->newton_matrices += p.newton_matrices;
       return seen;
     }
   }
   counters->residual_evaluations += p.evaluations;
+  counters->newton_matrices += p.newton_matrices;
   return spec::AnalysisFailure::Ok();
 }
 

@@ -52,6 +52,10 @@ struct StaticOptions {
   // translation rows of a body share one floor, its rotation rows another.
   int coordinates_per_body = 3;
   int translations_per_body = 2;
+  // KINSOL's Newton matrix from the system's analytic derivatives
+  // (EquilibriumJacobian) where they are its exact state Jacobian; false,
+  // or a system without one: KINSOL's difference quotients.
+  bool analytic_newton_matrix = true;
   // Charged one step per instant and per continuation step; also the
   // deadline and cancel flag. Null: no limit.
   budget::AnalysisBudget* budget = nullptr;
@@ -61,7 +65,19 @@ struct StaticCounters {
   std::int64_t position_solves = 0;      // one per instant
   std::int64_t newton_iterations = 0;
   std::int64_t residual_evaluations = 0;  // KINSOL's, Jacobian differences included
+  std::int64_t newton_matrices = 0;       // analytic ones (none when differenced)
 };
+
+// dG/d(q, lambda) of the equilibrium equations G = (Q(t, q, 0) - Phi_q^T
+// lambda, Phi(t, q)) from the system's analytic derivatives:
+//
+//   [Q_q - (Phi_q^T lambda)_q   -Phi_q^T]
+//   [Phi_q                        0     ]
+//
+// False where the system has no exact state Jacobian
+// (has_exact_state_jacobian) or a derivative fails.
+bool EquilibriumJacobian(const ConstrainedSystem& system, double t, const Eigen::VectorXd& q,
+                         const Eigen::VectorXd& lambda, Eigen::MatrixXd* jacobian);
 
 // The derivatives of an equilibrium (q, lambda) of `sample` (as
 // RunStaticEquilibrium reports it) with respect to each parameter, by the
