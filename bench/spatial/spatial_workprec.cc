@@ -13,7 +13,9 @@
 // being 1 m), with the Newton matrix the system provides and, when that is
 // analytic, also with IDAS's difference quotients of the residual (the
 // curve "idas-dq": what the engine did before), so both are measured in
-// the same run. Simbody runs as the program mbopt_simbody_spatial_oracle
+// the same run, and on the explicit path (curve "erk": ARKODE's Verner
+// 6(5) pair on the index-1 form, projected onto the joints' and the Euler
+// parameters' norm rows after every step). Simbody runs as the program mbopt_simbody_spatial_oracle
 // (tests/spatial) with Runge-Kutta-Merson (its default) and CPodes' BDF,
 // accuracy = tolerance.
 //
@@ -111,10 +113,13 @@ std::vector<double> Times() {
   return t;
 }
 
-Run RunMbopt(const spatial::SpatialSystem& system, bool difference_quotients, double tolerance, int repeats) {
+// `integrator`: "idas", "idas-dq" (IDAS with difference-quotient Newton
+// matrices) or "erk" (the explicit path, Verner 6(5) with projection).
+Run RunMbopt(const spatial::SpatialSystem& system, const std::string& integrator, double tolerance, int repeats) {
+  const bool difference_quotients = integrator == "idas-dq";
   Run run;
   run.code = "mbopt";
-  run.integrator = difference_quotients ? "idas-dq" : "idas";
+  run.integrator = integrator;
   run.tolerance = tolerance;
   const spatial::SpatialAssembly assembled = spatial::AssembleSpatial(system, 0.0);
   if (!assembled.failure.ok()) {
@@ -127,6 +132,7 @@ Run RunMbopt(const spatial::SpatialSystem& system, bool difference_quotients, do
   multibody::ForwardDynamicsOptions options;
   options.relative_tolerance = tolerance;
   options.absolute_tolerance = tolerance;  // the bars are 1 m
+  if (integrator == "erk") options.method = multibody::ForwardDynamicsOptions::Method::kExplicitRungeKutta;
   const int bodies = static_cast<int>(system.model().bodies.size());
   std::vector<double> cpu;
   for (int r = 0; r < repeats; ++r) {
@@ -258,12 +264,13 @@ int main(int argc, char** argv) {
   const spatial::SpatialSystem system(model);
   const std::vector<double> tolerances = {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
   std::vector<std::vector<Run>> curves;
-  std::vector<bool> dq_curves = {false};
-  if (system.has_analytic_derivatives()) dq_curves.push_back(true);
-  const Run mbopt_reference = RunMbopt(system, false, kReferenceTolerance, 1);
-  for (bool dq : dq_curves) {
+  std::vector<std::string> mbopt_curves = {"idas"};
+  if (system.has_analytic_derivatives()) mbopt_curves.push_back("idas-dq");
+  mbopt_curves.push_back("erk");
+  const Run mbopt_reference = RunMbopt(system, "idas", kReferenceTolerance, 1);
+  for (const std::string& integrator : mbopt_curves) {
     std::vector<Run> runs;
-    for (double tol : tolerances) runs.push_back(RunMbopt(system, dq, tol, repeats));
+    for (double tol : tolerances) runs.push_back(RunMbopt(system, integrator, tol, repeats));
     curves.push_back(runs);
   }
   const Run simbody_reference = RunSimbody("rkm", kReferenceTolerance, 1);
@@ -295,9 +302,9 @@ int main(int argc, char** argv) {
     }
   }
   // mbopt's time over Simbody's at each of mbopt's errors.
-  const std::vector<Run>& rkm_curve = curves[dq_curves.size()];
-  const std::vector<Run>& cpodes_curve = curves[dq_curves.size() + 1];
-  for (size_t c = 0; c < dq_curves.size(); ++c) {
+  const std::vector<Run>& rkm_curve = curves[mbopt_curves.size()];
+  const std::vector<Run>& cpodes_curve = curves[mbopt_curves.size() + 1];
+  for (size_t c = 0; c < mbopt_curves.size(); ++c) {
     for (const Run& r : curves[c]) {
       if (!r.ok) continue;
       const std::optional<double> t_rkm = TimeAtError(rkm_curve, r.error);

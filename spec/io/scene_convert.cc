@@ -188,11 +188,11 @@ void SceneConverter::ConvertIntegrator() {
       out.method = IntegratorMethod::kIdas;
       break;
     case v1::EXPLICIT_RUNGE_KUTTA:
-      // Only the planar multibody engine has the explicit path; a flexible
-      // link's stiff axial and bending modes would hold its step to their
-      // stability limit.
-      if (msg_.model_case() != v1::Scene::kMultibody) {
-        errors_.Add(w, "method", "EXPLICIT_RUNGE_KUTTA applies to `multibody` scenes only");
+      // The rigid-body engines (planar and spatial) have the explicit path;
+      // a lumped model's stiff network and a flexible link's stiff axial and
+      // bending modes would hold its step to their stability limit.
+      if (msg_.model_case() != v1::Scene::kMultibody && msg_.model_case() != v1::Scene::kSpatial) {
+        errors_.Add(w, "method", "EXPLICIT_RUNGE_KUTTA applies to `multibody` and `spatial` scenes only");
       } else if (msg_.multibody().flexible_links_size() > 0) {
         errors_.Add(w, "method",
                     "EXPLICIT_RUNGE_KUTTA does not apply to a scene with flexible links: their axial and bending "

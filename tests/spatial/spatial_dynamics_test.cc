@@ -36,7 +36,10 @@ struct Trajectory {
   multibody::ForwardDynamicsCounters counters;
 };
 
-Trajectory Simulate(const SpatialSystem& system, double end_s, int intervals, double tolerance = kTolerance) {
+using Method = multibody::ForwardDynamicsOptions::Method;
+
+Trajectory Simulate(const SpatialSystem& system, double end_s, int intervals, double tolerance = kTolerance,
+                    Method method = Method::kImplicitBdf) {
   Trajectory run;
   const SpatialAssembly assembled = AssembleSpatial(system, 0.0);
   EXPECT_TRUE(assembled.failure.ok()) << assembled.failure.reason;
@@ -45,6 +48,7 @@ Trajectory Simulate(const SpatialSystem& system, double end_s, int intervals, do
   multibody::ForwardDynamicsOptions options;
   options.relative_tolerance = tolerance;
   options.absolute_tolerance = tolerance;
+  options.method = method;
   const spec::AnalysisFailure f = multibody::IntegrateForward(
       system, 0.0, assembled.q, assembled.v, times, options,
       [&](const multibody::MotionSample& s) {
@@ -57,6 +61,10 @@ Trajectory Simulate(const SpatialSystem& system, double end_s, int intervals, do
   EXPECT_TRUE(f.ok()) << f.reason;
   EXPECT_EQ(run.t.size(), times.size());
   return run;
+}
+
+const char* MethodName(Method method) {
+  return method == Method::kExplicitRungeKutta ? "explicit Runge-Kutta, " : "IDAS, ";
 }
 
 Frame FrameOn(int body, const Vector3d& at, const Matrix3d& axes = Matrix3d::Identity()) {
@@ -80,7 +88,7 @@ double LargestNormError(const Trajectory& run, int bodies) {
 // theta: Omega^2 = g / (l cos theta) whatever the inertia, the body turning
 // with the rod. Over 2 s (3.4 turns) the centre of mass keeps its height
 // and radius and its azimuth is Omega t.
-TEST(SpatialDynamics, SphericalPendulumStaysConical) {
+void CheckSphericalPendulumStaysConical(Method method) {
   const double l = 0.8, theta = 0.6, g = 9.81;
   const double omega = std::sqrt(g / (l * std::cos(theta)));
   Model m;
@@ -97,7 +105,7 @@ TEST(SpatialDynamics, SphericalPendulumStaysConical) {
   m.gravity_m_per_s2 = Vector3d(0, 0, -g);
   ASSERT_TRUE(m.Validate().ok());
   const SpatialSystem s(m);
-  const Trajectory run = Simulate(s, 2.0, 200);
+  const Trajectory run = Simulate(s, 2.0, 200, kTolerance, method);
   // Measured: 1.4e-9 m (2.5e-8 at tolerance 1e-9, 2.0e-7 at 1e-8).
   constexpr double kConical = 1e-8;
   double worst = 0.0;
@@ -107,9 +115,15 @@ TEST(SpatialDynamics, SphericalPendulumStaysConical) {
     worst = std::max(worst, (run.q[i].head<3>() - expected).norm());
   }
   EXPECT_LT(worst, kConical);
-  std::cout << "conical pendulum: largest distance from the closed-form path " << worst << " m\n";
+  std::cout << MethodName(method) << "conical pendulum: largest distance from the closed-form path " << worst << " m\n";
   EXPECT_LT(LargestNormError(run, 1), 1e-8);
 }
+
+TEST(SpatialDynamics, SphericalPendulumStaysConical) { CheckSphericalPendulumStaysConical(Method::kImplicitBdf); }
+
+// The explicit path (Verner 6(5), projection onto the joints' and the
+// Euler parameters' norm rows after every step) to the same bounds.
+TEST(SpatialDynamics, ExplicitRungeKuttaSphericalPendulumStaysConical) { CheckSphericalPendulumStaysConical(Method::kExplicitRungeKutta); }
 
 // A symmetric top (transverse moment A about its centre of mass, axial C)
 // on a spherical joint at its tip, the centre of mass l along its axis,
@@ -118,7 +132,7 @@ TEST(SpatialDynamics, SphericalPendulumStaysConical) {
 //   m g l = phi' (C omega3 - A' phi' cos theta),  A' = A + m l^2,
 // precesses steadily: the axis keeps its angle to the vertical and its
 // azimuth is phi' t.
-TEST(SpatialDynamics, SymmetricTopPrecessesSteadily) {
+void CheckSymmetricTopPrecessesSteadily(Method method) {
   const double mass = 1.0, l = 0.1, a = 0.012, c = 0.02, g = 9.81, theta = 0.5, omega3 = 20.0;
   const double a_pivot = a + mass * l * l;
   const double precession = (c * omega3 - std::sqrt(c * c * omega3 * omega3 - 4 * a_pivot * std::cos(theta) * mass * g * l)) /
@@ -139,7 +153,7 @@ TEST(SpatialDynamics, SymmetricTopPrecessesSteadily) {
   m.gravity_m_per_s2 = Vector3d(0, 0, -g);
   ASSERT_TRUE(m.Validate().ok());
   const SpatialSystem s(m);
-  const Trajectory run = Simulate(s, 2.0, 200);
+  const Trajectory run = Simulate(s, 2.0, 200, kTolerance, method);
   // Measured: 1.9e-8 rad in nutation, 1.4e-7 rad in azimuth over 2 s (6
   // spins, 0.9 precession turns).
   constexpr double kSteady = 1e-6;
@@ -153,9 +167,15 @@ TEST(SpatialDynamics, SymmetricTopPrecessesSteadily) {
   }
   EXPECT_LT(worst_nutation, kSteady);
   EXPECT_LT(worst_azimuth, kSteady);
-  std::cout << "top: precession " << precession << " rad/s; largest nutation error " << worst_nutation
+  std::cout << MethodName(method) << "top: precession " << precession << " rad/s; largest nutation error " << worst_nutation
             << " rad, azimuth error " << worst_azimuth << " rad\n";
 }
+
+TEST(SpatialDynamics, SymmetricTopPrecessesSteadily) { CheckSymmetricTopPrecessesSteadily(Method::kImplicitBdf); }
+
+// The explicit path (Verner 6(5), projection onto the joints' and the
+// Euler parameters' norm rows after every step) to the same bounds.
+TEST(SpatialDynamics, ExplicitRungeKuttaSymmetricTopPrecessesSteadily) { CheckSymmetricTopPrecessesSteadily(Method::kExplicitRungeKutta); }
 
 // A free body (no gravity) spinning about principal axis `axis` at omega,
 // with a perturbation epsilon about the first axis.
@@ -177,11 +197,11 @@ Model FreeSpinner(int axis, double omega, double epsilon) {
 // Intermediate axis (J = 1, 2, 3, spin about 2): linearized Euler
 // equations give w1'' = (omega^2 / 3) w1, so w1 = epsilon cosh(omega t /
 // sqrt 3) while it stays small: the perturbation grows 160-fold in 2 s.
-TEST(SpatialDynamics, IntermediateAxisSpinIsUnstable) {
+void CheckIntermediateAxisSpinIsUnstable(Method method) {
   const double omega = 5.0, epsilon = 1e-6;
   const Model m = FreeSpinner(1, omega, epsilon);
   const SpatialSystem s(m);
-  const Trajectory run = Simulate(s, 2.0, 20);
+  const Trajectory run = Simulate(s, 2.0, 20, kTolerance, method);
   const double rate = omega / std::sqrt(3.0);
   for (size_t i = 0; i < run.t.size(); ++i) {
     const double w1 = s.BodyAngularVelocity(0, run.q[i], run.v[i])[0];
@@ -192,8 +212,14 @@ TEST(SpatialDynamics, IntermediateAxisSpinIsUnstable) {
   }
   const double growth = s.BodyAngularVelocity(0, run.q.back(), run.v.back())[0] / epsilon;
   EXPECT_GT(growth, 150.0);
-  std::cout << "intermediate axis: perturbation grew " << growth << "-fold in 2 s\n";
+  std::cout << MethodName(method) << "intermediate axis: perturbation grew " << growth << "-fold in 2 s\n";
 }
+
+TEST(SpatialDynamics, IntermediateAxisSpinIsUnstable) { CheckIntermediateAxisSpinIsUnstable(Method::kImplicitBdf); }
+
+// The explicit path (Verner 6(5), projection onto the joints' and the
+// Euler parameters' norm rows after every step) to the same bounds.
+TEST(SpatialDynamics, ExplicitRungeKuttaIntermediateAxisSpinIsUnstable) { CheckIntermediateAxisSpinIsUnstable(Method::kExplicitRungeKutta); }
 
 // Major axis (spin about 3): the perturbation oscillates, never grows.
 TEST(SpatialDynamics, MajorAxisSpinIsStable) {
@@ -282,7 +308,7 @@ TEST(SpatialDynamics, DoublePendulumConservesEnergy) {
 // A sleeve on a cylindrical joint along a horizontal axis, started sliding
 // at u and turning at w with its centre of mass on the axis: no force along
 // or about the axis, so it slides at u and turns at w whatever gravity does.
-TEST(SpatialDynamics, CylindricalJointSlidesFreely) {
+void CheckCylindricalJointSlidesFreely(Method method) {
   const double u = 0.4, w = 3.0;
   const Matrix3d axis_along_x = AxisAngle({0, 1, 0}, std::numbers::pi / 2);  // frame z along world x
   Model m;
@@ -298,7 +324,7 @@ TEST(SpatialDynamics, CylindricalJointSlidesFreely) {
   m.gravity_m_per_s2 = Vector3d(0, 0, -9.81);
   ASSERT_TRUE(m.Validate().ok());
   const SpatialSystem s(m);
-  const Trajectory run = Simulate(s, 2.0, 100);
+  const Trajectory run = Simulate(s, 2.0, 100, kTolerance, method);
   double slide = 0.0, turn = 0.0;
   for (size_t i = 0; i < run.t.size(); ++i) {
     slide = std::max(slide, std::abs(s.JointTranslation(0, run.q[i]) - u * run.t[i]));
@@ -306,8 +332,14 @@ TEST(SpatialDynamics, CylindricalJointSlidesFreely) {
   }
   EXPECT_LT(slide, 1e-8);  // m
   EXPECT_LT(turn, 1e-6);   // rad
-  std::cout << "cylindrical slide: " << slide << " m, " << turn << " rad after " << w * 2.0 << " rad of turning\n";
+  std::cout << MethodName(method) << "cylindrical slide: " << slide << " m, " << turn << " rad after " << w * 2.0 << " rad of turning\n";
 }
+
+TEST(SpatialDynamics, CylindricalJointSlidesFreely) { CheckCylindricalJointSlidesFreely(Method::kImplicitBdf); }
+
+// The explicit path (Verner 6(5), projection onto the joints' and the
+// Euler parameters' norm rows after every step) to the same bounds.
+TEST(SpatialDynamics, ExplicitRungeKuttaCylindricalJointSlidesFreely) { CheckCylindricalJointSlidesFreely(Method::kExplicitRungeKutta); }
 
 // A crank on a revolute joint driven at angle 0.3 + 2 t, carrying a
 // pendulum on a second hinge: the crank follows its driver exactly (to the
