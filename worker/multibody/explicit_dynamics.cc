@@ -140,6 +140,7 @@ bool Project(const ConstrainedSystem& s, double t, double position_tolerance, Ei
   MatrixXd phi_q;
   Eigen::LLT<MatrixXd> normal;
   const ContinuedPastBounds continued(s);
+  double previous_violation = std::numeric_limits<double>::infinity(), last_correction = 0.0;
   for (int iteration = 0;; ++iteration) {
     VectorXd q_copy = q;
     if (s.Constraints(t, q_copy, &phi) != 0 || !phi.allFinite()) {
@@ -148,6 +149,12 @@ bool Project(const ConstrainedSystem& s, double t, double position_tolerance, Ei
     }
     const double violation = MaxAbs(phi);
     if (violation <= position_tolerance) break;
+    // Rows written with a large scale (a spatial body's Euler-parameter
+    // norm row, s (p.p - 1) with s = 1e6) have a rounding floor above the
+    // tolerance: once a correction no longer halves |Phi| and moved q by
+    // less than the tolerance, q is as close as the rows can tell.
+    if (iteration > 0 && violation > 0.5 * previous_violation && last_correction <= position_tolerance) break;
+    previous_violation = violation;
     if (iteration == kMaxProjectionIterations) {
       *why = absl::StrFormat(
           "the projection onto the constraints did not converge at t = %.6g s (|Phi| = %.3g after %d iterations)",
@@ -163,7 +170,9 @@ bool Project(const ConstrainedSystem& s, double t, double position_tolerance, Ei
       *why = absl::StrFormat("dependent constraint rows at t = %.6g s: a locked position or redundant joints", t);
       return false;
     }
-    q -= phi_q.transpose() * normal.solve(phi);
+    const VectorXd correction = phi_q.transpose() * normal.solve(phi);
+    q -= correction;
+    last_correction = MaxAbs(correction);
   }
   const VectorXd q_copy = q;
   if (s.ConstraintJacobian(t, q_copy, &phi_q) != 0 || s.ConstraintTimeDerivative(t, q_copy, &phi_t) != 0) {
