@@ -141,8 +141,8 @@ constexpr char kConicalPendulum[] = R"pb(
   integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-10 }
 )pb";
 
-TEST(SpatialScene, ConicalPendulumKeepsItsHeightAndEnergy) {
-  const spec::Scene scene = Load(kConicalPendulum);
+void CheckConicalPendulumScene(const std::string& text) {
+  const spec::Scene scene = Load(text);
   const spec::AnalysisReport r = engine::Analyze(scene, scene.DefaultParameterValues());
   ASSERT_TRUE(r.ok()) << r.failure.reason;
   const double l = 0.8, theta = 0.6, omega = std::sqrt(9.81 / (l * std::cos(theta)));
@@ -163,6 +163,20 @@ TEST(SpatialScene, ConicalPendulumKeepsItsHeightAndEnergy) {
   std::cout << "conical pendulum scene: height error " << worst_height << " m, x error " << worst_x
             << " m, energy drift " << worst_energy << " J of " << energy0 << " J\n";
 }
+
+TEST(SpatialScene, ConicalPendulumKeepsItsHeightAndEnergy) { CheckConicalPendulumScene(kConicalPendulum); }
+
+// The same scene on the explicit path (`method: EXPLICIT_RUNGE_KUTTA`),
+// to the same bounds: the loader takes the method in a spatial scene and
+// the analysis integrates with it.
+TEST(SpatialScene, ConicalPendulumOnTheExplicitPath) {
+  std::string text = kConicalPendulum;
+  const std::string block = "integrator {";
+  text.insert(text.find(block) + block.size(), " method: EXPLICIT_RUNGE_KUTTA");
+  EXPECT_EQ(Load(text).integrator.method, spec::IntegratorMethod::kExplicitRungeKutta);
+  CheckConicalPendulumScene(text);
+}
+
 
 // A 1 kg block on a vertical prismatic joint hanging from a spring
 // (k = 100 N/m, L0 = 0.4 m) released 0.6 m below the anchor: the spring's
@@ -270,6 +284,27 @@ TEST(SpatialScene, RedundantHingesAreHandledNotRefused) {
   EXPECT_LT(worst_energy, 1e-7 * 12 * 9.81 * 0.4);  // J, relative to the drop to the bottom
   std::cout << "door on two hinges (scene): angle differs from one hinge's by " << worst_angle << " rad, energy drift "
             << worst_energy << " J\n";
+}
+
+// Redundant hinges on the explicit path: the rows integrated as
+// independent combinations and projected, as on IDAS.
+TEST(SpatialScene, RedundantHingesOnTheExplicitPath) {
+  std::string text = kDoorOnTwoHinges;
+  const std::string block = "integrator {";
+  ASSERT_NE(text.find(block), std::string::npos);
+  text.insert(text.find(block) + block.size(), " method: EXPLICIT_RUNGE_KUTTA");
+  const spec::Scene erk = Load(text);
+  const spec::Scene idas = Load(kDoorOnTwoHinges);
+  const spec::AnalysisReport r = engine::Analyze(erk, erk.DefaultParameterValues());
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  const spec::AnalysisReport r0 = engine::Analyze(idas, idas.DefaultParameterValues());
+  ASSERT_TRUE(r0.ok()) << r0.failure.reason;
+  double worst = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    worst = std::max(worst, std::abs(Series(r, "angle")[i] - Series(r0, "angle")[i]));
+  }
+  EXPECT_LT(worst, 5e-8);  // rad, the bound of the one-hinge comparison
+  std::cout << "door on two hinges, explicit path: angle differs from IDAS's by " << worst << " rad\n";
 }
 
 // A redundant mechanism's multipliers belong to combinations of rows: its
