@@ -51,6 +51,12 @@ class ConstrainedSystem {
   virtual int AccelerationRightSide(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,
                                     Eigen::VectorXd* gamma) const = 0;
 
+  // A mass matrix block diagonal in consecutive blocks of this many
+  // coordinates (0: none declared). The explicit path (explicit_dynamics.h)
+  // then factors each block alone and forms Phi_q M^-1 Phi_q^T from the rows
+  // that touch each block, instead of dense products over all coordinates.
+  virtual int mass_block_size() const { return 0; }
+
   // The derivatives the integrator's Newton matrix needs beyond M and Phi_q
   // (forward_dynamics.h). A system that returns false here leaves the
   // integrator to form that matrix by difference quotients of its residual,

@@ -29,10 +29,40 @@ spec::AnalysisFailure Failed(spec::FailureKind kind, std::string reason) {
 // G M^-1 Q - gamma and a = M^-1 (Q - G^T lambda). The Schur complement is
 // positive definite while the constraint rows are independent; a
 // dependent set (a locked position) fails its Cholesky factorization.
+// A system whose mass matrix is block diagonal (mass_block_size(): a
+// spatial body's 7 coordinates) has each block factored alone and the
+// Schur complement summed block by block over the few rows touching it.
 struct Accelerations {
   MatrixXd mass, phi_q, mass_inv_phi_q_t, schur;
   VectorXd forces, gamma, mass_inv_forces;
   Eigen::LLT<MatrixXd> mass_llt, schur_llt;
+  std::vector<Eigen::LLT<MatrixXd>> block_llts;
+  std::vector<int> touching;
+
+  // M^-1 Q, M^-1 Phi_q^T and Phi_q M^-1 Phi_q^T with blocks of size b.
+  int SolveBlocks(int b, int n, int m) {
+    const int blocks = n / b;
+    block_llts.resize(static_cast<size_t>(blocks));
+    mass_inv_forces.resize(n);
+    mass_inv_phi_q_t.setZero(n, m);
+    schur.setZero(m, m);
+    for (int k = 0; k < blocks; ++k) {
+      Eigen::LLT<MatrixXd>& llt = block_llts[static_cast<size_t>(k)];
+      llt.compute(mass.block(k * b, k * b, b, b));
+      if (llt.info() != Eigen::Success) return 1;
+      mass_inv_forces.segment(k * b, b) = llt.solve(forces.segment(k * b, b));
+      touching.clear();
+      for (int r = 0; r < m; ++r) {
+        if ((phi_q.row(r).segment(k * b, b).array() != 0.0).any()) touching.push_back(r);
+      }
+      if (touching.empty()) continue;
+      const MatrixXd rows = phi_q(touching, Eigen::seqN(k * b, b));
+      const MatrixXd solved = llt.solve(rows.transpose());
+      mass_inv_phi_q_t(Eigen::seqN(k * b, b), touching) = solved;
+      schur(touching, touching) += rows * solved;
+    }
+    return 0;
+  }
 
   int Solve(const ConstrainedSystem& s, double t, const VectorXd& q, const VectorXd& v, VectorXd* a,
             VectorXd* lambda) {
@@ -42,6 +72,20 @@ struct Accelerations {
     if (flag == 0 && m > 0) flag = s.ConstraintJacobian(t, q, &phi_q);
     if (flag == 0 && m > 0) flag = s.AccelerationRightSide(t, q, v, &gamma);
     if (flag != 0) return flag;
+    if (const int b = s.mass_block_size(); b > 0 && n % b == 0) {
+      if (SolveBlocks(b, n, m) != 0) return 1;
+      if (m == 0) {
+        *a = mass_inv_forces;
+        lambda->resize(0);
+        return a->allFinite() ? 0 : 1;
+      }
+      schur_llt.compute(schur);
+      if (schur_llt.info() != Eigen::Success) return 1;
+      *lambda = schur_llt.solve(phi_q * mass_inv_forces - gamma);
+      a->resize(n);
+      a->noalias() = mass_inv_forces - mass_inv_phi_q_t * *lambda;
+      return a->allFinite() && lambda->allFinite() ? 0 : 1;
+    }
     const bool diagonal = (mass.array() != 0.0).count() == (mass.diagonal().array() != 0.0).count();
     VectorXd inverse_diagonal;
     if (diagonal) {

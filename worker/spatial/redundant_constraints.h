@@ -77,6 +77,7 @@ class CombinedConstraintSystem : public multibody::ConstrainedSystem {
   // The full system's derivatives through the combination (its own when
   // it has them).
   bool has_analytic_derivatives() const override { return full_.has_analytic_derivatives(); }
+  int mass_block_size() const override { return full_.mass_block_size(); }
   bool has_exact_state_jacobian() const override { return full_.has_exact_state_jacobian(); }
   int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
                           Eigen::MatrixXd* curvature) const override;

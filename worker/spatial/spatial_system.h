@@ -79,6 +79,7 @@ class SpatialSystem : public multibody::ConstrainedSystem {
 
   // The Newton matrix's derivatives (spatial_derivatives.cc).
   bool has_analytic_derivatives() const override { return true; }
+  int mass_block_size() const override { return kCoordinatesPerBody; }  // one body's (r, p)
   // The Newton matrix leaves out d(M(q) v')/dq (the mass matrix depends on
   // the Euler parameters), and the force elements' Jacobians are difference
   // quotients: sensitivities difference the residual instead.
