@@ -39,6 +39,27 @@ struct Accelerations {
   std::vector<Eigen::LLT<MatrixXd>> block_llts;
   std::vector<int> touching;
 
+  // M^-1 Q, and with constraints M^-1 Phi_q^T and Phi_q M^-1 Phi_q^T,
+  // through M's diagonal when it is diagonal, else its Cholesky factor.
+  int DenseSolve(int m) {
+    const bool diagonal = (mass.array() != 0.0).count() == (mass.diagonal().array() != 0.0).count();
+    VectorXd inverse_diagonal;
+    if (diagonal) {
+      if (!(mass.diagonal().array() > 0.0).all()) return 1;
+      inverse_diagonal = mass.diagonal().cwiseInverse();
+      mass_inv_forces = inverse_diagonal.cwiseProduct(forces);
+    } else {
+      mass_llt.compute(mass);
+      if (mass_llt.info() != Eigen::Success) return 1;
+      mass_inv_forces = mass_llt.solve(forces);
+    }
+    if (m == 0) return 0;
+    mass_inv_phi_q_t = diagonal ? MatrixXd(inverse_diagonal.asDiagonal() * phi_q.transpose())
+                                : MatrixXd(mass_llt.solve(phi_q.transpose()));
+    schur.noalias() = phi_q * mass_inv_phi_q_t;
+    return 0;
+  }
+
   // M^-1 Q, M^-1 Phi_q^T and Phi_q M^-1 Phi_q^T with blocks of size b.
   int SolveBlocks(int b, int n, int m) {
     const int blocks = n / b;
@@ -74,37 +95,14 @@ struct Accelerations {
     if (flag != 0) return flag;
     if (const int b = s.mass_block_size(); b > 0 && n % b == 0) {
       if (SolveBlocks(b, n, m) != 0) return 1;
-      if (m == 0) {
-        *a = mass_inv_forces;
-        lambda->resize(0);
-        return a->allFinite() ? 0 : 1;
-      }
-      schur_llt.compute(schur);
-      if (schur_llt.info() != Eigen::Success) return 1;
-      *lambda = schur_llt.solve(phi_q * mass_inv_forces - gamma);
-      a->resize(n);
-      a->noalias() = mass_inv_forces - mass_inv_phi_q_t * *lambda;
-      return a->allFinite() && lambda->allFinite() ? 0 : 1;
-    }
-    const bool diagonal = (mass.array() != 0.0).count() == (mass.diagonal().array() != 0.0).count();
-    VectorXd inverse_diagonal;
-    if (diagonal) {
-      if (!(mass.diagonal().array() > 0.0).all()) return 1;
-      inverse_diagonal = mass.diagonal().cwiseInverse();
-      mass_inv_forces = inverse_diagonal.cwiseProduct(forces);
-    } else {
-      mass_llt.compute(mass);
-      if (mass_llt.info() != Eigen::Success) return 1;
-      mass_inv_forces = mass_llt.solve(forces);
+    } else if (DenseSolve(m) != 0) {
+      return 1;
     }
     if (m == 0) {
       *a = mass_inv_forces;
       lambda->resize(0);
       return a->allFinite() ? 0 : 1;
     }
-    mass_inv_phi_q_t = diagonal ? MatrixXd(inverse_diagonal.asDiagonal() * phi_q.transpose())
-                                : MatrixXd(mass_llt.solve(phi_q.transpose()));
-    schur.noalias() = phi_q * mass_inv_phi_q_t;
     schur_llt.compute(schur);
     if (schur_llt.info() != Eigen::Success) return 1;
     *lambda = schur_llt.solve(phi_q * mass_inv_forces - gamma);
