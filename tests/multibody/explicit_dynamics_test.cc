@@ -313,7 +313,8 @@ TEST(MultibodyExplicitDynamics, SceneLoaderRefusesItWhereItDoesNotApply) {
   ASSERT_TRUE(spec::io::ParseSceneText(vehicle, "vehicle.textproto").ok());
   absl::StatusOr<spec::Scene> lumped = spec::io::ParseSceneText(WithExplicitMethod(vehicle), "vehicle.textproto");
   ASSERT_FALSE(lumped.ok());
-  EXPECT_NE(lumped.status().message().find("`multibody` and `spatial` scenes only"), std::string::npos) << lumped.status();
+  EXPECT_NE(lumped.status().message().find("`multibody` and `spatial` scenes only"), std::string::npos)
+      << lumped.status();
   // Flexible links are stiff.
   const std::string flexible = FileText("examples/fourbar/fourbar_corotational.scene.textproto");
   ASSERT_TRUE(spec::io::ParseSceneText(flexible, "fourbar.textproto").ok());

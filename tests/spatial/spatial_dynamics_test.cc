@@ -1,7 +1,7 @@
-// Spatial forward dynamics (the planar kernel's IDAS integrator on the
-// spatial equations) against closed-form motions and invariants: a
-// spherical pendulum's conical motion, a symmetric top's steady
-// precession, the tennis-racket instability about the intermediate axis
+// Spatial forward dynamics (the planar kernel's IDAS integrator, and where
+// marked its explicit Runge-Kutta path, on the spatial equations) against
+// closed-form motions and invariants: a spherical pendulum's conical
+// motion, a symmetric top's steady precession, the tennis-racket instability about the intermediate axis
 // and the stability about the major one, conservation of energy and
 // angular momentum, a cylindrical joint's free slide, a driven hinge, the
 // Euler parameters' unit norm, a Cardan joint's speed fluctuation.
@@ -123,7 +123,9 @@ TEST(SpatialDynamics, SphericalPendulumStaysConical) { CheckSphericalPendulumSta
 
 // The explicit path (Verner 6(5), projection onto the joints' and the
 // Euler parameters' norm rows after every step) to the same bounds.
-TEST(SpatialDynamics, ExplicitRungeKuttaSphericalPendulumStaysConical) { CheckSphericalPendulumStaysConical(Method::kExplicitRungeKutta); }
+TEST(SpatialDynamics, ExplicitRungeKuttaSphericalPendulumStaysConical) {
+  CheckSphericalPendulumStaysConical(Method::kExplicitRungeKutta);
+}
 
 // A symmetric top (transverse moment A about its centre of mass, axial C)
 // on a spherical joint at its tip, the centre of mass l along its axis,
@@ -167,15 +169,17 @@ void CheckSymmetricTopPrecessesSteadily(Method method) {
   }
   EXPECT_LT(worst_nutation, kSteady);
   EXPECT_LT(worst_azimuth, kSteady);
-  std::cout << MethodName(method) << "top: precession " << precession << " rad/s; largest nutation error " << worst_nutation
-            << " rad, azimuth error " << worst_azimuth << " rad\n";
+  std::cout << MethodName(method) << "top: precession " << precession << " rad/s; largest nutation error "
+            << worst_nutation << " rad, azimuth error " << worst_azimuth << " rad\n";
 }
 
 TEST(SpatialDynamics, SymmetricTopPrecessesSteadily) { CheckSymmetricTopPrecessesSteadily(Method::kImplicitBdf); }
 
 // The explicit path (Verner 6(5), projection onto the joints' and the
 // Euler parameters' norm rows after every step) to the same bounds.
-TEST(SpatialDynamics, ExplicitRungeKuttaSymmetricTopPrecessesSteadily) { CheckSymmetricTopPrecessesSteadily(Method::kExplicitRungeKutta); }
+TEST(SpatialDynamics, ExplicitRungeKuttaSymmetricTopPrecessesSteadily) {
+  CheckSymmetricTopPrecessesSteadily(Method::kExplicitRungeKutta);
+}
 
 // A free body (no gravity) spinning about principal axis `axis` at omega,
 // with a perturbation epsilon about the first axis.
@@ -219,7 +223,9 @@ TEST(SpatialDynamics, IntermediateAxisSpinIsUnstable) { CheckIntermediateAxisSpi
 
 // The explicit path (Verner 6(5), projection onto the joints' and the
 // Euler parameters' norm rows after every step) to the same bounds.
-TEST(SpatialDynamics, ExplicitRungeKuttaIntermediateAxisSpinIsUnstable) { CheckIntermediateAxisSpinIsUnstable(Method::kExplicitRungeKutta); }
+TEST(SpatialDynamics, ExplicitRungeKuttaIntermediateAxisSpinIsUnstable) {
+  CheckIntermediateAxisSpinIsUnstable(Method::kExplicitRungeKutta);
+}
 
 // Major axis (spin about 3): the perturbation oscillates, never grows.
 TEST(SpatialDynamics, MajorAxisSpinIsStable) {
@@ -332,14 +338,17 @@ void CheckCylindricalJointSlidesFreely(Method method) {
   }
   EXPECT_LT(slide, 1e-8);  // m
   EXPECT_LT(turn, 1e-6);   // rad
-  std::cout << MethodName(method) << "cylindrical slide: " << slide << " m, " << turn << " rad after " << w * 2.0 << " rad of turning\n";
+  std::cout << MethodName(method) << "cylindrical slide: " << slide << " m, " << turn << " rad after " << w * 2.0
+            << " rad of turning\n";
 }
 
 TEST(SpatialDynamics, CylindricalJointSlidesFreely) { CheckCylindricalJointSlidesFreely(Method::kImplicitBdf); }
 
 // The explicit path (Verner 6(5), projection onto the joints' and the
 // Euler parameters' norm rows after every step) to the same bounds.
-TEST(SpatialDynamics, ExplicitRungeKuttaCylindricalJointSlidesFreely) { CheckCylindricalJointSlidesFreely(Method::kExplicitRungeKutta); }
+TEST(SpatialDynamics, ExplicitRungeKuttaCylindricalJointSlidesFreely) {
+  CheckCylindricalJointSlidesFreely(Method::kExplicitRungeKutta);
+}
 
 // A crank on a revolute joint driven at angle 0.3 + 2 t, carrying a
 // pendulum on a second hinge: the crank follows its driver exactly (to the
