@@ -35,6 +35,7 @@
 #include "absl/status/statusor.h"
 #include "server/jobs/analysis_record.h"
 #include "server/jobs/front_run.h"
+#include "server/jobs/point_runs.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/options.h"
 #include "server/slp/problem.h"
@@ -57,7 +58,7 @@ struct ParetoGridSetup {
 class ParetoGridRun final : public FrontRun {
  public:
   // Point k's request r has id k * kRequestStride + r, as ParetoRun's.
-  static constexpr std::int64_t kRequestStride = 1'000'000'000;
+  static constexpr std::int64_t kRequestStride = kPointRequestStride;
 
   // InvalidArgument when the setup does not fit (a traded constraint with
   // no rows or rows of different limits, the same constraint twice, too

@@ -398,26 +398,9 @@ slp::AnalysisResult ParetoRun::ResultFor(const Point& point, const AnalysisRecor
   return result;
 }
 
-std::vector<slp::AnalysisRequest> ParetoRun::PendingRequests() const {
-  std::vector<slp::AnalysisRequest> pending;
-  for (std::size_t k = 0; k < points_.size(); ++k) {
-    const Point& point = points_[k];
-    if (point.run == nullptr || point.ended) continue;
-    for (slp::AnalysisRequest request : point.run->PendingRequests()) {
-      request.id += static_cast<std::int64_t>(k) * kRequestStride;
-      pending.push_back(std::move(request));
-    }
-  }
-  return pending;
-}
+std::vector<slp::AnalysisRequest> ParetoRun::PendingRequests() const { return PendingRequestsOfPoints(points_); }
 
-bool ParetoRun::IsPending(std::int64_t request_id) const {
-  if (request_id < 0) return false;
-  const std::int64_t k = request_id / kRequestStride;
-  if (k >= static_cast<std::int64_t>(points_.size())) return false;
-  const Point& point = points_[static_cast<std::size_t>(k)];
-  return point.run != nullptr && !point.ended && point.run->IsPending(request_id % kRequestStride);
-}
+bool ParetoRun::IsPending(std::int64_t request_id) const { return IsPendingInPoints(points_, request_id); }
 
 absl::Status ParetoRun::Submit(const AnalysisRecord& record) {
   if (!IsPending(record.request_id)) {
@@ -436,17 +419,7 @@ absl::Status ParetoRun::Submit(const AnalysisRecord& record) {
     End(k);
     StartRuns();
   }
-  std::int64_t analyses_total = emitted_ == 0 ? 0 : points_[emitted_ - 1].record.analyses_total;
-  while (emitted_ < points_.size() && points_[emitted_].ended) {
-    slp::CycleRecord& r = points_[emitted_].record;
-    analyses_total += r.pareto_analyses;
-    r.analyses_total = analyses_total;
-    std::vector<slp::CycleRecord>& cycles = points_[emitted_].cycles;
-    for (slp::CycleRecord& cycle : cycles) new_records_.push_back(std::move(cycle));
-    cycles = {};
-    new_records_.push_back(r);
-    ++emitted_;
-  }
+  EmitEndedPointsInOrder(&points_, &emitted_, &new_records_);
   return absl::OkStatus();
 }
 

@@ -51,6 +51,7 @@
 #include "absl/status/statusor.h"
 #include "server/jobs/analysis_record.h"
 #include "server/jobs/front_run.h"
+#include "server/jobs/point_runs.h"
 #include "server/lp/linear_program.h"
 #include "server/slp/options.h"
 #include "server/slp/problem.h"
@@ -84,7 +85,7 @@ class ParetoRun final : public FrontRun {
  public:
   // Point k's request r has id k * kRequestStride + r: far more analyses than
   // a run may use (JobRunOptions::max_analyses).
-  static constexpr std::int64_t kRequestStride = 1'000'000'000;
+  static constexpr std::int64_t kRequestStride = kPointRequestStride;
 
   // InvalidArgument when the setup does not fit (no rows for the traded
   // constraint, rows of different limits, too few points).
