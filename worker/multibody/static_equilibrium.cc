@@ -31,7 +31,10 @@ struct Problem {
   VectorXd zero_velocity, forces, phi;
   MatrixXd phi_q;
   VectorXd offset;  // the homotopy's (1 - s) F(start), subtracted from F; empty otherwise
-  MatrixXd newton;  // NewtonMatrix's
+  MatrixXd newton;  // NewtonMatrix's and Stiffness's
+  // The system's derivatives are its exact state Jacobian and the options
+  // ask for them: KINSOL's Newton matrix and the stiffness are analytic.
+  bool analytic = false;
   std::int64_t newton_matrices = 0;
 };
 
@@ -72,10 +75,18 @@ spec::AnalysisFailure Failed(spec::FailureKind kind, std::string reason) {
   return spec::AnalysisFailure::Of(kind, std::move(reason));
 }
 
-// dF/dq at a solution by central differences (only the force rows are
-// needed: the stiffness).
+bool EquilibriumJacobianAt(const Problem& p, const VectorXd& x, MatrixXd* jacobian);
+
+// dF/dq of the force rows (the stiffness): the analytic matrix's block where
+// the system's derivatives are exact (the matrix KINSOL's Newton steps
+// use), else central differences of the residual.
 bool Stiffness(Problem* p, const VectorXd& x, MatrixXd* k) {
   const int n = p->n;
+  if (p->analytic) {
+    if (!EquilibriumJacobianAt(*p, x, &p->newton)) return false;
+    *k = p->newton.topLeftCorner(n, n);
+    return k->allFinite();
+  }
   k->resize(n, n);
   VectorXd xp = x, f_plus, f_minus;
   for (int i = 0; i < n; ++i) {
@@ -138,12 +149,16 @@ int NewtonMatrix(N_Vector uu, N_Vector /*fu*/, SUNMatrix matrix, void* user_data
   return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
     const int n = p->n, m = p->m, size = n + m;
     const Map<const VectorXd> x(N_VGetArrayPointer(uu), size);
-    if (!EquilibriumJacobian(*p->system, p->t, x.head(n), x.tail(m), &p->newton)) return 1;
+    if (!EquilibriumJacobianAt(*p, x, &p->newton)) return 1;
     if (!p->newton.allFinite()) return 1;
     ++p->newton_matrices;
     Map<MatrixXd>(SUNDenseMatrix_Data(matrix), size, size) = p->newton;
     return 0;
   });
+}
+
+bool EquilibriumJacobianAt(const Problem& p, const VectorXd& x, MatrixXd* jacobian) {
+  return EquilibriumJacobian(*p.system, p.t, x.head(p.n), x.tail(p.m), jacobian);
 }
 
 }  // namespace
@@ -205,6 +220,10 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
   if (times.empty()) return spec::AnalysisFailure::Ok();
   p.zero_velocity = VectorXd::Zero(n);
   p.t = times.front();
+  // The analytic matrix where the system's derivatives are its exact state
+  // Jacobian; a spatial system's (which leaves out terms) would slow Newton
+  // down to linear convergence, so its matrices are difference quotients.
+  p.analytic = options.analytic_newton_matrix && system.has_exact_state_jacobian();
 
   // Start: the assembled positions, multipliers by least squares, and the
   // scale of the force rows from the applied forces there.
@@ -267,14 +286,10 @@ spec::AnalysisFailure RunStaticEquilibrium(const ConstrainedSystem& system, cons
     fs[n + j] = constraint_tolerance[j] > options.tolerance ? options.tolerance / constraint_tolerance[j] : 1.0;
   }
   void* mem = kinsol.get();
-  // The analytic matrix where the system's derivatives are its exact state
-  // Jacobian; a spatial system's (which leaves out terms) would slow Newton
-  // down to linear convergence, so KINSOL differences its residual there.
-  const bool analytic = options.analytic_newton_matrix && system.has_exact_state_jacobian();
   if (KINInit(mem, Residual, u.get()) != KIN_SUCCESS || KINSetUserData(mem, &p) != KIN_SUCCESS ||
       KINSetErrHandlerFn(mem, sundials::CaptureMessage, &message) != KIN_SUCCESS ||
       KINSetLinearSolver(mem, solver.get(), jacobian.get()) != KIN_SUCCESS ||
-      (analytic && KINSetJacFn(mem, NewtonMatrix) != KIN_SUCCESS) ||
+      (p.analytic && KINSetJacFn(mem, NewtonMatrix) != KIN_SUCCESS) ||
       // A fresh Jacobian every iteration: plain Newton, quadratic near the
       // solution; the systems are small.
       KINSetMaxSetupCalls(mem, 1) != KIN_SUCCESS || KINSetFuncNormTol(mem, options.tolerance) != KIN_SUCCESS ||

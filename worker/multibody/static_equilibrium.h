@@ -52,9 +52,10 @@ struct StaticOptions {
   // translation rows of a body share one floor, its rotation rows another.
   int coordinates_per_body = 3;
   int translations_per_body = 2;
-  // KINSOL's Newton matrix from the system's analytic derivatives
-  // (EquilibriumJacobian) where they are its exact state Jacobian; false,
-  // or a system without one: KINSOL's difference quotients.
+  // KINSOL's Newton matrix and the stiffness (round-off floors, stability
+  // check) from the system's analytic derivatives (EquilibriumJacobian)
+  // where they are its exact state Jacobian; false, or a system without
+  // one: difference quotients.
   bool analytic_newton_matrix = true;
   // Charged one step per instant and per continuation step; also the
   // deadline and cancel flag. Null: no limit.
