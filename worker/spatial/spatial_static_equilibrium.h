@@ -15,8 +15,13 @@
 // Every free direction needs some stiffness (a joint, a spring, a bushing,
 // gravity on a pendulum): a body that may spin freely has a singular
 // Newton matrix and no isolated equilibrium; it fails as kAssembly naming
-// the time. Redundant joints are refused (kInvalidModel): their rows would
-// make the Newton matrix singular too.
+// the time. Redundant joints (redundant_constraints.h) would make the
+// Newton matrix singular too: each instant is solved with the joint rows
+// replaced by independent combinations of them, taken at the previous
+// instant's equilibrium (the assembled start's for the first), and every
+// row of the full system is checked at the result (kRowBound); a change of
+// rank or a row left unheld ends the analysis (kAssembly) naming the time.
+// Their multipliers belong to the combinations.
 #pragma once
 
 #include <vector>
