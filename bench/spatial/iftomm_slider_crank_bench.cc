@@ -17,7 +17,10 @@
 // mbopt runs in this process: IDAS (rtol = atol = tolerance) and the
 // explicit path (Verner 6(5) with projection). Simbody runs as the program
 // mbopt_simbody_spatial_oracle (tests/spatial) with Runge-Kutta-Merson and
-// CPodes' BDF, accuracy = tolerance.
+// CPodes' BDF, accuracy = tolerance. For each mbopt run, the ratio of its
+// CPU time to Simbody's at the same slider error, read off Simbody's curves
+// (the faster of the two) by linear interpolation in log-log, as
+// bench_spatial_workprec does.
 //
 //   build/bench/spatial/bench_spatial_slider_crank [--repeats=5] [--out=iftomm_slider_crank.csv]
 //
@@ -30,6 +33,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -179,6 +183,23 @@ double LargestDifference(const std::vector<double>& a, const std::vector<double>
   return worst;
 }
 
+// The time `curve` takes at `error`, by linear interpolation in
+// log(error)-log(time) between two of its runs whose errors bracket it (the
+// pair with the smallest time when several do); none outside its range.
+std::optional<double> TimeAtError(const std::vector<const Run*>& curve, double error) {
+  std::optional<double> best;
+  for (const Run* a : curve) {
+    for (const Run* b : curve) {
+      if (!a->ok || !b->ok || !(a->error_m > 0.0) || !(b->error_m > 0.0)) continue;
+      if (!(a->error_m >= error && b->error_m <= error) || a->error_m == b->error_m) continue;
+      const double w = std::log(error / a->error_m) / std::log(b->error_m / a->error_m);
+      const double t = std::exp((1 - w) * std::log(a->cpu_s) + w * std::log(b->cpu_s));
+      if (!best || t < *best) best = t;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -228,23 +249,41 @@ int main(int argc, char** argv) {
   for (double tol : tolerances) {
     if (tol >= kCpodesTightest) runs.push_back(RunSimbody("cpodes", tol, repeats));
   }
-  std::printf("| code | integrator | tolerance | slider x error (m) | energy change (J) | CPU (s) | steps |\n");
-  std::printf("|---|---|---|---|---|---|---|\n");
+  std::vector<const Run*> simbody_rkm, simbody_cpodes;
   for (Run& r : runs) {
     if (r.ok) {
       r.error_m = LargestDifference(r.slider_x_m, reference.slider_x_m);
       r.drift_j = Drift(r.energy_j);
     }
+    if (r.code == "simbody") (r.integrator == "rkm" ? simbody_rkm : simbody_cpodes).push_back(&r);
+  }
+  std::printf("| code | integrator | tolerance | slider x error (m) | energy change (J) | CPU (s) | steps | "
+              "CPU / Simbody's at this error (faster integrator) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (Run& r : runs) {
     std::string failure = r.failure;
     std::replace(failure.begin(), failure.end(), ',', ';');
     std::replace(failure.begin(), failure.end(), '\n', ' ');
     csv << r.code << "," << r.integrator << "," << r.tolerance << "," << r.error_m << "," << r.drift_j << ","
         << r.cpu_s << "," << r.steps << "," << failure << "\n";
     if (r.ok) {
-      std::printf("| %s | %s | %.0e | %.2g | %.2g | %.3g | %ld |\n", r.code.c_str(), r.integrator.c_str(),
-                  r.tolerance, r.error_m, r.drift_j, r.cpu_s, r.steps);
+      std::string ratio;
+      if (r.code == "mbopt") {
+        std::optional<double> t = TimeAtError(simbody_rkm, r.error_m);
+        const std::optional<double> t_cpodes = TimeAtError(simbody_cpodes, r.error_m);
+        const char* which = "rkm";
+        if (t_cpodes && (!t || *t_cpodes < *t)) {
+          t = t_cpodes;
+          which = "cpodes";
+        }
+        char text[64];
+        std::snprintf(text, sizeof text, "%.2f (%s)", t ? r.cpu_s / *t : NAN, which);
+        ratio = t ? text : "(Simbody's curves do not reach)";
+      }
+      std::printf("| %s | %s | %.0e | %.2g | %.2g | %.3g | %ld | %s |\n", r.code.c_str(), r.integrator.c_str(),
+                  r.tolerance, r.error_m, r.drift_j, r.cpu_s, r.steps, ratio.c_str());
     } else {
-      std::printf("| %s | %s | %.0e | failed: %s | | | |\n", r.code.c_str(), r.integrator.c_str(), r.tolerance,
+      std::printf("| %s | %s | %.0e | failed: %s | | | | |\n", r.code.c_str(), r.integrator.c_str(), r.tolerance,
                   failure.c_str());
     }
   }
