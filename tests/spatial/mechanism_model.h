@@ -1,6 +1,7 @@
 // The mbopt model of a mechanism of spatial_mechanisms.h: bodies with
-// their principal moments in body axes and start velocities, each joint's world frame fixed in
-// its two bodies (frames that coincide in the initial pose), the driver.
+// their principal moments in body axes and start velocities, each joint's
+// world frame fixed in its two bodies (frames that coincide in the initial
+// pose), the driver.
 #pragma once
 
 #include <Eigen/Dense>
