@@ -1,6 +1,7 @@
 // The mbopt model of a mechanism of spatial_mechanisms.h: bodies with
-// their principal moments in body axes, each joint's world frame fixed in
-// its two bodies (frames that coincide in the initial pose), the driver.
+// their principal moments in body axes and start velocities, each joint's
+// world frame fixed in its two bodies (frames that coincide in the initial
+// pose), the driver.
 #pragma once
 
 #include <Eigen/Dense>
@@ -28,6 +29,8 @@ inline Model ModelOf(const oracle::Mechanism& mechanism) {
     body.inertia_kg_m2 = ToVector(b.principal_moments_kg_m2).asDiagonal();
     body.position_m = ToVector(b.position_m);
     body.orientation = ToMatrix(b.orientation);
+    body.velocity_m_per_s = ToVector(b.velocity_m_per_s);
+    body.angular_velocity_rad_per_s = ToVector(b.angular_velocity_rad_per_s);
     model.bodies.push_back(body);
   }
   auto frame_on = [&](int body, const Eigen::Vector3d& point, const Eigen::Matrix3d& axes) {
@@ -51,6 +54,7 @@ inline Model ModelOf(const oracle::Mechanism& mechanism) {
       case oracle::MechanismJointKind::kSpherical: kind = Joint::Kind::kSpherical; break;
       case oracle::MechanismJointKind::kUniversal: kind = Joint::Kind::kUniversal; break;
       case oracle::MechanismJointKind::kPointOnLine: kind = Joint::Kind::kPointOnLine; break;
+      case oracle::MechanismJointKind::kPrismatic: kind = Joint::Kind::kPrismatic; break;
     }
     const Eigen::Vector3d point = ToVector(joint.point_m);
     const Eigen::Matrix3d axes = ToMatrix(joint.axes);

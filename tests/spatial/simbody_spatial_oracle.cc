@@ -2,18 +2,24 @@
 // its own for the reasons tests/oracle/simbody_oracle.h gives (Simbody 3.7's
 // headers are C++17 and its SimTKmath exports an old SUNDIALS' symbols).
 //
-//   mbopt_simbody_spatial_oracle [--integrator=rkm|cpodes] [--cpu=REPEATS]
+//   mbopt_simbody_spatial_oracle [--integrator=rkm|cpodes] [--cpu=REPEATS] [--energy]
 //       MECHANISM ACCURACY END_S INTERVALS
 //
 // MECHANISM is double_pendulum (released at rest),
 // spinning_double_pendulum or hung_chain (spatial_oracle.h), or one of the
-// closed loops of spatial_mechanisms.h: bricard, rssr, cardan, spherical_chain.
+// closed loops of spatial_mechanisms.h: bricard, rssr, cardan, spherical_chain,
+// slider_crank (the IFToMM spatial rigid slider-crank).
 // The options apply to the closed loops: the integrator (Runge-Kutta-Merson by
-// default, or CPodes' BDF) and CPU timing (see ClosedLoop). A closed loop becomes a
-// tree of mobilizers (each joint whose second body is not yet placed) and
+// default, or CPodes' BDF), CPU timing (see ClosedLoop) and --energy, which
+// appends the total energy (kinetic plus gravity's potential, J) to each
+// line. A closed loop becomes a
+// tree of mobilizers (each joint whose second body is not yet placed; a
+// prismatic joint is a MobilizedBody::Slider along W's z) and
 // constraints closing it: Constraint::Ball for a spherical joint, a ball
 // and two right angles (Constraint::ConstantAngle) for a revolute one,
-// Constraint::PointOnLine. Simbody solves its constraint equations with
+// Constraint::PointOnLine. Bodies start with the velocities the mechanism
+// gives (each mobilizer's u fitted to its bodies' relative velocity at the
+// joint), then projected onto the constraints. Simbody solves its constraint equations with
 // rank-revealing factorizations, so a redundant closure (Bricard's) is
 // given to it as it is.
 //
@@ -27,6 +33,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Simbody.h"
@@ -38,6 +45,7 @@ namespace {
 using namespace SimTK;
 
 std::string g_integrator = "rkm";
+bool g_energy = false;
 
 Rotation Initial(const mbopt::oracle::SpatialDoublePendulum& p, int body) {
   return Rotation(p.angle_rad[body], UnitVec3(Vec3(p.axis[body][0], p.axis[body][1], p.axis[body][2])));
@@ -115,7 +123,10 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
   };
   auto mobod = [&](int b) -> MobilizedBody& { return b < 0 ? matter.updGround() : bodies[b]; };
   std::vector<const mbopt::oracle::MechanismJoint*> closures;
-  std::vector<int> driven;  // the mobilizer of the driven joint
+  // Each mobilizer's joint and its F frame's axes in world at the start.
+  std::vector<std::pair<const mbopt::oracle::MechanismJoint*, Rotation>> mobilizers;
+  // A Slider translates along its frames' common x axis: W turned to put x on W's z.
+  const Rotation x_onto_z(-Pi / 2, YAxis);
   for (size_t k = 0; k < m.joints.size(); ++k) {
     const mbopt::oracle::MechanismJoint& j = m.joints[k];
     const bool parent_ready = j.a < 0 || placed[j.a];
@@ -128,6 +139,8 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
     const Body::Rigid info(MassProperties(mb.mass_kg, Vec3(0), Inertia(mb.principal_moments_kg_m2[0], mb.principal_moments_kg_m2[1], mb.principal_moments_kg_m2[2])));
     MobilizedBody& parent = mobod(j.a);
     const Transform x_pf = frame_in(j.a, j), x_bm = frame_in(j.b, j);
+    mobilizers.emplace_back(&j, j.kind == mbopt::oracle::MechanismJointKind::kPrismatic ? R(j.axes) * x_onto_z
+                                                                                        : R(j.axes));
     switch (j.kind) {
       case mbopt::oracle::MechanismJointKind::kRevolute:
         bodies[j.b] = MobilizedBody::Pin(parent, x_pf, info, x_bm);
@@ -137,6 +150,10 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
         break;
       case mbopt::oracle::MechanismJointKind::kUniversal:
         bodies[j.b] = MobilizedBody::Universal(parent, x_pf, info, x_bm);
+        break;
+      case mbopt::oracle::MechanismJointKind::kPrismatic:
+        bodies[j.b] = MobilizedBody::Slider(parent, Transform(x_pf.R() * x_onto_z, x_pf.p()), info,
+                                            Transform(x_bm.R() * x_onto_z, x_bm.p()));
         break;
       case mbopt::oracle::MechanismJointKind::kPointOnLine:
         throw std::runtime_error("a point-on-line joint must close a loop");
@@ -164,12 +181,28 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
       case mbopt::oracle::MechanismJointKind::kPointOnLine:
         Constraint::PointOnLine(a, fa.z(), fa.p(), b, fb.p());
         break;
+      case mbopt::oracle::MechanismJointKind::kPrismatic:
+        throw std::runtime_error("a prismatic joint must be a mobilizer");
     }
   }
   State state = system.realizeTopology();
   // Every mobilizer at q = 0 is the initial pose; the driven one's rate and
-  // the velocities the loops then need come from the projection below.
+  // the velocities the loops then need come from the projection below,
+  // starting from the bodies' given velocities: each mobilizer's F and M
+  // frames coincide at the start, so its relative velocity is that of the
+  // child's point at the joint less the parent's, in F's axes.
   system.realize(state, Stage::Position);
+  auto point_velocity = [&](int b, const Vec3& point) {
+    if (b < 0) return Vec3(0);
+    const mbopt::oracle::MechanismBody& mb = m.bodies[b];
+    return V(mb.velocity_m_per_s) + V(mb.angular_velocity_rad_per_s) % (point - V(mb.position_m));
+  };
+  auto angular_velocity = [&](int b) { return b < 0 ? Vec3(0) : V(m.bodies[b].angular_velocity_rad_per_s); };
+  for (const auto& [j, f_axes] : mobilizers) {
+    const Vec3 w_fm = angular_velocity(j->b) - angular_velocity(j->a);
+    const Vec3 v_fm = point_velocity(j->b, V(j->point_m)) - point_velocity(j->a, V(j->point_m));
+    bodies[j->b].setUToFitVelocity(state, SpatialVec(~f_axes * w_fm, ~f_axes * v_fm));
+  }
   system.project(state, 1e-14);
   // The constraint tolerance follows the accuracy (as tests/oracle's, a
   // hundredth of it) but not below 1e-12, where the comparisons run.
@@ -202,6 +235,10 @@ int ClosedLoop(const mbopt::oracle::Mechanism& m, double accuracy, const std::ve
         for (int i = 0; i < 3; ++i) {
           for (int k = 0; k < 3; ++k) row.push_back(r[i][k]);
         }
+      }
+      if (g_energy) {
+        system.realize(s, Stage::Dynamics);
+        row.push_back(system.calcEnergy(s));
       }
       values.push_back(row);
     }
@@ -280,14 +317,18 @@ int main(int argc, char** argv) {
       g_integrator = option.substr(13);
     } else if (option.rfind("--cpu=", 0) == 0 && std::atoi(option.c_str() + 6) > 0) {
       cpu_repeats = std::atoi(option.c_str() + 6);
+    } else if (option == "--energy") {
+      g_energy = true;
     } else {
-      std::fprintf(stderr, "unknown option '%s' (expected --integrator=rkm|cpodes or --cpu=REPEATS > 0)\n",
+      std::fprintf(stderr,
+                   "unknown option '%s' (expected --integrator=rkm|cpodes, --cpu=REPEATS > 0 or --energy)\n",
                    option.c_str());
       return 2;
     }
   }
   if (argc - first != 4) {
-    std::fprintf(stderr, "usage: %s [--integrator=rkm|cpodes] [--cpu=REPEATS] MECHANISM ACCURACY END_S INTERVALS\n",
+    std::fprintf(stderr,
+                 "usage: %s [--integrator=rkm|cpodes] [--cpu=REPEATS] [--energy] MECHANISM ACCURACY END_S INTERVALS\n",
                  argv[0]);
     return 2;
   }
@@ -303,6 +344,9 @@ int main(int argc, char** argv) {
     if (mechanism == "bricard") return ClosedLoop(mbopt::oracle::Bricard(), accuracy, times, cpu_repeats);
     if (mechanism == "rssr") return ClosedLoop(mbopt::oracle::Rssr(), accuracy, times, cpu_repeats);
     if (mechanism == "cardan") return ClosedLoop(mbopt::oracle::CardanShaft(), accuracy, times, cpu_repeats);
+    if (mechanism == "slider_crank") {
+      return ClosedLoop(mbopt::oracle::SpatialSliderCrank(), accuracy, times, cpu_repeats);
+    }
     if (mechanism == "spherical_chain") {
       return ClosedLoop(mbopt::oracle::SphericalChain(), accuracy, times, cpu_repeats);
     }

@@ -3,13 +3,14 @@
 // two: no Simbody and no mbopt types here (C++17, for the oracle).
 //
 // A mechanism: bodies (mass, principal moments in body axes, centre of
-// mass and orientation at the start, at rest unless a driver moves them)
-// and joints. A joint is given by one world point and one world frame W
+// mass and orientation at the start, velocities at the start: at rest
+// unless given or a driver moves them) and joints. A joint is given by one world point and one world frame W
 // (columns x, y, z) shared by its two sides in the initial pose; each side
 // fixes it in its body. Kinds as in mbopt (worker/spatial/spatial_model.h):
 // revolute about W's z, spherical, universal with the cross's axes W's x
 // (in body a) and W's y (in body b), point on line (b's point on the line
-// through the point along W's z, fixed in a). Values, per instant: each
+// through the point along W's z, fixed in a), prismatic (b slides along
+// W's z fixed in a, without turning). Values, per instant: each
 // body's centre of mass (x, y, z, world, m) and rotation matrix (row by
 // row), 12 numbers per body.
 #pragma once
@@ -28,9 +29,13 @@ struct MechanismBody {
   Vec principal_moments_kg_m2{};  // about the body's own x, y, z
   Vec position_m{};                // centre of mass, world
   Mat orientation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // body to world
+  // At the start, world axes; consistent with the joints (neither code
+  // corrects them much: both take the least change onto the joints).
+  Vec velocity_m_per_s{};              // of the centre of mass
+  Vec angular_velocity_rad_per_s{};
 };
 
-enum class MechanismJointKind { kRevolute, kSpherical, kUniversal, kPointOnLine };
+enum class MechanismJointKind { kRevolute, kSpherical, kUniversal, kPointOnLine, kPrismatic };
 
 struct MechanismJoint {
   MechanismJointKind kind = MechanismJointKind::kRevolute;
@@ -192,6 +197,57 @@ inline Mechanism SphericalChain() {
     joint = {joint[0] + u[0], joint[1] + u[1], joint[2] + u[2]};
   }
   m.joints.push_back({MechanismJointKind::kSpherical, kChainBars - 1, -1, joint, AxesWithZAlongZ()});
+  m.gravity_m_per_s2 = {0, 0, -9.81};
+  return m;
+}
+
+// The spatial rigid slider-crank of the IFToMM library of computational
+// benchmark problems, from its published input data (SI, gravity 9.81
+// along -z, no friction, 5 s). A crank on a revolute joint about world x
+// at A = (0, 0.1, 0.12), its centre of mass on the hinge, its pin B 0.08
+// above A at the start, turning at 6 rad/s; a connecting rod of 0.3 from B
+// (spherical joint) to C = (0.2, 0, 0) on a slider (a block on a prismatic
+// joint along world x through the origin), held there by a universal joint
+// whose cross has one axis along x in the slider and the other normal to x
+// and to the rod, (0, 2, -1) / sqrt 5, in the rod. C's x is
+// sqrt(0.3^2 - 0.1^2 - 0.2^2) = 0.2. The start's velocities, from the
+// crank's rate by the loop's closed form: B moves at (0, -0.48, 0), the rod
+// turns at (1.92, -0.96, 0.48) (its component along (0, -1, -2), which the
+// cross holds, is zero) and the slider moves at 0.24 along x. One degree of
+// freedom. Bodies in this order: crank, rod, slider.
+inline constexpr double kSliderCrankRateRadPerS = 6.0;
+inline Mechanism SpatialSliderCrank() {
+  const double w = kSliderCrankRateRadPerS;
+  const double root5 = std::sqrt(5.0);
+  const Vec a{0, 0.1, 0.12}, b{0, 0.1, 0.2}, c{0.2, 0, 0};
+  MechanismBody crank, rod, slider;
+  crank.mass_kg = 0.12;
+  // Along x (the hinge), y and z (along the crank at the start).
+  crank.principal_moments_kg_m2 = {1e-4, 1e-4, 1e-5};
+  crank.position_m = a;
+  crank.angular_velocity_rad_per_s = {w, 0, 0};
+  rod.mass_kg = 0.5;
+  rod.principal_moments_kg_m2 = {4e-4, 4e-3, 4e-3};  // about its own axis (body x), transverse
+  rod.position_m = {(b[0] + c[0]) / 2, (b[1] + c[1]) / 2, (b[2] + c[2]) / 2};
+  // Body x along the rod (C - B) / 0.3, y along the cross's rod axis.
+  const Vec u{2.0 / 3, -1.0 / 3, -2.0 / 3}, n{0, 2 / root5, -1 / root5};
+  const Vec k{u[1] * n[2] - u[2] * n[1], u[2] * n[0] - u[0] * n[2], u[0] * n[1] - u[1] * n[0]};
+  rod.orientation = {u[0], n[0], k[0], u[1], n[1], k[1], u[2], n[2], k[2]};
+  // The closed form above is linear in the crank's rate w.
+  rod.angular_velocity_rad_per_s = {0.32 * w, -0.16 * w, 0.08 * w};
+  rod.velocity_m_per_s = {0.02 * w, -0.04 * w, 0};  // midway between B's and C's
+  slider.mass_kg = 2.0;
+  slider.principal_moments_kg_m2 = {1e-4, 1e-4, 1e-4};
+  slider.position_m = c;
+  slider.velocity_m_per_s = {0.04 * w, 0, 0};
+  Mechanism m;
+  m.bodies = {crank, rod, slider};
+  m.joints.push_back({MechanismJointKind::kRevolute, -1, 0, a, AxesWithZAlongX()});
+  m.joints.push_back({MechanismJointKind::kSpherical, 0, 1, b, AxesWithZAlongZ()});
+  m.joints.push_back({MechanismJointKind::kPrismatic, -1, 2, {0, 0, 0}, AxesWithZAlongX()});
+  // The cross: W's x = world x (in the slider), W's y = n (in the rod).
+  const Vec z{0, 1 / root5, 2 / root5};  // x cross n
+  m.joints.push_back({MechanismJointKind::kUniversal, 2, 1, c, {1, n[0], z[0], 0, n[1], z[1], 0, n[2], z[2]}});
   m.gravity_m_per_s2 = {0, 0, -9.81};
   return m;
 }
