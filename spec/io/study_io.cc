@@ -181,8 +181,20 @@ absl::Status ResolveScene(const std::string& path, bool inline_only, ParsedStudy
   return absl::OkStatus();
 }
 
+// A scene file given where a study is expected fails to parse at its first
+// scene field; say what it is instead of naming that field.
 absl::Status ParseStudy(const std::string& path, ParsedStudy* parsed) {
-  MBOPT_RETURN_IF_ERROR(ParseFile(path, &parsed->study, &parsed->study_tree));
+  if (absl::Status status = ParseFile(path, &parsed->study, &parsed->study_tree); !status.ok()) {
+    v1::Scene scene;
+    TextFormat::ParseInfoTree tree;
+    if (status.code() == absl::StatusCode::kInvalidArgument && ParseFile(path, &scene, &tree).ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          path, ": this is a scene file, and a study is expected here: a study names its scene with scene_file: \"",
+          std::filesystem::path(path).filename().string(),
+          "\" and adds the variables, objective and limits (docs/study.md); `mbopt draw` takes the scene itself"));
+    }
+    return status;
+  }
   return ResolveScene(path, /*inline_only=*/false, parsed);
 }
 

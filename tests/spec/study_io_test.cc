@@ -144,6 +144,21 @@ TEST_F(StudyFiles, SyntaxErrorNamesFileLineAndColumn) {
   EXPECT_THAT(error, ::testing::ContainsRegex(":[0-9]+:[0-9]+: "));
 }
 
+// The scene file given where the study belongs: said as such, not as the
+// scene's first field unknown to a study.
+TEST_F(StudyFiles, SceneFileGivenAsTheStudyIsNamedAsSuch) {
+  auto loaded = LoadStudyFile(Write("oscillator.scene.textproto", kScene));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument);
+  const std::string error(loaded.status().message());
+  EXPECT_THAT(error, HasSubstr(ScenePath() + ": this is a scene file, and a study is expected here"));
+  EXPECT_THAT(error, HasSubstr("scene_file: \"oscillator.scene.textproto\""));
+  // A study with a real mistake keeps its own message.
+  const std::string typo = LoadError(kScene, Replace(kStudy, "name:", "nmae:"));
+  EXPECT_THAT(typo, ::testing::Not(HasSubstr("this is a scene file")));
+  EXPECT_THAT(typo, HasSubstr("nmae"));
+}
+
 TEST_F(StudyFiles, UnknownFieldIsASyntaxErrorWithItsLine) {
   const std::string scene = Replace(kScene, "dofs: DOF_Y", "dofs: DOF_Y colour: 3");
   const std::string error = LoadError(scene, kStudy);
