@@ -153,7 +153,7 @@ double OutputValue(const SpatialSystem& system, const Model& model, const spec::
       return -lambda[system.row_of_driver(o.driver)];
     case Quantity::kBushingForce: return BushingLoadOf(model, o.bushing, s.q, s.v).force_n[axis];
     case Quantity::kBushingMoment: return BushingLoadOf(model, o.bushing, s.q, s.v).moment_n_m[axis];
-    case Quantity::kRotationalSpringTorque: return RotationalSpringTorque(model, o.spring, s.q, s.v);
+    case Quantity::kRotationalSpringTorque: return system.RotationalSpringTorque(o.spring, s.q, s.v);
   }
   return NAN;
 }
