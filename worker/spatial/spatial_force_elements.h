@@ -19,7 +19,8 @@
 // energy; they depend only on the relative pose, so they conserve
 // momentum. The force on body b, at b's origin, is -(K u + C du/dt) in
 // a's axes; the couple on b is the moment whose power equals that of the
-// angles' generalized forces (docs/physics.md, "Spatial force elements").
+// angles' generalized forces (docs/physics.md section 8, "Force elements"
+// and "Why x-y-z angles for the bushing").
 // Past kBushingMiddleAngleLimit_rad the analysis ends naming the bushing
 // (a validity bound; an evaluation outside a continued scope fails).
 //
