@@ -412,6 +412,51 @@ TEST(SpatialForces, BushingNearItsSingularMiddleAngleEndsTheAnalysisNamingIt) {
   std::cout << "bushing past its limit: " << r.failure.reason << "\n";
 }
 
+// The same limit in a kinematic analysis, whose motion does not read the
+// bushing: a hinge about world y driven from 80 deg at 1 rad/s turns the
+// bushing's frame about its y axis; the analysis ends at the first instant
+// past 85 deg (t = 0.0873 s), 0.09 s, naming the bushing.
+constexpr char kDrivenPastTheLimit[] = R"pb(
+  spatial {
+    ground_markers { name: "mount" }
+    ground_markers { name: "hinge" orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } } }
+    bodies {
+      name: "rotor"
+      mass_kg { value: 2 }
+      principal_inertia { moments_kg_m2 { x { value: 0.1 } y { value: 0.2 } z { value: 0.25 } } }
+      orientation { axis_angle { axis { y { value: 1 } } angle_deg: 80 } }
+      markers { name: "mount" }
+      markers { name: "pivot" orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } } }
+    }
+    joints { name: "hinge" kind: SPATIAL_JOINT_REVOLUTE a: "ground.hinge" b: "rotor.pivot" }
+    drivers { joint: "hinge" constant_rate { start { expr: "80 * pi / 180" } rate { value: 1 } } }
+    bushings {
+      name: "mount" a: "ground.mount" b: "rotor.mount"
+      rotational_stiffness_n_m_per_rad { x { value: 10 } y { value: 6 } z { value: 4 } }
+    }
+  }
+  outputs { name: "moment_y" bushing_force { bushing: "mount" axis: AXIS_Y moment: true } }
+  time_grid { start_s: 0 end_s: 0.2 points: 21 }
+)pb";
+
+TEST(SpatialForces, KinematicAnalysisEndsWhereABushingReachesItsLimit) {
+  const spec::AnalysisReport r = engine::Analyze(Load(kDrivenPastTheLimit), {});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.formulation, spec::Formulation::kKinematic);
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kModelValidity);
+  EXPECT_NE(r.failure.reason.find("bushing 'mount'"), std::string::npos) << r.failure.reason;
+  EXPECT_NE(r.failure.reason.find("t = 0.09 s"), std::string::npos) << r.failure.reason;
+  // Up to 0.08 s it runs, the moment about y -6 times the angle.
+  std::string before = kDrivenPastTheLimit;
+  const std::string grid = "end_s: 0.2 points: 21";
+  before.replace(before.find(grid), grid.size(), "end_s: 0.08 points: 9");
+  const spec::AnalysisReport ok = AnalyzeScene(Load(before));
+  ASSERT_TRUE(ok.ok());
+  for (size_t i = 0; i < ok.times_s.size(); ++i) {
+    EXPECT_NEAR(Series(ok, "moment_y")[i], -6 * (80 * kPi / 180 + ok.times_s[i]), 1e-9);
+  }
+}
+
 // A flywheel (Izz = 0.25 kg m^2) on a hinge about world z with a torsion
 // spring (k = 4 N m/rad, undamped): theta'' = -W^2 (theta - theta0), W = 4
 // rad/s. Released at rest at theta = 0 with the spring free at theta0 = 5
@@ -485,6 +530,30 @@ TEST(SpatialForces, FlywheelOnASpringWoundTurnsSwingsAtSqrtKOverI) {
   const spec::AnalysisReport once = AnalyzeScene(scene, {5 * kPi, 0.0}), again = AnalyzeScene(scene, {5 * kPi, 0.0});
   EXPECT_EQ(Series(once, "torque"), Series(again, "torque"));
   EXPECT_EQ(Series(once, "angle"), Series(again, "angle"));
+}
+
+// The wound flywheel on the explicit path, which shares its step loop with
+// the planar engine: the turns are counted the same way (the spring's
+// torque follows -k (theta - theta0) through the five turns).
+TEST(SpatialForces, FlywheelOnASpringWoundTurnsOnTheExplicitPath) {
+  std::string text = kWoundFlywheel;
+  const std::string block = "integrator {";
+  text.insert(text.find(block) + block.size(), " method: EXPLICIT_RUNGE_KUTTA");
+  const spec::Scene scene = Load(text);
+  ASSERT_EQ(scene.integrator.method, spec::IntegratorMethod::kExplicitRungeKutta);
+  const double k = 4, w = 4, theta0 = 5 * kPi;
+  const spec::AnalysisReport r = AnalyzeScene(scene, {theta0, 0.0});
+  ASSERT_TRUE(r.ok());
+  double worst_angle = 0, worst_torque = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double theta = theta0 * (1 - std::cos(w * r.times_s[i]));
+    worst_angle = std::max(worst_angle, std::abs(std::remainder(Series(r, "angle")[i] - theta, 2 * kPi)));
+    worst_torque = std::max(worst_torque, std::abs(Series(r, "torque")[i] + k * (theta - theta0)));
+  }
+  EXPECT_LT(worst_angle, 1e-7);   // rad
+  EXPECT_LT(worst_torque, 4e-7);  // N m, of 63
+  std::cout << "wound flywheel, explicit path: largest error of the angle " << worst_angle << " rad, of the torque "
+            << worst_torque << " N m\n";
 }
 
 // The flywheel driven at 3 rad/s through two turns (kinematic analysis)
