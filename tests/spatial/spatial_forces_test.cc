@@ -280,11 +280,14 @@ TEST(SpatialForces, BodyOnABushingOscillatesAtSqrtKOverM) {
 // its z axis (a principal axis) from the ground's: released at rest, it
 // turns about that axis alone with the angle theta = -70 deg cos(W t),
 // W = sqrt(kz / Izz) = 4 rad/s, under the moment -kz theta (a small-angle
-// measure's -kz sin(theta) is 12 % short at 70 deg and changes the
+// measure's -kz sin(theta) is 23 % short at 70 deg and changes the
 // period); its energy kz theta^2 / 2 trades with Izz theta'^2 / 2.
 constexpr char kTurnedRotor[] = R"pb(
   spatial {
-    ground_markers { name: "mount" orientation { axis_angle { axis { x { value: 1 } y { value: 2 } z { value: 3 } } angle_deg: 50 } } }
+    ground_markers {
+      name: "mount"
+      orientation { axis_angle { axis { x { value: 1 } y { value: 2 } z { value: 3 } } angle_deg: 50 } }
+    }
     bodies {
       name: "rotor"
       mass_kg { value: 2 }
