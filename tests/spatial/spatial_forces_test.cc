@@ -502,10 +502,12 @@ constexpr char kWoundFlywheel[] = R"pb(
 TEST(SpatialForces, FlywheelOnASpringWoundTurnsSwingsAtSqrtKOverI) {
   const spec::Scene scene = Load(kWoundFlywheel);
   const double k = 4, w = 4;
+  spec::AnalysisReport wound_report;
   for (const bool wound : {true, false}) {
     const double theta0 = wound ? 5 * kPi : 0, spin = wound ? 0 : 24 * kPi;
     const spec::AnalysisReport r = AnalyzeScene(scene, {theta0, spin});
     ASSERT_TRUE(r.ok());
+    if (wound) wound_report = r;
     double worst_angle = 0, worst_rate = 0, worst_torque = 0, worst_energy = 0, widest = 0;
     const double energy0 = Series(r, "kinetic")[0] + Series(r, "potential")[0];
     for (size_t i = 0; i < r.times_s.size(); ++i) {
@@ -530,9 +532,9 @@ TEST(SpatialForces, FlywheelOnASpringWoundTurnsSwingsAtSqrtKOverI) {
               << energy0 << "\n";
   }
   // A rerun evaluates the same states in the same order: the same bits.
-  const spec::AnalysisReport once = AnalyzeScene(scene, {5 * kPi, 0.0}), again = AnalyzeScene(scene, {5 * kPi, 0.0});
-  EXPECT_EQ(Series(once, "torque"), Series(again, "torque"));
-  EXPECT_EQ(Series(once, "angle"), Series(again, "angle"));
+  const spec::AnalysisReport again = AnalyzeScene(scene, {5 * kPi, 0.0});
+  EXPECT_EQ(Series(wound_report, "torque"), Series(again, "torque"));
+  EXPECT_EQ(Series(wound_report, "angle"), Series(again, "angle"));
 }
 
 // The wound flywheel on the explicit path, which shares its step loop with
