@@ -6,9 +6,9 @@
 //       MECHANISM ACCURACY END_S INTERVALS
 //
 // MECHANISM is double_pendulum (released at rest),
-// spinning_double_pendulum or hung_chain (spatial_oracle.h), or one of the
-// closed loops of spatial_mechanisms.h: bricard, rssr, cardan, spherical_chain,
-// slider_crank (the IFToMM spatial rigid slider-crank).
+// spinning_double_pendulum, hung_chain or bushing_body (spatial_oracle.h), or
+// one of the closed loops of spatial_mechanisms.h: bricard, rssr, cardan,
+// spherical_chain, slider_crank (the IFToMM spatial rigid slider-crank).
 // The options apply to the closed loops: the integrator (Runge-Kutta-Merson by
 // default, or CPodes' BDF), CPU timing (see ClosedLoop) and --energy, which
 // appends the total energy (kinetic plus gravity's potential, J) to each
@@ -98,6 +98,7 @@ int DoublePendulum(bool spinning, double accuracy, const std::vector<double>& ti
 
 
 Vec3 V(const mbopt::oracle::Vec& v) { return Vec3(v[0], v[1], v[2]); }
+Vec3 V3(const double* v) { return Vec3(v[0], v[1], v[2]); }
 
 Rotation R(const mbopt::oracle::Mat& m) {
   return Rotation(Mat33(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8]));
@@ -306,6 +307,52 @@ int HungChain(double accuracy, const std::vector<double>& times) {
   return 0;
 }
 
+// The body of SpatialBushingBody on a Free mobilizer (its frame at the
+// centre of mass), held by Force::LinearBushing.
+int BushingBody(double accuracy, const std::vector<double>& times) {
+  const mbopt::oracle::SpatialBushingBody p;
+  MultibodySystem system;
+  SimbodyMatterSubsystem matter(system);
+  GeneralForceSubsystem forces(system);
+  Force::UniformGravity gravity(forces, matter, Vec3(0, 0, -p.g));
+  const Body::Rigid info(
+      MassProperties(p.mass_kg, Vec3(0), Inertia(Vec3(p.inertia_kg_m2[0], p.inertia_kg_m2[1], p.inertia_kg_m2[2]))));
+  MobilizedBody::Free body(matter.Ground(), Transform(), info, Transform());
+  const Rotation ground_axes(p.ground_angle_rad, UnitVec3(V3(p.ground_axis)));
+  const Vec3 ground_origin = V3(p.ground_frame_m), body_frame = V3(p.body_frame_m);
+  Vec6 stiffness, damping;
+  for (int k = 0; k < 6; ++k) {
+    stiffness[k] = p.stiffness[k];
+    damping[k] = p.damping[k];
+  }
+  Force::LinearBushing bushing(forces, matter.Ground(), Transform(ground_axes, ground_origin), body,
+                               Transform(Rotation(), body_frame), stiffness, damping);
+  State state = system.realizeTopology();
+  const Rotation turned = ground_axes * Rotation(p.turn_angle_rad, UnitVec3(V3(p.turn_axis)));
+  const Vec3 origin = ground_origin + ground_axes * V3(p.displacement_m) - turned * body_frame;
+  body.setQToFitTransform(state, Transform(turned, origin));
+  body.setUToFitAngularVelocity(state, V3(p.angular_velocity_rad_per_s));
+  body.setUToFitLinearVelocity(state, V3(p.velocity_m_per_s));
+  RungeKuttaMersonIntegrator integrator(system);
+  integrator.setAccuracy(accuracy);
+  TimeStepper stepper(system, integrator);
+  stepper.initialize(state);
+  for (double t : times) {
+    if (t > 0.0) stepper.stepTo(t);
+    const State& s = integrator.getState();
+    system.realize(s, Stage::Position);
+    std::printf("%.17g", t);
+    const Vec3 c = body.getBodyOriginLocation(s);
+    std::printf(" %.17g %.17g %.17g", c[0], c[1], c[2]);
+    const Rotation& r = body.getBodyRotation(s);
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) std::printf(" %.17g", r[i][k]);
+    }
+    std::printf("\n");
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -341,6 +388,7 @@ int main(int argc, char** argv) {
     if (mechanism == "double_pendulum") return DoublePendulum(false, accuracy, times);
     if (mechanism == "spinning_double_pendulum") return DoublePendulum(true, accuracy, times);
     if (mechanism == "hung_chain") return HungChain(accuracy, times);
+    if (mechanism == "bushing_body") return BushingBody(accuracy, times);
     if (mechanism == "bricard") return ClosedLoop(mbopt::oracle::Bricard(), accuracy, times, cpu_repeats);
     if (mechanism == "rssr") return ClosedLoop(mbopt::oracle::Rssr(), accuracy, times, cpu_repeats);
     if (mechanism == "cardan") return ClosedLoop(mbopt::oracle::CardanShaft(), accuracy, times, cpu_repeats);

@@ -214,8 +214,7 @@ TEST(SpatialForces, TorsionalPendulumSwingsAtSqrtKOverI) {
 // 0.5 m/s along the markers' x axis and turning at 1e-3 rad/s about z: it
 // moves only along that axis, u = v0 / Wd e^(-zeta W t) sin Wd t with
 // W = sqrt(200 / 2) = 10 rad/s and zeta = 0.1, and yaws by
-// (1e-3 / 4) sin 4 t (W = sqrt(4 / 0.25); the small-angle measure adds a
-// relative error of the order of the angle squared).
+// (1e-3 / 4) sin 4 t (W = sqrt(4 / 0.25)) under the moment -4 yaw.
 constexpr char kBushingMount[] = R"pb(
   spatial {
     ground_markers { name: "mount" orientation { axis_angle { axis { z { value: 1 } } angle_deg: 30 } } }
@@ -266,7 +265,7 @@ TEST(SpatialForces, BodyOnABushingOscillatesAtSqrtKOverM) {
     worst_yaw = std::max(worst_yaw, std::abs(Series(r, "yaw")[i] - yaw));
     worst_force = std::max({worst_force, std::abs(Series(r, "force_x")[i] - (-200 * u - 4 * u_rate)),
                             std::abs(Series(r, "force_y")[i])});
-    EXPECT_NEAR(Series(r, "moment_z")[i], -4 * std::sin(Series(r, "yaw")[i]), 1e-12);
+    EXPECT_NEAR(Series(r, "moment_z")[i], -4 * Series(r, "yaw")[i], 1e-12);
   }
   EXPECT_LT(worst_u, 1e-8);
   EXPECT_LT(worst_across, 1e-8);
@@ -274,6 +273,332 @@ TEST(SpatialForces, BodyOnABushingOscillatesAtSqrtKOverM) {
   EXPECT_LT(worst_force, 1e-6);
   std::cout << "bushing mount: largest error along the axis " << worst_u << " m, across it " << worst_across
             << " m, of the yaw " << worst_yaw << " rad, of the force " << worst_force << " N\n";
+}
+
+// A rotor (Izz = 0.25 kg m^2) on a bushing to ground whose frames' axes are
+// turned by 50 deg about (1, 2, 3), the body's frame turned by -70 deg about
+// its z axis (a principal axis) from the ground's: released at rest, it
+// turns about that axis alone with the angle theta = -70 deg cos(W t),
+// W = sqrt(kz / Izz) = 4 rad/s, under the moment -kz theta (a small-angle
+// measure's -kz sin(theta) is 23 % short at 70 deg and changes the
+// period); its energy kz theta^2 / 2 trades with Izz theta'^2 / 2.
+constexpr char kTurnedRotor[] = R"pb(
+  spatial {
+    ground_markers {
+      name: "mount"
+      orientation { axis_angle { axis { x { value: 1 } y { value: 2 } z { value: 3 } } angle_deg: 50 } }
+    }
+    bodies {
+      name: "rotor"
+      mass_kg { value: 2 }
+      principal_inertia { moments_kg_m2 { x { value: 0.1 } y { value: 0.2 } z { value: 0.25 } } }
+      orientation { axis_angle { axis { x { value: 1 } y { value: 2 } z { value: 3 } } angle_deg: 50 } }
+      markers { name: "mount" orientation { axis_angle { axis { z { value: 1 } } angle_deg: -70 } } }
+    }
+    bushings {
+      name: "mount" a: "ground.mount" b: "rotor.mount"
+      stiffness_n_per_m { x { value: 200 } y { value: 800 } z { value: 50 } }
+      rotational_stiffness_n_m_per_rad { x { value: 10 } y { value: 6 } z { value: 4 } }
+    }
+  }
+  outputs { name: "moment_x" bushing_force { bushing: "mount" axis: AXIS_X moment: true } }
+  outputs { name: "moment_y" bushing_force { bushing: "mount" axis: AXIS_Y moment: true } }
+  outputs { name: "moment_z" bushing_force { bushing: "mount" axis: AXIS_Z moment: true } }
+  outputs { name: "wz" body_angular_velocity { body: "rotor" axis: AXIS_Z body_axes: true } }
+  outputs { name: "wx" body_angular_velocity { body: "rotor" axis: AXIS_X body_axes: true } }
+  outputs { name: "potential" potential_energy {} }
+  time_grid { start_s: 0 end_s: 3 points: 31 }
+  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-10 }
+)pb";
+
+TEST(SpatialForces, BushingTurnedAboutOneAxisPullsBackWithStiffnessTimesAngle) {
+  const spec::AnalysisReport r = AnalyzeScene(Load(kTurnedRotor));
+  ASSERT_TRUE(r.ok());
+  const double theta0 = 70 * kPi / 180, w = 4, kz = 4;
+  double worst_moment = 0, worst_rate = 0, worst_energy = 0, worst_across = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double t = r.times_s[i], theta = -theta0 * std::cos(w * t);
+    worst_moment = std::max(worst_moment, std::abs(Series(r, "moment_z")[i] + kz * theta));
+    worst_rate = std::max(worst_rate, std::abs(Series(r, "wz")[i] - theta0 * w * std::sin(w * t)));
+    worst_energy = std::max(worst_energy, std::abs(Series(r, "potential")[i] - 0.5 * kz * theta * theta));
+    worst_across = std::max({worst_across, std::abs(Series(r, "moment_x")[i]), std::abs(Series(r, "moment_y")[i]),
+                             std::abs(Series(r, "wx")[i])});
+  }
+  EXPECT_LT(worst_moment, 1e-7);  // N m, of 4.9
+  EXPECT_LT(worst_rate, 1e-7);    // rad/s, of 4.9
+  EXPECT_LT(worst_energy, 1e-7);  // J, of 3.0
+  EXPECT_LT(worst_across, 1e-9);
+  std::cout << "rotor turned 70 deg on a bushing: largest error of the moment " << worst_moment
+            << " N m, of the rate " << worst_rate << " rad/s, of the energy " << worst_energy << " J\n";
+}
+
+// An undamped body on a bushing released with its frame turned by the
+// x-y-z angles (40, -30, 55) deg from the ground's and spinning at
+// (1, -0.5, 0.8) rad/s: the bushing's strain energy at the start is
+// (kx 40^2 + ky 30^2 + kz 55^2) (pi / 180)^2 / 2 (its angles are those
+// angles), and kinetic plus strain energy holds over the motion (the
+// moments are the energy's exact gradient).
+constexpr char kTumblingOnABushing[] = R"pb(
+  spatial {
+    ground_markers { name: "mount" position_m { z { value: 0.1 } } }
+    bodies {
+      name: "body"
+      mass_kg { value: 1.5 }
+      principal_inertia { moments_kg_m2 { x { value: 0.08 } y { value: 0.05 } z { value: 0.03 } } }
+      angular_velocity_rad_per_s { x { value: 1 } y { value: -0.5 } z { value: 0.8 } }
+      markers {
+        name: "mount" position_m { z { value: 0.1 } }
+        orientation { euler_angles { sequence: EULER_XYZ angles_deg: [40, -30, 55] } }
+      }
+    }
+    bushings {
+      name: "mount" a: "ground.mount" b: "body.mount"
+      stiffness_n_per_m { x { value: 400 } y { value: 250 } z { value: 600 } }
+      rotational_stiffness_n_m_per_rad { x { value: 3 } y { value: 5 } z { value: 2 } }
+    }
+  }
+  outputs { name: "kinetic" kinetic_energy {} }
+  outputs { name: "potential" potential_energy {} }
+  outputs { name: "wx" body_angular_velocity { body: "body" axis: AXIS_X } }
+  time_grid { start_s: 0 end_s: 2 points: 41 }
+  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-10 }
+)pb";
+
+TEST(SpatialForces, UndampedBushingKeepsItsEnergyAtLargeRotations) {
+  const spec::AnalysisReport r = AnalyzeScene(Load(kTumblingOnABushing));
+  ASSERT_TRUE(r.ok());
+  const double d = kPi / 180;
+  const double strain0 = 0.5 * (3 * 40 * 40 + 5 * 30 * 30 + 2 * 55 * 55) * d * d;
+  EXPECT_NEAR(Series(r, "potential")[0], strain0, 1e-12);
+  const double energy0 = Series(r, "kinetic")[0] + Series(r, "potential")[0];
+  double worst = 0, swing = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    worst = std::max(worst, std::abs(Series(r, "kinetic")[i] + Series(r, "potential")[i] - energy0));
+    swing = std::max(swing, std::abs(Series(r, "wx")[i] - Series(r, "wx")[0]));
+  }
+  EXPECT_GT(swing, 1.0);                 // rad/s: it tumbles
+  EXPECT_LT(worst, 1e-8 * energy0);      // J, of 2.4
+  std::cout << "body tumbling on a bushing: energy " << energy0 << " J, largest change " << worst << " J\n";
+}
+
+// The rotor of kTurnedRotor turned 80 deg about its frame's y axis (the
+// middle of the x-y-z angles) and spinning further at 1 rad/s with no
+// stiffness about y: the angle reaches the bushing's 85 deg limit near
+// t = 0.087 s and the analysis ends there, naming the bushing.
+constexpr char kBushingPastItsLimit[] = R"pb(
+  spatial {
+    ground_markers { name: "mount" }
+    bodies {
+      name: "rotor"
+      mass_kg { value: 2 }
+      principal_inertia { moments_kg_m2 { x { value: 0.1 } y { value: 0.2 } z { value: 0.25 } } }
+      angular_velocity_rad_per_s { y { value: 1 } }
+      markers { name: "mount" orientation { axis_angle { axis { y { value: 1 } } angle_deg: 80 } } }
+    }
+    bushings {
+      name: "mount" a: "ground.mount" b: "rotor.mount"
+      stiffness_n_per_m { x { value: 200 } y { value: 800 } z { value: 50 } }
+      rotational_stiffness_n_m_per_rad { x { value: 10 } z { value: 4 } }
+    }
+  }
+  outputs { name: "wy" body_angular_velocity { body: "rotor" axis: AXIS_Y } }
+  time_grid { start_s: 0 end_s: 1 points: 11 }
+  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-10 }
+)pb";
+
+TEST(SpatialForces, BushingNearItsSingularMiddleAngleEndsTheAnalysisNamingIt) {
+  const spec::AnalysisReport r = engine::Analyze(Load(kBushingPastItsLimit), {});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kModelValidity);
+  EXPECT_NE(r.failure.reason.find("bushing 'mount'"), std::string::npos) << r.failure.reason;
+  EXPECT_NE(r.failure.reason.find("t = 0.0872"), std::string::npos) << r.failure.reason;
+  std::cout << "bushing past its limit: " << r.failure.reason << "\n";
+}
+
+// The same limit in a kinematic analysis, whose motion does not read the
+// bushing: a hinge about world y driven from 80 deg at 1 rad/s turns the
+// bushing's frame about its y axis; the analysis ends at the first instant
+// past 85 deg (t = 0.0873 s), 0.09 s, naming the bushing.
+constexpr char kDrivenPastTheLimit[] = R"pb(
+  spatial {
+    ground_markers { name: "mount" }
+    ground_markers { name: "hinge" orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } } }
+    bodies {
+      name: "rotor"
+      mass_kg { value: 2 }
+      principal_inertia { moments_kg_m2 { x { value: 0.1 } y { value: 0.2 } z { value: 0.25 } } }
+      orientation { axis_angle { axis { y { value: 1 } } angle_deg: 80 } }
+      markers { name: "mount" }
+      markers { name: "pivot" orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } } }
+    }
+    joints { name: "hinge" kind: SPATIAL_JOINT_REVOLUTE a: "ground.hinge" b: "rotor.pivot" }
+    drivers { joint: "hinge" constant_rate { start { expr: "80 * pi / 180" } rate { value: 1 } } }
+    bushings {
+      name: "mount" a: "ground.mount" b: "rotor.mount"
+      rotational_stiffness_n_m_per_rad { x { value: 10 } y { value: 6 } z { value: 4 } }
+    }
+  }
+  outputs { name: "moment_y" bushing_force { bushing: "mount" axis: AXIS_Y moment: true } }
+  time_grid { start_s: 0 end_s: 0.2 points: 21 }
+)pb";
+
+TEST(SpatialForces, KinematicAnalysisEndsWhereABushingReachesItsLimit) {
+  const spec::AnalysisReport r = engine::Analyze(Load(kDrivenPastTheLimit), {});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.formulation, spec::Formulation::kKinematic);
+  EXPECT_EQ(r.failure.kind, spec::FailureKind::kModelValidity);
+  EXPECT_NE(r.failure.reason.find("bushing 'mount'"), std::string::npos) << r.failure.reason;
+  EXPECT_NE(r.failure.reason.find("t = 0.09 s"), std::string::npos) << r.failure.reason;
+  // Up to 0.08 s it runs, the moment about y -6 times the angle.
+  std::string before = kDrivenPastTheLimit;
+  const std::string grid = "end_s: 0.2 points: 21";
+  before.replace(before.find(grid), grid.size(), "end_s: 0.08 points: 9");
+  const spec::AnalysisReport ok = AnalyzeScene(Load(before));
+  ASSERT_TRUE(ok.ok());
+  for (size_t i = 0; i < ok.times_s.size(); ++i) {
+    EXPECT_NEAR(Series(ok, "moment_y")[i], -6 * (80 * kPi / 180 + ok.times_s[i]), 1e-9);
+  }
+}
+
+// A flywheel (Izz = 0.25 kg m^2) on a hinge about world z with a torsion
+// spring (k = 4 N m/rad, undamped): theta'' = -W^2 (theta - theta0), W = 4
+// rad/s. Released at rest at theta = 0 with the spring free at theta0 = 5
+// pi (wound two and a half turns), theta = theta0 (1 - cos W t) swings
+// through five turns and back; free at 0 and started at 24 pi rad/s, theta
+// = 6 pi sin(W t), three turns either way. Over 5 s (three periods) the
+// hinge's angle (in (-pi, pi], compared modulo a turn), its rate and the
+// spring's torque -k (theta - theta0) follow the closed forms, and the
+// energy holds: the spring's angle counts the turns (a measure in (-pi,
+// pi] flips the torque at half a turn). At tolerance 1e-12: at 1e-10 the
+// angle's error over the fifteen turns it travels is 1.7e-6 rad (the
+// integrator's phase error, 1e-8 of the way).
+constexpr char kWoundFlywheel[] = R"pb(
+  parameters { name: "free_angle" value: 0 unit: "rad" }
+  parameters { name: "spin" value: 0 unit: "rad/s" }
+  spatial {
+    ground_markers { name: "axle" }
+    bodies {
+      name: "flywheel"
+      mass_kg { value: 5 }
+      principal_inertia { moments_kg_m2 { x { value: 0.13 } y { value: 0.13 } z { value: 0.25 } } }
+      angular_velocity_rad_per_s { z { param: "spin" } }
+      markers { name: "hub" }
+    }
+    joints { name: "axle" kind: SPATIAL_JOINT_REVOLUTE a: "ground.axle" b: "flywheel.hub" }
+    rotational_springs {
+      name: "torsion" joint: "axle"
+      stiffness_n_m_per_rad { value: 4 } free_angle_rad { param: "free_angle" }
+    }
+  }
+  outputs { name: "angle" joint_coordinate { joint: "axle" } }
+  outputs { name: "rate" joint_rate { joint: "axle" } }
+  outputs { name: "torque" rotational_spring_torque { spring: "torsion" } }
+  outputs { name: "kinetic" kinetic_energy {} }
+  outputs { name: "potential" potential_energy {} }
+  time_grid { start_s: 0 end_s: 5 points: 101 }
+  integrator { relative_tolerance: 1e-12 absolute_tolerance: 1e-12 }
+)pb";
+
+TEST(SpatialForces, FlywheelOnASpringWoundTurnsSwingsAtSqrtKOverI) {
+  const spec::Scene scene = Load(kWoundFlywheel);
+  const double k = 4, w = 4;
+  spec::AnalysisReport wound_report;
+  for (const bool wound : {true, false}) {
+    const double theta0 = wound ? 5 * kPi : 0, spin = wound ? 0 : 24 * kPi;
+    const spec::AnalysisReport r = AnalyzeScene(scene, {theta0, spin});
+    ASSERT_TRUE(r.ok());
+    if (wound) wound_report = r;
+    double worst_angle = 0, worst_rate = 0, worst_torque = 0, worst_energy = 0, widest = 0;
+    const double energy0 = Series(r, "kinetic")[0] + Series(r, "potential")[0];
+    for (size_t i = 0; i < r.times_s.size(); ++i) {
+      const double t = r.times_s[i];
+      const double theta = wound ? theta0 * (1 - std::cos(w * t)) : spin / w * std::sin(w * t);
+      const double rate = wound ? theta0 * w * std::sin(w * t) : spin * std::cos(w * t);
+      widest = std::max(widest, std::abs(theta - theta0));
+      worst_angle = std::max(worst_angle, std::abs(std::remainder(Series(r, "angle")[i] - theta, 2 * kPi)));
+      worst_rate = std::max(worst_rate, std::abs(Series(r, "rate")[i] - rate));
+      worst_torque = std::max(worst_torque, std::abs(Series(r, "torque")[i] + k * (theta - theta0)));
+      worst_energy =
+          std::max(worst_energy, std::abs(Series(r, "kinetic")[i] + Series(r, "potential")[i] - energy0));
+    }
+    EXPECT_GT(widest, 2 * 2 * kPi);  // the spring is wound by more than two turns
+    EXPECT_LT(worst_angle, 1e-7);    // rad
+    EXPECT_LT(worst_rate, 4e-7);     // rad/s, of 63 and 75
+    EXPECT_LT(worst_torque, 4e-7);   // N m, of 63 and 75
+    EXPECT_LT(worst_energy, 1e-8 * energy0);
+    std::cout << (wound ? "flywheel released wound 2.5 turns" : "flywheel started at 24 pi rad/s")
+              << ": largest error of the angle " << worst_angle << " rad, of the rate " << worst_rate
+              << " rad/s, of the torque " << worst_torque << " N m, of the energy " << worst_energy << " J of "
+              << energy0 << "\n";
+  }
+  // A rerun evaluates the same states in the same order: the same bits.
+  const spec::AnalysisReport again = AnalyzeScene(scene, {5 * kPi, 0.0});
+  EXPECT_EQ(Series(wound_report, "torque"), Series(again, "torque"));
+  EXPECT_EQ(Series(wound_report, "angle"), Series(again, "angle"));
+}
+
+// The wound flywheel on the explicit path, which shares its step loop with
+// the planar engine: the turns are counted the same way (the spring's
+// torque follows -k (theta - theta0) through the five turns).
+TEST(SpatialForces, FlywheelOnASpringWoundTurnsOnTheExplicitPath) {
+  std::string text = kWoundFlywheel;
+  const std::string block = "integrator {";
+  text.insert(text.find(block) + block.size(), " method: EXPLICIT_RUNGE_KUTTA");
+  const spec::Scene scene = Load(text);
+  ASSERT_EQ(scene.integrator.method, spec::IntegratorMethod::kExplicitRungeKutta);
+  const double k = 4, w = 4, theta0 = 5 * kPi;
+  const spec::AnalysisReport r = AnalyzeScene(scene, {theta0, 0.0});
+  ASSERT_TRUE(r.ok());
+  double worst_angle = 0, worst_torque = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double theta = theta0 * (1 - std::cos(w * r.times_s[i]));
+    worst_angle = std::max(worst_angle, std::abs(std::remainder(Series(r, "angle")[i] - theta, 2 * kPi)));
+    worst_torque = std::max(worst_torque, std::abs(Series(r, "torque")[i] + k * (theta - theta0)));
+  }
+  EXPECT_LT(worst_angle, 1e-7);   // rad
+  EXPECT_LT(worst_torque, 4e-7);  // N m, of 63
+  std::cout << "wound flywheel, explicit path: largest error of the angle " << worst_angle << " rad, of the torque "
+            << worst_torque << " N m\n";
+}
+
+// The flywheel driven at 3 rad/s through two turns (kinematic analysis)
+// against its spring (k = 4 N m/rad, c = 0.5 N m s/rad, free at 0.5 rad):
+// the spring's torque -k (3 t - 0.5) - 3 c over the whole way.
+constexpr char kDrivenWinding[] = R"pb(
+  spatial {
+    ground_markers { name: "axle" }
+    bodies {
+      name: "flywheel"
+      mass_kg { value: 5 }
+      principal_inertia { moments_kg_m2 { x { value: 0.13 } y { value: 0.13 } z { value: 0.25 } } }
+      markers { name: "hub" }
+    }
+    joints { name: "axle" kind: SPATIAL_JOINT_REVOLUTE a: "ground.axle" b: "flywheel.hub" }
+    drivers { joint: "axle" constant_rate { rate { value: 3 } } }
+    rotational_springs {
+      name: "torsion" joint: "axle"
+      stiffness_n_m_per_rad { value: 4 } damping_n_m_s_per_rad { value: 0.5 } free_angle_rad { value: 0.5 }
+    }
+  }
+  outputs { name: "torque" rotational_spring_torque { spring: "torsion" } }
+  outputs { name: "potential" potential_energy {} }
+  time_grid { start_s: 0 end_s: 4.18879 points: 49 }
+)pb";
+
+TEST(SpatialForces, DrivenSpringReportsItsTorqueThroughTwoTurns) {
+  const spec::AnalysisReport r = AnalyzeScene(Load(kDrivenWinding));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.formulation, spec::Formulation::kKinematic);
+  double worst_torque = 0, worst_energy = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double deflection = 3 * r.times_s[i] - 0.5;
+    worst_torque = std::max(worst_torque, std::abs(Series(r, "torque")[i] - (-4 * deflection - 0.5 * 3)));
+    worst_energy = std::max(worst_energy, std::abs(Series(r, "potential")[i] - 0.5 * 4 * deflection * deflection));
+  }
+  EXPECT_GT(3 * r.times_s.back(), 2 * 2 * kPi - 1e-4);  // two turns
+  EXPECT_LT(worst_torque, 1e-9);
+  EXPECT_LT(worst_energy, 1e-9);
+  std::cout << "spring driven through two turns: largest error of the torque " << worst_torque << " N m\n";
 }
 
 // A crank (2 kg, CoM at r = 0.15 m from the hinge axis and h = 0.05 m along

@@ -47,4 +47,33 @@ struct SpatialHungChain {
   double hinge_damping_n_m_s_per_rad[2] = {4.0, 1.0};  // Simbody's only
 };
 
+// A body hung by a bushing (Simbody's Force::LinearBushing) from a frame F
+// fixed in ground, under gravity (0, 0, -g), and released turned far from
+// the bushing's rest. F's origin is at ground_frame_m (world), its axes
+// the world's turned by ground_angle_rad about ground_axis; the bushing's
+// frame M on the body is at body_frame_m from the centre of mass (body
+// axes) with the body's axes. At the start M is turned from F by
+// turn_angle_rad about turn_axis and displaced by displacement_m (both in
+// F's axes); the body moves at velocity_m_per_s (its centre of mass) and
+// angular_velocity_rad_per_s (world axes). Stiffnesses and dampings as
+// Simbody orders them: about M's x-y-z angles in F, then along F's axes.
+// Values per instant: the centre of mass and the rotation matrix (row by
+// row), 12 numbers.
+struct SpatialBushingBody {
+  double g = 9.81;
+  double mass_kg = 1.5;
+  double inertia_kg_m2[3] = {0.08, 0.05, 0.03};  // principal, body axes
+  double ground_frame_m[3] = {0.1, -0.2, 0.3};
+  double ground_axis[3] = {0.3, -1.0, 0.4};
+  double ground_angle_rad = 0.5;
+  double body_frame_m[3] = {0.02, -0.03, 0.15};
+  double stiffness[6] = {3.0, 5.0, 2.0, 400.0, 250.0, 600.0};  // N m/rad, then N/m
+  double damping[6] = {0.02, 0.05, 0.01, 2.0, 1.0, 3.0};       // N m s/rad, then N s/m
+  double turn_axis[3] = {1.0, 0.8, -0.6};
+  double turn_angle_rad = 1.1;
+  double displacement_m[3] = {0.03, -0.02, 0.05};
+  double velocity_m_per_s[3] = {0.1, 0.2, -0.1};
+  double angular_velocity_rad_per_s[3] = {1.5, -2.0, 1.0};
+};
+
 }  // namespace mbopt::oracle

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -183,10 +184,10 @@ TEST(SpatialStatics, InvertedPendulumIsStableOnlyWithAStiffEnoughSpring) {
 
 // A 2 kg block on a bushing to ground (no gravity): stiffness 200, 800, 50
 // N/m and 10, 10, 4 N m/rad. A force (4, -8, 2.5) t N at its centre
-// deflects it by F / k along each axis; a torque 0.6 t N m about z turns it
-// by psi with the bushing's restoring moment, the derivative of its energy
-// Kr sin(psi)^2 / 2, equal to the torque: sin(2 psi) = 2 M / Kr (M / Kr to
-// first order).
+// deflects it by F / k along each axis; a torque 3 t N m about z turns it
+// by psi = M / Kr, 43 deg at the end: about one axis the bushing's angle is
+// the turn itself (a small-angle measure, sin(psi), gave sin(2 psi) =
+// 2 M / Kr, which has no solution past M = Kr / 2).
 constexpr char kBushingMount[] = R"pb(
   spatial {
     analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
@@ -208,7 +209,7 @@ constexpr char kBushingMount[] = R"pb(
       tabulated { times_s: [0, 1] values: [0, 1] }
     }
     torques {
-      name: "twist" body: "block" torque_n_m { z { value: 0.6 } }
+      name: "twist" body: "block" torque_n_m { z { value: 3 } }
       tabulated { times_s: [0, 1] values: [0, 1] }
     }
   }
@@ -228,16 +229,119 @@ TEST(SpatialStatics, BodyOnABushingDeflectsByLoadOverStiffness) {
   double worst = 0;
   for (size_t i = 0; i < r.times_s.size(); ++i) {
     const double t = r.times_s[i];
-    const double psi = 0.5 * std::asin(2 * 0.6 * t / 4);
+    const double psi = 3 * t / 4;
     worst = std::max({worst, std::abs(Series(r, "x")[i] - 4 * t / 200), std::abs(Series(r, "y")[i] + 8 * t / 800),
                       std::abs(Series(r, "z")[i] - 2.5 * t / 50), std::abs(Series(r, "yaw")[i] - psi),
                       std::abs(Series(r, "pitch")[i]), std::abs(Series(r, "roll")[i]),
                       std::abs(Series(r, "force_y")[i] - 8 * t)});
   }
   EXPECT_LT(worst, kTolerance);
-  // Not the first-order rotation M / Kr: the test tells them apart.
-  EXPECT_GT(std::abs(Series(r, "yaw").back() - 0.6 / 4), 1e-3);
   std::cout << "body on a bushing: largest error " << worst << "\n";
+}
+
+// A body on a bushing to ground (rotational stiffnesses 3, 5, 2 N m/rad,
+// the frames at its centre with world axes) under a torque (1.5, -2, 1) t
+// N m: at rest the bushing's couple on the body is minus the torque, at
+// its x-y-z angles theta (29, -15, 40 deg at the end), and the angles
+// satisfy the balance of their generalized forces, Kr theta = W(theta)^T
+// T (W's columns x, Rx(theta_x) y, Rx(theta_x) Ry(theta_y) z).
+constexpr char kTwistedOnABushing[] = R"pb(
+  spatial {
+    analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
+    ground_markers { name: "mount" }
+    bodies {
+      name: "block"
+      mass_kg { value: 2 }
+      principal_inertia { moments_kg_m2 { x { value: 0.1 } y { value: 0.2 } z { value: 0.25 } } }
+      markers { name: "centre" }
+    }
+    bushings {
+      name: "mount" a: "ground.mount" b: "block.centre"
+      stiffness_n_per_m { x { value: 200 } y { value: 800 } z { value: 50 } }
+      rotational_stiffness_n_m_per_rad { x { value: 3 } y { value: 5 } z { value: 2 } }
+    }
+    torques {
+      name: "twist" body: "block" torque_n_m { x { value: 1.5 } y { value: -2 } z { value: 1 } }
+      tabulated { times_s: [0, 1] values: [0, 1] }
+    }
+  }
+  outputs { name: "mx" bushing_force { bushing: "mount" axis: AXIS_X moment: true } }
+  outputs { name: "my" bushing_force { bushing: "mount" axis: AXIS_Y moment: true } }
+  outputs { name: "mz" bushing_force { bushing: "mount" axis: AXIS_Z moment: true } }
+  outputs { name: "ax" body_orientation { body: "block" sequence: EULER_XYZ angle: 1 } }
+  outputs { name: "ay" body_orientation { body: "block" sequence: EULER_XYZ angle: 2 } }
+  outputs { name: "az" body_orientation { body: "block" sequence: EULER_XYZ angle: 3 } }
+  time_grid { start_s: 0 end_s: 1 points: 5 }
+)pb";
+
+TEST(SpatialStatics, BushingCoupleBalancesATorqueAtLargeRotations) {
+  const spec::AnalysisReport r = AnalyzeScene(Load(kTwistedOnABushing));
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  double worst_couple = 0, worst_balance = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double t = r.times_s[i];
+    const double torque[3] = {1.5 * t, -2 * t, 1 * t}, kr[3] = {3, 5, 2};
+    worst_couple = std::max({worst_couple, std::abs(Series(r, "mx")[i] + torque[0]),
+                             std::abs(Series(r, "my")[i] + torque[1]), std::abs(Series(r, "mz")[i] + torque[2])});
+    const double a = Series(r, "ax")[i], b = Series(r, "ay")[i], c = Series(r, "az")[i];
+    // W^T T, W's columns (1, 0, 0), (0, cos a, sin a), (sin b, -sin a cos b, cos a cos b).
+    const double wt[3] = {torque[0], std::cos(a) * torque[1] + std::sin(a) * torque[2],
+                          std::sin(b) * torque[0] - std::sin(a) * std::cos(b) * torque[1] +
+                              std::cos(a) * std::cos(b) * torque[2]};
+    const double angles[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) worst_balance = std::max(worst_balance, std::abs(kr[k] * angles[k] - wt[k]));
+  }
+  EXPECT_GT(std::abs(Series(r, "az").back()), 0.6);  // rad: far from small
+  EXPECT_LT(worst_couple, kTolerance);
+  EXPECT_LT(worst_balance, kTolerance);
+  std::cout << "body twisted on a bushing: angles " << Series(r, "ax").back() << ", " << Series(r, "ay").back()
+            << ", " << Series(r, "az").back() << " rad; largest error of the couple " << worst_couple
+            << " N m, of the balance " << worst_balance << " N m\n";
+}
+
+// A hub on a hinge about world z whose rotational spring (k = 2 N m/rad)
+// is free at theta0 = 4 pi + 0.2, wound two turns from the start, held by
+// a torque T of -4 pi k (constant) plus 0.5 t N m about z: at rest the
+// spring balances it, k (theta - theta0) = T, so theta = 0.2 + 0.25 t and
+// the spring's torque is 4 pi k - 0.5 t. A measure in (-pi, pi] could not
+// balance more than pi k.
+constexpr char kWoundHub[] = R"pb(
+  spatial {
+    analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
+    ground_markers { name: "axle" }
+    bodies {
+      name: "hub"
+      mass_kg { value: 1 }
+      principal_inertia { moments_kg_m2 { x { value: 0.02 } y { value: 0.02 } z { value: 0.03 } } }
+      markers { name: "centre" }
+    }
+    joints { name: "axle" kind: SPATIAL_JOINT_REVOLUTE a: "ground.axle" b: "hub.centre" }
+    rotational_springs {
+      name: "clock" joint: "axle"
+      stiffness_n_m_per_rad { value: 2 } free_angle_rad { expr: "4 * pi + 0.2" }
+    }
+    torques { name: "hold" body: "hub" torque_n_m { z { expr: "-8 * pi" } } }
+    torques {
+      name: "extra" body: "hub" torque_n_m { z { value: 0.5 } }
+      tabulated { times_s: [0, 1] values: [0, 1] }
+    }
+  }
+  outputs { name: "angle" joint_coordinate { joint: "axle" } }
+  outputs { name: "torque" rotational_spring_torque { spring: "clock" } }
+  time_grid { start_s: 0 end_s: 1 points: 5 }
+)pb";
+
+TEST(SpatialStatics, SpringWoundTwoTurnsBalancesItsLoad) {
+  const spec::AnalysisReport r = AnalyzeScene(Load(kWoundHub));
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  double worst = 0;
+  for (size_t i = 0; i < r.times_s.size(); ++i) {
+    const double t = r.times_s[i];
+    worst = std::max({worst, std::abs(Series(r, "angle")[i] - (0.2 + 0.25 * t)),
+                      std::abs(Series(r, "torque")[i] - (8 * std::numbers::pi - 0.5 * t))});
+  }
+  EXPECT_LT(worst, kTolerance);
+  std::cout << "hub on a spring wound two turns: largest error " << worst << "\n";
 }
 
 // The offset crank of spatial_forces_test (2 kg, centre of mass r = 0.15 m

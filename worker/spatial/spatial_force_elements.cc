@@ -78,30 +78,38 @@ struct JointAngleOf {
   int body_a = kGround, body_b = kGround;
 };
 
+// atan2(s, c) and its derivative (c ds - s dc) / (c^2 + s^2).
+Tracked1 Atan2(const Tracked1& s, const Tracked1& c) {
+  return {std::atan2(s.f, c.f), (c.f * s.jacobian - s.f * c.jacobian) / (c.f * c.f + s.f * s.f)};
+}
+
 JointAngleOf AngleOf(const Model& model, int joint, const VectorXd& q) {
   const Joint& j = model.joints[static_cast<size_t>(joint)];
   const Tracked xa = FixedIn(j.a.body, 0, j.a.axes.col(0), false, q);
   const Tracked ya = FixedIn(j.a.body, 0, j.a.axes.col(1), false, q);
   const Tracked xb = FixedIn(j.b.body, 1, j.b.axes.col(0), false, q);
-  const Tracked1 s = Dot(xb, ya), c = Dot(xb, xa);
   JointAngleOf out;
   out.body_a = j.a.body;
   out.body_b = j.b.body;
-  out.angle.f = std::atan2(s.f, c.f);
-  // d atan2(s, c) = (c ds - s dc) / (c^2 + s^2).
-  out.angle.jacobian = (c.f * s.jacobian - s.f * c.jacobian) / (c.f * c.f + s.f * s.f);
+  out.angle = Atan2(Dot(xb, ya), Dot(xb, xa));
   return out;
 }
 
-// theta - theta0 in (-pi, pi]: a spring wound by more than half a turn is
-// outside this element's range (docs/physics.md).
-double Deflection(const RotationalSpringDamper& spring, double angle) {
-  return std::remainder(angle - spring.free_angle_rad, 2.0 * std::numbers::pi);
+// theta - theta0 with theta continuous along the motion (SpringAngles).
+double Deflection(const RotationalSpringDamper& spring, int index, double principal, SpringAngles* angles) {
+  return angles->Follow(index, principal) - spring.free_angle_rad;
 }
 
-// A bushing's u and theta (value and Jacobian per component).
+bool HasRotation(const Bushing& b) {
+  return b.rotational_stiffness_n_m_per_rad.any() || b.rotational_damping_n_m_s_per_rad.any();
+}
+
+// A bushing's u and theta (value and Jacobian per component), and cos of
+// the middle angle (theta's Jacobians are not computed for a bushing
+// without rotational terms).
 struct BushingMeasures {
   Tracked1 u[3], theta[3];
+  double middle_cosine = 1.0;
 };
 
 BushingMeasures MeasuresOf(const Bushing& b, const VectorXd& q) {
@@ -116,24 +124,50 @@ BushingMeasures MeasuresOf(const Bushing& b, const VectorXd& q) {
     c[k] = FixedIn(b.b.body, 1, b.b.axes.col(k), false, q);
   }
   BushingMeasures m;
-  for (int k = 0; k < 3; ++k) {
-    m.u[k] = Dot(a[k], d);
-    // theta_k = (a_{k+2} . b_{k+1} - a_{k+1} . b_{k+2}) / 2.
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    const Tracked1 plus = Dot(a[j], c[i]), minus = Dot(a[i], c[j]);
-    m.theta[k] = {0.5 * (plus.f - minus.f), 0.5 * (plus.jacobian - minus.jacobian)};
-  }
+  for (int k = 0; k < 3; ++k) m.u[k] = Dot(a[k], d);
+  if (!HasRotation(b)) return m;
+  // R_ij = a_i . b_j = (Rx(t0) Ry(t1) Rz(t2))_ij, whose first row is
+  // (c1 c2, -c1 s2, s1) and last column (s1, -s0 c1, c0 c1).
+  const Tracked1 r00 = Dot(a[0], c[0]), r01 = Dot(a[0], c[1]), r02 = Dot(a[0], c[2]);
+  const Tracked1 r12 = Dot(a[1], c[2]), r22 = Dot(a[2], c[2]);
+  const auto minus = [](const Tracked1& x) { return Tracked1{-x.f, -x.jacobian}; };
+  Tracked1 cos1;
+  cos1.f = std::hypot(r00.f, r01.f);
+  cos1.jacobian = (r00.f * r00.jacobian + r01.f * r01.jacobian) / cos1.f;
+  m.middle_cosine = cos1.f;
+  m.theta[0] = Atan2(minus(r12), r22);
+  m.theta[1] = Atan2(r02, cos1);
+  m.theta[2] = Atan2(minus(r01), r00);
   return m;
 }
 
-BushingLoad LoadOf(const Bushing& b, const BushingMeasures& m, const Eigen::Matrix<double, kPair, 1>& v) {
+// The couple on b (a's axes) whose power equals that of the angles'
+// generalized forces f: with omega = W(theta) dtheta/dt the relative
+// angular velocity in a's axes, W's columns x, Rx(t0) y and Rx(t0) Ry(t1) z,
+// the couple solves W^T m = f.
+Vector3d CoupleOf(const Vector3d& theta, const Vector3d& f) {
+  const double c0 = std::cos(theta[0]), s0 = std::sin(theta[0]);
+  const double c1 = std::cos(theta[1]), s1 = std::sin(theta[1]);
+  const double g = (f[2] - s1 * f[0]) / c1;
+  return Vector3d(f[0], c0 * f[1] - s0 * g, s0 * f[1] + c0 * g);
+}
+
+// The force, the couple and the angles' generalized forces f_theta.
+struct BushingEffort {
   BushingLoad load;
+  Vector3d angle_forces = Vector3d::Zero();
+};
+
+BushingEffort EffortOf(const Bushing& b, const BushingMeasures& m, const Eigen::Matrix<double, kPair, 1>& v) {
+  BushingEffort e;
   for (int k = 0; k < 3; ++k) {
-    load.force_n[k] = -b.stiffness_n_per_m[k] * m.u[k].f - b.damping_n_s_per_m[k] * m.u[k].jacobian.dot(v);
-    load.moment_n_m[k] = -b.rotational_stiffness_n_m_per_rad[k] * m.theta[k].f -
-                         b.rotational_damping_n_m_s_per_rad[k] * m.theta[k].jacobian.dot(v);
+    e.load.force_n[k] = -b.stiffness_n_per_m[k] * m.u[k].f - b.damping_n_s_per_m[k] * m.u[k].jacobian.dot(v);
+    e.load.angles_rad[k] = m.theta[k].f;
+    e.angle_forces[k] = -b.rotational_stiffness_n_m_per_rad[k] * m.theta[k].f -
+                        b.rotational_damping_n_m_s_per_rad[k] * m.theta[k].jacobian.dot(v);
   }
-  return load;
+  if (HasRotation(b)) e.load.moment_n_m = CoupleOf(e.load.angles_rad, e.angle_forces);
+  return e;
 }
 
 double FactorAt(const std::optional<multibody::Profile>& factor, double t) {
@@ -324,7 +358,15 @@ absl::Status ValidateForceElements(const Model& model) {
   return absl::OkStatus();
 }
 
-int AddForceElementForces(const Model& model, double t, const VectorXd& q, const VectorXd& v, VectorXd* forces) {
+double SpringAngles::Follow(int spring, double principal_rad) {
+  double& latest = latest_rad_[static_cast<size_t>(spring)];
+  const double turns = std::round((latest - principal_rad) / (2.0 * std::numbers::pi));
+  latest = principal_rad + 2.0 * std::numbers::pi * turns;
+  return latest;
+}
+
+int AddForceElementForces(const Model& model, double t, const VectorXd& q, const VectorXd& v, bool continued,
+                          SpringAngles* angles, VectorXd* forces, std::string* failure) {
   for (const PointForce& f : model.point_forces) {
     if (f.at.body == kGround) continue;  // ground takes it
     const int at = kBlock * f.at.body;
@@ -347,25 +389,38 @@ int AddForceElementForces(const Model& model, double t, const VectorXd& q, const
     const RotationalSpringDamper& r = model.rotational_springs[k];
     const JointAngleOf a = AngleOf(model, r.joint, q);
     const double rate = a.angle.jacobian.dot(PairVelocity(a.body_a, a.body_b, v));
-    const double torque = -r.stiffness_n_m_per_rad * Deflection(r, a.angle.f) - r.damping_n_m_s_per_rad * rate;
+    const double torque = -r.stiffness_n_m_per_rad * Deflection(r, static_cast<int>(k), a.angle.f, angles) -
+                          r.damping_n_m_s_per_rad * rate;
     Scatter(torque * a.angle.jacobian, a.body_a, a.body_b, forces);
   }
   for (const Bushing& b : model.bushings) {
     const BushingMeasures m = MeasuresOf(b, q);
-    const BushingLoad load = LoadOf(b, m, PairVelocity(b.a.body, b.b.body, v));
+    if (!continued && !(m.middle_cosine >= std::cos(kBushingMiddleAngleLimit_rad))) {
+      if (failure != nullptr) {
+        *failure = absl::StrFormat(
+            "bushing '%s': the middle of its x-y-z angles reached %.6g deg, past the %.6g deg the bushing is "
+            "defined to (its angles are singular at 90 deg)",
+            b.name, std::acos(std::min(1.0, m.middle_cosine)) * 180.0 / std::numbers::pi,
+            kBushingMiddleAngleLimit_rad * 180.0 / std::numbers::pi);
+      }
+      return 1;
+    }
+    const BushingEffort e = EffortOf(b, m, PairVelocity(b.a.body, b.b.body, v));
     PairRow generalized = PairRow::Zero();
     for (int k = 0; k < 3; ++k) {
-      generalized += load.force_n[k] * m.u[k].jacobian + load.moment_n_m[k] * m.theta[k].jacobian;
+      generalized += e.load.force_n[k] * m.u[k].jacobian;
+      if (HasRotation(b)) generalized += e.angle_forces[k] * m.theta[k].jacobian;
     }
     Scatter(generalized, b.a.body, b.b.body, forces);
   }
   return forces->allFinite() ? 0 : 1;
 }
 
-double ForceElementPotentialEnergy(const Model& model, const VectorXd& q) {
+double ForceElementPotentialEnergy(const Model& model, const VectorXd& q, SpringAngles* angles) {
   double energy = 0.0;
-  for (const RotationalSpringDamper& r : model.rotational_springs) {
-    const double deflection = Deflection(r, AngleOf(model, r.joint, q).angle.f);
+  for (size_t k = 0; k < model.rotational_springs.size(); ++k) {
+    const RotationalSpringDamper& r = model.rotational_springs[k];
+    const double deflection = Deflection(r, static_cast<int>(k), AngleOf(model, r.joint, q).angle.f, angles);
     energy += 0.5 * r.stiffness_n_m_per_rad * deflection * deflection;
   }
   for (const Bushing& b : model.bushings) {
@@ -378,16 +433,41 @@ double ForceElementPotentialEnergy(const Model& model, const VectorXd& q) {
   return energy;
 }
 
-double RotationalSpringTorque(const Model& model, int spring, const VectorXd& q, const VectorXd& v) {
+double RotationalSpringTorque(const Model& model, int spring, const VectorXd& q, const VectorXd& v,
+                              SpringAngles* angles) {
   const RotationalSpringDamper& r = model.rotational_springs[static_cast<size_t>(spring)];
   const JointAngleOf a = AngleOf(model, r.joint, q);
   const double rate = a.angle.jacobian.dot(PairVelocity(a.body_a, a.body_b, v));
-  return -r.stiffness_n_m_per_rad * Deflection(r, a.angle.f) - r.damping_n_m_s_per_rad * rate;
+  return -r.stiffness_n_m_per_rad * Deflection(r, spring, a.angle.f, angles) - r.damping_n_m_s_per_rad * rate;
 }
 
 BushingLoad BushingLoadOf(const Model& model, int bushing, const VectorXd& q, const VectorXd& v) {
   const Bushing& b = model.bushings[static_cast<size_t>(bushing)];
-  return LoadOf(b, MeasuresOf(b, q), PairVelocity(b.a.body, b.b.body, v));
+  return EffortOf(b, MeasuresOf(b, q), PairVelocity(b.a.body, b.b.body, v)).load;
+}
+
+int BushingAngleBoundCount(const Model& model) {
+  return static_cast<int>(std::count_if(model.bushings.begin(), model.bushings.end(), HasRotation));
+}
+
+void BushingAngleBounds(const Model& model, const VectorXd& q, double* g) {
+  int k = 0;
+  for (const Bushing& b : model.bushings) {
+    if (HasRotation(b)) g[k++] = MeasuresOf(b, q).middle_cosine - std::cos(kBushingMiddleAngleLimit_rad);
+  }
+}
+
+std::string BushingAngleBoundReason(const Model& model, int bound, double t, const VectorXd& q) {
+  int k = 0;
+  for (const Bushing& b : model.bushings) {
+    if (!HasRotation(b) || k++ != bound) continue;
+    return absl::StrFormat(
+        "bushing '%s' reached the limit of its rotation measure at t = %.6g s: the middle of its x-y-z angles "
+        "reached %.6g deg (limit %.6g deg; the angles are singular at 90 deg)",
+        b.name, t, MeasuresOf(b, q).theta[1].f * 180.0 / std::numbers::pi,
+        kBushingMiddleAngleLimit_rad * 180.0 / std::numbers::pi);
+  }
+  return "";
 }
 
 }  // namespace mbopt::spatial

@@ -124,7 +124,8 @@ struct BodyTorque {
 
 // Torque -k (theta - theta0) - c dtheta/dt on body b of a revolute or
 // cylindrical joint about its axis (the opposite on body a), theta the
-// joint's angle and theta - theta0 taken in (-pi, pi].
+// joint's angle counting whole turns along the analysis
+// (spatial_force_elements.h, SpringAngles).
 struct RotationalSpringDamper {
   std::string name;
   int joint = -1;

@@ -153,7 +153,7 @@ double OutputValue(const SpatialSystem& system, const Model& model, const spec::
       return -lambda[system.row_of_driver(o.driver)];
     case Quantity::kBushingForce: return BushingLoadOf(model, o.bushing, s.q, s.v).force_n[axis];
     case Quantity::kBushingMoment: return BushingLoadOf(model, o.bushing, s.q, s.v).moment_n_m[axis];
-    case Quantity::kRotationalSpringTorque: return RotationalSpringTorque(model, o.spring, s.q, s.v);
+    case Quantity::kRotationalSpringTorque: return system.RotationalSpringTorque(o.spring, s.q, s.v);
   }
   return NAN;
 }
@@ -395,6 +395,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   }
   std::vector<multibody::StateSensitivity> kinematic;  // work space of the driven path
   size_t next_instant = 0;
+  std::vector<double> bushing_bounds;
   const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
     if (budget != nullptr) {
       if (spec::AnalysisFailure f = budget->Check(s.t_s); !f.ok()) return f;
@@ -403,6 +404,19 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       return spec::AnalysisFailure::Ok();
     }
     ++next_instant;
+    // A kinematic analysis' motion does not read the bushings, so nothing
+    // else stops it where their angles become singular (a motion's
+    // integrator and a static solve do).
+    if (!model->bushings.empty()) {
+      bushing_bounds.resize(static_cast<size_t>(BushingAngleBoundCount(*model)));
+      BushingAngleBounds(*model, s.q, bushing_bounds.data());
+      for (size_t k = 0; k < bushing_bounds.size(); ++k) {
+        if (!(bushing_bounds[k] >= 0.0)) {
+          return spec::AnalysisFailure::Of(spec::FailureKind::kModelValidity,
+                                           BushingAngleBoundReason(*model, static_cast<int>(k), s.t_s, s.q));
+        }
+      }
+    }
     // A static solve brings its multipliers; a motion's come from inverse
     // dynamics.
     const Eigen::VectorXd lambda = is_static           ? s.lambda

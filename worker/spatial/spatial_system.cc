@@ -35,7 +35,7 @@ bool AllFinite(const VectorXd& x) { return x.allFinite(); }
 
 }  // namespace
 
-SpatialSystem::SpatialSystem(const Model& model) : model_(model) {
+SpatialSystem::SpatialSystem(const Model& model) : model_(model), spring_angles_(model.rotational_springs.size()) {
   int row = static_cast<int>(model_.bodies.size());
   for (const Joint& j : model_.joints) {
     joint_row_.push_back(row);
@@ -96,6 +96,7 @@ int SpatialSystem::AppliedForces(double t, const VectorXd& q, const VectorXd& v,
 }
 
 int SpatialSystem::ElementForces(double t, const VectorXd& q, const VectorXd& v, VectorXd* forces) const {
+  failure_reason_.clear();
   forces->setZero(num_coordinates());
   for (const SpringDamper& s : model_.springs) {
     const PairVector d = Minus(FixedIn(CoordinatesOf(s.b.body, q, &v), 1, s.b.position_m, true),
@@ -110,7 +111,7 @@ int SpatialSystem::ElementForces(double t, const VectorXd& q, const VectorXd& v,
     Scatter(pair_row, s.a.body, s.b.body, scattered);
     *forces += scattered.row(0).transpose();
   }
-  return AddForceElementForces(model_, t, q, v, forces);
+  return AddForceElementForces(model_, t, q, v, continue_past_bounds_, &spring_angles_, forces, &failure_reason_);
 }
 
 void SpatialSystem::EvaluateRows(double t, const VectorXd& q, const VectorXd* v, VectorXd* phi,
@@ -303,17 +304,27 @@ double SpatialSystem::PotentialEnergy(const VectorXd& q) const {
   for (const SpringDamper& s : model_.springs) {
     energy += SpringStrainEnergy(s, (PointPosition(s.b, q) - PointPosition(s.a, q)).norm());
   }
-  return energy + ForceElementPotentialEnergy(model_, q);
+  return energy + ForceElementPotentialEnergy(model_, q, &spring_angles_);
 }
 
-int SpatialSystem::num_validity_bounds() const { return SpringCurveBoundCount(model_); }
+double SpatialSystem::RotationalSpringTorque(int spring, const VectorXd& q, const VectorXd& v) const {
+  return spatial::RotationalSpringTorque(model_, spring, q, v, &spring_angles_);
+}
+
+// The springs' curve bounds, then the bushings'.
+int SpatialSystem::num_validity_bounds() const {
+  return SpringCurveBoundCount(model_) + BushingAngleBoundCount(model_);
+}
 
 void SpatialSystem::ValidityBounds(double /*t*/, const VectorXd& q, const VectorXd& v, double* g) const {
   SpringCurveBounds(model_, q, v, g);
+  BushingAngleBounds(model_, q, g + SpringCurveBoundCount(model_));
 }
 
 std::string SpatialSystem::BoundReason(int bound, double t, const VectorXd& q, const VectorXd& v) const {
-  return SpringCurveBoundReason(model_, bound, t, q, v);
+  const int springs = SpringCurveBoundCount(model_);
+  return bound < springs ? SpringCurveBoundReason(model_, bound, t, q, v)
+                         : BushingAngleBoundReason(model_, bound - springs, t, q);
 }
 
 Vector3d SpatialSystem::AngularMomentum(const VectorXd& q, const VectorXd& v) const {

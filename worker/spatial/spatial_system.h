@@ -24,8 +24,10 @@
 // the Euler parameters), a term of the order of the step times the
 // accelerations: IDAS's Newton iteration converges with it left out.
 //
-// Immutable after construction; the model must be valid (Model::Validate)
-// and must outlive the system.
+// Immutable after construction but for the rotational springs' turn
+// counts (SpringAngles, spatial_force_elements.h): an analysis owns its
+// system and evaluates it in one order, so a rerun gives the same bits.
+// The model must be valid (Model::Validate) and must outlive the system.
 #pragma once
 
 #include <string>
@@ -34,6 +36,7 @@
 #include <Eigen/Dense>
 
 #include "worker/multibody/constrained_system.h"
+#include "worker/spatial/spatial_force_elements.h"
 #include "worker/spatial/spatial_model.h"
 
 namespace mbopt::spatial {
@@ -92,12 +95,15 @@ class SpatialSystem : public multibody::ConstrainedSystem {
                      Eigen::MatrixXd* q_v) const override;
   void DerivativePattern(Pattern* coupling, Pattern* rows) const override;
 
-  // The springs' force curves' tables (spatial_force_elements.h): past one,
-  // the analysis ends naming the spring.
+  // The springs' force curves' tables and the bushings' angle limits
+  // (spatial_force_elements.h): past one, the analysis ends naming the
+  // spring or bushing.
   int num_validity_bounds() const override;
   void ValidityBounds(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v, double* g) const override;
   std::string BoundReason(int bound, double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const override;
   void ContinuePastBounds(bool on) const override { continue_past_bounds_ = on; }
+  // A bushing past its angle limit (outside a continued scope).
+  std::string FailureReason() const override { return failure_reason_; }
 
   // The bodies' initial poses and velocities as coordinates (not yet
   // consistent with the joints: see AssembleSpatial).
@@ -126,6 +132,10 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   // Gravity (zero at the world origin) and the springs', rotational
   // springs' and bushings' strain energy.
   double PotentialEnergy(const Eigen::VectorXd& q) const;
+  // The torque of rotational spring `spring` on its joint's body b about
+  // the joint axis (N m), its angle continued from the system's latest
+  // evaluation (spatial_force_elements.h, SpringAngles).
+  double RotationalSpringTorque(int spring, const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
   // Of all bodies about the world origin, world axes (kg m^2/s).
   Eigen::Vector3d AngularMomentum(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const;
 
@@ -143,6 +153,8 @@ class SpatialSystem : public multibody::ConstrainedSystem {
 
   const Model& model_;
   mutable bool continue_past_bounds_ = false;  // ContinuePastBounds
+  mutable SpringAngles spring_angles_;
+  mutable std::string failure_reason_;  // FailureReason
   int num_rows_ = 0;
   std::vector<int> joint_row_, driver_row_;
 };
