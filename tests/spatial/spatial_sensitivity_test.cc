@@ -24,9 +24,10 @@
 namespace mbopt::spatial {
 namespace {
 
-// The whole analyses are integrated at rtol 1e-10, so that their central
-// differences (relative step 1e-4: noise about rtol / step = 1e-6,
-// truncation about step^2 = 1e-8) can judge the sensitivities.
+// The whole analyses are integrated at rtol 1e-10 (the pendulum at 1e-11),
+// so that their central differences (relative step 1e-4: noise about
+// rtol / step = 1e-6, truncation about step^2 = 1e-8) can judge the
+// sensitivities.
 constexpr double kRelativeStep = 1e-4;
 constexpr double kRelativeTolerance = 1e-10;
 constexpr double kAbsoluteTolerance = 1e-11;
@@ -153,7 +154,9 @@ spec::Scene Governor() {
 // 80 deg), the hinge's ground marker 20 mm off the rod's initial pivot (the
 // assembly moves the rod there, so the start depends on that coordinate),
 // pulled sideways by a spring from a ground anchor to its tip and swinging
-// under gravity.
+// under gravity. Integrated at rtol 1e-11: with the residual differenced
+// along the sensitivities (before the exact state Jacobian) their
+// corrector failed there at t = 0.35 s.
 constexpr char kPendulum[] = R"pb(
   parameters { name: "mass" value: 2 unit: "kg" }
   parameters { name: "stiffness" value: 150 unit: "N/m" }
@@ -189,27 +192,30 @@ constexpr char kPendulum[] = R"pb(
   outputs { name: "yaw" body_orientation { body: "rod" sequence: EULER_ZYX angle: 1 } }
   outputs { name: "reaction_z" joint_reaction { joint: "hinge" axis: AXIS_Z } }
   time_grid { start_s: 0 end_s: 1.5 points: 31 }
-  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-11 }
+  integrator { relative_tolerance: 1e-11 absolute_tolerance: 1e-12 }
 )pb";
 
 // What the comparisons hold to, relative to each output's largest
-// derivative (measured with the settings above: the governor 3.5e-5 over
-// the instants and 1.7e-5 at the peaks; the pendulum 1.3e-4 and 2.6e-6,
-// its hinge reaction, from multipliers of interpolated accelerations,
-// 4.4e-4 and 1.6e-5; the driven pendulum 6.7e-9). Not the 1e-6 the
-// differences could judge: the state terms of the sensitivity residuals
-// are themselves differences (GglStateDirectionalDerivative).
-constexpr double kSeriesAgreement = 3e-4;
-constexpr double kReactionSeriesAgreement = 2e-3;
-constexpr double kPeakAgreement = 5e-5;
+// derivative, with the exact state Jacobian (measured with the settings
+// above: the governor 2.5e-5 over the instants and 1.7e-5 at the peaks,
+// 5.0e-5 and 2.4e-5 with the residual differenced along the
+// sensitivities; the pendulum 1.2e-5 and 1.8e-6, its hinge reaction, from
+// multipliers of interpolated accelerations, 4.0e-5 and 1.1e-6; the driven
+// pendulum 6.7e-9). Not the 1e-6 the differences could judge: the errors
+// follow the integration tolerance (the pendulum at rtol 1e-10: 8.1e-5).
+constexpr double kGovernorSeriesAgreement = 4e-5;
+constexpr double kGovernorPeakAgreement = 3e-5;
+constexpr double kSeriesAgreement = 3e-5;
+constexpr double kReactionSeriesAgreement = 1e-4;
+constexpr double kPeakAgreement = 5e-6;
 constexpr double kDrivenAgreement = 1e-7;
 
 TEST(SpatialSensitivity, GovernorDerivativesAgreeWithCentralDifferences) {
   const spec::Scene scene = Governor();
   const Agreement a = Compare(scene, {"ball_mass", "stiffness", "arm"},
                               {"ball_x", "ball_z", "spring_force", "tilt", "kinetic_energy"});
-  EXPECT_LT(a.worst_series, kSeriesAgreement);
-  EXPECT_LT(a.worst_peak, kPeakAgreement);
+  EXPECT_LT(a.worst_series, kGovernorSeriesAgreement);
+  EXPECT_LT(a.worst_peak, kGovernorPeakAgreement);
   std::cout << "governor: worst " << a.worst_series << " over the instants, " << a.worst_peak << " at the peaks\n";
 }
 
