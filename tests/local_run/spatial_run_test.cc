@@ -1,4 +1,5 @@
-// examples/spatial/governor.study.textproto optimized in this process (the
+// examples/spatial/governor.study.textproto (and the static hung_linkage
+// studies, at the end) optimized in this process (the
 // service's job driver with an in-process evaluator): finite differences of
 // spatial forward-dynamics analyses reach the optimum the study describes,
 // the shortest arm and the spring that puts the flyweight on its radius
