@@ -1,6 +1,7 @@
 #include "worker/spatial/spatial_element_jacobians.h"
 
 #include <cmath>
+#include <optional>
 
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/pair_vectors.h"
