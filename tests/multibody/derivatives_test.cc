@@ -138,7 +138,7 @@ void ExpectNewtonMatrixMatchesDifferences(const Mechanism& m, double t) {
   constexpr double kCj = 1e3;
   GglWorkspace work;
   MatrixXd newton;
-  ASSERT_EQ(GglNewtonMatrix(m, t, kCj, y, &work, &newton), 0);
+  ASSERT_EQ(GglNewtonMatrix(m, t, kCj, y, y_dot, &work, &newton), 0);
   const auto residual = [&](const VectorXd& yy, const VectorXd& yy_dot) {
     VectorXd r(size);
     EXPECT_EQ(GglResidual(m, t, yy, yy_dot, &work, r), 0);

@@ -2,10 +2,13 @@
 // quotients of the equations they differentiate, as the planar
 // MultibodyDerivatives tests do: the constraints' curvature
 // d(Phi_q^T w)/dq for every joint kind and both drivers, the velocity
-// constraints' Jacobian d(Phi_q v + Phi_t)/dq, the force Jacobians (Euler
-// parameters' velocity terms, springs, force elements), the declared
+// constraints' Jacobian d(Phi_q v + Phi_t)/dq, the mass matrix's
+// d(M(q) a)/dq, the force Jacobians (Euler parameters' velocity terms,
+// linear and tabulated springs, point forces and torques in world and body
+// axes, and the differenced rotational springs and bushings), the declared
 // pattern, the same through combined rows (redundant joints), and the
-// assembled GGL Newton matrix against the residual.
+// assembled GGL Newton matrix against the residual at non-zero
+// accelerations: the whole state Jacobian.
 #include <cmath>
 #include <string>
 
@@ -226,6 +229,62 @@ Model ForcedPair() {
   return m;
 }
 
+// The elements with analytic Jacobians, each kind in both variants: a
+// damped linear spring with an actuator force between the bodies, a spring
+// from ground with tabulated deflection and velocity curves, point forces
+// in world and body axes (one with a time factor) and torques in world and
+// body axes.
+Model AnalyticForcedPair() {
+  Model m = TwoBodies(Joint::Kind::kRevolute);
+  SpringDamper linear;
+  linear.name = "linear";
+  linear.a = {0, {0.1, -0.2, 0.05}};
+  linear.b = {1, {0.05, -0.02, 0.1}};
+  linear.stiffness_n_per_m = 120.0;
+  linear.free_length_m = 0.2;
+  linear.damping_n_s_per_m = 3.0;
+  linear.actuator_force_n = 4.0;
+  m.springs.push_back(linear);
+  SpringDamper tabulated;
+  tabulated.name = "tabulated";
+  tabulated.a = {kGround, {0.3, 0.4, 0.5}};
+  tabulated.b = {1, {-0.1, 0.08, 0.02}};
+  tabulated.free_length_m = 0.3;
+  tabulated.deflection_curve.x = {-2.0, -0.5, 3.0};
+  tabulated.deflection_curve.y = {-300.0, -40.0, 500.0};
+  tabulated.velocity_curve.x = {-20.0, -3.0, 20.0};
+  tabulated.velocity_curve.y = {-90.0, -6.0, 60.0};
+  m.springs.push_back(tabulated);
+  PointForce world;
+  world.name = "world";
+  world.at = {1, {0.1, 0.2, -0.05}};
+  world.force_n = {2.0, -1.0, 3.0};
+  world.factor = multibody::Profile{};
+  world.factor->kind = multibody::Profile::Kind::kHarmonic;
+  world.factor->start = 0.5;
+  world.factor->amplitude = 0.8;
+  world.factor->angular_frequency_rad_per_s = 3.0;
+  m.point_forces.push_back(world);
+  PointForce follower;
+  follower.name = "follower";
+  follower.at = {0, {0.1, 0.0, -0.05}};
+  follower.force_n = {1.0, -2.0, 0.5};
+  follower.body_axes = true;
+  m.point_forces.push_back(follower);
+  BodyTorque body_torque;
+  body_torque.name = "twist";
+  body_torque.body = 1;
+  body_torque.torque_n_m = {0.3, 0.1, -0.2};
+  body_torque.body_axes = true;
+  m.torques.push_back(body_torque);
+  BodyTorque world_torque;
+  world_torque.name = "turn";
+  world_torque.body = 0;
+  world_torque.torque_n_m = {-0.4, 0.2, 0.6};
+  m.torques.push_back(world_torque);
+  return m;
+}
+
 // dQ/dq and dQ/dv against central differences of AppliedForces: with only
 // gravity (the Euler parameters' velocity terms alone) and with every
 // force element.
@@ -260,7 +319,53 @@ void ExpectForceJacobians(const Model& model) {
 
 TEST(SpatialDerivatives, VelocityTermsMatchDifferenceQuotients) { ExpectForceJacobians(TwoBodies(Joint::Kind::kUniversal)); }
 
-TEST(SpatialDerivatives, ForceElementsMatchDifferenceQuotients) { ExpectForceJacobians(ForcedPair()); }
+// Every element, the rotational spring and the bushing differenced.
+TEST(SpatialDerivatives, ForceElementsMatchDifferenceQuotients) {
+  const Model model = ForcedPair();
+  ExpectForceJacobians(model);
+  EXPECT_FALSE(SpatialSystem(model).has_exact_state_jacobian());
+}
+
+TEST(SpatialDerivatives, AnalyticElementJacobiansMatchDifferenceQuotients) {
+  const Model model = AnalyticForcedPair();
+  ExpectForceJacobians(model);
+  const SpatialSystem s(model);
+  EXPECT_TRUE(s.has_exact_state_jacobian());
+  // The tabulated spring's state lies inside its curves' middle segments
+  // (not across a breakpoint, where the difference would straddle two
+  // slopes) and well away from the linear coefficients.
+  VectorXd q, v;
+  GeneralState(s, &q, &v);
+  const Vector3d d = s.PointPosition(model.springs[1].b, q) - s.PointPosition(model.springs[1].a, q);
+  const double rate = d.normalized().dot(s.PointVelocity(model.springs[1].b, q, v));
+  EXPECT_GT(d.norm() - 0.3, -0.5 + 1e-3);
+  EXPECT_LT(d.norm() - 0.3, 3.0 - 1e-3);
+  EXPECT_GT(rate, -3.0 + 1e-3);
+  EXPECT_LT(rate, 20.0 - 1e-3);
+}
+
+// d(M(q) a)/dq against central differences of M(q) a, off the unit sphere.
+TEST(SpatialDerivatives, MassMatrixDerivativeMatchesDifferenceQuotients) {
+  const Model model = TwoBodies(Joint::Kind::kUniversal);
+  const SpatialSystem s(model);
+  VectorXd q, v;
+  GeneralState(s, &q, &v);
+  const VectorXd a = VectorXd::LinSpaced(q.size(), 2.0, -3.0);
+  MatrixXd jacobian;
+  ASSERT_EQ(s.MassTimesAccelerationJacobian(q, a, &jacobian), 0);
+  MatrixXd difference(q.size(), q.size());
+  for (int k = 0; k < q.size(); ++k) {
+    VectorXd plus = q, minus = q;
+    plus[k] += kStep;
+    minus[k] -= kStep;
+    MatrixXd m_plus, m_minus;
+    ASSERT_EQ(s.MassMatrix(plus, &m_plus), 0);
+    ASSERT_EQ(s.MassMatrix(minus, &m_minus), 0);
+    difference.col(k) = (m_plus - m_minus) * a / (2 * kStep);
+  }
+  EXPECT_LT(RelativeDifference(jacobian, difference), kDifferenceTolerance);
+  EXPECT_GT(jacobian.cwiseAbs().maxCoeff(), 1e-2);  // not trivially zero
+}
 
 // The pattern the sparse Newton matrix is built on holds every non-zero
 // entry of the derivatives: three bodies in a chain, the first and the
@@ -290,21 +395,24 @@ TEST(SpatialDerivatives, PatternHoldsEveryNonZero) {
 }
 
 // The GGL Newton matrix assembled from these derivatives against
-// difference quotients of the residual, at accelerations y' of zero (the
-// matrix leaves out d(M(q) v')/dq, see spatial_system.h).
-TEST(SpatialDerivatives, NewtonMatrixMatchesTheResidual) {
-  const Model model = DrivenCylinder();
+// difference quotients of the residual, in a moving state with non-zero
+// accelerations y' (so d(M(q) v')/dq counts), on the driven cylinder and
+// with every element that has an analytic Jacobian.
+void ExpectNewtonMatrixMatchesTheResidual(const Model& model) {
+  ASSERT_TRUE(model.Validate().ok()) << model.Validate();
   const SpatialSystem s(model);
+  EXPECT_TRUE(s.has_exact_state_jacobian());
   const int n = s.num_coordinates(), m = s.num_constraints(), size = 2 * n + 2 * m;
   VectorXd q, v;
   GeneralState(s, &q, &v);
   VectorXd y(size), y_dot = VectorXd::Zero(size);
   y << q, v, VectorXd::LinSpaced(m, 0.5, -0.4), VectorXd::LinSpaced(m, -0.02, 0.03);
   y_dot.head(n) = v;
+  y_dot.segment(n, n) = VectorXd::LinSpaced(n, 3.0, -2.5);
   const double t = 0.4, cj = 250.0;
   multibody::GglWorkspace work;
   MatrixXd newton;
-  ASSERT_EQ(multibody::GglNewtonMatrix(s, t, cj, y, &work, &newton), 0);
+  ASSERT_EQ(multibody::GglNewtonMatrix(s, t, cj, y, y_dot, &work, &newton), 0);
   MatrixXd difference(size, size);
   VectorXd r_plus(size), r_minus(size);
   for (int k = 0; k < size; ++k) {
@@ -314,24 +422,25 @@ TEST(SpatialDerivatives, NewtonMatrixMatchesTheResidual) {
     // F(y + h e_k, y' + cj h e_k): dF/dy + cj dF/dy'.
     ydp[k] += cj * kStep;
     ydm[k] -= cj * kStep;
-    if (k >= n && k < 2 * n) {
-      // v' is zero in y_dot's second block; keep it so (the term left out).
-      ydp[k] = ydm[k] = 0.0;
-    }
     ASSERT_EQ(multibody::GglResidual(s, t, yp, ydp, &work, r_plus), 0);
     ASSERT_EQ(multibody::GglResidual(s, t, ym, ydm, &work, r_minus), 0);
     difference.col(k) = (r_plus - r_minus) / (2 * kStep);
   }
-  // cj M's columns (v' = 0 kept above) come from the mass matrix directly.
-  MatrixXd mass;
-  ASSERT_EQ(s.MassMatrix(q, &mass), 0);
-  difference.block(n, n, n, n) += cj * mass;
   // Rows of the normalization constraints are scaled by 1e6: relative.
   for (int row = 0; row < size; ++row) {
     const double scale = std::max(1.0, newton.row(row).cwiseAbs().maxCoeff());
     EXPECT_LT((newton.row(row) - difference.row(row)).cwiseAbs().maxCoeff() / scale, kDifferenceTolerance)
         << "row " << row;
   }
+}
+
+TEST(SpatialDerivatives, NewtonMatrixMatchesTheResidual) { ExpectNewtonMatrixMatchesTheResidual(DrivenCylinder()); }
+
+TEST(SpatialDerivatives, NewtonMatrixWithForceElementsMatchesTheResidual) {
+  Model model = AnalyticForcedPair();
+  model.drivers = DrivenCylinder().drivers;
+  model.joints[1].kind = Joint::Kind::kCylindrical;
+  ExpectNewtonMatrixMatchesTheResidual(model);
 }
 
 }  // namespace

@@ -24,9 +24,10 @@
 namespace mbopt::spatial {
 namespace {
 
-// The whole analyses are integrated at rtol 1e-10, so that their central
-// differences (relative step 1e-4: noise about rtol / step = 1e-6,
-// truncation about step^2 = 1e-8) can judge the sensitivities.
+// The whole analyses are integrated at rtol 1e-10 (the pendulum at 1e-11),
+// so that their central differences (relative step 1e-4: noise about
+// rtol / step = 1e-6, truncation about step^2 = 1e-8) can judge the
+// sensitivities.
 constexpr double kRelativeStep = 1e-4;
 constexpr double kRelativeTolerance = 1e-10;
 constexpr double kAbsoluteTolerance = 1e-11;
@@ -57,8 +58,11 @@ size_t ArgMax(const std::vector<double>& v) {
   return static_cast<size_t>(std::max_element(v.begin(), v.end()) - v.begin());
 }
 
+// `reactions`: outputs whose agreement goes to `reaction_agreement`
+// instead (one set of analyses for both).
 Agreement Compare(const spec::Scene& scene, const std::vector<std::string>& parameters,
-                  const std::vector<std::string>& outputs) {
+                  const std::vector<std::string>& outputs, const std::vector<std::string>& reactions = {},
+                  Agreement* reaction_agreement = nullptr) {
   const std::vector<double> p = Values(scene);
   std::vector<int> indices;
   for (const std::string& name : parameters) indices.push_back(IndexOf(scene, name));
@@ -77,7 +81,7 @@ Agreement Compare(const spec::Scene& scene, const std::vector<std::string>& para
     if (a.size() != b.size()) return {INFINITY, INFINITY};
     for (size_t t = 0; t < a.size(); ++t) EXPECT_NEAR(a[t], b[t], 1e4 * scene.integrator.relative_tolerance * (1.0 + std::abs(b[t]))) << name;
   }
-  Agreement agreement;
+  Agreement overall;
   for (size_t i = 0; i < indices.size(); ++i) {
     const size_t k = static_cast<size_t>(indices[i]);
     const double h = kRelativeStep * std::abs(p[k]);
@@ -108,6 +112,8 @@ Agreement Compare(const spec::Scene& scene, const std::vector<std::string>& para
         std::cout << parameters[i] << " -> " << name << ": independent (difference " << difference << ")\n";
         continue;
       }
+      const bool reaction = std::find(reactions.begin(), reactions.end(), name) != reactions.end();
+      Agreement& agreement = reaction ? *reaction_agreement : overall;
       agreement.worst_series = std::max(agreement.worst_series, difference / scale);
       const std::vector<double>& values = scene_text::Series(result.report, name);
       const double peak_fd = (u[ArgMax(u)] - w[ArgMax(w)]) / (2 * h);
@@ -119,7 +125,7 @@ Agreement Compare(const spec::Scene& scene, const std::vector<std::string>& para
                 << peak_difference << " relative)\n";
     }
   }
-  return agreement;
+  return overall;
 }
 
 std::string ReadFile(const std::string& path) {
@@ -153,7 +159,9 @@ spec::Scene Governor() {
 // 80 deg), the hinge's ground marker 20 mm off the rod's initial pivot (the
 // assembly moves the rod there, so the start depends on that coordinate),
 // pulled sideways by a spring from a ground anchor to its tip and swinging
-// under gravity.
+// under gravity. Integrated at rtol 1e-11: with the residual differenced
+// along the sensitivities (before the exact state Jacobian) their
+// corrector failed there at t = 0.35 s.
 constexpr char kPendulum[] = R"pb(
   parameters { name: "mass" value: 2 unit: "kg" }
   parameters { name: "stiffness" value: 150 unit: "N/m" }
@@ -189,40 +197,44 @@ constexpr char kPendulum[] = R"pb(
   outputs { name: "yaw" body_orientation { body: "rod" sequence: EULER_ZYX angle: 1 } }
   outputs { name: "reaction_z" joint_reaction { joint: "hinge" axis: AXIS_Z } }
   time_grid { start_s: 0 end_s: 1.5 points: 31 }
-  integrator { relative_tolerance: 1e-10 absolute_tolerance: 1e-11 }
+  integrator { relative_tolerance: 1e-11 absolute_tolerance: 1e-12 }
 )pb";
 
 // What the comparisons hold to, relative to each output's largest
-// derivative (measured with the settings above: the governor 3.5e-5 over
-// the instants and 1.7e-5 at the peaks; the pendulum 1.3e-4 and 2.6e-6,
-// its hinge reaction, from multipliers of interpolated accelerations,
-// 4.4e-4 and 1.6e-5; the driven pendulum 6.7e-9). Not the 1e-6 the
-// differences could judge: the state terms of the sensitivity residuals
-// are themselves differences (GglStateDirectionalDerivative).
-constexpr double kSeriesAgreement = 3e-4;
-constexpr double kReactionSeriesAgreement = 2e-3;
-constexpr double kPeakAgreement = 5e-5;
+// derivative, with the exact state Jacobian (measured with the settings
+// above: the governor 2.5e-5 over the instants and 1.7e-5 at the peaks,
+// 5.0e-5 and 2.4e-5 with the residual differenced along the
+// sensitivities; the pendulum 1.2e-5 and 1.8e-6, its hinge reaction, from
+// multipliers of interpolated accelerations, 4.0e-5 and 1.1e-6; the driven
+// pendulum 6.7e-9). Not the 1e-6 the differences could judge: the errors
+// follow the integration tolerance (the pendulum at rtol 1e-10: 8.1e-5).
+constexpr double kGovernorSeriesAgreement = 4e-5;
+constexpr double kGovernorPeakAgreement = 3e-5;
+constexpr double kSeriesAgreement = 3e-5;
+constexpr double kReactionSeriesAgreement = 1e-4;
+constexpr double kPeakAgreement = 5e-6;
 constexpr double kDrivenAgreement = 1e-7;
 
 TEST(SpatialSensitivity, GovernorDerivativesAgreeWithCentralDifferences) {
   const spec::Scene scene = Governor();
   const Agreement a = Compare(scene, {"ball_mass", "stiffness", "arm"},
                               {"ball_x", "ball_z", "spring_force", "tilt", "kinetic_energy"});
-  EXPECT_LT(a.worst_series, kSeriesAgreement);
-  EXPECT_LT(a.worst_peak, kPeakAgreement);
+  EXPECT_LT(a.worst_series, kGovernorSeriesAgreement);
+  EXPECT_LT(a.worst_peak, kGovernorPeakAgreement);
   std::cout << "governor: worst " << a.worst_series << " over the instants, " << a.worst_peak << " at the peaks\n";
 }
 
 TEST(SpatialSensitivity, PendulumDerivativesAgreeWithCentralDifferences) {
   const spec::Scene scene = scene_text::Load(kPendulum, "pendulum.scene.textproto");
-  const Agreement a =
-      Compare(scene, {"mass", "stiffness", "hinge_x"}, {"tip_x", "tip_z", "angle", "kinetic", "yaw"});
+  Agreement reaction;
+  const Agreement a = Compare(scene, {"mass", "stiffness", "hinge_x"},
+                              {"tip_x", "tip_z", "angle", "kinetic", "yaw", "reaction_z"}, {"reaction_z"}, &reaction);
   EXPECT_LT(a.worst_series, kSeriesAgreement);
   EXPECT_LT(a.worst_peak, kPeakAgreement);
-  const Agreement reaction = Compare(scene, {"mass", "stiffness", "hinge_x"}, {"reaction_z"});
   EXPECT_LT(reaction.worst_series, kReactionSeriesAgreement);
   EXPECT_LT(reaction.worst_peak, kPeakAgreement);
-  std::cout << "pendulum: worst " << a.worst_series << " over the instants, " << a.worst_peak << " at the peaks\n";
+  std::cout << "pendulum: worst " << a.worst_series << " over the instants, " << a.worst_peak
+            << " at the peaks; its hinge reaction " << reaction.worst_series << " and " << reaction.worst_peak << "\n";
 }
 
 // The same pendulum with its hinge driven (no degree of freedom left): the

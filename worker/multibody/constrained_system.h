@@ -79,6 +79,16 @@ class ConstrainedSystem {
                                          Eigen::MatrixXd* /*jacobian*/) const {
     return -1;
   }
+  // d(M(q) a)/dq for given accelerations a (n values): n x n. The default
+  // is the zero matrix of a constant mass matrix (the planar kernel's); a
+  // system whose M depends on q gives it here, or its Newton matrix and
+  // state Jacobian leave it out (then it says false to
+  // has_exact_state_jacobian()).
+  virtual int MassTimesAccelerationJacobian(const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*a*/,
+                                            Eigen::MatrixXd* jacobian) const {
+    jacobian->setZero(num_coordinates(), num_coordinates());
+    return 0;
+  }
   // dQ/dq (minus the stiffness) and dQ/dv (minus the damping): n x n each.
   virtual int ForceJacobians(double /*t*/, const Eigen::VectorXd& /*q*/, const Eigen::VectorXd& /*v*/,
                              Eigen::MatrixXd* /*q_q*/, Eigen::MatrixXd* /*q_v*/) const {

@@ -40,7 +40,7 @@ struct Problem {
   // (state_jacobian_t, state_jacobian_at), for the sensitivity residuals.
   Eigen::MatrixXd state_jacobian, state_mass, state_phi_q;
   double state_jacobian_t = 0.0;
-  VectorXd state_jacobian_at;
+  VectorXd state_jacobian_at, state_jacobian_at_rates;
   // The sparse Newton matrix's pattern in compressed columns (KLU only).
   std::vector<sunindextype> column_starts, row_indices;
   // For the error weights (ErrorWeights): the integrator, the tolerances and
@@ -79,18 +79,19 @@ int Residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void* user_data)
 
 // The exact Newton matrix into p->newton, for either storage below; the
 // budget is checked here because forming it runs no residual.
-int FormNewtonMatrix(Problem* p, realtype t, realtype cj, N_Vector yy) {
+int FormNewtonMatrix(Problem* p, realtype t, realtype cj, N_Vector yy, N_Vector yp) {
   if (BudgetStops(p, t)) return -1;
   const int size = 2 * p->n + 2 * p->m;
   const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
-  return GglNewtonMatrix(*p->system, t, cj, y, &p->work, &p->newton);
+  const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
+  return GglNewtonMatrix(*p->system, t, cj, y, y_dot, &p->work, &p->newton);
 }
 
-int DenseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_Vector /*rr*/, SUNMatrix jac,
+int DenseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector yp, N_Vector /*rr*/, SUNMatrix jac,
                       void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
-    if (int flag = FormNewtonMatrix(p, t, cj, yy); flag != 0) return flag;
+    if (int flag = FormNewtonMatrix(p, t, cj, yy, yp); flag != 0) return flag;
     const int size = 2 * p->n + 2 * p->m;
     // SUNDIALS' dense matrices are column-major like Eigen's.
     Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(jac), size, size) = p->newton;
@@ -101,11 +102,11 @@ int DenseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_V
 // The same matrix in the compressed-column pattern built once per
 // integration (KLU analyses it once and refactors with it); IDAS zeroes
 // the matrix, indices included, before every call.
-int SparseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector /*yp*/, N_Vector /*rr*/, SUNMatrix jac,
+int SparseNewtonMatrix(realtype t, realtype cj, N_Vector yy, N_Vector yp, N_Vector /*rr*/, SUNMatrix jac,
                        void* user_data, N_Vector, N_Vector, N_Vector) {
   auto* p = static_cast<Problem*>(user_data);
   return sundials::GuardCallback(&p->callback_failure, "the Newton matrix", [&]() -> int {
-    if (int flag = FormNewtonMatrix(p, t, cj, yy); flag != 0) return flag;
+    if (int flag = FormNewtonMatrix(p, t, cj, yy, yp); flag != 0) return flag;
     const int size = 2 * p->n + 2 * p->m;
     sunindextype* starts = SUNSparseMatrix_IndexPointers(jac);
     sunindextype* rows = SUNSparseMatrix_IndexValues(jac);
@@ -133,14 +134,15 @@ int ValidityBounds(realtype t, N_Vector yy, N_Vector /*yp*/, realtype* g, void* 
 }
 
 // The sensitivity residuals F_y s_k + F_y' s_k' + F_p_k. F_y is the Newton
-// matrix's at cj = 0 (exact, ggl_residual.h) and F_y' s' = (s_q', M s_v',
-// 0, 0) (F is linear in y' and M is constant); both are formed once per
+// matrix's at cj = 0 (exact, ggl_residual.h: d(M(q) v')/dq included) and
+// F_y' s' = (s_q', M s_v', 0, 0) (F is linear in y'); both are formed once per
 // state: IDAS's staggered corrector calls this again at the same (t, y) for
 // every iteration of the sensitivities. F_p_k is exact where the parameter
 // has a derivative model, else the central difference of the residual
 // alone between the systems at p_k +- step_k, at the same state
-// (parameter_derivatives.h). A system without an exact state Jacobian (the
-// spatial one) gets F_y s_k from GglStateDirectionalDerivative instead: two
+// (parameter_derivatives.h). A system without an exact state Jacobian (a
+// spatial one with bushings or rotational spring-dampers) gets F_y s_k from
+// GglStateDirectionalDerivative instead: two
 // residuals per parameter and call. The first version differenced the residual
 // along (s, s') too (round-off then forced exact constraint rows by
 // polarization of gamma): eight residuals per parameter and call, and the
@@ -153,9 +155,13 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
     const Map<const VectorXd> y(N_VGetArrayPointer(yy), size);
     const Map<const VectorXd> y_dot(N_VGetArrayPointer(yp), size);
     const bool analytic = p->system->has_exact_state_jacobian();
-    if (!(p->state_jacobian_at.size() == size && p->state_jacobian_t == t && p->state_jacobian_at == y)) {
+    // Keyed on y' too: the exact F_y holds d(M(q) v')/dq.
+    if (!(p->state_jacobian_at.size() == size && p->state_jacobian_t == t && p->state_jacobian_at == y &&
+          p->state_jacobian_at_rates == y_dot)) {
       if (analytic) {
-        if (int flag = GglNewtonMatrix(*p->system, t, 0.0, y, &p->work, &p->state_jacobian); flag != 0) return flag;
+        if (int flag = GglNewtonMatrix(*p->system, t, 0.0, y, y_dot, &p->work, &p->state_jacobian); flag != 0) {
+          return flag;
+        }
         p->state_mass = p->work.mass;
       } else {
         const VectorXd q = y.head(n);
@@ -167,6 +173,7 @@ int SensitivityResidual(int count, realtype t, N_Vector yy, N_Vector yp, N_Vecto
       }
       p->state_jacobian_t = t;
       p->state_jacobian_at = y;
+      p->state_jacobian_at_rates = y_dot;
     }
     VectorXd partial(size);
     for (int k = 0; k < count; ++k) {

@@ -36,16 +36,17 @@ int GglResidual(const ConstrainedSystem& s, double t, const Eigen::Ref<const Vec
 // (q, v, lambda, mu):
 //
 //   [ cj I + (Phi_q^T mu)_q     -I            0        Phi_q^T ]
-//   [ (Phi_q^T lambda)_q - Q_q   cj M - Q_v    Phi_q^T  0       ]
+//   [ (M v')_q + (Phi_q^T lambda)_q - Q_q   cj M - Q_v    Phi_q^T  0 ]
 //   [ Phi_q                      0             0        0       ]
 //   [ (Phi_q v + Phi_t)_q        Phi_q         0        0       ]
 int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen::Ref<const VectorXd>& y,
-                    GglWorkspace* w, Eigen::MatrixXd* j) {
+                    const Eigen::Ref<const VectorXd>& y_dot, GglWorkspace* w, Eigen::MatrixXd* j) {
   const int n = s.num_coordinates(), m = s.num_constraints(), size = 2 * n + 2 * m;
   const VectorXd q = y.head(n), v = y.segment(n, n);
   const ContinuedPastBounds continued(s);
   int flag = s.MassMatrix(q, &w->mass);
   if (flag == 0) flag = s.ForceJacobians(t, q, v, &w->force_q, &w->force_v);
+  if (flag == 0) flag = s.MassTimesAccelerationJacobian(q, y_dot.segment(n, n), &w->mass_q);
   if (flag == 0 && m > 0) flag = s.ConstraintJacobian(t, q, &w->phi_q);
   if (flag == 0 && m > 0) flag = s.ConstraintCurvature(t, q, y.segment(2 * n + m, m), &w->curvature_mu);
   if (flag == 0 && m > 0) flag = s.ConstraintCurvature(t, q, y.segment(2 * n, m), &w->curvature_lambda);
@@ -54,7 +55,7 @@ int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen
   j->setZero(size, size);
   j->topLeftCorner(n, n).diagonal().setConstant(cj);
   j->block(0, n, n, n).diagonal().setConstant(-1.0);
-  j->block(n, 0, n, n) = -w->force_q;
+  j->block(n, 0, n, n) = w->mass_q - w->force_q;
   j->block(n, n, n, n) = cj * w->mass - w->force_v;
   if (m > 0) {
     j->topLeftCorner(n, n) += w->curvature_mu;

@@ -19,7 +19,7 @@ namespace mbopt::multibody {
 struct GglWorkspace {
   Eigen::MatrixXd mass, phi_q;
   Eigen::VectorXd forces, phi, phi_t;
-  Eigen::MatrixXd force_q, force_v, curvature_mu, curvature_lambda, velocity_q;
+  Eigen::MatrixXd force_q, force_v, curvature_mu, curvature_lambda, velocity_q, mass_q;
 };
 
 // F(t, y, y') into `r` (size 2n + 2m); the SUNDIALS callback contract: 0 ok,
@@ -29,11 +29,12 @@ struct GglWorkspace {
 int GglResidual(const ConstrainedSystem& s, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
                 const Eigen::Ref<const Eigen::VectorXd>& y_dot, GglWorkspace* work, Eigen::Ref<Eigen::VectorXd> r);
 
-// dF/dy + cj dF/dy' at (t, y) (F is linear in y', so y' does not enter),
-// from the system's analytic derivatives: the caller checks
-// has_analytic_derivatives().
+// dF/dy + cj dF/dy' at (t, y, y') from the system's analytic derivatives:
+// the caller checks has_analytic_derivatives(). F is linear in y'; y' enters
+// only through d(M(q) v')/dq (MassTimesAccelerationJacobian), zero for a
+// constant mass matrix.
 int GglNewtonMatrix(const ConstrainedSystem& s, double t, double cj, const Eigen::Ref<const Eigen::VectorXd>& y,
-                    GglWorkspace* work, Eigen::MatrixXd* newton);
+                    const Eigen::Ref<const Eigen::VectorXd>& y_dot, GglWorkspace* work, Eigen::MatrixXd* newton);
 
 // dF/dy times `direction` at (t, y, y'), for a system without an exact
 // state Jacobian (has_exact_state_jacobian(); forward sensitivities: forward_dynamics.h). The parts of F

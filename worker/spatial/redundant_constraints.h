@@ -79,6 +79,10 @@ class CombinedConstraintSystem : public multibody::ConstrainedSystem {
   bool has_analytic_derivatives() const override { return full_.has_analytic_derivatives(); }
   int mass_block_size() const override { return full_.mass_block_size(); }
   bool has_exact_state_jacobian() const override { return full_.has_exact_state_jacobian(); }
+  int MassTimesAccelerationJacobian(const Eigen::VectorXd& q, const Eigen::VectorXd& a,
+                                    Eigen::MatrixXd* jacobian) const override {
+    return full_.MassTimesAccelerationJacobian(q, a, jacobian);
+  }
   int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
                           Eigen::MatrixXd* curvature) const override;
   int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,

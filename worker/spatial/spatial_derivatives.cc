@@ -1,9 +1,12 @@
 // SpatialSystem's Newton-matrix derivatives (docs/physics.md section 8,
 // "Newton matrix"): the constraints' curvature d(Phi_q^T w)/dq and the
 // velocity constraints' Jacobian d(Phi_q v + Phi_t)/dq from the equations'
-// exact Hessians (pair_vectors.h), the Euler parameters' quadratic
-// velocity terms analytically, and the springs' and force elements'
-// Jacobians by central differences of their forces alone.
+// exact Hessians (pair_vectors.h), the Euler parameters' mass matrix
+// d(M(q) a)/dq and quadratic velocity terms analytically, the springs',
+// point forces' and torques' Jacobians analytically
+// (spatial_element_jacobians.h), and those of a model with rotational
+// spring-dampers or bushings by central differences of its elements'
+// forces alone.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,6 +14,7 @@
 
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/pair_vectors.h"
+#include "worker/spatial/spatial_element_jacobians.h"
 #include "worker/spatial/spatial_force_elements.h"
 #include "worker/spatial/spatial_system.h"
 
@@ -107,6 +111,29 @@ int SpatialSystem::VelocityConstraintJacobian(double t, const VectorXd& q, const
   return jacobian->allFinite() ? 0 : 1;
 }
 
+bool SpatialSystem::has_exact_state_jacobian() const { return HasAnalyticElementJacobians(model_); }
+
+// A body's block of M(q) a is m a_r and (4 L(p)^T J L(p) + c p p^T) b with
+// b = a_p and c = 4 tr(J) / 3. L is linear in p with L(p) b = -L(b) p and
+// L(p)^T x = X(x) p (TransposedRateMatrixApplied), so
+//   d(4 L(p)^T J L(p) b)/dp = 4 X(J L(p) b) - 4 L(p)^T J L(b),
+//   d(c p p^T b)/dp = c ((p . b) I + p b^T).
+int SpatialSystem::MassTimesAccelerationJacobian(const VectorXd& q, const VectorXd& a, MatrixXd* jacobian) const {
+  const int n = num_coordinates();
+  jacobian->setZero(n, n);
+  for (size_t i = 0; i < model_.bodies.size(); ++i) {
+    const int at = kBlock * static_cast<int>(i) + 3;
+    const Matrix3d& inertia = model_.bodies[i].inertia_kg_m2;
+    const Vector4d p = q.segment<4>(at), b = a.segment<4>(at);
+    const Matrix34d l = BodyRateMatrix(p);
+    const double along_p = 4.0 * inertia.trace() / 3.0;
+    jacobian->block<4, 4>(at, at) = 4.0 * TransposedRateMatrixApplied(inertia * l * b) -
+                                    4.0 * l.transpose() * inertia * BodyRateMatrix(b) +
+                                    along_p * (p.dot(b) * Matrix4d::Identity() + p * b.transpose());
+  }
+  return jacobian->allFinite() ? 0 : 1;
+}
+
 bool SpatialSystem::has_force_elements() const {
   return !model_.springs.empty() || !model_.point_forces.empty() || !model_.torques.empty() ||
          !model_.rotational_springs.empty() || !model_.bushings.empty();
@@ -129,6 +156,9 @@ int SpatialSystem::ForceJacobians(double t, const VectorXd& q, const VectorXd& v
         8.0 * TransposedRateMatrixApplied(inertia * l_dot * p) - 8.0 * l_dot.transpose() * inertia * l;
   }
   if (!has_force_elements()) return 0;
+  if (HasAnalyticElementJacobians(model_)) {
+    return AddElementJacobians(model_, t, q, v, continue_past_bounds_, q_q, q_v);
+  }
   // Central differences of the elements' forces, column by column of the
   // bodies they act on.
   std::set<int> bodies;

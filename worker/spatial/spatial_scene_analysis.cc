@@ -266,9 +266,12 @@ std::string MakeVariant(const spec::Scene& scene, std::vector<double> p, const S
 // outputs thus follow the Euler parameters' derivatives; multipliers (for
 // reactions and efforts) are the variants' inverse dynamics of the moved
 // states.
+// `is_static`: the multipliers are the equilibrium's own and move with
+// their sensitivities; a motion's come from inverse dynamics of each
+// variant's state.
 double OutputDerivative(const spec::SpatialModel& sm, const spec::SpatialOutput& o, const Perturbed& dp,
                         const multibody::MotionSample& s, const multibody::StateSensitivity& ds,
-                        bool needs_multipliers) {
+                        bool needs_multipliers, bool is_static) {
   const double h = dp.step;
   auto value = [&](const Variant& variant, double sign) {
     multibody::MotionSample x;
@@ -276,8 +279,9 @@ double OutputDerivative(const spec::SpatialModel& sm, const spec::SpatialOutput&
     x.q = s.q + sign * h * ds.q;
     x.v = s.v + sign * h * ds.v;
     x.a = s.a + sign * h * ds.a;
-    const Eigen::VectorXd lambda =
-        needs_multipliers ? Multipliers(*variant.system, x.t_s, x.q, x.v, x.a) : Eigen::VectorXd();
+    const Eigen::VectorXd lambda = is_static           ? Eigen::VectorXd(s.lambda + sign * h * ds.lambda)
+                                   : needs_multipliers ? Multipliers(*variant.system, x.t_s, x.q, x.v, x.a)
+                                                       : Eigen::VectorXd();
     return OutputValue(*variant.system, variant.model, sm, o, variant.p, x, lambda);
   };
   return (value(*dp.plus, 1.0) - value(*dp.minus, -1.0)) / (2.0 * h);
@@ -351,8 +355,10 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   // exact derivative models for spatial systems), their assemblies give the
   // start's derivatives.
   std::vector<Perturbed> perturbed;
-  if (sensitivities && is_static) {
-    result->unavailable = "static equilibrium of spatial scenes has no sensitivity equations yet";
+  if (sensitivities && is_static && !system.has_exact_state_jacobian()) {
+    result->unavailable =
+        "static equilibrium of a spatial scene with rotational spring-dampers or bushings has no sensitivity "
+        "equations yet (their Jacobians are difference quotients)";
   } else if (sensitivities && assembled.redundant_rows > 0) {
     result->unavailable = absl::StrFormat(
         "the mechanism has %d redundant constraint equation(s): its motion is integrated with combinations of its "
@@ -393,7 +399,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     perturbations.push_back(
         multibody::ParameterPerturbation{dp.plus->system.get(), dp.minus->system.get(), dp.step, dp.magnitude, nullptr});
   }
-  std::vector<multibody::StateSensitivity> kinematic;  // work space of the driven path
+  std::vector<multibody::StateSensitivity> kinematic;  // work space of the driven and static paths
   size_t next_instant = 0;
   std::vector<double> bushing_bounds;
   const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
@@ -434,10 +440,13 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     }
     if (!with_derivatives || !result->unavailable.empty()) return spec::AnalysisFailure::Ok();
     // Forward dynamics brings the state's derivatives; a driven
-    // mechanism's come from its differentiated constraint equations.
+    // mechanism's come from its differentiated constraint equations, an
+    // equilibrium's from its differentiated equilibrium equations.
     const std::vector<multibody::StateSensitivity>* ds = &s.sensitivities;
     if (ds->size() != perturbed.size()) {
-      if (!multibody::KinematicStateSensitivities(system, perturbations, s, &kinematic)) {
+      const bool solved = is_static ? multibody::StaticStateSensitivities(system, perturbations, s, &kinematic)
+                                    : multibody::KinematicStateSensitivities(system, perturbations, s, &kinematic);
+      if (!solved) {
         result->unavailable = absl::StrFormat("no state derivative at t = %.6g s", s.t_s);
         return spec::AnalysisFailure::Ok();
       }
@@ -447,7 +456,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       for (size_t k = 0; k < scene.outputs.size(); ++k) {
         const auto& o = std::get<spec::SpatialOutput>(scene.outputs[k].kind);
         result->output_derivatives[i][k].push_back(
-            OutputDerivative(sm, o, perturbed[i], s, (*ds)[i], needs_multipliers));
+            OutputDerivative(sm, o, perturbed[i], s, (*ds)[i], needs_multipliers, is_static));
       }
     }
     return spec::AnalysisFailure::Ok();

@@ -18,11 +18,11 @@
 // that row's reaction and only its multiplier changes, not the motion.
 //
 // Analytic Newton derivatives (spatial_derivatives.cc): the constraints'
-// exact second derivatives and the Euler parameters' velocity terms; the
-// springs' and force elements' Jacobians are central differences of their
-// forces alone. The Newton matrix leaves out d(M(q) a)/dq (M depends on
-// the Euler parameters), a term of the order of the step times the
-// accelerations: IDAS's Newton iteration converges with it left out.
+// exact second derivatives, the mass matrix's d(M(q) a)/dq, the Euler
+// parameters' velocity terms, and the springs', point forces' and torques'
+// Jacobians (spatial_element_jacobians.h). Rotational spring-dampers and
+// bushings have no analytic Jacobian yet: a model with one takes central
+// differences of its elements' forces and has no exact state Jacobian.
 //
 // Immutable after construction but for the rotational springs' turn
 // counts (SpringAngles, spatial_force_elements.h): an analysis owns its
@@ -83,10 +83,12 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   // The Newton matrix's derivatives (spatial_derivatives.cc).
   bool has_analytic_derivatives() const override { return true; }
   int mass_block_size() const override { return kCoordinatesPerBody; }  // one body's (r, p)
-  // The Newton matrix leaves out d(M(q) v')/dq (the mass matrix depends on
-  // the Euler parameters), and the force elements' Jacobians are difference
-  // quotients: sensitivities difference the residual instead.
-  bool has_exact_state_jacobian() const override { return false; }
+  // True unless the model has a rotational spring-damper or a bushing,
+  // whose Jacobians are difference quotients: then sensitivities difference
+  // the residual instead, and statics difference their Newton matrices.
+  bool has_exact_state_jacobian() const override;
+  int MassTimesAccelerationJacobian(const Eigen::VectorXd& q, const Eigen::VectorXd& a,
+                                    Eigen::MatrixXd* jacobian) const override;
   int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
                           Eigen::MatrixXd* curvature) const override;
   int VelocityConstraintJacobian(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& v,

@@ -1,0 +1,177 @@
+// Simulator sensitivities of spatial static equilibria (the implicit
+// function theorem on the equilibrium equations, multibody::
+// StaticStateSensitivities, on the spatial system's exact state Jacobian)
+// against central differences of whole static analyses: a two-body
+// linkage (an arm on a tilted hinge, a bob hung from it on a spherical
+// joint) held by a linear and a tabulated spring, pushed by a follower
+// force and twisted by a torque under gravity, with respect to a mass, a
+// stiffness, a marker coordinate and a load. Outputs: marker positions, the
+// hinge's angle, joint reactions, a spring's force and length. Also: the
+// Newton matrix is analytic now (fewer residual evaluations than the
+// difference-quotient matrices), and a scene with a bushing still says its
+// sensitivities are unavailable.
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/spatial/scene_text_testing.h"
+#include "worker/spatial/spatial_scene_analysis.h"
+
+namespace mbopt::spatial {
+namespace {
+
+// Relative step of the whole analyses' central differences: the equilibria
+// are converged far below 1e-10 in their residuals (Newton's last step is
+// quadratic), so the differences' noise stays near 1e-10 / 1e-4 = 1e-6 at
+// worst and their truncation near 1e-8.
+constexpr double kRelativeStep = 1e-4;
+
+constexpr char kLinkage[] = R"pb(
+  parameters { name: "bob_mass" value: 1.5 unit: "kg" }
+  parameters { name: "stiffness" value: 300 unit: "N/m" }
+  parameters { name: "anchor_y" value: 400 unit: "mm" }
+  parameters { name: "push" value: 4 unit: "N" }
+  spatial {
+    analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
+    ground_markers {
+      name: "hinge"
+      orientation { euler_angles { sequence: EULER_ZYX angles_deg: [15, 0, 80] } }
+    }
+    ground_markers { name: "anchor" position_m { x { value: 0.1 } y { param: "anchor_y" } z { value: -0.5 } } }
+    ground_markers { name: "post" position_m { x { value: -0.4 } y { value: -0.1 } z { value: -0.6 } } }
+    bodies {
+      name: "arm"
+      mass_kg { value: 1 }
+      principal_inertia { moments_kg_m2 { x { value: 0.01 } y { value: 0.01 } z { value: 0.001 } } }
+      position_m { z { value: -0.15 } }
+      markers {
+        name: "top" position_m { z { value: 0.15 } }
+        orientation { euler_angles { sequence: EULER_ZYX angles_deg: [15, 0, 80] } }
+      }
+      markers { name: "tip" position_m { z { value: -0.15 } } }
+    }
+    bodies {
+      name: "bob"
+      mass_kg { param: "bob_mass" }
+      principal_inertia { moments_kg_m2 { x { value: 0.02 } y { value: 0.03 } z { value: 0.01 } } }
+      position_m { z { value: -0.5 } }
+      markers { name: "socket" position_m { z { value: 0.2 } } }
+      markers { name: "left" position_m { x { value: 0.05 } y { value: 0.08 } z { value: -0.1 } } }
+      markers { name: "right" position_m { x { value: -0.06 } y { value: -0.05 } z { value: -0.1 } } }
+    }
+    joints { name: "hinge" kind: SPATIAL_JOINT_REVOLUTE a: "ground.hinge" b: "arm.top" }
+    joints { name: "socket" kind: SPATIAL_JOINT_SPHERICAL a: "arm.tip" b: "bob.socket" }
+    springs {
+      name: "pull" a: "ground.anchor" b: "bob.left"
+      free_length_m { value: 0.2 } stiffness_n_per_m { param: "stiffness" } damping_n_s_per_m { value: 2 }
+    }
+    springs {
+      name: "strap" a: "ground.post" b: "bob.right"
+      free_length_m { value: 0.25 }
+      deflection_curve { x: [-0.5, 0.05, 1] force_n: [-50, 10, 400] }
+    }
+    point_forces {
+      name: "push" at: "bob.left" force_n { x { param: "push" } z { value: 1 } } axes: SPATIAL_LOAD_BODY_AXES
+      tabulated { times_s: [0, 1] values: [0.5, 1.5] }
+    }
+    torques { name: "twist" body: "arm" torque_n_m { x { value: 0.3 } z { value: -0.2 } } }
+    gravity { acceleration_m_per_s2 { z { value: -9.81 } } }
+  }
+  outputs { name: "left_x" marker_position { marker: "bob.left" axis: AXIS_X } }
+  outputs { name: "left_y" marker_position { marker: "bob.left" axis: AXIS_Y } }
+  outputs { name: "right_z" marker_position { marker: "bob.right" axis: AXIS_Z } }
+  outputs { name: "angle" joint_coordinate { joint: "hinge" } }
+  outputs { name: "hinge_fx" joint_reaction { joint: "hinge" axis: AXIS_X } }
+  outputs { name: "socket_fz" joint_reaction { joint: "socket" axis: AXIS_Z } }
+  outputs { name: "pull_force" spring_force { spring: "pull" } }
+  outputs { name: "strap_length" spring_length { spring: "strap" } }
+  time_grid { start_s: 0 end_s: 1 points: 3 }
+)pb";
+
+spec::Scene Linkage() { return scene_text::Load(kLinkage, "linkage.scene.textproto"); }
+
+// The largest |simulator - central difference| over outputs and instants,
+// each output relative to its largest |central difference| over the
+// instants, for each parameter.
+double WorstDisagreement(const spec::Scene& scene) {
+  const std::vector<double> p = scene.DefaultParameterValues();
+  std::vector<int> indices;
+  for (size_t k = 0; k < p.size(); ++k) indices.push_back(static_cast<int>(k));
+  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, p, indices);
+  EXPECT_TRUE(result.report.ok()) << result.report.failure.reason;
+  EXPECT_EQ(result.unavailable, "");
+  EXPECT_EQ(result.report.formulation, spec::Formulation::kStatic);
+  if (!result.report.ok() || result.output_derivatives.size() != indices.size()) return INFINITY;
+  double worst = 0.0;
+  for (size_t i = 0; i < indices.size(); ++i) {
+    const double h = kRelativeStep * std::abs(p[i]);
+    std::vector<double> plus = p, minus = p;
+    plus[i] += h;
+    minus[i] -= h;
+    const spec::AnalysisReport up = AnalyzeSpatialScene(scene, plus), down = AnalyzeSpatialScene(scene, minus);
+    EXPECT_TRUE(up.ok() && down.ok()) << up.failure.reason << down.failure.reason;
+    if (!up.ok() || !down.ok()) return INFINITY;
+    for (size_t o = 0; o < scene.outputs.size(); ++o) {
+      const std::string& name = scene.outputs[o].name;
+      const std::vector<double>& d = result.output_derivatives[i][o];
+      const std::vector<double>&u = scene_text::Series(up, name), &w = scene_text::Series(down, name);
+      EXPECT_EQ(d.size(), u.size()) << name;
+      double scale = 0.0, difference = 0.0;
+      for (size_t t = 0; t < d.size() && t < u.size(); ++t) {
+        const double fd = (u[t] - w[t]) / (2 * h);
+        scale = std::max(scale, std::abs(fd));
+        difference = std::max(difference, std::abs(d[t] - fd));
+      }
+      // Every output depends on every parameter here.
+      EXPECT_GT(scale, 1e-6) << scene.parameters[i].name << " -> " << name;
+      worst = std::max(worst, difference / scale);
+      std::cout << scene.parameters[i].name << " -> " << name << ": max |d| " << scale << ", difference "
+                << difference << " (" << difference / scale << " relative)\n";
+    }
+  }
+  return worst;
+}
+
+// Measured: 4.8e-8 at worst relative to each output's largest derivative
+// (the hinge's reaction on the anchor's coordinate), most below 1e-8.
+constexpr double kAgreement = 1e-6;
+
+TEST(SpatialStaticSensitivity, LinkageDerivativesAgreeWithCentralDifferences) {
+  const double worst = WorstDisagreement(Linkage());
+  EXPECT_LT(worst, kAgreement);
+  std::cout << "linkage statics: worst " << worst << "\n";
+}
+
+// The analytic Newton matrix costs a residual or so per Newton iteration
+// (and the line search's); difference quotients one more per unknown of
+// the 14 coordinates and 12 multipliers. Measured: 167 iterations and 549
+// residuals; with difference quotients the same iterations and 4669.
+TEST(SpatialStaticSensitivity, NewtonMatrixIsAnalytic) {
+  const spec::Scene scene = Linkage();
+  const spec::AnalysisReport r = AnalyzeSpatialScene(scene, scene.DefaultParameterValues());
+  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  std::cout << "linkage statics: " << r.counters.newton_iterations << " Newton iterations, "
+            << r.counters.rhs_evaluations << " residual evaluations\n";
+  EXPECT_GT(r.counters.newton_iterations, 0);
+  EXPECT_LT(r.counters.rhs_evaluations, 4 * r.counters.newton_iterations);
+}
+
+TEST(SpatialStaticSensitivity, BushingLeavesThemUnavailable) {
+  std::string text = kLinkage;
+  const std::string from = "    gravity {";
+  text.replace(text.find(from), from.size(),
+               "    bushings { name: \"mount\" a: \"ground.post\" b: \"bob.right\" stiffness_n_per_m { x { value: 50 } "
+               "y { value: 50 } z { value: 50 } } }\n    gravity {");
+  const spec::Scene scene = scene_text::Load(text, "bushing.scene.textproto");
+  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, scene.DefaultParameterValues(), {0});
+  ASSERT_TRUE(result.report.ok()) << result.report.failure.reason;
+  EXPECT_NE(result.unavailable.find("bushings"), std::string::npos) << result.unavailable;
+  EXPECT_TRUE(result.output_derivatives.empty());
+}
+
+}  // namespace
+}  // namespace mbopt::spatial
