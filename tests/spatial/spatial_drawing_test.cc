@@ -2,7 +2,6 @@
 // axes: markers against closed-form positions, joint axes and a load that
 // turns with its body along their world directions, the parts of the
 // examples' scenes; a dynamic example drawn on the explicit path as on IDAS.
-#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <numbers>
@@ -15,6 +14,7 @@
 #include "spec/io/study_io.h"
 #include "tests/spatial/scene_text_testing.h"
 #include "tests/spatial/tilted_crank_scene.h"
+#include "tests/testing/drawing_agreement.h"
 #include "tests/testing/file_text.h"
 #include "worker/spatial/spatial_drawing.h"
 
@@ -192,32 +192,17 @@ TEST(SpatialDrawing, TheExplicitPathDrawsTheFramesOfTheDefaultPath) {
   ASSERT_EQ(idas.failure, "");
   ASSERT_EQ(erk.failure, "");
   ASSERT_EQ(idas.times_s.size(), 61u);
-  ASSERT_EQ(erk.times_s, idas.times_s);
-  ASSERT_EQ(erk.point_names, idas.point_names);
-  ASSERT_EQ(erk.points_m.size(), idas.times_s.size());
-  ASSERT_EQ(idas.points_m.size(), idas.times_s.size());
+  const mbopt::testing::DrawingAgreement agreement = mbopt::testing::CompareFrames(idas, erk);
+  ASSERT_TRUE(agreement.same_frames) << "the explicit drawing's instants or points are not IDAS's";
   // The example integrates at rtol 1e-7, atol 1e-8 over 3 s: the paths'
   // positions differ by 2.6e-7 m at most (measured), each path's own error
   // being of that order on coordinates of 0.1 to 0.4 m.
   constexpr double kPathAgreement = 2e-6;  // m
-  double worst = 0.0, travel = 0.0;
-  bool bitwise_same = true;
-  for (size_t i = 0; i < idas.times_s.size(); ++i) {
-    ASSERT_EQ(erk.points_m[i].size(), idas.points_m[i].size()) << "t = " << idas.times_s[i];
-    for (size_t k = 0; k < idas.points_m[i].size(); ++k) {
-      const spec::DrawingPosition &a = idas.points_m[i][k], &b = erk.points_m[i][k];
-      const double gap = std::max({std::abs(a.x_m - b.x_m), std::abs(a.y_m - b.y_m), std::abs(a.z_m - b.z_m)});
-      EXPECT_LT(gap, kPathAgreement) << idas.point_names[k] << " at t = " << idas.times_s[i];
-      worst = std::max(worst, gap);
-      bitwise_same = bitwise_same && a.x_m == b.x_m && a.y_m == b.y_m && a.z_m == b.z_m;
-      const spec::DrawingPosition& start = erk.points_m[0][k];
-      travel = std::max(travel, std::hypot(b.x_m - start.x_m, b.y_m - start.y_m, b.z_m - start.z_m));
-    }
-  }
-  EXPECT_GT(travel, 0.1);  // m: the flyweight swings round with the spindle
-  EXPECT_FALSE(bitwise_same) << "the explicit scene's drawing is IDAS's to the bit: was the path taken?";
-  std::cout << "governor drawn on both paths: positions differ by " << worst << " m at most, largest travel "
-            << travel << " m\n";
+  EXPECT_LT(agreement.largest_gap_m, kPathAgreement) << agreement.largest_gap_at;
+  EXPECT_GT(agreement.largest_travel_m, 0.1);  // m: the flyweight swings round with the spindle
+  EXPECT_FALSE(agreement.bitwise_same) << "the explicit scene's drawing is IDAS's to the bit: was the path taken?";
+  std::cout << "governor drawn on both paths: positions differ by " << agreement.largest_gap_m
+            << " m at most, largest travel " << agreement.largest_travel_m << " m\n";
 }
 
 }  // namespace
