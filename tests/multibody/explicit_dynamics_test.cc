@@ -8,10 +8,12 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
+#include <optional>
 
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
+#include "tests/multibody/andrews_on_both_paths.h"
 #include "tests/multibody/mechanisms.h"
 #include "tests/multibody/time_grid.h"
 #include "tests/testing/file_text.h"
@@ -109,14 +111,10 @@ TEST(MultibodyExplicitDynamics, RefusesSimulatorSensitivities) {
 // (the seven angles at every millisecond) within both runs' errors at rtol
 // 1e-8 (each about 3e-7 rad from its reference, bench_multibody_workprec).
 TEST(MultibodyExplicitDynamics, SceneSettingChoosesThePathForAWholeAnalysis) {
-  const std::string text = mbopt::testing::FileText("examples/andrews/andrews.scene.textproto");
-  ASSERT_FALSE(text.empty());
-  const std::string tolerances = " relative_tolerance: 1e-8 absolute_tolerance: 1e-10 }\n";
-  absl::StatusOr<spec::Scene> bdf = spec::io::ParseSceneText(text + "integrator {" + tolerances, "andrews.textproto");
-  absl::StatusOr<spec::Scene> erk = spec::io::ParseSceneText(
-      text + "integrator { method: EXPLICIT_RUNGE_KUTTA" + tolerances, "andrews.textproto");
-  ASSERT_TRUE(bdf.ok()) << bdf.status();
-  ASSERT_TRUE(erk.ok()) << erk.status();
+  const std::optional<testing::ScenesOnBothPaths> scenes = testing::AndrewsOnBothPaths();
+  ASSERT_TRUE(scenes.has_value());
+  const spec::Scene* bdf = &scenes->idas;
+  const spec::Scene* erk = &scenes->explicit_path;
   EXPECT_EQ(bdf->integrator.method, spec::IntegratorMethod::kIdas);
   EXPECT_EQ(erk->integrator.method, spec::IntegratorMethod::kExplicitRungeKutta);
   const spec::AnalysisReport a = AnalyzeMultibodyScene(*bdf, bdf->DefaultParameterValues(), nullptr);

@@ -3,8 +3,8 @@
 // closed-form positions, and against the analysis' own numbers; a scene
 // drawn on the explicit path as on IDAS.
 #include <cmath>
-#include <iostream>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "spec/io/study_io.h"
+#include "tests/multibody/andrews_on_both_paths.h"
 #include "tests/testing/drawing_agreement.h"
-#include "tests/testing/file_text.h"
 #include "worker/multibody/kinematic_analysis.h"
 #include "worker/multibody/linkage_geometry.h"
 #include "worker/multibody/scene_analysis.h"
@@ -229,30 +229,19 @@ TEST(MultibodyDrawing, AnUnassembledSceneIsDrawnAsGivenWithTheReason) {
 // point where IDAS puts it to the paths' integration error; the explicit
 // path must have run (its round-off is not IDAS's) and the mechanism moved.
 TEST(MultibodyDrawing, TheExplicitPathDrawsTheFramesOfTheDefaultPath) {
-  const std::string text = mbopt::testing::FileText("examples/andrews/andrews.scene.textproto");
-  ASSERT_FALSE(text.empty());
-  ASSERT_EQ(text.find("integrator {"), std::string::npos);
-  const std::string tolerances = " relative_tolerance: 1e-8 absolute_tolerance: 1e-10 }\n";
-  absl::StatusOr<spec::Scene> bdf = spec::io::ParseSceneText(text + "integrator {" + tolerances, "andrews.textproto");
-  absl::StatusOr<spec::Scene> erk = spec::io::ParseSceneText(
-      text + "integrator { method: EXPLICIT_RUNGE_KUTTA" + tolerances, "andrews.textproto");
-  ASSERT_TRUE(bdf.ok()) << bdf.status();
-  ASSERT_TRUE(erk.ok()) << erk.status();
-  const spec::SceneDrawing idas = DrawMultibodyScene(*bdf, bdf->DefaultParameterValues());
-  const spec::SceneDrawing explicit_drawing = DrawMultibodyScene(*erk, erk->DefaultParameterValues());
+  const std::optional<testing::ScenesOnBothPaths> scenes = testing::AndrewsOnBothPaths();
+  ASSERT_TRUE(scenes.has_value());
+  const spec::SceneDrawing idas = DrawMultibodyScene(scenes->idas, scenes->idas.DefaultParameterValues());
+  const spec::SceneDrawing erk =
+      DrawMultibodyScene(scenes->explicit_path, scenes->explicit_path.DefaultParameterValues());
   ASSERT_EQ(idas.failure, "");
-  ASSERT_EQ(explicit_drawing.failure, "");
+  ASSERT_EQ(erk.failure, "");
   ASSERT_EQ(idas.times_s.size(), 31u);
-  const mbopt::testing::DrawingAgreement agreement = mbopt::testing::CompareFrames(idas, explicit_drawing);
-  ASSERT_TRUE(agreement.same_frames) << "the explicit drawing's instants or points are not IDAS's";
   // Both paths at rtol 1e-8 over 0.03 s, links of a few centimetres: the
-  // positions differ by 2.1e-9 m at most (measured).
+  // positions differ by 2.1e-9 m at most (measured); the points move up to
+  // 14 mm.
   constexpr double kPathAgreement = 2e-8;  // m
-  EXPECT_LT(agreement.largest_gap_m, kPathAgreement) << agreement.largest_gap_at;
-  EXPECT_GT(agreement.largest_travel_m, 0.005);  // m: the points move 14 mm at most
-  EXPECT_FALSE(agreement.bitwise_same) << "the explicit scene's drawing is IDAS's to the bit: was the path taken?";
-  std::cout << "Andrews drawn on both paths: positions differ by " << agreement.largest_gap_m
-            << " m at most, largest travel " << agreement.largest_travel_m << " m\n";
+  mbopt::testing::ExpectTheFramesOfTheDefaultPath(idas, erk, kPathAgreement, 0.005, "Andrews' mechanism");
 }
 
 }  // namespace

@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <iostream>
 #include <string>
+
+#include <gtest/gtest.h>
 
 #include "spec/scene_drawing.h"
 
@@ -42,6 +45,22 @@ inline DrawingAgreement CompareFrames(const spec::SceneDrawing& a, const spec::S
     }
   }
   return agreement;
+}
+
+// What a scene drawn on the explicit path must share with its drawing on
+// the default path (IDAS): the same instants and points, every point within
+// `tolerance_m` of IDAS's at every instant; a point moving more than
+// `least_travel_m` (a drawing repeating its start fails) and some
+// coordinate not IDAS's to the bit (the explicit path ran).
+inline void ExpectTheFramesOfTheDefaultPath(const spec::SceneDrawing& idas, const spec::SceneDrawing& explicit_path,
+                                            double tolerance_m, double least_travel_m, const std::string& scene) {
+  const DrawingAgreement agreement = CompareFrames(idas, explicit_path);
+  ASSERT_TRUE(agreement.same_frames) << scene << ": the explicit drawing's instants or points are not IDAS's";
+  EXPECT_LT(agreement.largest_gap_m, tolerance_m) << scene << ": " << agreement.largest_gap_at;
+  EXPECT_GT(agreement.largest_travel_m, least_travel_m) << scene;
+  EXPECT_FALSE(agreement.bitwise_same) << scene << ": the explicit drawing is IDAS's to the bit: was the path taken?";
+  std::cout << scene << " drawn on both paths: positions differ by " << agreement.largest_gap_m
+            << " m at most, largest travel " << agreement.largest_travel_m << " m\n";
 }
 
 }  // namespace mbopt::testing
