@@ -45,7 +45,7 @@ struct ParetoGridSetup : FrontSetup {
 struct ParetoGridAnalysed : AnalysedDesign {
   std::array<double, 2> traded_si = {0, 0};  // F2, F3
 };
-struct ParetoGridRunPoint : FrontPoint<ParetoGridAnalysed> {
+struct ParetoGridRunPoint : FrontRunPoint<ParetoGridAnalysed> {
   std::array<double, 2> level_si;  // NaN for the anchors
   int objective = -1;              // the study's F, or 0 / 1: the run minimizes F2 / F3
 };

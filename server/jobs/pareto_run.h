@@ -68,7 +68,7 @@ struct ParetoSetup : FrontSetup {
 struct ParetoAnalysed : AnalysedDesign {
   double traded_value_si = 0;  // the second objective (ParetoRun::TradedValue)
 };
-struct ParetoRunPoint : FrontPoint<ParetoAnalysed> {
+struct ParetoRunPoint : FrontRunPoint<ParetoAnalysed> {
   double level_si = 0;  // NaN for the anchors; an added point's parent is set when it starts
 };
 

@@ -5,7 +5,7 @@
 // derive from it and keep only what differs: which points start when, the
 // problems their runs solve, and the front's values in a point's record.
 //
-// Setup derives from FrontSetup, Point from FrontPoint.
+// Setup derives from FrontSetup, Point from FrontRunPoint.
 //
 // Pure: no I/O, no clock, no threads.
 #pragma once
@@ -52,7 +52,7 @@ struct AnalysedDesign {
 };
 
 template <typename AnalysedT>
-struct FrontPoint {
+struct FrontRunPoint {
   using Analysed = AnalysedT;
   int parent = -1;                       // the point whose result starts this one
   slp::ProblemSpec problem;              // set when the run starts
