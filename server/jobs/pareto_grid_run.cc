@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "common/check.h"
 #include "server/jobs/analysis_gradients.h"
 #include "spec/pareto.h"
 
@@ -18,26 +16,10 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kAnchors = spec::kParetoAnchorsOfThree;
 
-bool SameBits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
-}
-
-// Row `row` of a row-major matrix of `columns` columns, times `factor`,
-// appended to `out`.
-void AppendRow(const std::vector<double>& matrix, std::size_t columns, int row, double factor,
-               std::vector<double>* out) {
-  const std::size_t first = static_cast<std::size_t>(row) * columns;
-  for (std::size_t c = 0; c < columns; ++c) out->push_back(matrix[first + c] * factor);
-}
-
-// A limit's scale as the study's layout scales one (spec/layout.cc), so a
-// single run with this limit written in the study is the same problem.
-double ScaleOf(double limit) { return limit != 0.0 ? std::abs(limit) : 1.0; }
-
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<ParetoGridRun>> ParetoGridRun::Create(
-    ParetoGridSetup setup, std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver) {
+absl::StatusOr<std::unique_ptr<ParetoGridRun>> ParetoGridRun::Create(ParetoGridSetup setup,
+                                                                     LpSolverFactory make_lp_solver) {
   if (setup.levels < spec::kMinParetoGridLevels || setup.levels > spec::kMaxParetoGridLevels) {
     return absl::InvalidArgumentError(absl::StrFormat("a front of three objectives has %d to %d levels, got %d",
                                                       spec::kMinParetoGridLevels, spec::kMaxParetoGridLevels,
@@ -60,14 +42,7 @@ absl::StatusOr<std::unique_ptr<ParetoGridRun>> ParetoGridRun::Create(
                                                      setup.traded_constraints[static_cast<std::size_t>(g)],
                                                      " has no constraint rows"));
     }
-    const slp::ProblemSpec& p = setup.problem;
-    for (int h : rows) {
-      if (p.constraint_limits[h] != p.constraint_limits[rows[0]] || p.constraint_scales[h] != p.constraint_scales[rows[0]]) {
-        return absl::InvalidArgumentError(absl::StrCat("the traded constraint's rows \"", p.constraint_names[rows[0]],
-                                                       "\" and \"", p.constraint_names[h],
-                                                       "\" have different limits; a front moves one limit"));
-      }
-    }
+    if (absl::Status shared = CheckTradedRowsShareLimit(setup.problem, rows); !shared.ok()) return shared;
   }
   std::unique_ptr<ParetoGridRun> run(new ParetoGridRun(std::move(setup), std::move(make_lp_solver)));
   run->traded_rows_ = std::move(traded);
@@ -78,8 +53,8 @@ absl::StatusOr<std::unique_ptr<ParetoGridRun>> ParetoGridRun::Create(
   return run;
 }
 
-ParetoGridRun::ParetoGridRun(ParetoGridSetup setup, std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver)
-    : setup_(std::move(setup)), make_lp_solver_(std::move(make_lp_solver)) {
+ParetoGridRun::ParetoGridRun(ParetoGridSetup setup, LpSolverFactory make_lp_solver)
+    : PointFrontRun(std::move(setup), std::move(make_lp_solver)) {
   const std::vector<int> parents = spec::ParetoGridWarmStartParents(setup_.levels);
   points_.resize(parents.size());
   for (std::size_t k = 0; k < points_.size(); ++k) {
@@ -161,147 +136,41 @@ void ParetoGridRun::Start(int k, const Eigen::VectorXd& initial) {
     if (!anchor || TradedGroup(h) < 0) point.rows.push_back(h);
   }
   if (anchor) {
-    problem.constraint_names.clear();
-    problem.constraint_limits.resize(static_cast<Eigen::Index>(point.rows.size()));
-    problem.constraint_scales.resize(static_cast<Eigen::Index>(point.rows.size()));
-    for (std::size_t j = 0; j < point.rows.size(); ++j) {
-      const int h = point.rows[j];
-      problem.constraint_names.push_back(study.constraint_names[static_cast<std::size_t>(h)]);
-      problem.constraint_limits[static_cast<Eigen::Index>(j)] = study.constraint_limits[h];
-      problem.constraint_scales[static_cast<Eigen::Index>(j)] = study.constraint_scales[h];
-    }
+    KeepStudyRows(study, point.rows, &problem);
   } else {
     for (std::size_t g = 0; g < 2; ++g) {
       for (int h : traded_rows_[g]) {
         problem.constraint_limits[h] = point.level_si[g];
-        problem.constraint_scales[h] = ScaleOf(point.level_si[g]);
+        problem.constraint_scales[h] = LimitScale(point.level_si[g]);
       }
     }
   }
   if (point.objective != kStudyObjective) {
-    // F2 or F3, in the study's scale of its rows so that F is of order one
-    // near the constraint's limit.
-    problem.num_objective_terms = static_cast<int>(traded_rows_[static_cast<std::size_t>(point.objective)].size());
-    problem.objective_form = problem.num_objective_terms == 1 ? slp::ObjectiveForm::kScalar : slp::ObjectiveForm::kMinMax;
-    problem.objective_group_sizes.clear();
-    options.objective_target.reset();  // the study's target is for its own objective
+    MinimizeTradedRows(static_cast<int>(traded_rows_[static_cast<std::size_t>(point.objective)].size()), &problem,
+                       &options);
   }
-  const absl::Status valid = problem.Validate();
-  MBOPT_CHECK(valid.ok(), absl::StrCat("Pareto point ", k + 1, ": ", valid.message()).c_str());
-  point.problem = problem;
-  point.run = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, make_lp_solver_());
+  StartRun(k, std::move(problem), options);
 }
 
-void ParetoGridRun::EndWithoutRun(int k, const std::string& reason) {
-  Point& point = points_[static_cast<std::size_t>(k)];
-  point.ended = true;
-  point.usable = false;
-  slp::CycleRecord& r = point.record;
-  r.design_set = true;
-  r.pareto = true;
-  r.pareto_three = true;
-  r.cycle = k + 1;
-  r.x0 = r.x_trial = setup_.problem.initial;
-  r.accepted = false;
-  r.rejection_reason = reason;
-  r.objective_x0 = r.objective_trial = r.objective_predicted = kNaN;
-  r.max_violation_x0 = r.max_violation_trial = kNaN;
-  r.objective_error = r.max_approximation_error = r.optimality_residual = kNaN;
-  r.constraint_violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
-  r.pareto_level_si = point.level_si[0];
-  r.pareto_level3_si = point.level_si[1];
-  r.pareto_value_si = r.pareto_value3_si = kNaN;
-  r.pareto_state = "not_run";
+void ParetoGridRun::SetFrontFields(const Point& point, const Analysed* values, slp::CycleRecord* r) const {
+  r->pareto_three = true;
+  r->pareto_level_si = point.level_si[0];
+  r->pareto_level3_si = point.level_si[1];
+  r->pareto_value_si = values == nullptr ? kNaN : values->traded_si[0];
+  r->pareto_value3_si = values == nullptr ? kNaN : values->traded_si[1];
 }
 
-void ParetoGridRun::End(int k) {
-  Point& point = points_[static_cast<std::size_t>(k)];
-  const slp::SlpOptimizer& run = *point.run;
-  point.ended = true;
-  const slp::DesignPoint best = run.best_design();
-  const Analysed* values = nullptr;
-  for (auto it = point.analysed.rbegin(); it != point.analysed.rend() && values == nullptr; ++it) {
-    if (SameBits(it->x, best.x)) values = &*it;
-  }
-  slp::CycleRecord& r = point.record;
-  r.design_set = true;
-  r.pareto = true;
-  r.pareto_three = true;
-  r.cycle = k + 1;
-  r.x0 = r.x_trial = best.x;
-  r.objective_predicted = r.objective_error = r.max_approximation_error = r.optimality_residual = kNaN;
-  r.pareto_level_si = point.level_si[0];
-  r.pareto_level3_si = point.level_si[1];
-  r.pareto_state = slp::RunStateName(run.state());
-  r.pareto_cycles = run.cycles_completed();
-  r.pareto_analyses = run.analyses_used();
-  if (values == nullptr) {
-    r.objective_x0 = r.objective_trial = kNaN;
-    r.max_violation_x0 = r.max_violation_trial = kNaN;
-    r.constraint_violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
-    r.pareto_value_si = r.pareto_value3_si = kNaN;
-  } else {
-    r.objective_x0 = r.objective_trial = values->objective;
-    r.max_violation_x0 = r.max_violation_trial = best.max_violation;
-    r.constraint_violations = values->violations;
-    r.pareto_value_si = values->traded_si[0];
-    r.pareto_value3_si = values->traded_si[1];
-  }
-  point.usable = values != nullptr && run.state() != slp::RunState::kFailed &&
-                 best.max_violation <= setup_.options.convergence_violation_tolerance;
-  r.accepted = point.usable;
-  if (!point.usable) {
-    // A grid point whose levels no design meets (the box of its bounds
-    // misses the front's reach) ends here: its best design still violates.
-    r.rejection_reason = run.state() == slp::RunState::kFailed || values == nullptr
-                             ? absl::StrCat("the run failed: ", run.end_reason())
-                             : absl::StrFormat("no feasible design: maxg %.4g at the best design", best.max_violation);
-  }
-}
-
-slp::CycleRecord ParetoGridRun::RunCycle(const Point& point, int k, slp::CycleRecord record) const {
-  record.pareto_point = k + 1;
-  auto study_row = [&](int h) {
-    if (h < 0 || static_cast<std::size_t>(h) >= point.rows.size()) return h;
-    return point.rows[static_cast<std::size_t>(h)];
-  };
-  record.worst_constraint_trial = study_row(record.worst_constraint_trial);
-  record.worst_approximation_row = study_row(record.worst_approximation_row);
-  return record;
-}
-
-ParetoGridRun::Analysed ParetoGridRun::Analyse(const AnalysisRecord& record) const {
-  const slp::ProblemSpec& p = setup_.problem;
-  Analysed a;
-  a.x = Eigen::Map<const Eigen::VectorXd>(record.x_scaled.data(), static_cast<Eigen::Index>(record.x_scaled.size()));
-  const Eigen::Map<const Eigen::VectorXd> terms(record.objective_terms.data(),
-                                                static_cast<Eigen::Index>(record.objective_terms.size()));
-  a.objective = slp::ObjectiveValue(p, terms);
+void ParetoGridRun::AnalyseTraded(const AnalysisRecord& record, Analysed* a) const {
   for (std::size_t g = 0; g < 2; ++g) {
     double largest = -std::numeric_limits<double>::infinity();
     for (int h : traded_rows_[g]) largest = std::max(largest, record.constraint_values[static_cast<std::size_t>(h)]);
-    a.traded_si[g] = largest;
+    a->traded_si[g] = largest;
   }
-  a.violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
-  for (std::size_t h = 0; h < record.constraint_values.size(); ++h) {
-    const double g = record.constraint_values[h];
-    const auto row = static_cast<Eigen::Index>(h);
-    const int c = setup_.row_constraints[h];
-    if (c >= 0 && c < setup_.num_constraints) {
-      const double normalized = (g - p.constraint_limits[row]) / p.constraint_scales[row];
-      double& of_constraint = a.violations[static_cast<std::size_t>(c)];
-      of_constraint = std::isnan(of_constraint) ? normalized : std::max(of_constraint, normalized);
-    }
-  }
-  return a;
 }
 
-slp::AnalysisResult ParetoGridRun::ResultFor(const Point& point, const AnalysisRecord& record) const {
-  slp::AnalysisResult result;
-  result.request_id = record.request_id % kRequestStride;
-  result.outcome = record.ok() ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
-  result.failure_reason = record.failure.reason;
-  if (!record.ok()) return result;
+void ParetoGridRun::TranslateResult(const Point& point, const AnalysisRecord& record,
+                                    slp::AnalysisResult* out) const {
+  slp::AnalysisResult& result = *out;
   const std::vector<double>& values = record.constraint_values;
   if (point.objective == kStudyObjective) {
     result.objective_terms = Eigen::Map<const Eigen::VectorXd>(record.objective_terms.data(),
@@ -332,34 +201,6 @@ slp::AnalysisResult ParetoGridRun::ResultFor(const Point& point, const AnalysisR
     for (int h : point.rows) AppendRow(record.constraint_gradients, n, h, 1.0, &constraint_gradients);
     AttachGradients(point.problem, objective_gradients, constraint_gradients, &result);
   }
-  return result;
 }
-
-std::vector<slp::AnalysisRequest> ParetoGridRun::PendingRequests() const { return PendingRequestsOfPoints(points_); }
-
-bool ParetoGridRun::IsPending(std::int64_t request_id) const { return IsPendingInPoints(points_, request_id); }
-
-absl::Status ParetoGridRun::Submit(const AnalysisRecord& record) {
-  if (!IsPending(record.request_id)) {
-    return absl::InvalidArgumentError(absl::StrCat("request ", record.request_id, " is not pending in the front"));
-  }
-  const int k = static_cast<int>(record.request_id / kRequestStride);
-  Point& point = points_[static_cast<std::size_t>(k)];
-  ++analyses_;
-  if (record.ok()) point.analysed.push_back(Analyse(record));
-  const absl::Status submitted = point.run->SubmitResult(ResultFor(point, record));
-  if (!submitted.ok()) return submitted;
-  for (slp::CycleRecord& cycle : point.run->TakeNewRecords()) {
-    if (log_run_cycles_) point.cycles.push_back(RunCycle(point, k, std::move(cycle)));
-  }
-  if (point.run->state() != slp::RunState::kRunning) {
-    End(k);
-    StartRuns();
-  }
-  EmitEndedPointsInOrder(&points_, &emitted_, &new_records_);
-  return absl::OkStatus();
-}
-
-std::vector<slp::CycleRecord> ParetoGridRun::TakeNewRecords() { return std::exchange(new_records_, {}); }
 
 }  // namespace mbopt::jobs

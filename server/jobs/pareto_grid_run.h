@@ -17,109 +17,61 @@
 //    number of workers, answered in any order, give the same front bit for
 //    bit;
 //  - request ids, records in the points' order and each run's cycle
-//    records just before its point's, as ParetoRun's.
+//    records just before its point's, as ParetoRun's (point_front_run.h).
 //
 // Pure: no I/O, no clock, no threads.
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
-#include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "server/jobs/analysis_record.h"
-#include "server/jobs/front_run.h"
-#include "server/jobs/point_runs.h"
-#include "server/lp/linear_program.h"
-#include "server/slp/options.h"
-#include "server/slp/problem.h"
-#include "server/slp/slp_optimizer.h"
+#include "server/jobs/point_front_run.h"
 
 namespace mbopt::jobs {
 
-struct ParetoGridSetup {
-  slp::ProblemSpec problem;  // the study's problem: every objective term and row
-  slp::SlpOptions options;   // the study's optimizer settings, for every run
-  // The study constraint of each row (spec::ConstraintRow::constraint), and
-  // how many the study has.
-  std::vector<int> row_constraints;
-  int num_constraints = 0;
+struct ParetoGridSetup : FrontSetup {
   // The study constraints whose largest values are F2 and F3.
   std::array<int, 2> traded_constraints = {-1, -1};
   int levels = 0;  // per bounded objective, >= 2
 };
 
-class ParetoGridRun final : public FrontRun {
- public:
-  // Point k's request r has id k * kRequestStride + r, as ParetoRun's.
-  static constexpr std::int64_t kRequestStride = kPointRequestStride;
+// What ParetoGridRun keeps of an analysed design and of each point.
+struct ParetoGridAnalysed : AnalysedDesign {
+  std::array<double, 2> traded_si = {0, 0};  // F2, F3
+};
+struct ParetoGridRunPoint : FrontRunPoint<ParetoGridAnalysed> {
+  std::array<double, 2> level_si;  // NaN for the anchors
+  int objective = -1;              // the study's F, or 0 / 1: the run minimizes F2 / F3
+};
 
+class ParetoGridRun final : public PointFrontRun<ParetoGridSetup, ParetoGridRunPoint> {
+ public:
   // InvalidArgument when the setup does not fit (a traded constraint with
   // no rows or rows of different limits, the same constraint twice, too
   // few levels).
-  static absl::StatusOr<std::unique_ptr<ParetoGridRun>> Create(ParetoGridSetup setup,
-                                                               std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver);
-
-  std::vector<slp::AnalysisRequest> PendingRequests() const override;
-  bool IsPending(std::int64_t request_id) const override;
-  absl::Status Submit(const AnalysisRecord& record) override;
-  std::vector<slp::CycleRecord> TakeNewRecords() override;
-  void LogRunCycles(bool log) override { log_run_cycles_ = log; }
-
-  bool done() const override { return emitted_ == points_.size(); }
-  int size() const override { return static_cast<int>(points_.size()); }
-  int points_done() const override { return static_cast<int>(emitted_); }
-  std::int64_t analyses_used() const override { return analyses_; }
+  static absl::StatusOr<std::unique_ptr<ParetoGridRun>> Create(ParetoGridSetup setup, LpSolverFactory make_lp_solver);
 
  private:
+  using Point = ParetoGridRunPoint;
   static constexpr int kStudyObjective = -1;
 
-  struct Analysed {
-    Eigen::VectorXd x;
-    double objective = 0;                  // the study's F
-    std::array<double, 2> traded_si = {0, 0};  // F2, F3
-    std::vector<double> violations;        // per study constraint, against the study's limits
-  };
-  struct Point {
-    int parent = -1;
-    std::array<double, 2> level_si;        // NaN for the anchors
-    int objective = kStudyObjective;       // or 0 / 1: the run minimizes F2 / F3
-    slp::ProblemSpec problem;              // set when the run starts
-    std::vector<int> rows;                 // the run's row h -> the study's row
-    std::unique_ptr<slp::SlpOptimizer> run;
-    std::vector<Analysed> analysed;
-    bool ended = false;
-    bool usable = false;
-    slp::CycleRecord record;
-    std::vector<slp::CycleRecord> cycles;
-  };
-
-  ParetoGridRun(ParetoGridSetup setup, std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver);
-  void StartRuns();
+  ParetoGridRun(ParetoGridSetup setup, LpSolverFactory make_lp_solver);
+  void StartRuns() override;
   void Start(int k, const Eigen::VectorXd& initial);
-  void EndWithoutRun(int k, const std::string& reason);
-  void End(int k);
-  slp::CycleRecord RunCycle(const Point& point, int k, slp::CycleRecord record) const;
-  slp::AnalysisResult ResultFor(const Point& point, const AnalysisRecord& record) const;
-  Analysed Analyse(const AnalysisRecord& record) const;
+  void AnalyseTraded(const AnalysisRecord& record, Analysed* a) const override;
+  void TranslateResult(const Point& point, const AnalysisRecord& record, slp::AnalysisResult* result) const override;
+  void SetFrontFields(const Point& point, const Analysed* values, slp::CycleRecord* r) const override;
   // Which of F2, F3 row h belongs to; -1: neither.
   int TradedGroup(int row) const;
 
-  ParetoGridSetup setup_;
-  std::function<std::unique_ptr<lp::LpSolver>()> make_lp_solver_;
   std::array<std::vector<int>, 2> traded_rows_;
   std::array<double, 2> traded_scale_ = {1, 1};
-  std::vector<Point> points_;
-  std::int64_t analyses_ = 0;
-  std::size_t emitted_ = 0;
-  bool log_run_cycles_ = true;
-  std::vector<slp::CycleRecord> new_records_;
 };
 
 }  // namespace mbopt::jobs

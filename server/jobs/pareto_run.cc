@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "common/check.h"
 #include "server/jobs/analysis_gradients.h"
 #include "spec/pareto.h"
 
@@ -16,21 +14,6 @@ namespace mbopt::jobs {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-bool SameBits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return a.size() == b.size() && (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
-}
-
-// Rows `rows` of a row-major matrix of `columns` columns, each times `factor`.
-std::vector<double> PickRows(const std::vector<double>& matrix, std::size_t columns, const std::vector<int>& rows,
-                             double factor) {
-  std::vector<double> picked;
-  picked.reserve(rows.size() * columns);
-  for (int row : rows) {
-    for (std::size_t c = 0; c < columns; ++c) picked.push_back(matrix[static_cast<std::size_t>(row) * columns + c] * factor);
-  }
-  return picked;
-}
 
 }  // namespace
 
@@ -71,15 +54,7 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
           "a factor of the second objective's rows is %g; a largest of values needs factors above 0", factor));
     }
   }
-  const slp::ProblemSpec& p = setup.problem;
-  for (int h : traded) {
-    if (p.constraint_limits[h] != p.constraint_limits[traded[0]] ||
-        p.constraint_scales[h] != p.constraint_scales[traded[0]]) {
-      return absl::InvalidArgumentError(absl::StrCat("the traded constraint's rows \"", p.constraint_names[traded[0]],
-                                                     "\" and \"", p.constraint_names[h],
-                                                     "\" have different limits; a front moves one limit"));
-    }
-  }
+  if (absl::Status shared = CheckTradedRowsShareLimit(setup.problem, traded); !shared.ok()) return shared;
   std::unique_ptr<ParetoRun> run(new ParetoRun(std::move(setup), std::move(make_lp_solver)));
   run->traded_rows_ = std::move(traded);
   run->traded_scale_ = run->setup_.problem.constraint_scales[run->traded_rows_[0]];
@@ -88,7 +63,7 @@ absl::StatusOr<std::unique_ptr<ParetoRun>> ParetoRun::Create(ParetoSetup setup, 
 }
 
 ParetoRun::ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver)
-    : setup_(std::move(setup)), make_lp_solver_(std::move(make_lp_solver)) {
+    : PointFrontRun(std::move(setup), std::move(make_lp_solver)) {
   points_.resize(static_cast<std::size_t>(setup_.points + setup_.refine + setup_.refine_again));
   const std::vector<int> parents = spec::ParetoWarmStartParents(setup_.points);
   for (std::size_t k = 0; k < points_.size(); ++k) {
@@ -202,153 +177,43 @@ void ParetoRun::Start(int k, const Eigen::VectorXd& initial) {
   for (int h = 0; h < study.num_constraints(); ++h) {
     if (!leaves_out_traded || !IsTraded(h)) point.rows.push_back(h);
   }
-  // An ordinary limit at the level, scaled as the study's layout scales a
-  // limit (spec/layout.cc), so a single run with this limit written in
-  // the study is the same problem.
-  auto scale_of = [](double limit) { return limit != 0.0 ? std::abs(limit) : 1.0; };
-  if (!anchor && setup_.traded_sum) point.rows.push_back(kSumRow);
+  const bool bounds_sum = !anchor && setup_.traded_sum;
+  if (bounds_sum) point.rows.push_back(kSumRow);
   if (leaves_out_traded) {
-    problem.constraint_names.clear();
-    problem.constraint_limits.resize(static_cast<Eigen::Index>(point.rows.size()));
-    problem.constraint_scales.resize(static_cast<Eigen::Index>(point.rows.size()));
-    for (std::size_t j = 0; j < point.rows.size(); ++j) {
-      const int h = point.rows[j];
-      const auto row = static_cast<Eigen::Index>(j);
-      if (h == kSumRow) {
-        problem.constraint_names.push_back("second objective");
-        problem.constraint_limits[row] = point.level_si;
-        problem.constraint_scales[row] = scale_of(point.level_si);
-        continue;
-      }
-      problem.constraint_names.push_back(study.constraint_names[static_cast<std::size_t>(h)]);
-      problem.constraint_limits[row] = study.constraint_limits[h];
-      problem.constraint_scales[row] = study.constraint_scales[h];
+    KeepStudyRows(study, point.rows, &problem);
+    if (bounds_sum) {
+      const auto row = static_cast<Eigen::Index>(point.rows.size() - 1);
+      problem.constraint_names.back() = "second objective";
+      problem.constraint_limits[row] = point.level_si;
+      problem.constraint_scales[row] = LimitScale(point.level_si);
     }
   } else {
+    // An ordinary limit at the level, scaled as the study scales a limit.
     for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
       const double limit = point.level_si / setup_.traded_factors[j];
       problem.constraint_limits[traded_rows_[j]] = limit;
-      problem.constraint_scales[traded_rows_[j]] = scale_of(limit);
+      problem.constraint_scales[traded_rows_[j]] = LimitScale(limit);
     }
   }
   if (k == setup_.points - 1) {
-    // The second objective, in the study's scale of its rows so that F is
-    // of order one near a constraint's limit.
-    problem.num_objective_terms = setup_.traded_sum ? 1 : static_cast<int>(traded_rows_.size());
-    problem.objective_form = problem.num_objective_terms == 1 ? slp::ObjectiveForm::kScalar : slp::ObjectiveForm::kMinMax;
-    problem.objective_group_sizes.clear();
-    options.objective_target.reset();  // the study's target is for its own objective
+    MinimizeTradedRows(setup_.traded_sum ? 1 : static_cast<int>(traded_rows_.size()), &problem, &options);
   }
-  const absl::Status valid = problem.Validate();
-  MBOPT_CHECK(valid.ok(), absl::StrCat("Pareto point ", k + 1, ": ", valid.message()).c_str());
-  point.problem = problem;
-  point.run = std::make_unique<slp::SlpOptimizer>(std::move(problem), options, make_lp_solver_());
+  StartRun(k, std::move(problem), options);
 }
 
-void ParetoRun::EndWithoutRun(int k, const std::string& reason) {
-  Point& point = points_[static_cast<std::size_t>(k)];
-  point.ended = true;
-  point.usable = false;
-  point.not_run_reason = reason;
-  slp::CycleRecord& r = point.record;
-  r.design_set = true;
-  r.pareto = true;
-  r.cycle = k + 1;
-  r.x0 = r.x_trial = setup_.problem.initial;
-  r.accepted = false;
-  r.rejection_reason = reason;
-  r.objective_x0 = r.objective_trial = r.objective_predicted = kNaN;
-  r.max_violation_x0 = r.max_violation_trial = kNaN;
-  r.objective_error = r.max_approximation_error = r.optimality_residual = kNaN;
-  r.constraint_violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
-  r.pareto_level_si = point.level_si;
-  r.pareto_value_si = kNaN;
-  r.pareto_state = "not_run";
+void ParetoRun::SetFrontFields(const Point& point, const Analysed* values, slp::CycleRecord* r) const {
+  r->pareto_level_si = point.level_si;
+  r->pareto_value_si = values == nullptr ? kNaN : values->traded_value_si;
 }
 
-void ParetoRun::End(int k) {
-  Point& point = points_[static_cast<std::size_t>(k)];
-  const slp::SlpOptimizer& run = *point.run;
-  point.ended = true;
-  const slp::DesignPoint best = run.best_design();
-  const Analysed* values = nullptr;
-  for (auto it = point.analysed.rbegin(); it != point.analysed.rend() && values == nullptr; ++it) {
-    if (SameBits(it->x, best.x)) values = &*it;
-  }
-  slp::CycleRecord& r = point.record;
-  r.design_set = true;
-  r.pareto = true;
-  r.cycle = k + 1;
-  r.x0 = r.x_trial = best.x;
-  r.objective_predicted = r.objective_error = r.max_approximation_error = r.optimality_residual = kNaN;
-  r.pareto_level_si = point.level_si;
-  r.pareto_state = slp::RunStateName(run.state());
-  r.pareto_cycles = run.cycles_completed();
-  r.pareto_analyses = run.analyses_used();
-  if (values == nullptr) {
-    r.objective_x0 = r.objective_trial = kNaN;
-    r.max_violation_x0 = r.max_violation_trial = kNaN;
-    r.constraint_violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
-    r.pareto_value_si = kNaN;
-  } else {
-    r.objective_x0 = r.objective_trial = values->objective;
-    r.max_violation_x0 = r.max_violation_trial = best.max_violation;
-    r.constraint_violations = values->violations;
-    r.pareto_value_si = values->traded_value_si;
-  }
-  point.usable = values != nullptr && run.state() != slp::RunState::kFailed &&
-                 best.max_violation <= setup_.options.convergence_violation_tolerance;
-  r.accepted = point.usable;
-  if (!point.usable) {
-    r.rejection_reason = run.state() == slp::RunState::kFailed || values == nullptr
-                             ? absl::StrCat("the run failed: ", run.end_reason())
-                             : absl::StrFormat("no feasible design: maxg %.4g at the best design", best.max_violation);
-  }
+int ParetoRun::StudyRow(int entry) const { return entry == kSumRow ? traded_rows_.front() : entry; }
+
+void ParetoRun::AnalyseTraded(const AnalysisRecord& record, Analysed* a) const {
+  a->traded_value_si = TradedValue(record.constraint_values);
 }
 
-slp::CycleRecord ParetoRun::RunCycle(const Point& point, int k, slp::CycleRecord record) const {
-  record.pareto_point = k + 1;
-  // The run's row h is the study's row point.rows[h]; the bound on a
-  // second objective that is a sum has no row of the study's and is named
-  // by its first term's.
-  auto study_row = [&](int h) {
-    if (h < 0 || static_cast<std::size_t>(h) >= point.rows.size()) return h;
-    const int row = point.rows[static_cast<std::size_t>(h)];
-    return row == kSumRow ? traded_rows_.front() : row;
-  };
-  record.worst_constraint_trial = study_row(record.worst_constraint_trial);
-  record.worst_approximation_row = study_row(record.worst_approximation_row);
-  return record;
-}
-
-ParetoRun::Analysed ParetoRun::Analyse(const AnalysisRecord& record) const {
-  const slp::ProblemSpec& p = setup_.problem;
-  Analysed a;
-  a.x = Eigen::Map<const Eigen::VectorXd>(record.x_scaled.data(), static_cast<Eigen::Index>(record.x_scaled.size()));
-  const Eigen::Map<const Eigen::VectorXd> terms(record.objective_terms.data(),
-                                                static_cast<Eigen::Index>(record.objective_terms.size()));
-  a.objective = slp::ObjectiveValue(p, terms);
-  a.traded_value_si = TradedValue(record.constraint_values);
-  a.violations.assign(static_cast<std::size_t>(setup_.num_constraints), kNaN);
-  for (std::size_t h = 0; h < record.constraint_values.size(); ++h) {
-    const double g = record.constraint_values[h];
-    const auto row = static_cast<Eigen::Index>(h);
-    const int c = setup_.row_constraints[h];
-    if (c >= 0 && c < setup_.num_constraints) {
-      const double normalized = (g - p.constraint_limits[row]) / p.constraint_scales[row];
-      double& of_constraint = a.violations[static_cast<std::size_t>(c)];
-      of_constraint = std::isnan(of_constraint) ? normalized : std::max(of_constraint, normalized);
-    }
-  }
-  return a;
-}
-
-slp::AnalysisResult ParetoRun::ResultFor(const Point& point, const AnalysisRecord& record) const {
-  slp::AnalysisResult result;
-  result.request_id = record.request_id % kRequestStride;
-  result.outcome = record.ok() ? slp::AnalysisOutcome::kOk : slp::AnalysisOutcome::kFailed;
-  result.failure_reason = record.failure.reason;
-  if (!record.ok()) return result;
+void ParetoRun::TranslateResult(const Point& point, const AnalysisRecord& record, slp::AnalysisResult* out) const {
+  slp::AnalysisResult& result = *out;
   const Eigen::Map<const Eigen::VectorXd> terms(record.objective_terms.data(),
                                                 static_cast<Eigen::Index>(record.objective_terms.size()));
   const Eigen::Map<const Eigen::VectorXd> values(record.constraint_values.data(),
@@ -381,48 +246,22 @@ slp::AnalysisResult ParetoRun::ResultFor(const Point& point, const AnalysisRecor
       for (double& d : objective_gradients) d /= traded_scale_;
     } else {
       for (std::size_t j = 0; j < traded_rows_.size(); ++j) {
-        const std::vector<double> row = PickRows(record.constraint_gradients, n, {traded_rows_[j]},
-                                                 setup_.traded_factors[j] * (1.0 / traded_scale_));
-        objective_gradients.insert(objective_gradients.end(), row.begin(), row.end());
+        AppendRow(record.constraint_gradients, n, traded_rows_[j], setup_.traded_factors[j] * (1.0 / traded_scale_),
+                  &objective_gradients);
       }
     }
     std::vector<double> constraint_gradients;
     constraint_gradients.reserve(point.rows.size() * n);
     for (int h : point.rows) {
-      const std::vector<double> row =
-          h == kSumRow ? SumGradient(record.constraint_gradients, n) : PickRows(record.constraint_gradients, n, {h}, 1.0);
-      constraint_gradients.insert(constraint_gradients.end(), row.begin(), row.end());
+      if (h != kSumRow) {
+        AppendRow(record.constraint_gradients, n, h, 1.0, &constraint_gradients);
+        continue;
+      }
+      const std::vector<double> sum_gradient = SumGradient(record.constraint_gradients, n);
+      constraint_gradients.insert(constraint_gradients.end(), sum_gradient.begin(), sum_gradient.end());
     }
     AttachGradients(point.problem, objective_gradients, constraint_gradients, &result);
   }
-  return result;
 }
-
-std::vector<slp::AnalysisRequest> ParetoRun::PendingRequests() const { return PendingRequestsOfPoints(points_); }
-
-bool ParetoRun::IsPending(std::int64_t request_id) const { return IsPendingInPoints(points_, request_id); }
-
-absl::Status ParetoRun::Submit(const AnalysisRecord& record) {
-  if (!IsPending(record.request_id)) {
-    return absl::InvalidArgumentError(absl::StrCat("request ", record.request_id, " is not pending in the front"));
-  }
-  const int k = static_cast<int>(record.request_id / kRequestStride);
-  Point& point = points_[static_cast<std::size_t>(k)];
-  ++analyses_;
-  if (record.ok()) point.analysed.push_back(Analyse(record));
-  const absl::Status submitted = point.run->SubmitResult(ResultFor(point, record));
-  if (!submitted.ok()) return submitted;
-  for (slp::CycleRecord& cycle : point.run->TakeNewRecords()) {
-    if (log_run_cycles_) point.cycles.push_back(RunCycle(point, k, std::move(cycle)));
-  }
-  if (point.run->state() != slp::RunState::kRunning) {
-    End(k);
-    StartRuns();
-  }
-  EmitEndedPointsInOrder(&points_, &emitted_, &new_records_);
-  return absl::OkStatus();
-}
-
-std::vector<slp::CycleRecord> ParetoRun::TakeNewRecords() { return std::exchange(new_records_, {}); }
 
 }  // namespace mbopt::jobs

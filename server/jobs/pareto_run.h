@@ -39,35 +39,18 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
-#include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "server/jobs/analysis_record.h"
-#include "server/jobs/front_run.h"
-#include "server/jobs/point_runs.h"
-#include "server/lp/linear_program.h"
-#include "server/slp/options.h"
-#include "server/slp/problem.h"
-#include "server/slp/slp_optimizer.h"
+#include "server/jobs/point_front_run.h"
 
 namespace mbopt::jobs {
 
-using LpSolverFactory = std::function<std::unique_ptr<lp::LpSolver>()>;
-
-struct ParetoSetup {
-  slp::ProblemSpec problem;  // the study's problem: every objective term and row
-  slp::SlpOptions options;   // the study's optimizer settings, for every run
-  // The study constraint of each row (spec::ConstraintRow::constraint), and
-  // how many the study has.
-  std::vector<int> row_constraints;
-  int num_constraints = 0;
+struct ParetoSetup : FrontSetup {
   // The rows of the second objective: those whose row_constraints entry is
   // traded_constraint (a study constraint, or spec::kSecondObjectiveRow).
   int traded_constraint = -1;
@@ -81,80 +64,47 @@ struct ParetoSetup {
   int refine_again = 0;        // a second generation, 0 to points + refine - 1; only with refine > 0
 };
 
-class ParetoRun final : public FrontRun {
- public:
-  // Point k's request r has id k * kRequestStride + r: far more analyses than
-  // a run may use (JobRunOptions::max_analyses).
-  static constexpr std::int64_t kRequestStride = kPointRequestStride;
+// What ParetoRun keeps of an analysed design and of each point.
+struct ParetoAnalysed : AnalysedDesign {
+  double traded_value_si = 0;  // the second objective (ParetoRun::TradedValue)
+};
+struct ParetoRunPoint : FrontRunPoint<ParetoAnalysed> {
+  double level_si = 0;  // NaN for the anchors; an added point's parent is set when it starts
+};
 
+class ParetoRun final : public PointFrontRun<ParetoSetup, ParetoRunPoint> {
+ public:
   // InvalidArgument when the setup does not fit (no rows for the traded
   // constraint, rows of different limits, too few points).
   static absl::StatusOr<std::unique_ptr<ParetoRun>> Create(ParetoSetup setup, LpSolverFactory make_lp_solver);
 
-  std::vector<slp::AnalysisRequest> PendingRequests() const override;
-  bool IsPending(std::int64_t request_id) const override;
-  absl::Status Submit(const AnalysisRecord& record) override;
-  std::vector<slp::CycleRecord> TakeNewRecords() override;
-  void LogRunCycles(bool log) override { log_run_cycles_ = log; }
-
-  bool done() const override { return emitted_ == points_.size(); }
-  int size() const override { return static_cast<int>(points_.size()); }
-  int points_done() const override { return static_cast<int>(emitted_); }
-  std::int64_t analyses_used() const override { return analyses_; }
-
  private:
-  // A design a run analysed, with what the point's record needs of it.
-  struct Analysed {
-    Eigen::VectorXd x;
-    double objective = 0;                 // the study's F
-    double traded_value_si = 0;           // the second objective (TradedValue)
-    std::vector<double> violations;       // per study constraint, against the study's limits
-  };
-  struct Point {
-    int parent = -1;                      // for an added point: set when it starts
-    double level_si = 0;                  // NaN for the anchors
-    slp::ProblemSpec problem;             // set when the run starts
-    // The run's row h -> the study's row, or kSumRow: the traded rows'
-    // weighted sum (a second objective that is a sum).
-    std::vector<int> rows;
-    std::unique_ptr<slp::SlpOptimizer> run;  // null until it starts
-    std::vector<Analysed> analysed;       // its successful analyses, in arrival order
-    bool ended = false;
-    bool usable = false;                  // ended with a feasible result
-    std::string not_run_reason;           // "" unless the point was never run
-    slp::CycleRecord record;              // set when it ends
-    std::vector<slp::CycleRecord> cycles;  // its run's records, until they are emitted
-  };
+  using Point = ParetoRunPoint;
 
-  explicit ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
-  void StartRuns();
+  ParetoRun(ParetoSetup setup, LpSolverFactory make_lp_solver);
+  void StartRuns() override;
   // Generation `first` (points or points + refine) of `count` points,
   // chosen on the front of points 0 to first - 1 once they have ended.
   void StartRefinement(std::size_t first, int count);
   void Start(int k, const Eigen::VectorXd& initial);
-  void EndWithoutRun(int k, const std::string& reason);
-  void End(int k);
-  // A run's record as the log keeps it: its point's number, the study's rows.
-  slp::CycleRecord RunCycle(const Point& point, int k, slp::CycleRecord record) const;
-  slp::AnalysisResult ResultFor(const Point& point, const AnalysisRecord& record) const;
-  Analysed Analyse(const AnalysisRecord& record) const;
+  void AnalyseTraded(const AnalysisRecord& record, Analysed* a) const override;
+  void TranslateResult(const Point& point, const AnalysisRecord& record, slp::AnalysisResult* result) const override;
+  void SetFrontFields(const Point& point, const Analysed* values, slp::CycleRecord* r) const override;
+  // The bound on a second objective that is a sum has no row of the
+  // study's and is named by its first term's.
+  int StudyRow(int entry) const override;
   bool IsTraded(int row) const;
   // The second objective at the study's row values, and its gradient
   // from the rows' (row-major, `columns` each; none when empty).
   double TradedValue(const std::vector<double>& row_values) const;
   std::vector<double> SumGradient(const std::vector<double>& row_gradients, std::size_t columns) const;
 
+  // A point's row that is the traded rows' weighted sum (a second
+  // objective that is a sum).
   static constexpr int kSumRow = -1;
 
-  ParetoSetup setup_;
-  LpSolverFactory make_lp_solver_;
   std::vector<int> traded_rows_;
   double traded_scale_ = 1;  // the traded rows' scale in the study
-  std::vector<Point> points_;
-  std::int64_t analyses_ = 0;
-  std::size_t emitted_ = 0;
-  bool log_run_cycles_ = true;
-  std::vector<slp::CycleRecord> new_records_;
 };
 
 }  // namespace mbopt::jobs

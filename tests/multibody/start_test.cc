@@ -11,6 +11,7 @@
 
 #include "spec/io/study_io.h"
 #include "tests/multibody/mechanisms.h"
+#include "tests/multibody/time_grid.h"
 #include "worker/multibody/assembly.h"
 #include "worker/multibody/forward_dynamics.h"
 #include "worker/multibody/mechanism.h"
@@ -20,12 +21,7 @@ namespace mbopt::multibody {
 namespace {
 
 using testing::At;
-
-std::vector<double> Grid(double end_s, int intervals) {
-  std::vector<double> t;
-  for (int i = 0; i <= intervals; ++i) t.push_back(end_s * i / intervals);
-  return t;
-}
+using testing::Grid;
 
 ForwardDynamicsOptions Tight() {
   ForwardDynamicsOptions options;

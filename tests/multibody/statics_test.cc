@@ -7,6 +7,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <unistd.h>
@@ -352,6 +353,16 @@ outputs { name: "tip_y" marker_position { marker: "arm.tip" axis: AXIS_Y } }
 time_grid { start_s: 0 end_s: 0 points: 1 }
 )pb";
 
+// Whole analyses with parameter i moved up and down by h, for central
+// differences.
+std::pair<spec::AnalysisReport, spec::AnalysisReport> AnalysesAround(const spec::Scene& scene,
+                                                                     const std::vector<double>& p, size_t i, double h) {
+  std::vector<double> plus = p, minus = p;
+  plus[i] += h;
+  minus[i] -= h;
+  return {AnalyzeMultibodyScene(scene, plus), AnalyzeMultibodyScene(scene, minus)};
+}
+
 // Simulator sensitivities of a static equilibrium (the implicit function
 // theorem at the solution) against central differences of whole analyses
 // (step 1e-5 of each value: truncation about 1e-10, the equilibrium solved
@@ -372,10 +383,7 @@ TEST(MultibodyStatics, SensitivitiesAgreeWithCentralDifferencesOfWholeAnalyses) 
   ASSERT_EQ(result.output_derivatives.size(), 3u);
   for (size_t i = 0; i < p.size(); ++i) {
     const double h = 1e-5 * p[i];
-    std::vector<double> plus = p, minus = p;
-    plus[i] += h;
-    minus[i] -= h;
-    const spec::AnalysisReport up = AnalyzeMultibodyScene(*scene, plus), down = AnalyzeMultibodyScene(*scene, minus);
+    const auto [up, down] = AnalysesAround(*scene, p, i, h);
     ASSERT_TRUE(up.ok() && down.ok());
     for (size_t o = 0; o < up.outputs.size(); ++o) {
       const double fd = (up.outputs[o].series[0][0] - down.outputs[o].series[0][0]) / (2 * h);
@@ -410,10 +418,7 @@ TEST(MultibodyStatics, LoadedArmSensitivitiesAgreeAtEveryInstant) {
   double worst = 0.0;
   for (size_t i = 0; i < p.size(); ++i) {
     const double h = 1e-5 * p[i];
-    std::vector<double> plus = p, minus = p;
-    plus[i] += h;
-    minus[i] -= h;
-    const spec::AnalysisReport up = AnalyzeMultibodyScene(*scene, plus), down = AnalyzeMultibodyScene(*scene, minus);
+    const auto [up, down] = AnalysesAround(*scene, p, i, h);
     ASSERT_TRUE(up.ok() && down.ok());
     for (size_t o = 0; o < up.outputs.size(); ++o) {
       const std::vector<double>& d = result.output_derivatives[i][o][0];

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "worker/multibody/integrator_setup.h"
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
@@ -268,28 +269,19 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
   // regular there.
   if (p.accelerations.Solve(system, t0, q0, v0, &p.a, &p.lambda) != 0) return equations_failed(t0);
 
+  SundialsCalls check;
   struct Handles {
     sundials::Context context;
-    sundials::Vector y;
+    sundials::Vector y, interpolated;
     sundials::Memory<&ERKStepFree> erk;
   } h;
-  std::string sundials_message;
-  h.context = sundials::MakeContext();
-  if (!h.context) return Failed(spec::FailureKind::kIntegrator, "SUNContext_Create failed");
-  h.y.reset(N_VNew_Serial(2 * n, h.context.get()));
-  if (!h.y) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
+  if (spec::AnalysisFailure f = CreateContextAndVectors(2 * n, &h.context, {&h.y, &h.interpolated}); !f.ok()) return f;
   Map<VectorXd> y(N_VGetArrayPointer(h.y.get()), 2 * n);
   y.head(n) = q0;
   y.tail(n) = v0;
   h.erk.reset(ERKStepCreate(&RightSide, t0, h.y.get(), h.context.get()));
   if (!h.erk) return Failed(spec::FailureKind::kIntegrator, "ERKStepCreate failed");
   void* erk = h.erk.get();
-  auto check = [&](int flag, const char* call) {
-    if (flag >= 0) return true;
-    sundials_message = absl::StrFormat("%s failed (%d)%s%s", call, flag, sundials_message.empty() ? "" : ": ",
-                                       sundials_message);
-    return false;
-  };
   // The outputs and the validity bounds' root finding read the interpolant
   // over one step (the restart after every projection clears it): Hermite's
   // of degree 5 from the step's ends and derivatives (one right-hand side
@@ -298,7 +290,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
   // Lagrange's, which costs no right-hand side, saves those (11 % of the
   // evaluations on the rod chain, the same steps and results).
   const bool reads_interpolant = !options.explicit_stop_at_instants || system.num_validity_bounds() > 0;
-  bool ok = check(ERKStepSetErrHandlerFn(erk, &sundials::CaptureMessage, &sundials_message),
+  bool ok = check(ERKStepSetErrHandlerFn(erk, &sundials::CaptureMessage, check.message_sink()),
                   "ERKStepSetErrHandlerFn") &&
             check(ERKStepSetUserData(erk, &p), "ERKStepSetUserData") &&
             check(ERKStepSetTableNum(erk, TableOf(options.explicit_pair)), "ERKStepSetTableNum") &&
@@ -309,7 +301,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
                   "ERKStepSStolerances") &&
             check(ERKStepSetMaxNumSteps(erk, options.max_steps), "ERKStepSetMaxNumSteps") &&
             (options.max_step_size <= 0.0 || check(ERKStepSetMaxStep(erk, options.max_step_size), "ERKStepSetMaxStep"));
-  if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+  if (!ok) return check.Failure();
 
   const int num_bounds = system.num_validity_bounds();
   std::vector<int> bounds_crossed(static_cast<size_t>(num_bounds), 0);
@@ -320,14 +312,8 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
                                check(ERKStepSetNoInactiveRootWarn(erk), "ERKStepSetNoInactiveRootWarn"));
   };
   if (num_bounds > 0) {
-    std::vector<double> g(static_cast<size_t>(num_bounds));
-    system.ValidityBounds(t0, q0, v0, g.data());
-    for (int k = 0; k < num_bounds; ++k) {
-      if (!(g[static_cast<size_t>(k)] >= 0.0)) {
-        return Failed(spec::FailureKind::kModelValidity, system.BoundReason(k, t0, q0, v0));
-      }
-    }
-    if (!init_roots()) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+    if (spec::AnalysisFailure f = ValidityBoundsHoldAtStart(system, t0, q0, v0); !f.ok()) return f;
+    if (!init_roots()) return check.Failure();
   }
 
   // The projection's tolerance: a fraction of the absolute tolerance, but
@@ -350,9 +336,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
   long steps = 0, error_test_failures = 0, last_error_test_failures = 0;
   VectorXd phi, phi_t;
   MatrixXd phi_q;
-  sundials::Vector interpolated(N_VNew_Serial(2 * n, h.context.get()));
-  if (!interpolated) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
-  Map<VectorXd> y_out(N_VGetArrayPointer(interpolated.get()), 2 * n);
+  Map<VectorXd> y_out(N_VGetArrayPointer(h.interpolated.get()), 2 * n);
   auto failed_near = [&](double t, double target, int flag) {
     if (!system.FailureReason().empty()) {
       return Failed(spec::FailureKind::kModelValidity,
@@ -369,7 +353,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
     }
     return Failed(spec::FailureKind::kIntegrator,
                   absl::StrFormat("the explicit Runge-Kutta integrator failed near t = %.6g s (target %.6g s): %s%s%s",
-                                  t, target, sundials_message, callback, advice));
+                                  t, target, check.message(), callback, advice));
   };
   // The state at t (consistent with the constraints) to the caller.
   auto emit = [&](double t, const VectorXd& q, const VectorXd& v) {
@@ -405,7 +389,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
     }
     const double stop = options.explicit_stop_at_instants ? std::min(times[next], end) : end;
     if (!check(ERKStepSetStopTime(erk, stop), "ERKStepSetStopTime")) {
-      return Failed(spec::FailureKind::kIntegrator, sundials_message);
+      return check.Failure();
     }
     if (steps >= options.max_steps) return failed_near(t_reached, times[next], ARK_TOO_MUCH_WORK);
     realtype t_step = t_reached;
@@ -419,7 +403,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
     ++steps;
     if (flag == ARK_ROOT_RETURN) {
       if (!check(ERKStepGetRootInfo(erk, bounds_crossed.data()), "ERKStepGetRootInfo")) {
-        return Failed(spec::FailureKind::kIntegrator, sundials_message);
+        return check.Failure();
       }
       const int k = static_cast<int>(std::find(bounds_crossed.begin(), bounds_crossed.end(), -1) -
                                      bounds_crossed.begin());
@@ -429,8 +413,8 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
     for (; next < times.size() && times[next] <= t_step; ++next) {
       if (times[next] == t_step) {
         y_out = y;
-      } else if (!check(ERKStepGetDky(erk, times[next], 0, interpolated.get()), "ERKStepGetDky")) {
-        return Failed(spec::FailureKind::kIntegrator, sundials_message);
+      } else if (!check(ERKStepGetDky(erk, times[next], 0, h.interpolated.get()), "ERKStepGetDky")) {
+        return check.Failure();
       }
       if (!Project(system, times[next], position_tolerance, y_out.head(n), y_out.tail(n), &why)) {
         return Failed(spec::FailureKind::kIntegrator, why);
@@ -445,7 +429,7 @@ spec::AnalysisFailure IntegrateForwardExplicit(const ConstrainedSystem& system, 
     if (!check(ERKStepGetCurrentStep(erk, &next_step), "ERKStepGetCurrentStep") ||
         (next_step > 0.0 && !check(ERKStepSetInitStep(erk, next_step), "ERKStepSetInitStep")) ||
         !check(ERKStepReset(erk, t_reached, h.y.get()), "ERKStepReset") || !init_roots()) {
-      return Failed(spec::FailureKind::kIntegrator, sundials_message);
+      return check.Failure();
     }
   }
   counters->steps = steps;

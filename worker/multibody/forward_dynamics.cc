@@ -18,6 +18,7 @@
 #include "worker/multibody/ggl_residual.h"
 #include "worker/multibody/mechanism.h"
 #include "worker/multibody/parameter_derivatives.h"
+#include "worker/multibody/integrator_setup.h"
 #include "worker/sundials/sundials_handles.h"
 
 namespace mbopt::multibody {
@@ -449,6 +450,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     return f;
   }
 
+  SundialsCalls check;
   struct Handles {
     sundials::Context context;
     sundials::Vector yy, yp, id, atol;
@@ -456,13 +458,9 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     sundials::LinearSolver linear_solver;
     sundials::Memory<&IDAFree> ida;
   } h;
-  std::string sundials_message;
-  h.context = sundials::MakeContext();
-  if (!h.context) return Failed(spec::FailureKind::kIntegrator, "SUNContext_Create failed");
-  h.yy.reset(N_VNew_Serial(size, h.context.get()));
-  h.yp.reset(N_VNew_Serial(size, h.context.get()));
-  h.id.reset(N_VNew_Serial(size, h.context.get()));
-  if (!h.yy || !h.yp || !h.id) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
+  if (spec::AnalysisFailure f = CreateContextAndVectors(size, &h.context, {&h.yy, &h.yp, &h.id, &h.atol}); !f.ok()) {
+    return f;
+  }
   Map<VectorXd> y(N_VGetArrayPointer(h.yy.get()), size), y_dot(N_VGetArrayPointer(h.yp.get()), size),
       id(N_VGetArrayPointer(h.id.get()), size);
   y.setZero();
@@ -477,8 +475,6 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   // The multipliers are left out of the error test; their weights only enter
   // Newton's convergence test and are scaled to the step (ErrorWeights), so
   // only q and v have absolute tolerances.
-  h.atol.reset(N_VNew_Serial(size, h.context.get()));
-  if (!h.atol) return Failed(spec::FailureKind::kIntegrator, "SUNDIALS allocation failed");
   Map<VectorXd> atol(N_VGetArrayPointer(h.atol.get()), size);
   atol.setZero();
   atol.head(2 * n).setConstant(options.absolute_tolerance);
@@ -529,13 +525,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
     if (options.max_step_size > 0.0) first = std::min(first, options.max_step_size);
     p.first_step = first;
   }
-  auto check = [&](int flag, const char* call) {
-    if (flag >= 0) return true;
-    sundials_message = absl::StrFormat("%s failed (%d)%s%s", call, flag, sundials_message.empty() ? "" : ": ",
-                                       sundials_message);
-    return false;
-  };
-  bool ok = check(IDASetErrHandlerFn(ida, &sundials::CaptureMessage, &sundials_message), "IDASetErrHandlerFn") &&
+  bool ok = check(IDASetErrHandlerFn(ida, &sundials::CaptureMessage, check.message_sink()), "IDASetErrHandlerFn") &&
             check(IDAInit(ida, &Residual, t0, h.yy.get(), h.yp.get()), "IDAInit") &&
             check(IDASetUserData(ida, &p), "IDASetUserData") &&
             check(IDAWFtolerances(ida, &ErrorWeights), "IDAWFtolerances") &&
@@ -547,7 +537,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
             check(IDASetMaxNumSteps(ida, options.max_steps), "IDASetMaxNumSteps") &&
             (p.first_step <= 0.0 || check(IDASetInitStep(ida, p.first_step), "IDASetInitStep")) &&
             (options.max_step_size <= 0.0 || check(IDASetMaxStep(ida, options.max_step_size), "IDASetMaxStep"));
-  if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+  if (!ok) return check.Failure();
 
   // A table that ends at the last instant (a tabulated driver up to the time
   // grid's end): IDAS would step past it and interpolate back, and the
@@ -555,7 +545,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   const double defined_until = system.DefinedUntil_s();
   if (std::isfinite(defined_until) && !times.empty() &&
       !check(IDASetStopTime(ida, std::min(defined_until, times.back())), "IDASetStopTime")) {
-    return Failed(spec::FailureKind::kIntegrator, sundials_message);
+    return check.Failure();
   }
 
   // Validity bounds: a start outside is a failure at t0; a crossing later
@@ -564,18 +554,12 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
   const int num_bounds = system.num_validity_bounds();
   std::vector<int> bounds_crossed(static_cast<size_t>(num_bounds), 0);
   if (num_bounds > 0) {
-    std::vector<double> g(static_cast<size_t>(num_bounds));
-    system.ValidityBounds(t0, q0, v0, g.data());
-    for (int k = 0; k < num_bounds; ++k) {
-      if (!(g[static_cast<size_t>(k)] >= 0.0)) {
-        return Failed(spec::FailureKind::kModelValidity, system.BoundReason(k, t0, q0, v0));
-      }
-    }
+    if (spec::AnalysisFailure f = ValidityBoundsHoldAtStart(system, t0, q0, v0); !f.ok()) return f;
     std::vector<int> downwards(static_cast<size_t>(num_bounds), -1);
     ok = check(IDARootInit(ida, num_bounds, &ValidityBounds), "IDARootInit") &&
          check(IDASetRootDirection(ida, downwards.data()), "IDASetRootDirection") &&
          check(IDASetNoInactiveRootWarn(ida), "IDASetNoInactiveRootWarn");
-    if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+    if (!ok) return check.Failure();
   }
 
   // Sensitivities: initial values by central differences of the consistent
@@ -625,7 +609,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
                "IDASensInit") &&
          check(IDASensSVtolerances(ida, options.relative_tolerance, atol_s.get()), "IDASensSVtolerances") &&
          check(IDASetSensErrCon(ida, SUNTRUE), "IDASetSensErrCon");
-    if (!ok) return Failed(spec::FailureKind::kIntegrator, sundials_message);
+    if (!ok) return check.Failure();
   }
 
   VectorXd phi, phi_t;
@@ -645,12 +629,12 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
         const std::string callback = p.callback_failure.empty() ? "" : " [" + p.callback_failure + "]";
         return Failed(spec::FailureKind::kIntegrator,
                       absl::StrFormat("the integrator failed near t = %.6g s (target %.6g s): %s%s%s", t_reached, t,
-                                      sundials_message, callback,
+                                      check.message(), callback,
                                       FailureAdvice(system, flag, t0, t_reached, t, y.head(n), options, p.first_step)));
       }
       if (flag == IDA_ROOT_RETURN) {
         if (!check(IDAGetRootInfo(ida, bounds_crossed.data()), "IDAGetRootInfo")) {
-          return Failed(spec::FailureKind::kIntegrator, sundials_message);
+          return check.Failure();
         }
         const int k = static_cast<int>(std::find(bounds_crossed.begin(), bounds_crossed.end(), -1) -
                                        bounds_crossed.begin());
@@ -677,7 +661,7 @@ spec::AnalysisFailure IntegrateForward(const ConstrainedSystem& system, double t
       // (and IDAS has no interpolant yet).
       if (t > t0 && (!check(IDAGetSens(ida, &t_sens, y_s.get()), "IDAGetSens") ||
                      !check(IDAGetSensDky(ida, t, 1, yp_s.get()), "IDAGetSensDky"))) {
-        return Failed(spec::FailureKind::kIntegrator, sundials_message);
+        return check.Failure();
       }
       sample.sensitivities.resize(static_cast<size_t>(num_sens));
       for (int k = 0; k < num_sens; ++k) {
