@@ -3,13 +3,16 @@
 // service's job driver with an in-process evaluator): finite differences of
 // spatial forward-dynamics analyses reach the optimum the study describes,
 // the shortest arm and the spring that puts the flyweight on its radius
-// limit.
+// limit; and a bob on two coaxial hinges (redundant joints) with
+// simulator sensitivities against its closed-form optimum.
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "absl/strings/str_cat.h"
 #include "spec/io/study_io.h"
 #include "tests/testing/local_run/local_run.h"
 
@@ -104,6 +107,99 @@ TEST(RunStudyLocally, SpatialStaticLinkageWithSimulatorSensitivitiesReachesTheSa
             << " analyses with simulator sensitivities (k " << simulator->design_physical[0] << " N/m); "
             << differences->outcome.cycles << " cycles, " << differences->analyses_run
             << " analyses with finite differences (k " << differences->design_physical[0] << " N/m)\n";
+}
+
+// A bob on two coaxial hinges (five redundant joint rows, solved with
+// independent combinations of them) swung out by a torque growing to
+// 8 N m against gravity, in static equilibrium: the lightest bob that
+// keeps its swing within 40 degrees. sin(theta) = tau / (m g l), so the
+// optimum is m = 8 / (9.81 x 0.5 x sin 40 deg) = 2.5374 kg. The
+// simulator's gradients (the combined equilibrium equations
+// differentiated) reach it as finite differences do.
+constexpr char kCoaxialBobScene[] = R"pb(
+name: "coaxial_bob"
+parameters { name: "mass" value: 5 unit: "kg" }
+spatial {
+  analysis: MULTIBODY_ANALYSIS_STATIC_EQUILIBRIUM
+  ground_markers { name: "hinge" orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } } }
+  ground_markers {
+    name: "hinge2" position_m { y { value: 0.3 } }
+    orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } }
+  }
+  bodies {
+    name: "bob"
+    mass_kg { param: "mass" }
+    principal_inertia { moments_kg_m2 { x { value: 0.02 } y { value: 0.02 } z { value: 0.01 } } }
+    position_m { z { value: -0.5 } }
+    markers {
+      name: "pivot" position_m { z { value: 0.5 } }
+      orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } }
+    }
+    markers {
+      name: "pivot2" position_m { y { value: 0.3 } z { value: 0.5 } }
+      orientation { axis_angle { axis { x { value: 1 } } angle_deg: -90 } }
+    }
+  }
+  joints { name: "hinge" kind: SPATIAL_JOINT_REVOLUTE a: "ground.hinge" b: "bob.pivot" }
+  joints { name: "hinge2" kind: SPATIAL_JOINT_REVOLUTE a: "ground.hinge2" b: "bob.pivot2" }
+  torques {
+    name: "swing" body: "bob" torque_n_m { y { value: 8 } }
+    tabulated { times_s: [0, 1] values: [0, 1] }
+  }
+  gravity { acceleration_m_per_s2 { z { value: -9.81 } } }
+}
+outputs { name: "angle" joint_coordinate { joint: "hinge" } }
+time_grid { start_s: 0 end_s: 1 points: 5 }
+)pb";
+
+std::string CoaxialBobStudy(const char* sensitivity) {
+  return absl::StrCat(R"pb(
+name: "coaxial_bob"
+scene_file: "coaxial_bob.scene.textproto"
+variables { name: "m" parameter: "mass" scale: 1 initial: 5 lower: 2 upper: 8 }
+responses { name: "m_response" expr: "mass" unit: "kg" }
+objective { minimize: "m_response" unit: "kg" }
+constraints { name: "swing" output: "angle" reduction: REDUCTION_MAX limit: 40 unit: "deg" }
+optimizer { sensitivity: )pb", sensitivity, " }\n");
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  ASSERT_TRUE(out.good()) << path;
+}
+
+TEST(RunStudyLocally, RedundantHingesWithSimulatorSensitivitiesReachTheClosedFormOptimum) {
+  const std::string dir = ::testing::TempDir();
+  WriteText(dir + "/coaxial_bob.scene.textproto", kCoaxialBobScene);
+  WriteText(dir + "/coaxial_bob.study.textproto", CoaxialBobStudy("SENSITIVITY_METHOD_FINITE_DIFFERENCE"));
+  WriteText(dir + "/coaxial_bob_sensitivity.study.textproto", CoaxialBobStudy("SENSITIVITY_METHOD_SIMULATOR"));
+  absl::StatusOr<spec::Study> differences_study = spec::io::LoadStudyFile(dir + "/coaxial_bob.study.textproto");
+  absl::StatusOr<spec::Study> simulator_study =
+      spec::io::LoadStudyFile(dir + "/coaxial_bob_sensitivity.study.textproto");
+  ASSERT_TRUE(differences_study.ok()) << differences_study.status();
+  ASSERT_TRUE(simulator_study.ok()) << simulator_study.status();
+  ASSERT_TRUE(simulator_study->optimizer.simulator_sensitivities);
+  absl::StatusOr<LocalRunResult> differences = RunStudyLocally(*differences_study);
+  absl::StatusOr<LocalRunResult> simulator = RunStudyLocally(*simulator_study);
+  ASSERT_TRUE(differences.ok()) << differences.status();
+  ASSERT_TRUE(simulator.ok()) << simulator.status();
+  const double optimum_kg = 8.0 / (9.81 * 0.5 * std::sin(40.0 * std::acos(-1.0) / 180.0));
+  for (const LocalRunResult* r : {&*differences, &*simulator}) {
+    EXPECT_EQ(r->outcome.state, slp::RunState::kConverged) << slp::RunStateName(r->outcome.state) << " " << r->end_reason;
+    EXPECT_EQ(r->analyses_failed, 0);
+    ASSERT_EQ(r->design_physical.size(), 1u);
+    // The constraint met to 1e-4 of its limit moves the mass by about as
+    // much relative to it.
+    EXPECT_NEAR(r->design_physical[0], optimum_kg, 1e-3 * optimum_kg);
+  }
+  // One analysis per cycle: fewer than 1 + 1 per cycle.
+  EXPECT_LT(simulator->analyses_run, differences->analyses_run);
+  std::cout << "bob on coaxial hinges: " << simulator->outcome.cycles << " cycles, " << simulator->analyses_run
+            << " analyses with simulator sensitivities (m " << simulator->design_physical[0] << " kg); "
+            << differences->outcome.cycles << " cycles, " << differences->analyses_run
+            << " analyses with finite differences (m " << differences->design_physical[0] << " kg); closed form "
+            << optimum_kg << " kg\n";
 }
 
 }  // namespace
