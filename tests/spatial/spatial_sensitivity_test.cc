@@ -19,114 +19,21 @@
 #include "absl/strings/str_cat.h"
 #include "spec/io/study_io.h"
 #include "tests/spatial/scene_text_testing.h"
+#include "tests/spatial/sensitivity_comparison.h"
 #include "worker/spatial/spatial_scene_analysis.h"
 
 namespace mbopt::spatial {
 namespace {
 
 // The whole analyses are integrated at rtol 1e-10 (the pendulum at 1e-11),
-// so that their central differences (relative step 1e-4: noise about
-// rtol / step = 1e-6, truncation about step^2 = 1e-8) can judge the
-// sensitivities.
-constexpr double kRelativeStep = 1e-4;
+// so that their central differences (sensitivity_comparison.h) can judge
+// the sensitivities.
 constexpr double kRelativeTolerance = 1e-10;
 constexpr double kAbsoluteTolerance = 1e-11;
 
-// Below this a derivative counts as zero (outputs are O(1) in SI here).
-constexpr double kNoDependence = 1e-8;
-
-// Per output, the largest |simulator - central difference| over the
-// instants relative to the largest |central difference|; and the same for
-// the peak (the largest value over the instants), whose derivative is the
-// output's derivative at the peak's instant.
-struct Agreement {
-  double worst_series = 0.0;
-  double worst_peak = 0.0;
-};
-
-std::vector<double> Values(const spec::Scene& scene) { return scene.DefaultParameterValues(); }
-
-int IndexOf(const spec::Scene& scene, const std::string& name) {
-  for (size_t i = 0; i < scene.parameters.size(); ++i) {
-    if (scene.parameters[i].name == name) return static_cast<int>(i);
-  }
-  ADD_FAILURE() << "no parameter " << name;
-  return 0;
-}
-
-size_t ArgMax(const std::vector<double>& v) {
-  return static_cast<size_t>(std::max_element(v.begin(), v.end()) - v.begin());
-}
-
-// `reactions`: outputs whose agreement goes to `reaction_agreement`
-// instead (one set of analyses for both).
-Agreement Compare(const spec::Scene& scene, const std::vector<std::string>& parameters,
-                  const std::vector<std::string>& outputs, const std::vector<std::string>& reactions = {},
-                  Agreement* reaction_agreement = nullptr) {
-  const std::vector<double> p = Values(scene);
-  std::vector<int> indices;
-  for (const std::string& name : parameters) indices.push_back(IndexOf(scene, name));
-  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, p, indices);
-  EXPECT_TRUE(result.report.ok()) << result.report.failure.reason;
-  EXPECT_EQ(result.unavailable, "");
-  if (!result.report.ok() || result.output_derivatives.size() != indices.size()) return {INFINITY, INFINITY};
-  // The values are the plain analysis', to the integration tolerance (the
-  // sensitivities in the error test change the steps).
-  const spec::AnalysisReport plain = AnalyzeSpatialScene(scene, p);
-  EXPECT_TRUE(plain.ok()) << plain.failure.reason;
-  for (const std::string& name : outputs) {
-    const std::vector<double>& a = scene_text::Series(result.report, name);
-    const std::vector<double>& b = scene_text::Series(plain, name);
-    EXPECT_EQ(a.size(), b.size());
-    if (a.size() != b.size()) return {INFINITY, INFINITY};
-    for (size_t t = 0; t < a.size(); ++t) EXPECT_NEAR(a[t], b[t], 1e4 * scene.integrator.relative_tolerance * (1.0 + std::abs(b[t]))) << name;
-  }
-  Agreement overall;
-  for (size_t i = 0; i < indices.size(); ++i) {
-    const size_t k = static_cast<size_t>(indices[i]);
-    const double h = kRelativeStep * std::abs(p[k]);
-    std::vector<double> plus = p, minus = p;
-    plus[k] += h;
-    minus[k] -= h;
-    const spec::AnalysisReport up = AnalyzeSpatialScene(scene, plus), down = AnalyzeSpatialScene(scene, minus);
-    EXPECT_TRUE(up.ok() && down.ok()) << up.failure.reason << down.failure.reason;
-    if (!up.ok() || !down.ok()) return {INFINITY, INFINITY};
-    for (const std::string& name : outputs) {
-      size_t o = 0;
-      while (o < scene.outputs.size() && scene.outputs[o].name != name) ++o;
-      EXPECT_LT(o, scene.outputs.size()) << name;
-      if (o == scene.outputs.size()) return {INFINITY, INFINITY};
-      const std::vector<double>& d = result.output_derivatives[i][o];
-      const std::vector<double>&u = scene_text::Series(up, name), &w = scene_text::Series(down, name);
-      EXPECT_EQ(d.size(), u.size());
-      double scale = 0.0, difference = 0.0;
-      for (size_t t = 0; t < d.size() && t < u.size(); ++t) {
-        const double fd = (u[t] - w[t]) / (2 * h);
-        scale = std::max(scale, std::abs(fd));
-        difference = std::max(difference, std::abs(d[t] - fd));
-      }
-      if (scale < kNoDependence) {
-        // The output does not depend on the parameter (a position of a
-        // driven mechanism on a mass): the simulator must say so too.
-        EXPECT_LT(difference, kNoDependence) << parameters[i] << " -> " << name;
-        std::cout << parameters[i] << " -> " << name << ": independent (difference " << difference << ")\n";
-        continue;
-      }
-      const bool reaction = std::find(reactions.begin(), reactions.end(), name) != reactions.end();
-      Agreement& agreement = reaction ? *reaction_agreement : overall;
-      agreement.worst_series = std::max(agreement.worst_series, difference / scale);
-      const std::vector<double>& values = scene_text::Series(result.report, name);
-      const double peak_fd = (u[ArgMax(u)] - w[ArgMax(w)]) / (2 * h);
-      const double peak = d[ArgMax(values)];
-      const double peak_difference = std::abs(peak - peak_fd) / scale;
-      agreement.worst_peak = std::max(agreement.worst_peak, peak_difference);
-      std::cout << parameters[i] << " -> " << name << ": max |d| " << scale << ", difference " << difference
-                << " (" << difference / scale << " relative); peak " << peak << " vs " << peak_fd << " ("
-                << peak_difference << " relative)\n";
-    }
-  }
-  return overall;
-}
+using sensitivity_testing::Agreement;
+using sensitivity_testing::Compare;
+using sensitivity_testing::Values;
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path);
@@ -252,46 +159,6 @@ TEST(SpatialSensitivity, DrivenPendulumDerivativesAgreeWithCentralDifferences) {
   EXPECT_LT(a.worst_series, kDrivenAgreement);
   EXPECT_LT(a.worst_peak, kDrivenAgreement);
   std::cout << "driven pendulum: worst " << a.worst_series << " over the instants\n";
-}
-
-// A door on two coaxial hinges (redundant rows, integrated as combinations
-// of its rows) has no sensitivity equations: the analysis says so and
-// returns its values without derivatives, and a study then differences
-// plain analyses for that design (engine::AnalyzeStudyWithGradients), as
-// for any planar scene whose sensitivities are unavailable.
-constexpr char kDoorOnTwoHinges[] = R"pb(
-  parameters { name: "mass" value: 12 unit: "kg" }
-  spatial {
-    ground_markers { name: "low" position_m { z { value: -0.8 } } }
-    ground_markers { name: "high" position_m { z { value: 0.8 } } }
-    bodies {
-      name: "door"
-      mass_kg { param: "mass" }
-      principal_inertia { moments_kg_m2 { x { value: 1.0 } y { value: 1.2 } z { value: 0.25 } } }
-      position_m { x { value: 0.4 } }
-      markers { name: "low" position_m { x { value: -0.4 } z { value: -0.8 } } }
-      markers { name: "high" position_m { x { value: -0.4 } z { value: 0.8 } } }
-    }
-    joints { name: "lower" kind: SPATIAL_JOINT_REVOLUTE a: "ground.low" b: "door.low" }
-    joints { name: "upper" kind: SPATIAL_JOINT_REVOLUTE a: "ground.high" b: "door.high" }
-    gravity { acceleration_m_per_s2 { y { value: -9.81 } } }
-  }
-  outputs { name: "angle" joint_coordinate { joint: "lower" } }
-  time_grid { start_s: 0 end_s: 0.5 points: 11 }
-)pb";
-
-TEST(SpatialSensitivity, RedundantJointsSayTheirSensitivitiesAreUnavailable) {
-  const spec::Scene scene = scene_text::Load(kDoorOnTwoHinges, "door.scene.textproto");
-  const SpatialSensitivityResult result = AnalyzeSpatialSceneWithSensitivities(scene, Values(scene), {0});
-  ASSERT_TRUE(result.report.ok()) << result.report.failure.reason;
-  EXPECT_NE(result.unavailable.find("redundant constraint equation"), std::string::npos) << result.unavailable;
-  EXPECT_TRUE(result.output_derivatives.empty());
-  const spec::AnalysisReport plain = AnalyzeSpatialScene(scene, Values(scene));
-  ASSERT_TRUE(plain.ok()) << plain.failure.reason;
-  // The same motion (its start polished by two more Newton steps).
-  const std::vector<double>&a = scene_text::Series(result.report, "angle"), &b = scene_text::Series(plain, "angle");
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-9) << "t = " << plain.times_s[i];
 }
 
 }  // namespace

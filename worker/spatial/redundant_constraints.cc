@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "absl/strings/str_format.h"
 
@@ -113,6 +114,19 @@ void CombinedConstraintSystem::DerivativePattern(Pattern* coupling, Pattern* row
   }
 }
 
+CombinedPerturbations::CombinedPerturbations(const std::vector<multibody::ParameterPerturbation>& full,
+                                             const MatrixXd& combination) {
+  for (const multibody::ParameterPerturbation& dp : full) {
+    systems_.push_back(std::make_unique<CombinedConstraintSystem>(*dp.plus, combination));
+    const CombinedConstraintSystem* plus = systems_.back().get();
+    systems_.push_back(std::make_unique<CombinedConstraintSystem>(*dp.minus, combination));
+    const CombinedConstraintSystem* minus = systems_.back().get();
+    // A derivative model holds dM/dp and dQ/dp only (no constraint
+    // depends on its parameter), which the combination does not touch.
+    parameters_.push_back(multibody::ParameterPerturbation{plus, minus, dp.step, dp.magnitude, dp.derivative});
+  }
+}
+
 namespace {
 
 // The cosine of the largest principal angle between the ranges spanned by
@@ -132,7 +146,8 @@ spec::AnalysisFailure IntegrateWithRedundantRows(const SpatialSystem& system, co
                                                  const multibody::ForwardDynamicsOptions& options,
                                                  const multibody::MotionCallback& at_instant,
                                                  multibody::ForwardDynamicsCounters* counters,
-                                                 RedundantIntegrationCounters* redundant) {
+                                                 RedundantIntegrationCounters* redundant,
+                                                 const multibody::ForwardSensitivityInput* sensitivities) {
   const int bodies = static_cast<int>(system.model().bodies.size());
   const int rank = static_cast<int>(combination.rows());
   // The requested instants and the checks between them, each marked.
@@ -150,6 +165,13 @@ spec::AnalysisFailure IntegrateWithRedundantRows(const SpatialSystem& system, co
   MatrixXd current = combination;
   double start_t = t0;
   VectorXd start_q = q0, start_v = v0;
+  const bool with_sensitivities = sensitivities != nullptr && !sensitivities->parameters.empty();
+  // The state's sensitivities at the start of each integration.
+  std::vector<VectorXd> start_dq, start_dv;
+  if (with_sensitivities) {
+    start_dq = sensitivities->q0;
+    start_dv = sensitivities->v0;
+  }
   size_t next = 0;  // the first check not yet seen
   while (true) {
     std::vector<double> segment;
@@ -206,6 +228,12 @@ spec::AnalysisFailure IntegrateWithRedundantRows(const SpatialSystem& system, co
         start_t = s.t_s;
         start_q = s.q;
         start_v = s.v;
+        if (with_sensitivities) {
+          for (size_t k = 0; k < s.sensitivities.size(); ++k) {
+            start_dq[k] = s.sensitivities[k].q;
+            start_dv[k] = s.sensitivities[k].v;
+          }
+        }
         // Stops this integration; the loop below restarts from here.
         return spec::AnalysisFailure::Of(spec::FailureKind::kCancelled, "new combination");
       }
@@ -213,8 +241,16 @@ spec::AnalysisFailure IntegrateWithRedundantRows(const SpatialSystem& system, co
     };
     // The integrator reports its own totals: one integration's, summed here.
     multibody::ForwardDynamicsCounters part;
-    const spec::AnalysisFailure f =
-        multibody::IntegrateForward(combined, start_t, start_q, start_v, segment, options, check, &part);
+    std::unique_ptr<CombinedPerturbations> varied;
+    multibody::ForwardSensitivityInput input;
+    if (with_sensitivities) {
+      varied = std::make_unique<CombinedPerturbations>(sensitivities->parameters, current);
+      input.parameters = varied->parameters();
+      input.q0 = start_dq;
+      input.v0 = start_dv;
+    }
+    const spec::AnalysisFailure f = multibody::IntegrateForward(combined, start_t, start_q, start_v, segment, options,
+                                                                check, &part, with_sensitivities ? &input : nullptr);
     counters->steps += part.steps;
     counters->residual_evaluations += part.residual_evaluations;
     counters->jacobian_evaluations += part.jacobian_evaluations;

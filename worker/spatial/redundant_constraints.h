@@ -30,6 +30,7 @@
 // Deterministic: the same matrix gives the same T.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,26 @@ class CombinedConstraintSystem : public multibody::ConstrainedSystem {
   Eigen::MatrixXd combination_;
 };
 
+// The varied systems of a sensitivity analysis (multibody::
+// ParameterPerturbation) with the nominal system's combination T: the rows
+// are the same functions of (q, p) in every variant, so T Phi(q, p +- h)
+// differenced is T dPhi/dp, the parameter derivative of the equations
+// integrated or solved. T is not a function of p here, and need not be:
+// every T whose T Phi_q has full rank has the same solutions (the motion,
+// the equilibrium) near the pose, so their derivatives are the same too;
+// only the multipliers belong to T. Keeps references to the full
+// variants, which must outlive it.
+class CombinedPerturbations {
+ public:
+  CombinedPerturbations(const std::vector<multibody::ParameterPerturbation>& full,
+                        const Eigen::MatrixXd& combination);
+  const std::vector<multibody::ParameterPerturbation>& parameters() const { return parameters_; }
+
+ private:
+  std::vector<std::unique_ptr<CombinedConstraintSystem>> systems_;
+  std::vector<multibody::ParameterPerturbation> parameters_;
+};
+
 // Restart when the range of the joint rows' Jacobian has turned by more
 // than 45 degrees (the cosine of the largest principal angle below this)
 // from the range the combination was taken at: fixed combinations become
@@ -127,12 +148,26 @@ struct RedundantIntegrationCounters {
 // (SpatialAssembly::independent_combination); `at_instant` sees the
 // requested instants only, once each. Fails with kAssembly naming the
 // row and time when a row leaves kRowBound or the rank changes.
+//
+// With `sensitivities` (the full variants and the start's derivatives):
+// IDAS's forward sensitivities of the combined system, its variants
+// combined alike (CombinedPerturbations). At a restart the new
+// integration starts from the state's sensitivities reached there, as is:
+// they satisfy every row's derivative, Phi_q s_q + Phi_p = 0, not only
+// the old combination's. That residual r lies in the range of Phi_q (the
+// variants keep the redundancy, so Phi_p = -Phi_q dq/dp), the old
+// combination holds T_old r = 0, and T_old is one-to-one on that range
+// as long as the range has turned by less than 90 degrees (the restart
+// comes at 45): so r = 0, and T_new r = 0. The same for the velocities.
+// The multipliers' and accelerations' sensitivities, which do belong to
+// the combination, are taken anew as at the start.
 spec::AnalysisFailure IntegrateWithRedundantRows(const SpatialSystem& system, const Eigen::MatrixXd& combination,
                                                  double t0_s, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
                                                  const std::vector<double>& times_s,
                                                  const multibody::ForwardDynamicsOptions& options,
                                                  const multibody::MotionCallback& at_instant,
                                                  multibody::ForwardDynamicsCounters* counters,
-                                                 RedundantIntegrationCounters* redundant);
+                                                 RedundantIntegrationCounters* redundant,
+                                                 const multibody::ForwardSensitivityInput* sensitivities = nullptr);
 
 }  // namespace mbopt::spatial

@@ -359,11 +359,6 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     result->unavailable =
         "static equilibrium of a spatial scene with rotational spring-dampers or bushings has no sensitivity "
         "equations yet (their Jacobians are difference quotients)";
-  } else if (sensitivities && assembled.redundant_rows > 0) {
-    result->unavailable = absl::StrFormat(
-        "the mechanism has %d redundant constraint equation(s): its motion is integrated with combinations of its "
-        "rows, which have no sensitivity equations yet",
-        assembled.redundant_rows);
   }
   if (sensitivities && result->unavailable.empty()) {
     for (const int index : *parameters) {
@@ -400,6 +395,9 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
         multibody::ParameterPerturbation{dp.plus->system.get(), dp.minus->system.get(), dp.step, dp.magnitude, nullptr});
   }
   std::vector<multibody::StateSensitivity> kinematic;  // work space of the driven and static paths
+  // Redundant joints: a static instant's rows are combined as its solve
+  // combined them (its multipliers belong to that combination).
+  Eigen::MatrixXd static_combination;
   size_t next_instant = 0;
   std::vector<double> bushing_bounds;
   const multibody::MotionCallback record = [&](const multibody::MotionSample& s) {
@@ -444,8 +442,28 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
     // equilibrium's from its differentiated equilibrium equations.
     const std::vector<multibody::StateSensitivity>* ds = &s.sensitivities;
     if (ds->size() != perturbed.size()) {
-      const bool solved = is_static ? multibody::StaticStateSensitivities(system, perturbations, s, &kinematic)
-                                    : multibody::KinematicStateSensitivities(system, perturbations, s, &kinematic);
+      bool solved = false;
+      if (assembled.redundant_rows > 0) {
+        // The equations differentiated with independent combinations of
+        // the rows (redundant_constraints.h): square and regular where the
+        // full ones are not. A driven instant's rows hold exactly, so any
+        // combination of full rank gives the same derivative; the one at
+        // the instant's pose.
+        Eigen::MatrixXd combination = static_combination;
+        if (!is_static) {
+          const IndependentConstraints now = IndependentCombination(system, s.t_s, s.q);
+          if (now.ok) combination = now.combination;
+        }
+        if (combination.rows() > 0) {
+          const CombinedConstraintSystem combined(system, combination);
+          const CombinedPerturbations varied(perturbations, combination);
+          solved = is_static ? multibody::StaticStateSensitivities(combined, varied.parameters(), s, &kinematic)
+                             : multibody::KinematicStateSensitivities(combined, varied.parameters(), s, &kinematic);
+        }
+      } else {
+        solved = is_static ? multibody::StaticStateSensitivities(system, perturbations, s, &kinematic)
+                           : multibody::KinematicStateSensitivities(system, perturbations, s, &kinematic);
+      }
       if (!solved) {
         result->unavailable = absl::StrFormat("no state derivative at t = %.6g s", s.t_s);
         return spec::AnalysisFailure::Ok();
@@ -469,7 +487,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   if (is_static) {
     report.formulation = spec::Formulation::kStatic;
     multibody::StaticCounters counters;
-    outcome = RunSpatialStaticEquilibrium(system, assembled, times, budget, record, &counters);
+    outcome = RunSpatialStaticEquilibrium(system, assembled, times, budget, record, &counters, &static_combination);
     report.counters.position_solves += counters.position_solves;
     report.counters.newton_iterations += counters.newton_iterations;
     report.counters.rhs_evaluations += counters.residual_evaluations;
@@ -495,11 +513,13 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
       }
     }
     // Redundant joints: integrated as independent combinations of their
-    // rows (redundant_constraints.h), every row checked along the way.
+    // rows (redundant_constraints.h), every row checked along the way, the
+    // sensitivities with them.
     RedundantIntegrationCounters redundant;
     outcome = assembled.redundant_rows > 0
                   ? IntegrateWithRedundantRows(system, assembled.independent_combination, 0.0, assembled.q,
-                                               assembled.v, times, options, record, &counters, &redundant)
+                                               assembled.v, times, options, record, &counters, &redundant,
+                                               with_derivatives ? &input : nullptr)
                   : multibody::IntegrateForward(system, 0.0, assembled.q, assembled.v, times, options, record,
                                                 &counters, with_derivatives ? &input : nullptr);
     report.counters.time_steps = counters.steps;

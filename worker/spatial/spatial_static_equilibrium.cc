@@ -21,7 +21,8 @@ namespace {
 spec::AnalysisFailure StaticWithRedundantRows(const SpatialSystem& system, const SpatialAssembly& assembled,
                                               const std::vector<double>& times_s, budget::AnalysisBudget* budget,
                                               const multibody::MotionCallback& at_instant,
-                                              multibody::StaticCounters* counters) {
+                                              multibody::StaticCounters* counters,
+                                              Eigen::MatrixXd* combination_in_use) {
   const int bodies = static_cast<int>(system.model().bodies.size());
   const int rank = static_cast<int>(assembled.independent_combination.rows());
   const multibody::StaticOptions options = SpatialStaticOptions(budget);
@@ -36,6 +37,7 @@ spec::AnalysisFailure StaticWithRedundantRows(const SpatialSystem& system, const
                           now.rank, t, rank));
     }
     const CombinedConstraintSystem combined(system, now.combination);
+    if (combination_in_use != nullptr) *combination_in_use = now.combination;
     const multibody::MotionCallback check = [&](const multibody::MotionSample& s) {
       Eigen::VectorXd phi;
       if (system.Constraints(s.t_s, s.q, &phi) != 0) {
@@ -74,10 +76,11 @@ spec::AnalysisFailure StaticWithRedundantRows(const SpatialSystem& system, const
 spec::AnalysisFailure RunSpatialStaticEquilibrium(const SpatialSystem& system, const SpatialAssembly& assembled,
                                                   const std::vector<double>& times_s, budget::AnalysisBudget* budget,
                                                   const multibody::MotionCallback& at_instant,
-                                                  multibody::StaticCounters* counters) {
+                                                  multibody::StaticCounters* counters,
+                                                  Eigen::MatrixXd* combination_in_use) {
   if (assembled.redundant_rows > 0) {
     // KINSOL's Newton matrix would be singular with the dependent rows.
-    return StaticWithRedundantRows(system, assembled, times_s, budget, at_instant, counters);
+    return StaticWithRedundantRows(system, assembled, times_s, budget, at_instant, counters, combination_in_use);
   }
   return multibody::RunStaticEquilibrium(system, assembled.q, times_s, SpatialStaticOptions(budget), at_instant,
                                          counters);

@@ -40,9 +40,14 @@ multibody::StaticOptions SpatialStaticOptions(budget::AnalysisBudget* budget);
 
 // From `assembled` (AssembleSpatial at times_s.front()); reports (q, lambda)
 // with zero velocities and accelerations at each of `times_s` (ascending).
+// With redundant joints and `combination_in_use`, that holds the
+// combination of the rows each instant was solved with (its multipliers'
+// rows) while `at_instant` sees it; its sensitivities are those of the
+// CombinedConstraintSystem with that combination.
 spec::AnalysisFailure RunSpatialStaticEquilibrium(const SpatialSystem& system, const SpatialAssembly& assembled,
                                                   const std::vector<double>& times_s, budget::AnalysisBudget* budget,
                                                   const multibody::MotionCallback& at_instant,
-                                                  multibody::StaticCounters* counters);
+                                                  multibody::StaticCounters* counters,
+                                                  Eigen::MatrixXd* combination_in_use = nullptr);
 
 }  // namespace mbopt::spatial
