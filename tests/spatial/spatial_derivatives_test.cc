@@ -290,10 +290,12 @@ Model AnalyticForcedPair() {
 
 // dQ/dq and dQ/dv against central differences of AppliedForces: with only
 // gravity (the Euler parameters' velocity terms alone) and with every
-// force element.
+// force element. Every model has the exact state Jacobian now (before, one
+// with a rotational spring or a bushing had not).
 void ExpectForceJacobians(const Model& model) {
   ASSERT_TRUE(model.Validate().ok()) << model.Validate();
   const SpatialSystem s(model);
+  EXPECT_TRUE(s.has_exact_state_jacobian());
   VectorXd q, v;
   GeneralState(s, &q, &v);
   const double t = 0.25;
@@ -324,11 +326,7 @@ TEST(SpatialDerivatives, VelocityTermsMatchDifferenceQuotients) { ExpectForceJac
 
 // Every element, the rotational spring and the bushing among them (before,
 // those two were differenced and the system had no exact state Jacobian).
-TEST(SpatialDerivatives, ForceElementsMatchDifferenceQuotients) {
-  const Model model = ForcedPair();
-  ExpectForceJacobians(model);
-  EXPECT_TRUE(SpatialSystem(model).has_exact_state_jacobian());
-}
+TEST(SpatialDerivatives, ForceElementsMatchDifferenceQuotients) { ExpectForceJacobians(ForcedPair()); }
 
 // Rx(x) Ry(y) Rz(z), the angles in degrees.
 Matrix3d XyzRotation(double x_deg, double y_deg, double z_deg) {
@@ -345,34 +343,23 @@ Model BushedPair() {
   Model m = TwoBodies(Joint::Kind::kRevolute);
   const Matrix3d one = m.bodies[0].orientation, two = m.bodies[1].orientation;
   const Matrix3d ground_axes = AxisAngle({0, 0, 1}, 0.3), between_axes = AxisAngle({1, 0, 1}, 0.5);
-  Bushing from_ground;
-  from_ground.name = "mount";
-  from_ground.a = FrameOn(kGround, {0.4, -0.2, 0.1}, ground_axes);
-  from_ground.b = FrameOn(0, {-0.1, 0.05, 0.02}, one.transpose() * ground_axes * XyzRotation(50, -40, 65));
-  from_ground.stiffness_n_per_m = {200, 300, 400};
-  from_ground.damping_n_s_per_m = {2, 3, 4};
-  from_ground.rotational_stiffness_n_m_per_rad = {30, 60, 45};
-  from_ground.rotational_damping_n_m_s_per_rad = {2, 5, 3};
-  m.bushings.push_back(from_ground);
-  Bushing between;
-  between.name = "link";
-  between.a = FrameOn(0, {0.1, 0.1, -0.05}, between_axes);
-  between.b = FrameOn(1, {-0.05, 0.1, 0.08}, two.transpose() * one * between_axes * XyzRotation(40, 70, -50));
-  between.stiffness_n_per_m = {500, 100, 250};
-  between.damping_n_s_per_m = {1, 6, 3};
-  between.rotational_stiffness_n_m_per_rad = {50, 20, 35};
-  between.rotational_damping_n_m_s_per_rad = {4, 1, 2.5};
-  m.bushings.push_back(between);
+  // Bushing{name, a, b, stiffness, damping, rotational stiffness and damping}.
+  m.bushings.push_back(Bushing{"mount", FrameOn(kGround, {0.4, -0.2, 0.1}, ground_axes),
+                               FrameOn(0, {-0.1, 0.05, 0.02}, one.transpose() * ground_axes * XyzRotation(50, -40, 65)),
+                               {200, 300, 400}, {2, 3, 4}, {30, 60, 45}, {2, 5, 3}});
+  m.bushings.push_back(
+      Bushing{"link", FrameOn(0, {0.1, 0.1, -0.05}, between_axes),
+              FrameOn(1, {-0.05, 0.1, 0.08}, two.transpose() * one * between_axes * XyzRotation(40, 70, -50)),
+              {500, 100, 250}, {1, 6, 3}, {50, 20, 35}, {4, 1, 2.5}});
   return m;
 }
 
 TEST(SpatialDerivatives, BushingsAtLargeRotationsMatchDifferenceQuotients) {
   const Model model = BushedPair();
   ExpectForceJacobians(model);
-  const SpatialSystem s(model);
-  EXPECT_TRUE(s.has_exact_state_jacobian());
   // The angles are what they were set to, give or take the general
   // state's offsets.
+  const SpatialSystem s(model);
   VectorXd q, v;
   GeneralState(s, &q, &v);
   for (int b = 0; b < 2; ++b) {
@@ -403,7 +390,6 @@ TEST(SpatialDerivatives, RotationalSpringsMatchDifferenceQuotients) {
     const Model model = WoundSpringPair(kind);
     ExpectForceJacobians(model);
     const SpatialSystem s(model);
-    EXPECT_TRUE(s.has_exact_state_jacobian());
     VectorXd q, v;
     GeneralState(s, &q, &v);
     EXPECT_GT(std::abs(s.RotationalSpringTorque(0, q, v)), 40.0);
@@ -428,7 +414,6 @@ TEST(SpatialDerivatives, AnalyticElementJacobiansMatchDifferenceQuotients) {
   const Model model = AnalyticForcedPair();
   ExpectForceJacobians(model);
   const SpatialSystem s(model);
-  EXPECT_TRUE(s.has_exact_state_jacobian());
   // The tabulated spring's state lies inside its curves' middle segments
   // (not across a breakpoint, where the difference would straddle two
   // slopes) and well away from the linear coefficients.

@@ -155,15 +155,19 @@ TEST(SpatialStaticSensitivity, LinkageDerivativesAgreeWithCentralDifferences) {
 // (and the line search's); difference quotients one more per unknown of
 // the 14 coordinates and 12 multipliers. Measured: 167 iterations and 549
 // residuals; with difference quotients the same iterations and 4669.
-TEST(SpatialStaticSensitivity, NewtonMatrixIsAnalytic) {
-  const spec::Scene scene = Linkage();
+// The scene's static analysis, expecting a few residuals per Newton
+// iteration (an analytic Newton matrix).
+spec::AnalysisReport ExpectAnalyticNewtonMatrix(const spec::Scene& scene, const char* label) {
   const spec::AnalysisReport r = AnalyzeSpatialScene(scene, scene.DefaultParameterValues());
-  ASSERT_TRUE(r.ok()) << r.failure.reason;
-  std::cout << "linkage statics: " << r.counters.newton_iterations << " Newton iterations, "
+  EXPECT_TRUE(r.ok()) << r.failure.reason;
+  std::cout << label << " statics: " << r.counters.newton_iterations << " Newton iterations, "
             << r.counters.rhs_evaluations << " residual evaluations\n";
   EXPECT_GT(r.counters.newton_iterations, 0);
   EXPECT_LT(r.counters.rhs_evaluations, 4 * r.counters.newton_iterations);
+  return r;
 }
+
+TEST(SpatialStaticSensitivity, NewtonMatrixIsAnalytic) { ExpectAnalyticNewtonMatrix(Linkage(), "linkage"); }
 
 // The linkage with `element` added before gravity and `outputs` after the
 // others; `marker` added to the bob.
@@ -207,8 +211,9 @@ spec::Scene RotationalSpringLinkage() {
 }
 
 // Before, both said their sensitivities were unavailable (their element
-// Jacobians were difference quotients). Measured: see docs/physics.md
-// section 8, "Static equilibrium sensitivities".
+// Jacobians were difference quotients). Measured: 1.0e-7 with the bushing
+// and 2.1e-8 with the rotational spring at worst (both the hinge's reaction
+// on the anchor's coordinate).
 TEST(SpatialStaticSensitivity, BushingDerivativesAgreeWithCentralDifferences) {
   const double worst = WorstDisagreement(BushingLinkage());
   EXPECT_LT(worst, kAgreement);
@@ -221,18 +226,19 @@ TEST(SpatialStaticSensitivity, RotationalSpringDerivativesAgreeWithCentralDiffer
   std::cout << "rotational spring statics: worst " << worst << "\n";
 }
 
-// KINSOL's Newton matrix is analytic with a bushing too. Measured: see
-// docs/physics.md section 8 (difference quotients cost one residual more
-// per unknown).
+// KINSOL's Newton matrix is analytic with a bushing or a rotational spring
+// too. Measured: 118 iterations and 371 residuals with the bushing, 193
+// and 729 with the rotational spring; with their Jacobians differenced the
+// same iterations and 3315 and 5473 residuals. The bushing's angles at the
+// equilibria: (76-78, 20-23, 34-35) deg.
 TEST(SpatialStaticSensitivity, BushingNewtonMatrixIsAnalytic) {
   std::string orientation;
   for (const char* k : {"1", "2", "3"}) {
     orientation += std::string("  outputs { name: \"bob_") + k +
                    "\" body_orientation { body: \"bob\" sequence: EULER_XYZ angle: " + k + " } }\n";
   }
-  const spec::Scene scene = BushingLinkage(orientation);
-  const spec::AnalysisReport r = AnalyzeSpatialScene(scene, scene.DefaultParameterValues());
-  ASSERT_TRUE(r.ok()) << r.failure.reason;
+  const spec::AnalysisReport r = ExpectAnalyticNewtonMatrix(BushingLinkage(orientation), "bushing");
+  ASSERT_TRUE(r.ok());
   // The bushing's x-y-z angles, R = A_bob R_mount (the post's axes are
   // the world's), at every instant: large rotations.
   const double to_rad = std::numbers::pi / 180.0;
@@ -245,20 +251,10 @@ TEST(SpatialStaticSensitivity, BushingNewtonMatrixIsAnalytic) {
     std::cout << "bushing angles at t = " << r.times_s[t] << " s: " << angles_deg.transpose() << " deg\n";
     EXPECT_GT(angles_deg.cwiseAbs().maxCoeff(), 30.0);
   }
-  std::cout << "bushing statics: " << r.counters.newton_iterations << " Newton iterations, "
-            << r.counters.rhs_evaluations << " residual evaluations\n";
-  EXPECT_GT(r.counters.newton_iterations, 0);
-  EXPECT_LT(r.counters.rhs_evaluations, 4 * r.counters.newton_iterations);
 }
 
 TEST(SpatialStaticSensitivity, RotationalSpringNewtonMatrixIsAnalytic) {
-  const spec::Scene scene = RotationalSpringLinkage();
-  const spec::AnalysisReport r = AnalyzeSpatialScene(scene, scene.DefaultParameterValues());
-  ASSERT_TRUE(r.ok()) << r.failure.reason;
-  std::cout << "rotational spring statics: " << r.counters.newton_iterations << " Newton iterations, "
-            << r.counters.rhs_evaluations << " residual evaluations\n";
-  EXPECT_GT(r.counters.newton_iterations, 0);
-  EXPECT_LT(r.counters.rhs_evaluations, 4 * r.counters.newton_iterations);
+  ExpectAnalyticNewtonMatrix(RotationalSpringLinkage(), "rotational spring");
 }
 
 }  // namespace
