@@ -5,11 +5,13 @@
 // constraints' Jacobian d(Phi_q v + Phi_t)/dq, the mass matrix's
 // d(M(q) a)/dq, the force Jacobians (Euler parameters' velocity terms,
 // linear and tabulated springs, point forces and torques in world and body
-// axes, and the differenced rotational springs and bushings), the declared
+// axes, rotational spring-dampers on revolute and cylindrical joints, wound
+// past a turn, and bushings at x-y-z angles of 40-70 deg), the declared
 // pattern, the same through combined rows (redundant joints), and the
 // assembled GGL Newton matrix against the residual at non-zero
 // accelerations: the whole state Jacobian.
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -17,6 +19,7 @@
 #include "worker/multibody/ggl_residual.h"
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/redundant_constraints.h"
+#include "worker/spatial/spatial_force_elements.h"
 #include "worker/spatial/spatial_system.h"
 
 namespace mbopt::spatial {
@@ -287,10 +290,12 @@ Model AnalyticForcedPair() {
 
 // dQ/dq and dQ/dv against central differences of AppliedForces: with only
 // gravity (the Euler parameters' velocity terms alone) and with every
-// force element.
+// force element. Every model has the exact state Jacobian now (before, one
+// with a rotational spring or a bushing had not).
 void ExpectForceJacobians(const Model& model) {
   ASSERT_TRUE(model.Validate().ok()) << model.Validate();
   const SpatialSystem s(model);
+  EXPECT_TRUE(s.has_exact_state_jacobian());
   VectorXd q, v;
   GeneralState(s, &q, &v);
   const double t = 0.25;
@@ -319,18 +324,96 @@ void ExpectForceJacobians(const Model& model) {
 
 TEST(SpatialDerivatives, VelocityTermsMatchDifferenceQuotients) { ExpectForceJacobians(TwoBodies(Joint::Kind::kUniversal)); }
 
-// Every element, the rotational spring and the bushing differenced.
-TEST(SpatialDerivatives, ForceElementsMatchDifferenceQuotients) {
-  const Model model = ForcedPair();
+// Every element, the rotational spring and the bushing among them (before,
+// those two were differenced and the system had no exact state Jacobian).
+TEST(SpatialDerivatives, ForceElementsMatchDifferenceQuotients) { ExpectForceJacobians(ForcedPair()); }
+
+// Rx(x) Ry(y) Rz(z), the angles in degrees.
+Matrix3d XyzRotation(double x_deg, double y_deg, double z_deg) {
+  const double to_rad = std::numbers::pi / 180.0;
+  return AxisAngle({1, 0, 0}, x_deg * to_rad) * AxisAngle({0, 1, 0}, y_deg * to_rad) *
+         AxisAngle({0, 0, 1}, z_deg * to_rad);
+}
+
+// Two bushings at large rotations, frames off the centres of mass,
+// stiffnesses and dampings different on every axis: ground to body one
+// with frames at x-y-z angles (50, -40, 65) deg, body one to body two at
+// (40, 70, -50) deg (a middle angle of 70 deg, 1 / cos = 2.9).
+Model BushedPair() {
+  Model m = TwoBodies(Joint::Kind::kRevolute);
+  const Matrix3d one = m.bodies[0].orientation, two = m.bodies[1].orientation;
+  const Matrix3d ground_axes = AxisAngle({0, 0, 1}, 0.3), between_axes = AxisAngle({1, 0, 1}, 0.5);
+  // Bushing{name, a, b, stiffness, damping, rotational stiffness and damping}.
+  m.bushings.push_back(Bushing{"mount", FrameOn(kGround, {0.4, -0.2, 0.1}, ground_axes),
+                               FrameOn(0, {-0.1, 0.05, 0.02}, one.transpose() * ground_axes * XyzRotation(50, -40, 65)),
+                               {200, 300, 400}, {2, 3, 4}, {30, 60, 45}, {2, 5, 3}});
+  m.bushings.push_back(
+      Bushing{"link", FrameOn(0, {0.1, 0.1, -0.05}, between_axes),
+              FrameOn(1, {-0.05, 0.1, 0.08}, two.transpose() * one * between_axes * XyzRotation(40, 70, -50)),
+              {500, 100, 250}, {1, 6, 3}, {50, 20, 35}, {4, 1, 2.5}});
+  return m;
+}
+
+TEST(SpatialDerivatives, BushingsAtLargeRotationsMatchDifferenceQuotients) {
+  const Model model = BushedPair();
   ExpectForceJacobians(model);
-  EXPECT_FALSE(SpatialSystem(model).has_exact_state_jacobian());
+  // The angles are what they were set to, give or take the general
+  // state's offsets.
+  const SpatialSystem s(model);
+  VectorXd q, v;
+  GeneralState(s, &q, &v);
+  for (int b = 0; b < 2; ++b) {
+    const Vector3d angles_deg = BushingLoadOf(model, b, q, v).angles_rad * 180.0 / std::numbers::pi;
+    EXPECT_GT(angles_deg.cwiseAbs().minCoeff(), 35.0) << angles_deg.transpose();
+    EXPECT_LT(angles_deg.cwiseAbs().maxCoeff(), 75.0) << angles_deg.transpose();
+  }
+}
+
+// A rotational spring-damper on the joint between the bodies, wound past a
+// turn (theta - theta0 near 9 rad: a torque of 60 N m or so, so its
+// curvature term, torque times the angle's Hessian, counts).
+Model WoundSpringPair(Joint::Kind kind) {
+  Model m = TwoBodies(kind);
+  RotationalSpringDamper wound;
+  wound.name = "wound";
+  wound.joint = 1;
+  wound.stiffness_n_m_per_rad = 7.0;
+  wound.damping_n_m_s_per_rad = 0.6;
+  wound.free_angle_rad = -9.0;
+  m.rotational_springs.push_back(wound);
+  return m;
+}
+
+TEST(SpatialDerivatives, RotationalSpringsMatchDifferenceQuotients) {
+  for (const Joint::Kind kind : {Joint::Kind::kRevolute, Joint::Kind::kCylindrical}) {
+    SCOPED_TRACE(JointKindName(kind));
+    const Model model = WoundSpringPair(kind);
+    ExpectForceJacobians(model);
+    const SpatialSystem s(model);
+    VectorXd q, v;
+    GeneralState(s, &q, &v);
+    EXPECT_GT(std::abs(s.RotationalSpringTorque(0, q, v)), 40.0);
+  }
+}
+
+// A bushing past its middle-angle limit: no Jacobian outside a continued
+// scope, as no force.
+TEST(SpatialDerivatives, BushingPastItsAngleLimitHasNoJacobian) {
+  Model model = BushedPair();
+  const Matrix3d one = model.bodies[0].orientation;
+  model.bushings[0].b.axes = one.transpose() * model.bushings[0].a.axes * XyzRotation(10, 87, 20);
+  const SpatialSystem s(model);
+  const VectorXd q = s.InitialGuess(), v = VectorXd::Zero(q.size());
+  VectorXd forces;
+  MatrixXd q_q, q_v;
+  EXPECT_NE(s.AppliedForces(0.0, q, v, &forces), 0);
+  EXPECT_NE(s.ForceJacobians(0.0, q, v, &q_q, &q_v), 0);
 }
 
 TEST(SpatialDerivatives, AnalyticElementJacobiansMatchDifferenceQuotients) {
   const Model model = AnalyticForcedPair();
   ExpectForceJacobians(model);
   const SpatialSystem s(model);
-  EXPECT_TRUE(s.has_exact_state_jacobian());
   // The tabulated spring's state lies inside its curves' middle segments
   // (not across a breakpoint, where the difference would straddle two
   // slopes) and well away from the linear coefficients.
@@ -440,6 +523,13 @@ TEST(SpatialDerivatives, NewtonMatrixWithForceElementsMatchesTheResidual) {
   Model model = AnalyticForcedPair();
   model.drivers = DrivenCylinder().drivers;
   model.joints[1].kind = Joint::Kind::kCylindrical;
+  ExpectNewtonMatrixMatchesTheResidual(model);
+}
+
+TEST(SpatialDerivatives, NewtonMatrixWithBushingsAndRotationalSpringMatchesTheResidual) {
+  Model model = BushedPair();
+  model.joints[1].kind = Joint::Kind::kCylindrical;
+  model.rotational_springs = WoundSpringPair(Joint::Kind::kCylindrical).rotational_springs;
   ExpectNewtonMatrixMatchesTheResidual(model);
 }
 

@@ -2,15 +2,9 @@
 // "Newton matrix"): the constraints' curvature d(Phi_q^T w)/dq and the
 // velocity constraints' Jacobian d(Phi_q v + Phi_t)/dq from the equations'
 // exact Hessians (pair_vectors.h), the Euler parameters' mass matrix
-// d(M(q) a)/dq and quadratic velocity terms analytically, the springs',
-// point forces' and torques' Jacobians analytically
-// (spatial_element_jacobians.h), and those of a model with rotational
-// spring-dampers or bushings by central differences of its elements'
-// forces alone.
-#include <algorithm>
+// d(M(q) a)/dq and quadratic velocity terms analytically, and the force
+// elements' Jacobians analytically (spatial_element_jacobians.h).
 #include <cmath>
-#include <limits>
-#include <set>
 
 #include "worker/spatial/euler_parameters.h"
 #include "worker/spatial/pair_vectors.h"
@@ -111,8 +105,6 @@ int SpatialSystem::VelocityConstraintJacobian(double t, const VectorXd& q, const
   return jacobian->allFinite() ? 0 : 1;
 }
 
-bool SpatialSystem::has_exact_state_jacobian() const { return HasAnalyticElementJacobians(model_); }
-
 // A body's block of M(q) a is m a_r and (4 L(p)^T J L(p) + c p p^T) b with
 // b = a_p and c = 4 tr(J) / 3. L is linear in p with L(p) b = -L(b) p and
 // L(p)^T x = X(x) p (TransposedRateMatrixApplied), so
@@ -156,39 +148,7 @@ int SpatialSystem::ForceJacobians(double t, const VectorXd& q, const VectorXd& v
         8.0 * TransposedRateMatrixApplied(inertia * l_dot * p) - 8.0 * l_dot.transpose() * inertia * l;
   }
   if (!has_force_elements()) return 0;
-  if (HasAnalyticElementJacobians(model_)) {
-    return AddElementJacobians(model_, t, q, v, continue_past_bounds_, q_q, q_v);
-  }
-  // Central differences of the elements' forces, column by column of the
-  // bodies they act on.
-  std::set<int> bodies;
-  for (const SpringDamper& s : model_.springs) bodies.insert({s.a.body, s.b.body});
-  for (const PointForce& f : model_.point_forces) bodies.insert(f.at.body);
-  for (const BodyTorque& b : model_.torques) bodies.insert(b.body);
-  for (const RotationalSpringDamper& r : model_.rotational_springs) {
-    const Joint& joint = model_.joints[static_cast<size_t>(r.joint)];
-    bodies.insert({joint.a.body, joint.b.body});
-  }
-  for (const Bushing& b : model_.bushings) bodies.insert({b.a.body, b.b.body});
-  bodies.erase(kGround);
-  const double relative_step = std::cbrt(std::numeric_limits<double>::epsilon());
-  VectorXd qq = q, vv = v, plus, minus;
-  for (int body : bodies) {
-    for (int k = kBlock * body; k < kBlock * (body + 1); ++k) {
-      for (int which = 0; which < 2; ++which) {
-        VectorXd& x = which == 0 ? qq : vv;
-        const double saved = x[k];
-        const double h = relative_step * std::max(1.0, std::abs(saved));
-        x[k] = saved + h;
-        if (ElementForces(t, qq, vv, &plus) != 0) return 1;
-        x[k] = saved - h;
-        if (ElementForces(t, qq, vv, &minus) != 0) return 1;
-        x[k] = saved;
-        (which == 0 ? q_q : q_v)->col(k) += (plus - minus) / (2.0 * h);
-      }
-    }
-  }
-  return q_q->allFinite() && q_v->allFinite() ? 0 : 1;
+  return AddElementJacobians(model_, t, q, v, continue_past_bounds_, &spring_angles_, q_q, q_v);
 }
 
 void SpatialSystem::DerivativePattern(Pattern* coupling, Pattern* rows) const {

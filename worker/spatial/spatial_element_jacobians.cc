@@ -20,6 +20,7 @@ using pair::kBlock;
 using pair::PairHessian;
 using pair::PairJacobian3;
 using pair::PairRow;
+using pair::PairScalar;
 
 double FactorAt(const std::optional<multibody::Profile>& factor, double t) {
   return factor ? factor->At(t).q : 1.0;
@@ -104,19 +105,128 @@ void AddTorqueJacobian(const BodyTorque& torque, double t, MatrixXd* q_q) {
   }
 }
 
-}  // namespace
-
-bool HasAnalyticElementJacobians(const Model& model) {
-  return model.rotational_springs.empty() && model.bushings.empty();
+// -x, with its derivatives.
+PairScalar Negated(PairScalar x) {
+  x.f = -x.f;
+  x.jacobian = -x.jacobian;
+  x.hessian = -x.hessian;
+  return x;
 }
 
+// atan2(s, c) with its Jacobian J = (c J_s - s J_c) / rho, rho = c^2 + s^2,
+// and its Hessian (c H_s - s H_c + J_s^T J_c - J_c^T J_s
+// - 2 J^T (c J_c + s J_s)) / rho, symmetric up to round-off (made exact).
+PairScalar Atan2(const PairScalar& s, const PairScalar& c) {
+  const double rho = c.f * c.f + s.f * s.f;
+  PairScalar out;
+  out.f = std::atan2(s.f, c.f);
+  out.jacobian = (c.f * s.jacobian - s.f * c.jacobian) / rho;
+  const PairHessian h = (c.f * s.hessian - s.f * c.hessian + s.jacobian.transpose() * c.jacobian -
+                         c.jacobian.transpose() * s.jacobian -
+                         2.0 * out.jacobian.transpose() * (c.f * c.jacobian + s.f * s.jacobian)) /
+                        rho;
+  out.hessian = 0.5 * (h + h.transpose());
+  return out;
+}
+
+// sqrt(x^2 + y^2): J = (x J_x + y J_y) / h,
+// H = (J_x^T J_x + x H_x + J_y^T J_y + y H_y - J^T J) / h.
+PairScalar Hypot(const PairScalar& x, const PairScalar& y) {
+  PairScalar out;
+  out.f = std::hypot(x.f, y.f);
+  out.jacobian = (x.f * x.jacobian + y.f * y.jacobian) / out.f;
+  out.hessian = (x.jacobian.transpose() * x.jacobian + x.f * x.hessian + y.jacobian.transpose() * y.jacobian +
+                 y.f * y.hessian - out.jacobian.transpose() * out.jacobian) /
+                out.f;
+  return out;
+}
+
+// A measure m(q) of an element whose generalized force is
+//   Q = g J^T,  g = -k m_elastic - c m',  m' = J v,
+// with J and H m's Jacobian and Hessian over the pair and m_elastic m or,
+// for a rotational spring, its turns-continued deflection (the same
+// derivatives: the turn count is locally constant). Then
+//   dQ/dq = J^T (-k J - c (H v)^T) + g H,  dQ/dv = -c J^T J.
+void AddMeasureJacobians(const PairScalar& m, double elastic, double stiffness, double damping,
+                         const Eigen::Matrix<double, pair::kPairColumns, 1>& rates, PairHessian* force_q,
+                         PairHessian* force_v) {
+  const double rate = m.jacobian.dot(rates);
+  const double g = -stiffness * elastic - damping * rate;
+  const PairRow rate_q = (m.hessian * rates).transpose();
+  *force_q += m.jacobian.transpose() * (-stiffness * m.jacobian - damping * rate_q) + g * m.hessian;
+  *force_v -= damping * m.jacobian.transpose() * m.jacobian;
+}
+
+// A rotational spring's angle atan2(x_b . y_a, x_b . x_a) over the joint's
+// frames (spatial_force_elements.cc), k (theta - theta0) with theta
+// following the turns as the force does.
+int AddRotationalSpringJacobians(const Model& model, int index, const VectorXd& q, const VectorXd& v,
+                                 SpringAngles* angles, MatrixXd* q_q, MatrixXd* q_v) {
+  const RotationalSpringDamper& r = model.rotational_springs[static_cast<size_t>(index)];
+  const Joint& joint = model.joints[static_cast<size_t>(r.joint)];
+  const pair::FrameVectors a = pair::FrameOf(joint.a, 0, q, &v, true), b = pair::FrameOf(joint.b, 1, q, &v, true);
+  const PairScalar angle = Atan2(pair::Dot(b.x, a.y), pair::Dot(b.x, a.x));
+  const double deflection = angles->Follow(index, angle.f) - r.free_angle_rad;
+  PairHessian force_q = PairHessian::Zero(), force_v = PairHessian::Zero();
+  AddMeasureJacobians(angle, deflection, r.stiffness_n_m_per_rad, r.damping_n_m_s_per_rad,
+                      pair::PairRates(joint.a.body, joint.b.body, v), &force_q, &force_v);
+  if (!force_q.allFinite() || !force_v.allFinite()) return 1;
+  pair::ScatterHessian(force_q, 1.0, joint.a.body, joint.b.body, q_q);
+  pair::ScatterHessian(force_v, 1.0, joint.a.body, joint.b.body, q_v);
+  return 0;
+}
+
+// A bushing's six measures: u_k = a_k . (o_b - o_a) and the x-y-z angles
+// from R_ij = a_i . b_j (spatial_force_elements.cc):
+//   theta_x = atan2(-R_12, R_22), theta_y = atan2(R_02, hypot(R_00, R_01)),
+//   theta_z = atan2(-R_01, R_00),
+// each a composition of dot products, whose Hessians are exact
+// (pair_vectors.h), so the angles' second derivatives are too. Past the
+// middle-angle limit, outside a continued scope, 1, as the force.
+int AddBushingJacobians(const Bushing& bushing, const VectorXd& q, const VectorXd& v, bool continued, MatrixXd* q_q,
+                        MatrixXd* q_v) {
+  const pair::FrameVectors a = pair::FrameOf(bushing.a, 0, q, &v, true), b = pair::FrameOf(bushing.b, 1, q, &v, true);
+  const pair::PairVector d = pair::Minus(b.origin, a.origin);
+  const pair::PairVector* a_axes[3] = {&a.x, &a.y, &a.z};
+  const Eigen::Matrix<double, pair::kPairColumns, 1> rates = pair::PairRates(bushing.a.body, bushing.b.body, v);
+  PairHessian force_q = PairHessian::Zero(), force_v = PairHessian::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const PairScalar u = pair::Dot(*a_axes[k], d);
+    AddMeasureJacobians(u, u.f, bushing.stiffness_n_per_m[k], bushing.damping_n_s_per_m[k], rates, &force_q,
+                        &force_v);
+  }
+  if (bushing.rotational_stiffness_n_m_per_rad.any() || bushing.rotational_damping_n_m_s_per_rad.any()) {
+    const PairScalar r00 = pair::Dot(a.x, b.x), r01 = pair::Dot(a.x, b.y), r02 = pair::Dot(a.x, b.z);
+    const PairScalar r12 = pair::Dot(a.y, b.z), r22 = pair::Dot(a.z, b.z);
+    const PairScalar middle_cosine = Hypot(r00, r01);
+    if (!continued && !(middle_cosine.f >= std::cos(kBushingMiddleAngleLimit_rad))) return 1;
+    const PairScalar theta[3] = {Atan2(Negated(r12), r22), Atan2(r02, middle_cosine), Atan2(Negated(r01), r00)};
+    for (int k = 0; k < 3; ++k) {
+      AddMeasureJacobians(theta[k], theta[k].f, bushing.rotational_stiffness_n_m_per_rad[k],
+                          bushing.rotational_damping_n_m_s_per_rad[k], rates, &force_q, &force_v);
+    }
+  }
+  if (!force_q.allFinite() || !force_v.allFinite()) return 1;
+  pair::ScatterHessian(force_q, 1.0, bushing.a.body, bushing.b.body, q_q);
+  pair::ScatterHessian(force_v, 1.0, bushing.a.body, bushing.b.body, q_v);
+  return 0;
+}
+
+}  // namespace
+
 int AddElementJacobians(const Model& model, double t, const VectorXd& q, const VectorXd& v, bool continued,
-                        MatrixXd* q_q, MatrixXd* q_v) {
+                        SpringAngles* angles, MatrixXd* q_q, MatrixXd* q_v) {
   for (const SpringDamper& s : model.springs) {
     if (AddSpringJacobians(s, q, v, continued, q_q, q_v) != 0) return 1;
   }
   for (const PointForce& f : model.point_forces) AddPointForceJacobian(f, t, q, q_q);
   for (const BodyTorque& torque : model.torques) AddTorqueJacobian(torque, t, q_q);
+  for (int k = 0; k < static_cast<int>(model.rotational_springs.size()); ++k) {
+    if (AddRotationalSpringJacobians(model, k, q, v, angles, q_q, q_v) != 0) return 1;
+  }
+  for (const Bushing& b : model.bushings) {
+    if (AddBushingJacobians(b, q, v, continued, q_q, q_v) != 0) return 1;
+  }
   return q_q->allFinite() && q_v->allFinite() ? 0 : 1;
 }
 

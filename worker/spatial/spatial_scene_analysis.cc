@@ -357,8 +357,7 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   std::vector<Perturbed> perturbed;
   if (sensitivities && is_static && !system.has_exact_state_jacobian()) {
     result->unavailable =
-        "static equilibrium of a spatial scene with rotational spring-dampers or bushings has no sensitivity "
-        "equations yet (their Jacobians are difference quotients)";
+        "static equilibrium of this spatial scene has no sensitivity equations (no exact state Jacobian)";
   }
   if (sensitivities && result->unavailable.empty()) {
     for (const int index : *parameters) {

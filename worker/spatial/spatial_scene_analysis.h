@@ -38,8 +38,7 @@ spec::AnalysisReport AnalyzeSpatialScene(const spec::Scene& scene, const std::ve
 // sensitivities (multibody::IntegrateForward) whose parameter terms are
 // central differences of the GGL residual between the varied systems
 // (there are no exact derivative models of spatial systems) and whose
-// state terms are directional differences (SpatialSystem has no analytic
-// derivatives); the unit-norm rows of the Euler parameters do not depend
+// state terms come from SpatialSystem's exact state Jacobian; the unit-norm rows of the Euler parameters do not depend
 // on any parameter, so their terms vanish. Driven mechanisms: the
 // differentiated constraint equations at each instant
 // (multibody::KinematicStateSensitivities). Outputs: central differences

@@ -19,10 +19,9 @@
 //
 // Analytic Newton derivatives (spatial_derivatives.cc): the constraints'
 // exact second derivatives, the mass matrix's d(M(q) a)/dq, the Euler
-// parameters' velocity terms, and the springs', point forces' and torques'
-// Jacobians (spatial_element_jacobians.h). Rotational spring-dampers and
-// bushings have no analytic Jacobian yet: a model with one takes central
-// differences of its elements' forces and has no exact state Jacobian.
+// parameters' velocity terms, and the force elements' Jacobians
+// (spatial_element_jacobians.h): together the exact state Jacobian, for
+// every model.
 //
 // Immutable after construction but for the rotational springs' turn
 // counts (SpringAngles, spatial_force_elements.h): an analysis owns its
@@ -83,10 +82,8 @@ class SpatialSystem : public multibody::ConstrainedSystem {
   // The Newton matrix's derivatives (spatial_derivatives.cc).
   bool has_analytic_derivatives() const override { return true; }
   int mass_block_size() const override { return kCoordinatesPerBody; }  // one body's (r, p)
-  // True unless the model has a rotational spring-damper or a bushing,
-  // whose Jacobians are difference quotients: then sensitivities difference
-  // the residual instead, and statics difference their Newton matrices.
-  bool has_exact_state_jacobian() const override;
+  // has_exact_state_jacobian() stays the base's (true with the analytic
+  // derivatives): every force element has an analytic Jacobian.
   int MassTimesAccelerationJacobian(const Eigen::VectorXd& q, const Eigen::VectorXd& a,
                                     Eigen::MatrixXd* jacobian) const override;
   int ConstraintCurvature(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& w,
