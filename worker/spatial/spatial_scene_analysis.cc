@@ -355,10 +355,6 @@ void Analyze(const spec::Scene& scene, const std::vector<double>& p, const std::
   // exact derivative models for spatial systems), their assemblies give the
   // start's derivatives.
   std::vector<Perturbed> perturbed;
-  if (sensitivities && is_static && !system.has_exact_state_jacobian()) {
-    result->unavailable =
-        "static equilibrium of this spatial scene has no sensitivity equations (no exact state Jacobian)";
-  }
   if (sensitivities && result->unavailable.empty()) {
     for (const int index : *parameters) {
       Perturbed dp;
