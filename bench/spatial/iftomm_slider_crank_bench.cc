@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/spatial/workprec_support.h"
 #include "tests/spatial/mechanism_model.h"
 #include "tests/spatial/spatial_mechanisms.h"
 #include "worker/multibody/forward_dynamics.h"
@@ -47,6 +48,8 @@
 namespace {
 
 using namespace mbopt;
+using bench::CpuSeconds;
+using bench::Median;
 
 constexpr double kEnd_s = 5.0;  // the benchmark's duration
 constexpr int kIntervals = 500;
@@ -66,17 +69,6 @@ struct Run {
   double error_m = NAN;    // largest |x - x_reference| over the instants
   double drift_j = NAN;    // largest |E(t) - E(0)| over the instants
 };
-
-double CpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 std::vector<double> Times() {
   std::vector<double> t;
@@ -183,39 +175,12 @@ double LargestDifference(const std::vector<double>& a, const std::vector<double>
   return worst;
 }
 
-// The time `curve` takes at `error`, by linear interpolation in
-// log(error)-log(time) between two of its runs whose errors bracket it (the
-// pair with the smallest time when several do); none outside its range.
-std::optional<double> TimeAtError(const std::vector<const Run*>& curve, double error) {
-  std::optional<double> best;
-  for (const Run* a : curve) {
-    for (const Run* b : curve) {
-      if (!a->ok || !b->ok || !(a->error_m > 0.0) || !(b->error_m > 0.0)) continue;
-      if (!(a->error_m >= error && b->error_m <= error) || a->error_m == b->error_m) continue;
-      const double w = std::log(error / a->error_m) / std::log(b->error_m / a->error_m);
-      const double t = std::exp((1 - w) * std::log(a->cpu_s) + w * std::log(b->cpu_s));
-      if (!best || t < *best) best = t;
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   int repeats = 5;
   std::string out = "iftomm_slider_crank.csv";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a.rfind("--repeats=", 0) == 0 && std::atoi(a.c_str() + 10) > 0) {
-      repeats = std::atoi(a.c_str() + 10);
-    } else if (a.rfind("--out=", 0) == 0) {
-      out = a.substr(6);
-    } else {
-      std::cerr << "unknown argument '" << a << "' (expected --repeats=N > 0, --out=FILE.csv)\n";
-      return 2;
-    }
-  }
+  if (!bench::ParseRepeatsAndOut(argc, argv, &repeats, &out)) return 2;
   std::ofstream csv(out);
   if (!csv) {
     std::cerr << "cannot write " << out << "\n";
@@ -249,13 +214,13 @@ int main(int argc, char** argv) {
   for (double tol : tolerances) {
     if (tol >= kCpodesTightest) runs.push_back(RunSimbody("cpodes", tol, repeats));
   }
-  std::vector<const Run*> simbody_rkm, simbody_cpodes;
+  std::vector<bench::CurvePoint> simbody_rkm, simbody_cpodes;
   for (Run& r : runs) {
     if (r.ok) {
       r.error_m = LargestDifference(r.slider_x_m, reference.slider_x_m);
       r.drift_j = Drift(r.energy_j);
     }
-    if (r.code == "simbody") (r.integrator == "rkm" ? simbody_rkm : simbody_cpodes).push_back(&r);
+    if (r.code == "simbody") (r.integrator == "rkm" ? simbody_rkm : simbody_cpodes).push_back({r.ok, r.error_m, r.cpu_s});
   }
   std::printf("| code | integrator | tolerance | slider x error (m) | energy change (J) | CPU (s) | steps | "
               "CPU / Simbody's at this error (faster integrator) |\n");
@@ -269,8 +234,8 @@ int main(int argc, char** argv) {
     if (r.ok) {
       std::string ratio;
       if (r.code == "mbopt") {
-        std::optional<double> t = TimeAtError(simbody_rkm, r.error_m);
-        const std::optional<double> t_cpodes = TimeAtError(simbody_cpodes, r.error_m);
+        std::optional<double> t = bench::CpuAtError(simbody_rkm, r.error_m);
+        const std::optional<double> t_cpodes = bench::CpuAtError(simbody_cpodes, r.error_m);
         const char* which = "rkm";
         if (t_cpodes && (!t || *t_cpodes < *t)) {
           t = t_cpodes;

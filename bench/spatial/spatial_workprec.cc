@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/spatial/workprec_support.h"
 #include "tests/spatial/mechanism_model.h"
 #include "tests/spatial/spatial_mechanisms.h"
 #include "worker/multibody/forward_dynamics.h"
@@ -45,6 +46,8 @@
 namespace {
 
 using namespace mbopt;
+using bench::CpuSeconds;
+using bench::Median;
 using Values = std::vector<std::vector<double>>;  // [instant][value]
 
 constexpr double kEnd_s = 2.0;
@@ -65,17 +68,6 @@ struct Run {
   multibody::ForwardDynamicsCounters counters;  // mbopt's only
   double error = NAN;
 };
-
-double CpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 // A system's equations with its analytic derivatives hidden: IDAS then
 // forms the Newton matrix by difference quotients of the residual.
@@ -216,39 +208,12 @@ double LargestDifference(const Values& a, const Values& b) {
   return worst;
 }
 
-// The time `curve` takes at `error`, by linear interpolation in
-// log(error)-log(time) between two of its runs whose errors bracket it (the
-// pair with the smallest time when several do); none outside its range.
-std::optional<double> TimeAtError(const std::vector<Run>& curve, double error) {
-  std::optional<double> best;
-  for (const Run& a : curve) {
-    for (const Run& b : curve) {
-      if (!a.ok || !b.ok || !(a.error > 0.0) || !(b.error > 0.0)) continue;
-      if (!(a.error >= error && b.error <= error) || a.error == b.error) continue;
-      const double w = std::log(error / a.error) / std::log(b.error / a.error);
-      const double t = std::exp((1 - w) * std::log(a.cpu_s) + w * std::log(b.cpu_s));
-      if (!best || t < *best) best = t;
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   int repeats = 5;
   std::string out = "spatial_workprec.csv";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a.rfind("--repeats=", 0) == 0 && std::atoi(a.c_str() + 10) > 0) {
-      repeats = std::atoi(a.c_str() + 10);
-    } else if (a.rfind("--out=", 0) == 0) {
-      out = a.substr(6);
-    } else {
-      std::cerr << "unknown argument '" << a << "' (expected --repeats=N > 0, --out=FILE.csv)\n";
-      return 2;
-    }
-  }
+  if (!bench::ParseRepeatsAndOut(argc, argv, &repeats, &out)) return 2;
   std::ofstream csv(out);
   if (!csv) {
     std::cerr << "cannot write " << out << "\n";
@@ -302,13 +267,18 @@ int main(int argc, char** argv) {
     }
   }
   // mbopt's time over Simbody's at each of mbopt's errors.
-  const std::vector<Run>& rkm_curve = curves[mbopt_curves.size()];
-  const std::vector<Run>& cpodes_curve = curves[mbopt_curves.size() + 1];
+  const auto points = [](const std::vector<Run>& curve) {
+    std::vector<bench::CurvePoint> p;
+    for (const Run& r : curve) p.push_back({r.ok, r.error, r.cpu_s});
+    return p;
+  };
+  const std::vector<bench::CurvePoint> rkm_curve = points(curves[mbopt_curves.size()]);
+  const std::vector<bench::CurvePoint> cpodes_curve = points(curves[mbopt_curves.size() + 1]);
   for (size_t c = 0; c < mbopt_curves.size(); ++c) {
     for (const Run& r : curves[c]) {
       if (!r.ok) continue;
-      const std::optional<double> t_rkm = TimeAtError(rkm_curve, r.error);
-      const std::optional<double> t_cpodes = TimeAtError(cpodes_curve, r.error);
+      const std::optional<double> t_rkm = bench::CpuAtError(rkm_curve, r.error);
+      const std::optional<double> t_cpodes = bench::CpuAtError(cpodes_curve, r.error);
       std::optional<double> fastest = t_rkm;
       if (t_cpodes && (!fastest || *t_cpodes < *fastest)) fastest = t_cpodes;
       auto ratio = [&](const std::optional<double>& simbody_s) { return simbody_s ? r.cpu_s / *simbody_s : NAN; };
